@@ -1,0 +1,17 @@
+//! `compose`: the compositor as its own binary (identical to `glassdb compose`).
+
+use std::process::ExitCode;
+
+use clap::Parser;
+use glassdb::cmd;
+
+#[derive(Parser)]
+#[command(name = "compose", version, about = "Composite reflection and transmission passes through an id + cos θ mask")]
+struct Cli {
+    #[command(flatten)]
+    args: cmd::compose::Args,
+}
+
+fn main() -> ExitCode {
+    cmd::finish(cmd::compose::run(Cli::parse().args))
+}

@@ -1,0 +1,45 @@
+//! `glassdb`: fit, spectral, registry, compose, mirror and mask in one binary.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use glassdb::cmd;
+
+#[derive(Parser)]
+#[command(name = "glassdb", version, about = "Architectural glass optical data and glazing compositor")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Fit angle-dependence polynomials C_r, C_t to a measured angle table.
+    Fit(cmd::fit::FitArgs),
+    /// Evaluate fitted curves (a `glassdb fit` JSON) at given angles.
+    Eval(cmd::fit::EvalArgs),
+    /// Spectral data to per-channel and luminous values.
+    Spectral(cmd::spectral::Args),
+    /// Build, show and check the id-indexed glass table of a scene.
+    Registry(cmd::registry::Args),
+    /// Composite reflection and transmission passes through a mask (same as the `compose` binary).
+    Compose(cmd::compose::Args),
+    /// Mirror an OBJ scene across its glass planes (the virtual image for reflection passes).
+    Mirror(cmd::scene::MirrorArgs),
+    /// Rasterise the id + cos θ mask of an OBJ scene from a camera.
+    Mask(cmd::scene::MaskArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Fit(a) => cmd::fit::run_fit(a),
+        Command::Eval(a) => cmd::fit::run_eval(a),
+        Command::Spectral(a) => cmd::spectral::run(a),
+        Command::Registry(a) => cmd::registry::run(a),
+        Command::Compose(a) => cmd::compose::run(a),
+        Command::Mirror(a) => cmd::scene::run_mirror(a),
+        Command::Mask(a) => cmd::scene::run_mask(a),
+    };
+    glassdb::cmd::finish(result)
+}

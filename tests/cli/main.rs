@@ -1,0 +1,4 @@
+//! End-to-end tests: one binary that drives the built `glassdb` and `compose` executables.
+//! One module per area; shared helpers in `util`.
+
+mod util;
