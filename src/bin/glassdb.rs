@@ -28,6 +28,10 @@ enum Command {
     Mirror(cmd::scene::MirrorArgs),
     /// Rasterise the id + cos θ mask of an OBJ scene from a camera.
     Mask(cmd::scene::MaskArgs),
+    /// Plot fits, spectra, a registry or a mask's reflectance (PNG or SVG).
+    Plot(cmd::plot::Args),
+    /// Regenerate the speed-against-error tables of docs/accuracy.md.
+    Report(cmd::report::Args),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +44,8 @@ fn main() -> ExitCode {
         Command::Compose(a) => cmd::compose::run(a),
         Command::Mirror(a) => cmd::scene::run_mirror(a),
         Command::Mask(a) => cmd::scene::run_mask(a),
+        Command::Plot(a) => cmd::plot::run(a),
+        Command::Report(a) => cmd::report::run(a),
     };
     glassdb::cmd::finish(result)
 }

@@ -2,7 +2,9 @@
 
 pub mod compose;
 pub mod fit;
+pub mod plot;
 pub mod registry;
+pub mod report;
 pub mod scene;
 pub mod spectral;
 

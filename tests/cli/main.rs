@@ -7,4 +7,5 @@ mod spectral;
 mod registry;
 mod compose;
 mod scene;
+mod plot;
 mod util;

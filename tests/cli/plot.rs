@@ -1,0 +1,1 @@
+//! End-to-end tests of `glassdb plot` and `glassdb report`.
