@@ -10,14 +10,23 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
     /// The directory the output goes into does not exist or cannot take a temporary file.
-    #[error("cannot create a temporary file beside {path}: {source}")]
-    CreateTemp { path: PathBuf, source: std::io::Error },
+    #[error("cannot create a temporary file beside {path}")]
+    CreateTemp {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     /// Writing the content failed (disk full, I/O error, or the producer reported an error).
-    #[error("cannot write {path}: {source}")]
-    Write { path: PathBuf, source: std::io::Error },
+    #[error("cannot write {path}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     /// The finished temporary file could not be renamed over the target.
-    #[error("cannot move the finished output into place at {path}: {source}")]
-    Persist { path: PathBuf, source: std::io::Error },
+    #[error("cannot move the finished output into place at {path}")]
+    Persist {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     /// The output path names one of the run's own inputs.
     #[error("refusing to overwrite the input file {path} with the output")]
     OutputIsInput { path: PathBuf },
@@ -34,20 +43,45 @@ where
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".glassdb-tmp-")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".glassdb-tmp-");
+    // A replaced file keeps its mode; a new one gets what any other tool would give it
+    // (0666 masked by the umask), not the temporary file's private 0600.
+    if let Ok(meta) = std::fs::metadata(path) {
+        builder.permissions(meta.permissions());
+    } else {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+    }
+    let mut tmp = builder
         .tempfile_in(&dir)
-        .map_err(|source| OutputError::CreateTemp { path: path.to_path_buf(), source })?;
+        .map_err(|source| OutputError::CreateTemp {
+            path: path.to_path_buf(),
+            source,
+        })?;
     {
         let file = tmp.as_file_mut();
         let mut w = BufWriter::new(file);
-        let write_err = |source| OutputError::Write { path: path.to_path_buf(), source };
+        let write_err = |source| OutputError::Write {
+            path: path.to_path_buf(),
+            source,
+        };
         produce(&mut w).map_err(write_err)?;
         w.flush().map_err(write_err)?;
     }
-    tmp.as_file().sync_all().map_err(|source| OutputError::Write { path: path.to_path_buf(), source })?;
-    tmp.persist(path)
-        .map_err(|e| OutputError::Persist { path: path.to_path_buf(), source: e.error })?;
+    tmp.as_file()
+        .sync_all()
+        .map_err(|source| OutputError::Write {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    tmp.persist(path).map_err(|e| OutputError::Persist {
+        path: path.to_path_buf(),
+        source: e.error,
+    })?;
     Ok(())
 }
 
@@ -67,10 +101,28 @@ where
     };
     for input in inputs {
         if input.canonicalize().is_ok_and(|i| i == out) {
-            return Err(OutputError::OutputIsInput { path: output.to_path_buf() });
+            return Err(OutputError::OutputIsInput {
+                path: output.to_path_buf(),
+            });
         }
     }
     Ok(())
+}
+
+/// Displays an error with its causes as `outer: cause: root`, as `anyhow`'s `{:#}` does, for
+/// messages that are printed or written without going through `anyhow`.
+pub struct ErrorChain<'a>(pub &'a (dyn std::error::Error + 'static));
+
+impl std::fmt::Display for ErrorChain<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)?;
+        let mut cause = self.0.source();
+        while let Some(c) = cause {
+            write!(f, ": {c}")?;
+            cause = c.source();
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -93,11 +145,44 @@ mod tests {
     }
 
     #[test]
+    fn error_chain_prints_every_cause_once() {
+        let err =
+            write_bytes_atomic(Path::new("/nonexistent-dir-glassdb/x.json"), b"{}").unwrap_err();
+        let text = ErrorChain(&err).to_string();
+        assert!(
+            text.starts_with(
+                "cannot create a temporary file beside /nonexistent-dir-glassdb/x.json: "
+            ),
+            "{text}"
+        );
+        assert_eq!(text.matches("(os error").count(), 1, "{text}");
+    }
+
+    #[test]
     fn success_replaces_target() {
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("out.txt");
         write_bytes_atomic(&target, b"new").unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"new");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn new_output_is_not_private_and_replaced_output_keeps_its_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let fresh = dir.path().join("fresh.txt");
+        write_bytes_atomic(&fresh, b"x").unwrap();
+        let mode = std::fs::metadata(&fresh).unwrap().permissions().mode() & 0o777;
+        // Any usual umask (022, 002, 077 aside) leaves the owner read+write; the private
+        // temporary-file mode 0600 must not leak unless the umask itself asks for it.
+        assert_eq!(mode & 0o600, 0o600, "mode {mode:o}");
+        let kept = dir.path().join("kept.txt");
+        std::fs::write(&kept, b"old").unwrap();
+        std::fs::set_permissions(&kept, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_bytes_atomic(&kept, b"new").unwrap();
+        let mode = std::fs::metadata(&kept).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640, "mode {mode:o}");
     }
 
     #[test]
