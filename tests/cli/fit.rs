@@ -1,1 +1,632 @@
-//! End-to-end tests of the fit commands.
+//! End-to-end tests of `glassdb fit` and `glassdb eval`, including the 50-digit oracle
+//! comparisons of issue 2 (hard cases 3 and 4, normal-equations digit loss).
+
+use std::ffi::OsStr;
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::util::{fails, glassdb, ok, repo_path, run, run_oracle, write_file};
+
+const CLEAR: &str = "data/angles/clear_6mm_fresnel.csv";
+const BRONZE: &str = "data/angles/bronze_coated_window4.csv";
+
+fn json(text: &str) -> Value {
+    serde_json::from_str(text).unwrap_or_else(|e| panic!("not JSON ({e}):\n{text}"))
+}
+
+fn f(v: &Value) -> f64 {
+    match v {
+        Value::String(s) => s.parse().unwrap(),
+        other => other
+            .as_f64()
+            .unwrap_or_else(|| panic!("not a number: {other}")),
+    }
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(f).collect()
+}
+
+/// Unpolarised reflectance of a non-absorbing slab (Fresnel, incoherent multiple reflections).
+fn slab_r(angle_deg: f64, n: f64) -> f64 {
+    if angle_deg == 90.0 {
+        return 1.0;
+    }
+    let ci = angle_deg.to_radians().cos();
+    let st = angle_deg.to_radians().sin() / n;
+    let ct = (1.0 - st * st).sqrt();
+    let rs = ((ci - n * ct) / (ci + n * ct)).powi(2);
+    let rp = ((n * ci - ct) / (n * ci + ct)).powi(2);
+    rs / (1.0 + rs) + rp / (1.0 + rp) // (2ρ/(1+ρ))/2 per polarisation
+}
+
+/// Table values in the file at the given column (R = 1, T = 2), by angle.
+fn table_column(rel: &str, col: usize) -> Vec<(f64, f64)> {
+    std::fs::read_to_string(repo_path(rel))
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (c[0].parse().unwrap(), c[col].parse().unwrap())
+        })
+        .collect()
+}
+
+/// Max |a − b| / max |b|: the relative agreement of two curves sampled at the same angles.
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = b.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+        / scale
+}
+
+/// Fitted values (normal · C) from a curve of a fit file, at the given angles.
+fn eval_curve(curve: &Value, angles: &[f64]) -> Vec<f64> {
+    let normal = f(&curve["normal"]);
+    let powers: Vec<i32> = curve["powers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_i64().unwrap() as i32)
+        .collect();
+    let coef = floats(&curve["coefficients"]);
+    angles
+        .iter()
+        .map(|&a| {
+            let x = if a == 90.0 { 0.0 } else { a.to_radians().cos() };
+            normal
+                * powers
+                    .iter()
+                    .zip(&coef)
+                    .map(|(&p, c)| c * x.powi(p))
+                    .sum::<f64>()
+        })
+        .collect()
+}
+
+#[test]
+fn main_job_fits_the_bundled_clear_glass() {
+    let out = ok(glassdb().args(["fit", CLEAR]).current_dir(repo_path("")));
+    assert!(out.contains("glass clear_6mm_fresnel"), "{out}");
+    assert!(
+        out.contains("reflectance") && out.contains("transmittance"),
+        "{out}"
+    );
+    assert!(
+        out.contains("0.078819"),
+        "normal reflectance of the table's 0° row:\n{out}"
+    );
+    assert!(
+        out.contains("C_r(θ) =") && out.contains("C_t(θ) ="),
+        "{out}"
+    );
+}
+
+#[test]
+fn json_output_file_and_eval_agree_with_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let fits = dir.path().join("fits.json");
+    let stdout = ok(glassdb()
+        .arg("fit")
+        .arg(repo_path(CLEAR))
+        .arg("--json")
+        .arg("-o")
+        .arg(&fits));
+    let printed = json(&stdout);
+    let written = json(&std::fs::read_to_string(&fits).unwrap());
+    assert_eq!(printed, written);
+    let g = &written["glasses"][0];
+    assert_eq!(g["name"], "clear_6mm_fresnel");
+    for q in ["reflectance", "transmittance"] {
+        for key in [
+            "normal",
+            "basis",
+            "powers",
+            "coefficients",
+            "degree",
+            "rms_error",
+            "max_abs_error",
+            "max_error_angle_deg",
+            "condition_number",
+        ] {
+            assert!(g[q].get(key).is_some(), "{q}.{key} missing");
+        }
+        assert_eq!(
+            g[q]["powers"].as_array().unwrap().len(),
+            g[q]["coefficients"].as_array().unwrap().len()
+        );
+    }
+    // eval: r(0°) is the table's 0° value exactly (the constraint), and the curve stays close to
+    // the physics table away from grazing incidence
+    let ev = json(&ok(glassdb()
+        .arg("eval")
+        .arg(&fits)
+        .args(["--angles", "0:85:5", "--json"])));
+    let e = &ev["glasses"][0];
+    let angles = floats(&e["angle_deg"]);
+    assert_eq!(angles.len(), 18);
+    let r = floats(&e["reflectance"]);
+    let t = floats(&e["transmittance"]);
+    assert!((r[0] - 0.078818868).abs() < 1e-12, "{}", r[0]);
+    assert!((t[0] - 0.884).abs() < 1e-12, "{}", t[0]);
+    let rt = table_column(CLEAR, 1);
+    let tt = table_column(CLEAR, 2);
+    for (i, &a) in angles.iter().enumerate() {
+        let k = a as usize;
+        assert!(
+            (r[i] - rt[k].1).abs() < 0.003,
+            "r at {a}°: {} vs {}",
+            r[i],
+            rt[k].1
+        );
+        assert!(
+            (t[i] - tt[k].1).abs() < 0.003,
+            "t at {a}°: {} vs {}",
+            t[i],
+            tt[k].1
+        );
+    }
+    let text = ok(glassdb()
+        .arg("eval")
+        .arg(&fits)
+        .args(["--angles", "0,45,90"]));
+    assert!(
+        text.contains("angle_deg") && text.contains("0.078819"),
+        "{text}"
+    );
+}
+
+#[test]
+fn degree_10_on_91_points_matches_the_50_digit_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = json(&ok(glassdb()
+        .arg("fit")
+        .arg(repo_path(CLEAR))
+        .args(["--degree", "10", "--basis", "full", "--json"])));
+    let g = &out["glasses"][0];
+    let angles: Vec<f64> = (0..=90).map(f64::from).collect();
+    let _ = dir;
+    for (q, col) in [("reflectance", "R"), ("transmittance", "T")] {
+        let reference = json(&run_oracle(
+            "fit_oracle.py",
+            &[
+                OsStr::new("fit"),
+                repo_path(CLEAR).as_os_str(),
+                OsStr::new("--column"),
+                OsStr::new(col),
+                OsStr::new("--basis"),
+                OsStr::new("full"),
+                OsStr::new("--degree"),
+                OsStr::new("10"),
+            ],
+        ));
+        let ours = eval_curve(&g[q], &angles);
+        let theirs = floats(&reference["fitted"]);
+        let d = rel_diff(&ours, &theirs);
+        assert!(
+            d <= 1e-10,
+            "{q}: fitted values differ from the 50-digit fit by {d:e} (relative)"
+        );
+        // coefficients: as far as the conditioning allows (power-basis cond ≈ 3e7)
+        let c_ours = floats(&g[q]["coefficients"]);
+        let c_ref = floats(&reference["coefficients"]);
+        let dc = rel_diff(&c_ours, &c_ref);
+        let cond = f(&reference["power_condition_number"]);
+        eprintln!(
+            "{q}: degree 10 fitted values rel. diff {d:.2e}, coefficients rel. diff {dc:.2e}, power-basis cond {cond:.2e}"
+        );
+        assert!(dc <= 1e-7, "{q}: coefficients differ by {dc:e}");
+        assert_eq!(f(&g[q]["normal"]), f(&reference["normal"]));
+    }
+}
+
+#[test]
+fn normal_equations_lose_digits_that_the_qr_fit_keeps() {
+    let out = json(&ok(glassdb()
+        .arg("fit")
+        .arg(repo_path(CLEAR))
+        .args(["--degree", "10", "--basis", "full", "--json"])));
+    let reference = json(&run_oracle(
+        "fit_oracle.py",
+        &[
+            OsStr::new("fit"),
+            repo_path(CLEAR).as_os_str(),
+            OsStr::new("--column"),
+            OsStr::new("R"),
+            OsStr::new("--basis"),
+            OsStr::new("full"),
+            OsStr::new("--degree"),
+            OsStr::new("10"),
+        ],
+    ));
+    let ne = json(&run_oracle(
+        "fit_oracle.py",
+        &[
+            OsStr::new("normal-equations"),
+            repo_path(CLEAR).as_os_str(),
+            OsStr::new("--column"),
+            OsStr::new("R"),
+            OsStr::new("--basis"),
+            OsStr::new("full"),
+            OsStr::new("--degree"),
+            OsStr::new("10"),
+        ],
+    ));
+    let angles: Vec<f64> = (0..=90).map(f64::from).collect();
+    let ours = eval_curve(&out["glasses"][0]["reflectance"], &angles);
+    let our_digits = -rel_diff(&ours, &floats(&reference["fitted"]))
+        .max(1e-17)
+        .log10();
+    let ne_digits = f(&ne["normal_equations"]["fitted_digits"]);
+    let ne_coef_digits = f(&ne["normal_equations"]["coefficient_digits"]);
+    eprintln!(
+        "degree 10, 91 points: glassdb {our_digits:.1} digits; normal equations {ne_digits:.1} (coefficients {ne_coef_digits:.1}); cond(A) {:.2e}, cond(AᵀA) {:.2e}",
+        f(&ne["cond_A"]),
+        f(&ne["cond_AtA"])
+    );
+    assert!(our_digits >= 10.0);
+    assert!(
+        ne_digits <= our_digits - 3.0,
+        "normal equations kept {ne_digits} digits, glassdb {our_digits}"
+    );
+    assert!(f(&ne["cond_AtA"]) > 1e12);
+}
+
+#[test]
+fn narrow_range_matches_the_50_digit_fit_and_eval_warns_beyond_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows: String = (0..=30)
+        .map(|a| format!("{a},{:.12}\n", slab_r(a as f64, 1.52)))
+        .collect();
+    let csv = write_file(
+        dir.path(),
+        "narrow.csv",
+        format!("angle_deg,R\n{rows}").as_bytes(),
+    );
+    let fits = dir.path().join("narrow.json");
+    let (res, _stdout, stderr) = run(glassdb().arg("fit").arg(&csv).arg("-o").arg(&fits));
+    assert!(res.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("extrapolated"),
+        "fit should warn that 30–90° is extrapolated:\n{stderr}"
+    );
+    for degree in ["2", "4", "6"] {
+        let out = json(&ok(glassdb()
+            .arg("fit")
+            .arg(&csv)
+            .args(["--degree", degree, "--json"])));
+        let curve = &out["glasses"][0]["reflectance"];
+        let reference = json(&run_oracle(
+            "fit_oracle.py",
+            &[
+                OsStr::new("fit"),
+                csv.as_os_str(),
+                OsStr::new("--column"),
+                OsStr::new("R"),
+                OsStr::new("--basis"),
+                OsStr::new("full"),
+                OsStr::new("--degree"),
+                OsStr::new(degree),
+            ],
+        ));
+        let angles: Vec<f64> = (0..=30).map(f64::from).collect();
+        let d = rel_diff(&eval_curve(curve, &angles), &floats(&reference["fitted"]));
+        eprintln!(
+            "0–30°, degree {degree}: rel. diff {d:.2e}, cond solved {}, power-basis cond {:.2e}",
+            curve["condition_number"],
+            f(&reference["power_condition_number"])
+        );
+        assert!(d <= 1e-10, "degree {degree}: {d:e}");
+        assert!(f(&curve["condition_number"]) < 100.0);
+    }
+    let (res, _out, stderr) = run(glassdb()
+        .arg("eval")
+        .arg(&fits)
+        .args(["--angles", "0:60:10"]));
+    assert!(res.status.success());
+    assert!(
+        stderr.contains("40, 50, 60° outside the measured 0–30°"),
+        "{stderr}"
+    );
+    let (_, _, stderr) = run(glassdb()
+        .arg("eval")
+        .arg(&fits)
+        .args(["--angles", "0:30:10"]));
+    assert!(!stderr.contains("extrapolated"), "{stderr}");
+}
+
+#[test]
+fn coated_glass_with_ct_above_one_passes_strict() {
+    let dir = tempfile::tempdir().unwrap();
+    let fits = dir.path().join("bronze.json");
+    let (res, _out, stderr) = run(glassdb()
+        .arg("fit")
+        .arg(repo_path(BRONZE))
+        .arg("--strict")
+        .arg("-o")
+        .arg(&fits));
+    assert!(res.status.success(), "{stderr}");
+    // at degree 8 the fitted curve follows the data above 1 near normal incidence, and strict
+    // mode still accepts it (WINDOW-4 bronze: C_t(10°) = 1.0066)
+    let (res, _out, stderr) = run(glassdb()
+        .arg("fit")
+        .arg(repo_path(BRONZE))
+        .args(["--strict", "--degree", "8", "-o"])
+        .arg(&fits));
+    assert!(res.status.success(), "{stderr}");
+    assert!(!stderr.contains("physical check"), "{stderr}");
+    let ev = json(&ok(glassdb()
+        .arg("eval")
+        .arg(&fits)
+        .args(["--angles", "0,10", "--json"])));
+    let t = floats(&ev["glasses"][0]["transmittance"]);
+    assert!((t[0] - 0.169).abs() < 1e-15, "{}", t[0]);
+    assert!(
+        t[1] / t[0] > 1.0 && t[1] / t[0] < 1.0066,
+        "C_t(10°) = {}",
+        t[1] / t[0]
+    );
+}
+
+/// Deterministic N(0, 1) draws (64-bit LCG + Box–Muller).
+fn gaussian(seed: u64, n: usize) -> Vec<f64> {
+    let mut state = seed;
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    (0..n)
+        .map(|_| (-2.0 * uniform().ln()).sqrt() * (2.0 * std::f64::consts::PI * uniform()).cos())
+        .collect()
+}
+
+#[test]
+fn outlier_in_noisy_data_is_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let noise = gaussian(7, 91);
+    let rows: String = (0..=90)
+        .map(|a| {
+            let mut v = slab_r(a as f64, 1.52) + if a > 0 { 0.002 * noise[a] } else { 0.0 };
+            if a == 55 {
+                v += 0.03;
+            }
+            format!("{a},{:.6}\n", v.clamp(0.0, 1.0))
+        })
+        .collect();
+    let csv = write_file(
+        dir.path(),
+        "noisy.csv",
+        format!("angle_deg,R\n{rows}").as_bytes(),
+    );
+    let (res, stdout, stderr) = run(glassdb().arg("fit").arg(&csv));
+    assert!(res.status.success(), "{stderr}");
+    assert!(stdout.contains("suspect point at 55°"), "{stdout}");
+    assert!(stderr.contains("suspect point at 55°"), "{stderr}");
+    let out = json(&ok(glassdb().arg("fit").arg(&csv).arg("--json")));
+    let r = &out["glasses"][0]["reflectance"];
+    assert_eq!(f(&r["max_error_angle_deg"]), 55.0);
+    assert_eq!(f(&r["suspect_points"][0]["angle_deg"]), 55.0);
+}
+
+fn fit_error(name: &str, contents: &str, extra: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write_file(dir.path(), name, contents.as_bytes());
+    let stderr = fails(glassdb().arg("fit").arg(&p).args(extra));
+    assert!(
+        stderr.contains(name),
+        "the message should name the file {name}:\n{stderr}"
+    );
+    stderr
+}
+
+#[test]
+fn bad_tables_fail_with_a_clear_message() {
+    assert!(fit_error("empty.csv", "", &[]).contains("empty"));
+    assert!(fit_error("nocol.csv", "angle_deg,glass\n0,a\n", &[]).contains("missing column R"));
+    let e = fit_error(
+        "text.csv",
+        "angle_deg,R,T\n0,0.08,0.88\n10,0.08,eighty\n",
+        &[],
+    );
+    assert!(
+        e.contains("line 3, column 3 (T): `eighty` is not a number"),
+        "{e}"
+    );
+    let e = fit_error("nan.csv", "angle_deg,R\n0,0.08\n10,nan\n", &[]);
+    assert!(
+        e.contains("line 3, column 2") && e.contains("not a finite number"),
+        "{e}"
+    );
+    let e = fit_error("angle.csv", "angle_deg,R\n0,0.08\n95,0.5\n", &[]);
+    assert!(
+        e.contains("line 3, column 1") && e.contains("outside 0–90°"),
+        "{e}"
+    );
+    let e = fit_error(
+        "few.csv",
+        "angle_deg,R\n0,0.08\n40,0.09\n80,0.5\n",
+        &["--degree", "5"],
+    );
+    assert!(
+        e.contains("3 distinct angle(s)") && e.contains("6 coefficients"),
+        "{e}"
+    );
+    let e = fit_error("pct.csv", "angle_deg,T\n0,88\n45,86\n", &[]);
+    assert!(
+        e.contains("line 2, column 2") && e.contains("--percent"),
+        "{e}"
+    );
+    let e = fit_error("ragged.csv", "angle_deg,R\n0,0.08,0.9\n", &[]);
+    assert!(e.contains("line 2"), "{e}");
+    // with --percent the same table works
+    let dir = tempfile::tempdir().unwrap();
+    let p = write_file(dir.path(), "pct.csv", b"angle_deg,T\n0,88\n45,86\n60,80\n");
+    let out = ok(glassdb().arg("fit").arg(&p).arg("--percent"));
+    assert!(out.contains("0.880000"), "{out}");
+}
+
+#[test]
+fn strict_mode_fails_on_a_physical_violation() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows: String = (0..=9)
+        .map(|i| {
+            format!(
+                "{},{},{}\n",
+                i * 10,
+                0.1 + 0.001 * i as f64,
+                0.92 - 0.001 * i as f64
+            )
+        })
+        .collect();
+    let p = write_file(
+        dir.path(),
+        "sum.csv",
+        format!("angle_deg,R,T\n{rows}").as_bytes(),
+    );
+    let (res, _, stderr) = run(glassdb().arg("fit").arg(&p));
+    assert!(res.status.success());
+    assert!(stderr.contains("r + t > 1"), "{stderr}");
+    let e = fails(glassdb().arg("fit").arg(&p).arg("--strict"));
+    assert!(e.contains("r + t > 1") && e.contains("worst at"), "{e}");
+}
+
+#[test]
+fn output_problems_fail_without_touching_anything() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = write_file(
+        dir.path(),
+        "t.csv",
+        b"angle_deg,T\n0,0.88\n45,0.86\n60,0.8\n",
+    );
+    let e = fails(
+        glassdb()
+            .arg("fit")
+            .arg(&table)
+            .arg("-o")
+            .arg(dir.path().join("missing/dir/out.json")),
+    );
+    assert!(e.contains("missing/dir/out.json"), "{e}");
+    let e = fails(glassdb().arg("fit").arg(&table).arg("-o").arg(&table));
+    assert!(e.contains("refusing to overwrite"), "{e}");
+    assert_eq!(
+        std::fs::read(&table).unwrap(),
+        b"angle_deg,T\n0,0.88\n45,0.86\n60,0.8\n"
+    );
+    let e = fails(glassdb().arg("fit").arg(dir.path().join("nope.csv")));
+    assert!(e.contains("nope.csv"), "{e}");
+}
+
+#[test]
+fn eval_rejects_bad_fit_files_and_angles() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = write_file(dir.path(), "bad.json", b"{\"glasses\": [{\"name\": 3}]}");
+    let e = fails(glassdb().arg("eval").arg(&bad));
+    assert!(e.contains("bad.json"), "{e}");
+    let fits = dir.path().join("f.json");
+    ok(glassdb()
+        .arg("fit")
+        .arg(repo_path(BRONZE))
+        .arg("-o")
+        .arg(&fits));
+    for spec in ["0:100:10", "10:0:5", "0:90:0", "a,b", "0:90", "-5", "nan"] {
+        let e = fails(
+            glassdb()
+                .arg("eval")
+                .arg(&fits)
+                .arg(format!("--angles={spec}")),
+        );
+        assert!(e.contains("--angles"), "{spec}: {e}");
+    }
+    let e = fails(
+        glassdb()
+            .arg("eval")
+            .arg(&fits)
+            .args(["--glass", "nonesuch"]),
+    );
+    assert!(
+        e.contains("no glass `nonesuch`") && e.contains("bronze_coated_window4"),
+        "{e}"
+    );
+    assert!(Path::new(&fits).exists());
+}
+
+#[test]
+fn several_glasses_in_percent_with_repeated_angles() {
+    let table = repo_path("fixtures/fit/two_glasses_percent.csv");
+    let e = fails(glassdb().arg("fit").arg(&table));
+    assert!(e.contains("--percent"), "{e}");
+    let (res, stdout, stderr) = run(glassdb()
+        .arg("fit")
+        .arg(&table)
+        .args(["--percent", "--json"]));
+    assert!(res.status.success(), "{stderr}");
+    assert!(stderr.contains("glass `clear`: angle 30° given on 2 rows: averaged (R spread 0.00020, T spread 0.00020)"), "{stderr}");
+    let out = json(&stdout);
+    let names: Vec<&str> = out["glasses"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| g["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["clear", "bronze"]);
+    let clear = &out["glasses"][0];
+    assert_eq!(f(&clear["reflectance"]["normal"]), 0.0788);
+    assert_eq!(f(&clear["reflectance"]["points"]), 7.0); // 30° counted once
+    let bronze = &out["glasses"][1];
+    assert_eq!(f(&bronze["reflectance"]["points"]), 5.0); // no R at 45°
+    assert_eq!(f(&bronze["transmittance"]["points"]), 6.0);
+    // the averaged 30° value: (8.09 + 8.11)/2 % = 0.0810; a degree-6 fit through 7 points
+    // interpolates it
+    // (the bronze glass has too few R points for degree 6: that is an error naming it)
+    let e = fails(glassdb().arg("fit").arg(&table).args([
+        "--percent",
+        "--degree",
+        "6",
+        "--basis",
+        "full",
+    ]));
+    assert!(
+        e.contains("glass `bronze`, reflectance: 5 distinct angle(s)"),
+        "{e}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let clear_only: String = std::fs::read_to_string(&table)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with("bronze"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let clear_table = write_file(dir.path(), "clear.csv", clear_only.as_bytes());
+    let exact = json(&ok(glassdb().arg("fit").arg(&clear_table).args([
+        "--percent",
+        "--json",
+        "--degree",
+        "6",
+        "--basis",
+        "full",
+    ])));
+    let r30 = eval_curve(&exact["glasses"][0]["reflectance"], &[30.0])[0];
+    assert!((r30 - 0.0810).abs() < 1e-9, "{r30}");
+}
+
+#[test]
+fn bundled_angle_tables_regenerate_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    run_oracle("make_angle_tables.py", &[dir.path().as_os_str()]);
+    for name in ["clear_6mm_fresnel.csv", "bronze_coated_window4.csv"] {
+        let fresh = std::fs::read(dir.path().join(name)).unwrap();
+        let bundled = std::fs::read(repo_path("data/angles").join(name)).unwrap();
+        assert!(
+            fresh == bundled,
+            "data/angles/{name} differs from what python_oracle/make_angle_tables.py computes"
+        );
+    }
+}

@@ -1,0 +1,167 @@
+//! The one error type of the fit crate: one variant per failure a user can act on.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong reading an angle table, fitting a curve or reading a fit file.
+/// Table errors name the file, and the line and column where the problem is.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    /// The file could not be opened or read.
+    #[error("cannot read {path}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The file is larger than any angle table can reasonably be.
+    #[error("{path}: file is {bytes} bytes, more than the {limit}-byte limit for an angle table")]
+    TooLarge {
+        path: PathBuf,
+        bytes: u64,
+        limit: u64,
+    },
+    /// The file has no header line (or nothing at all).
+    #[error("{path}: the file is empty (expected a header line such as `angle_deg,R,T`)")]
+    EmptyFile { path: PathBuf },
+    /// The file has a header but no data rows.
+    #[error("{path}: no data rows after the header")]
+    NoRows { path: PathBuf },
+    /// The CSV structure is broken (e.g. a row with a different number of fields than the header).
+    #[error("{path}, line {line}: {message}")]
+    Csv {
+        path: PathBuf,
+        line: u64,
+        message: String,
+    },
+    /// A required column is missing from the header.
+    #[error("{path}, line {line}: missing column {wanted} (header has: {found})")]
+    MissingColumn {
+        path: PathBuf,
+        line: u64,
+        wanted: String,
+        found: String,
+    },
+    /// The header has a column the reader does not know.
+    #[error(
+        "{path}, line {line}, column {column}: unknown column `{name}` (accepted: angle_deg/theta_deg, R/reflectance, T/transmittance, glass)"
+    )]
+    UnknownColumn {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        name: String,
+    },
+    /// Two header cells name the same quantity (e.g. `R` and `reflectance`).
+    #[error(
+        "{path}, line {line}, column {column}: column `{name}` repeats a quantity already given in column {first}"
+    )]
+    DuplicateColumn {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        first: usize,
+        name: String,
+    },
+    /// A cell is not a number.
+    #[error("{path}, line {line}, column {column} ({header}): `{value}` is not a number")]
+    NotANumber {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        header: String,
+        value: String,
+    },
+    /// A cell is NaN or infinite.
+    #[error("{path}, line {line}, column {column} ({header}): `{value}` is not a finite number")]
+    NotFinite {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        header: String,
+        value: String,
+    },
+    /// A required cell (the angle) is empty.
+    #[error("{path}, line {line}, column {column} ({header}): empty cell")]
+    EmptyCell {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        header: String,
+    },
+    /// An angle outside 0–90°.
+    #[error("{path}, line {line}, column {column} ({header}): angle {value}° is outside 0–90°")]
+    AngleOutOfRange {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        header: String,
+        value: f64,
+    },
+    /// A value above 1 in a table read as fractions.
+    #[error(
+        "{path}, line {line}, column {column} ({header}): {value} is above 1; values are fractions 0–1 (if the table is in percent, pass --percent)"
+    )]
+    PercentWithoutFlag {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        header: String,
+        value: f64,
+    },
+    /// A value outside 0–1 (or 0–100 with `--percent`).
+    #[error("{path}, line {line}, column {column} ({header}): {value} is outside {range}")]
+    ValueOutOfRange {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+        header: String,
+        value: f64,
+        range: &'static str,
+    },
+    /// A glass name cell is empty in a file with a `glass` column.
+    #[error("{path}, line {line}, column {column} (glass): empty glass name")]
+    EmptyGlassName {
+        path: PathBuf,
+        line: u64,
+        column: usize,
+    },
+    /// The table has neither an R nor a T column, or a glass has no value in either.
+    #[error("{path}: glass `{glass}` has no R or T values")]
+    NoValues { path: PathBuf, glass: String },
+    /// Samples handed to the fitter are inconsistent (different lengths, NaN, angle outside 0–90°).
+    #[error("invalid samples: {0}")]
+    InvalidSamples(String),
+    /// Fewer distinct angles than the coefficients the requested fit needs.
+    #[error(
+        "{points} distinct angle(s) but the {basis} basis at degree {degree} has {coefficients} coefficients: need at least as many points as coefficients"
+    )]
+    TooFewPoints {
+        points: usize,
+        coefficients: usize,
+        degree: u32,
+        basis: &'static str,
+    },
+    /// The fit options are inconsistent (degree 0 with the paper basis, tol not positive, …).
+    #[error("invalid fit options: {0}")]
+    InvalidOptions(String),
+    /// The value at normal incidence is zero or negative, so the ratio C(θ) is undefined.
+    #[error(
+        "the normal-incidence value is {normal}, {detail}: C(θ) = value(θ)/value(0°) is undefined"
+    )]
+    BadNormal { normal: f64, detail: &'static str },
+    /// The least-squares system is singular (should not happen with distinct angles).
+    #[error("the least-squares system is singular (degree {degree}, {points} points)")]
+    Singular { degree: u32, points: usize },
+    /// A fit file (JSON) is malformed or inconsistent.
+    #[error("{path}: {message}")]
+    FitFile { path: PathBuf, message: String },
+    /// A fit of one curve of one glass failed (the inner error says why).
+    #[error("glass `{glass}`, {quantity}: {error}")]
+    Curve {
+        glass: String,
+        quantity: &'static str,
+        error: Box<FitError>,
+    },
+    /// A physical check failed and strict mode turns it into an error.
+    #[error("glass `{glass}`: {message}")]
+    Physical { glass: String, message: String },
+}

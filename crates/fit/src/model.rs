@@ -1,0 +1,263 @@
+//! The fitted model of `docs/method.md` eqs. 11–14 and its JSON form (`docs/fit-json.md`):
+//! `r(θ) = r0·C_r(θ)`, `t(θ) = t0·C_t(θ)`, `C(θ) = Σ_k c_k·cos^{p_k} θ`.
+
+use serde::{Deserialize, Serialize};
+
+/// Which powers of cos θ a curve uses.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Basis {
+    /// Powers 1…n, no constant term: the paper's eqs. 12–13 (and EnergyPlus's form). Forces
+    /// C(90°) = 0, right for transmittance, wrong for reflectance (which rises to 1 at grazing).
+    Paper,
+    /// Powers 0…n: a constant term lets C_r reach 1/r0 at grazing incidence.
+    Full,
+}
+
+impl Basis {
+    /// The lowercase name used in JSON and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Basis::Paper => "paper",
+            Basis::Full => "full",
+        }
+    }
+
+    /// The powers of cos θ of this basis at `degree` (paper: 1..=degree, full: 0..=degree).
+    pub fn powers(self, degree: u32) -> Vec<u32> {
+        match self {
+            Basis::Paper => (1..=degree).collect(),
+            Basis::Full => (0..=degree).collect(),
+        }
+    }
+
+    /// The smallest meaningful degree (paper: 1, full: 0).
+    pub fn min_degree(self) -> u32 {
+        match self {
+            Basis::Paper => 1,
+            Basis::Full => 0,
+        }
+    }
+}
+
+/// `C(θ) = Σ_k coefficients[k] · cos(θ)^powers[k]` (method eqs. 12–13): the ratio of a
+/// quantity at incidence angle θ to its normal-incidence value. `powers` ascend strictly.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct CosPolynomial {
+    pub basis: Basis,
+    pub powers: Vec<u32>,
+    pub coefficients: Vec<f64>,
+}
+
+impl CosPolynomial {
+    /// C at `cos_theta` by Horner's rule over the (ascending) powers: one multiply-add per
+    /// coefficient when the powers are contiguous, as every fit this crate produces is.
+    #[inline]
+    pub fn eval(&self, cos_theta: f64) -> f64 {
+        let n = self.coefficients.len().min(self.powers.len());
+        if n == 0 {
+            return 0.0;
+        }
+        let x = cos_theta;
+        let (first, last) = (self.powers[0], self.powers[n - 1]);
+        if last.checked_sub(first) == Some(n as u32 - 1) {
+            // contiguous powers first..=last (every fit this crate writes): plain Horner
+            let acc = self.coefficients[..n]
+                .iter()
+                .rev()
+                .fold(0.0, |acc, &c| acc * x + c);
+            return match first {
+                0 => acc,
+                1 => acc * x,
+                p => acc * x.powi(p as i32),
+            };
+        }
+        let mut acc = self.coefficients[n - 1];
+        for k in (0..n - 1).rev() {
+            let gap = i64::from(self.powers[k + 1]) - i64::from(self.powers[k]);
+            acc = if gap == 1 {
+                acc * x
+            } else {
+                acc * x.powi(gap as i32)
+            } + self.coefficients[k];
+        }
+        match self.powers[0] {
+            0 => acc,
+            1 => acc * x,
+            p => acc * x.powi(p as i32),
+        }
+    }
+
+    /// C at an incidence angle in degrees (cos 90° is taken as exactly 0).
+    pub fn eval_angle_deg(&self, angle_deg: f64) -> f64 {
+        self.eval(cos_deg(angle_deg))
+    }
+
+    /// The highest power (the degree n of eqs. 12–13).
+    pub fn degree(&self) -> u32 {
+        self.powers.last().copied().unwrap_or(0)
+    }
+}
+
+/// cos of an angle in degrees, exact at 0° and 90° (so the paper basis gives exactly 0 at 90°).
+pub fn cos_deg(angle_deg: f64) -> f64 {
+    if angle_deg == 90.0 {
+        0.0
+    } else if angle_deg == 0.0 {
+        1.0
+    } else {
+        angle_deg.to_radians().cos()
+    }
+}
+
+/// A data point whose residual stands out from the noise of the rest (externally studentized
+/// residual above 4, and above the tolerance): a probable outlier or typo in the table.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct SuspectPoint {
+    pub angle_deg: f64,
+    /// fitted − measured, in the quantity's units (fraction).
+    pub residual: f64,
+    /// The residual in units of the noise estimated without this point.
+    pub studentized: f64,
+}
+
+/// How well a curve fits its data, and what was solved. The first five fields are the issue's
+/// JSON keys; the rest are extra keys (all optional when reading).
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct FitDiagnostics {
+    /// Highest power of cos θ.
+    pub degree: u32,
+    /// RMS of fitted − measured over the data (fraction, absolute: r(θ), not C(θ)).
+    pub rms_error: f64,
+    /// Largest |fitted − measured| over the data.
+    pub max_abs_error: f64,
+    /// The angle of that largest residual.
+    pub max_error_angle_deg: f64,
+    /// 2-norm condition number of the least-squares matrix actually solved (orthogonal
+    /// Chebyshev basis on the data's cos θ range, restricted to the constraint's null space).
+    pub condition_number: f64,
+    /// Condition number of the same fit written in the power basis (cos^p θ columns): what a
+    /// naive solver would face; the normal equations square it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub power_basis_condition_number: Option<f64>,
+    /// Distinct angles fitted (repeated angles averaged first).
+    #[serde(default)]
+    pub points: usize,
+    /// The measured range of angles; evaluating outside it is extrapolation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_min_deg: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_max_deg: Option<f64>,
+    /// True when `normal` is the table's 0° value; false when the table had no 0° row and
+    /// `normal` is the fitted absolute curve's value at cos θ = 1.
+    #[serde(default = "default_true")]
+    pub normal_measured: bool,
+    /// Leave-one-out RMS prediction error (each point predicted by the fit without it);
+    /// absent when a point determines a coefficient by itself (as many coefficients as points).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loo_rms_error: Option<f64>,
+    /// How the degree was chosen: `fixed` (--degree), `tolerance` (smallest degree meeting
+    /// --tol), `leave-one-out` (tolerance unmet or overfitting: best leave-one-out error).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub degree_selection: String,
+    /// Points whose residual stands out from the rest (probable outliers), worst first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub suspect_points: Vec<SuspectPoint>,
+    /// Warnings about this curve (tolerance not met, extrapolated normal value, …).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+/// One fitted curve: `value(θ) = normal · C(θ)`. Serialises to the flat JSON object of
+/// `docs/fit-json.md` (`normal`, `basis`, `powers`, `coefficients`, `degree`, …).
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct CurveFit {
+    /// The normal-incidence value r0 or t0 (fraction).
+    pub normal: f64,
+    #[serde(flatten)]
+    pub polynomial: CosPolynomial,
+    #[serde(flatten)]
+    pub diagnostics: FitDiagnostics,
+}
+
+impl CurveFit {
+    /// The fitted absolute value (fraction) at an incidence angle in degrees: normal · C(θ).
+    pub fn eval_angle_deg(&self, angle_deg: f64) -> f64 {
+        self.normal * self.polynomial.eval_angle_deg(angle_deg)
+    }
+
+    /// The fitted absolute value at a given cos θ (what the compositor's mask stores).
+    #[inline]
+    pub fn eval_cos(&self, cos_theta: f64) -> f64 {
+        self.normal * self.polynomial.eval(cos_theta)
+    }
+
+    /// True when `angle_deg` lies outside the measured range by more than `margin_deg`
+    /// (unknown range: false).
+    pub fn is_extrapolated(&self, angle_deg: f64, margin_deg: f64) -> bool {
+        let lo = self.diagnostics.angle_min_deg.unwrap_or(0.0);
+        let hi = self.diagnostics.angle_max_deg.unwrap_or(90.0);
+        angle_deg < lo - margin_deg || angle_deg > hi + margin_deg
+    }
+}
+
+/// One measured curve: angles of incidence (degrees, 0–90) and the value at each (fraction).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct AngleSamples {
+    pub angle_deg: Vec<f64>,
+    pub value: Vec<f64>,
+}
+
+/// Which quantity a curve is: it decides the default basis.
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Quantity {
+    Reflectance,
+    Transmittance,
+}
+
+impl Quantity {
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::Reflectance => "reflectance",
+            Quantity::Transmittance => "transmittance",
+        }
+    }
+}
+
+/// Default `--tol`: largest acceptable |fitted − measured| over the data (fraction).
+pub const DEFAULT_TOL: f64 = 0.002;
+/// Default `--max-degree` for automatic degree selection.
+pub const DEFAULT_MAX_DEGREE: u32 = 8;
+
+/// How to fit one curve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// Fixed degree; `None` selects it (smallest meeting `tol`, guarded by leave-one-out error).
+    pub degree: Option<u32>,
+    /// Tolerance on max |fitted − measured| over the data, in absolute value (fraction).
+    pub tol: f64,
+    /// Highest degree tried by automatic selection.
+    pub max_degree: u32,
+    /// `None`: full for reflectance; for transmittance the more accurate of paper and full on
+    /// the data, preferring one whose t(θ) stays within 0–1 over 0–90°.
+    pub basis: Option<Basis>,
+    pub quantity: Quantity,
+}
+
+impl FitOptions {
+    /// The defaults: automatic degree, tol 0.002, max degree 8, default basis.
+    pub fn new(quantity: Quantity) -> Self {
+        FitOptions {
+            degree: None,
+            tol: DEFAULT_TOL,
+            max_degree: DEFAULT_MAX_DEGREE,
+            basis: None,
+            quantity,
+        }
+    }
+}

@@ -1,0 +1,380 @@
+//! The angle-table CSV reader (format: `docs/fit.md`, "Input").
+//!
+//! Columns (header names case-insensitive, surrounding blanks ignored): `angle_deg` (or
+//! `theta_deg`), `R` (or `reflectance`) and/or `T` (or `transmittance`), optional `glass`.
+//! Lines starting with `#` are comments. Rows may come in any order; repeated angles of one
+//! glass are averaged and reported. An empty R or T cell means "not measured at this angle".
+
+use std::path::{Path, PathBuf};
+
+use crate::error::FitError;
+use crate::model::AngleSamples;
+
+/// Largest angle table read (bytes): far above any real table, small enough to never exhaust memory.
+pub const MAX_TABLE_BYTES: u64 = 64 << 20;
+
+/// An angle that appeared on more than one row of a glass: the values were averaged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RepeatedAngle {
+    pub angle_deg: f64,
+    /// How many rows gave this angle.
+    pub rows: usize,
+    /// Largest minus smallest value among those rows, per quantity (None: not measured).
+    pub reflectance_spread: Option<f64>,
+    pub transmittance_spread: Option<f64>,
+}
+
+/// The measured curves of one glass, sorted by angle, repeated angles averaged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GlassAngleTable {
+    /// The `glass` column's value, or the file stem when there is no `glass` column.
+    pub name: String,
+    pub reflectance: Option<AngleSamples>,
+    pub transmittance: Option<AngleSamples>,
+    /// Angles given on several rows (averaged), ascending.
+    pub repeated_angles: Vec<RepeatedAngle>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Field {
+    Angle,
+    R,
+    T,
+    Glass,
+}
+
+fn classify(header: &str) -> Option<Field> {
+    match header.trim().to_ascii_lowercase().as_str() {
+        "angle_deg" | "theta_deg" => Some(Field::Angle),
+        "r" | "reflectance" => Some(Field::R),
+        "t" | "transmittance" => Some(Field::T),
+        "glass" => Some(Field::Glass),
+        _ => None,
+    }
+}
+
+struct Row {
+    glass: String,
+    angle_deg: f64,
+    r: Option<f64>,
+    t: Option<f64>,
+}
+
+/// Reads an angle table. With `percent`, R and T are in percent (0–100) and converted to
+/// fractions; without it a value above 1 is an error that suggests `--percent`.
+/// Every error names the file, and the line and column of the offending cell.
+pub fn read_angle_table(path: &Path, percent: bool) -> Result<Vec<GlassAngleTable>, FitError> {
+    let io_err = |source| FitError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io_err)?;
+    if meta.len() > MAX_TABLE_BYTES {
+        return Err(FitError::TooLarge {
+            path: path.to_path_buf(),
+            bytes: meta.len(),
+            limit: MAX_TABLE_BYTES,
+        });
+    }
+    let bytes = std::fs::read(path).map_err(io_err)?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "glass".to_string());
+    parse_angle_table(&bytes, path, &stem, percent)
+}
+
+/// Parses angle-table bytes (see [`read_angle_table`]); `path` is used in messages only and
+/// `default_name` names the glass when there is no `glass` column.
+pub fn parse_angle_table(
+    bytes: &[u8],
+    path: &Path,
+    default_name: &str,
+    percent: bool,
+) -> Result<Vec<GlassAngleTable>, FitError> {
+    let p = || path.to_path_buf();
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .flexible(false)
+        .from_reader(bytes);
+
+    let headers = rdr.byte_headers().map_err(|e| csv_error(p(), &e))?.clone();
+    if headers.is_empty() || (headers.len() == 1 && headers[0].iter().all(u8::is_ascii_whitespace))
+    {
+        return Err(FitError::EmptyFile { path: p() });
+    }
+    let header_line = headers.position().map(|pos| pos.line()).unwrap_or(1);
+    let mut names = Vec::with_capacity(headers.len());
+    let mut cols: [Option<usize>; 4] = [None; 4];
+    for (i, raw) in headers.iter().enumerate() {
+        let name = String::from_utf8_lossy(raw).trim().to_string();
+        let Some(field) = classify(&name) else {
+            return Err(FitError::UnknownColumn {
+                path: p(),
+                line: header_line,
+                column: i + 1,
+                name,
+            });
+        };
+        let slot = &mut cols[field as usize];
+        if let Some(first) = *slot {
+            return Err(FitError::DuplicateColumn {
+                path: p(),
+                line: header_line,
+                column: i + 1,
+                first: first + 1,
+                name,
+            });
+        }
+        *slot = Some(i);
+        names.push(name);
+    }
+    let found = names.join(", ");
+    let Some(angle_col) = cols[Field::Angle as usize] else {
+        return Err(FitError::MissingColumn {
+            path: p(),
+            line: header_line,
+            wanted: "angle_deg (or theta_deg)".into(),
+            found,
+        });
+    };
+    let (r_col, t_col, glass_col) = (
+        cols[Field::R as usize],
+        cols[Field::T as usize],
+        cols[Field::Glass as usize],
+    );
+    if r_col.is_none() && t_col.is_none() {
+        return Err(FitError::MissingColumn {
+            path: p(),
+            line: header_line,
+            wanted: "R (or reflectance) and/or T (or transmittance)".into(),
+            found,
+        });
+    }
+
+    let mut rows = Vec::new();
+    let mut record = csv::ByteRecord::new();
+    loop {
+        match rdr.read_byte_record(&mut record) {
+            Ok(true) => {}
+            Ok(false) => break,
+            Err(e) => return Err(csv_error(p(), &e)),
+        }
+        let line = record.position().map(|pos| pos.line()).unwrap_or(0);
+        let cell = |col: usize| -> Result<&str, FitError> {
+            let raw = record.get(col).unwrap_or(b"");
+            std::str::from_utf8(raw)
+                .map(str::trim)
+                .map_err(|_| FitError::NotANumber {
+                    path: p(),
+                    line,
+                    column: col + 1,
+                    header: names.get(col).cloned().unwrap_or_default(),
+                    value: String::from_utf8_lossy(raw).into_owned(),
+                })
+        };
+        let number = |col: usize, text: &str| -> Result<f64, FitError> {
+            let header = names.get(col).cloned().unwrap_or_default();
+            let v: f64 = text.parse().map_err(|_| FitError::NotANumber {
+                path: p(),
+                line,
+                column: col + 1,
+                header: header.clone(),
+                value: text.to_string(),
+            })?;
+            if !v.is_finite() {
+                return Err(FitError::NotFinite {
+                    path: p(),
+                    line,
+                    column: col + 1,
+                    header,
+                    value: text.to_string(),
+                });
+            }
+            Ok(v)
+        };
+        let angle_text = cell(angle_col)?;
+        if angle_text.is_empty() {
+            return Err(FitError::EmptyCell {
+                path: p(),
+                line,
+                column: angle_col + 1,
+                header: names[angle_col].clone(),
+            });
+        }
+        let angle_deg = number(angle_col, angle_text)?;
+        if !(0.0..=90.0).contains(&angle_deg) {
+            return Err(FitError::AngleOutOfRange {
+                path: p(),
+                line,
+                column: angle_col + 1,
+                header: names[angle_col].clone(),
+                value: angle_deg,
+            });
+        }
+        let fraction = |col: Option<usize>| -> Result<Option<f64>, FitError> {
+            let Some(col) = col else { return Ok(None) };
+            let text = cell(col)?;
+            if text.is_empty() {
+                return Ok(None);
+            }
+            let v = number(col, text)?;
+            let header = names[col].clone();
+            if percent {
+                if !(0.0..=100.0).contains(&v) {
+                    return Err(FitError::ValueOutOfRange {
+                        path: p(),
+                        line,
+                        column: col + 1,
+                        header,
+                        value: v,
+                        range: "0–100 (percent)",
+                    });
+                }
+                Ok(Some(v / 100.0))
+            } else if v > 1.0 {
+                Err(FitError::PercentWithoutFlag {
+                    path: p(),
+                    line,
+                    column: col + 1,
+                    header,
+                    value: v,
+                })
+            } else if v < 0.0 {
+                Err(FitError::ValueOutOfRange {
+                    path: p(),
+                    line,
+                    column: col + 1,
+                    header,
+                    value: v,
+                    range: "0–1",
+                })
+            } else {
+                Ok(Some(v))
+            }
+        };
+        let r = fraction(r_col)?;
+        let t = fraction(t_col)?;
+        let glass = match glass_col {
+            Some(col) => {
+                let name = cell(col)?;
+                if name.is_empty() {
+                    return Err(FitError::EmptyGlassName {
+                        path: p(),
+                        line,
+                        column: col + 1,
+                    });
+                }
+                name.to_string()
+            }
+            None => default_name.to_string(),
+        };
+        rows.push(Row {
+            glass,
+            angle_deg,
+            r,
+            t,
+        });
+    }
+    if rows.is_empty() {
+        return Err(FitError::NoRows { path: p() });
+    }
+    group(rows, path)
+}
+
+fn csv_error(path: PathBuf, e: &csv::Error) -> FitError {
+    let line = e.position().map(|pos| pos.line()).unwrap_or(0);
+    let message = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => {
+            format!("row has {len} field(s) but the header has {expected_len}")
+        }
+        csv::ErrorKind::Utf8 { .. } => "text is not valid UTF-8".to_string(),
+        csv::ErrorKind::Io(io) => format!("read error: {io}"),
+        _ => e.to_string(),
+    };
+    FitError::Csv {
+        path,
+        line,
+        message,
+    }
+}
+
+/// Groups rows by glass (first-appearance order), sorts by angle, averages repeated angles.
+fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> {
+    let mut order: Vec<String> = Vec::new();
+    let mut by_glass: std::collections::HashMap<String, Vec<Row>> =
+        std::collections::HashMap::new();
+    for row in rows {
+        if !by_glass.contains_key(&row.glass) {
+            order.push(row.glass.clone());
+        }
+        by_glass.entry(row.glass.clone()).or_default().push(row);
+    }
+    let mut out = Vec::with_capacity(order.len());
+    for name in order {
+        let mut rows = by_glass.remove(&name).unwrap_or_default();
+        rows.sort_by(|a, b| a.angle_deg.total_cmp(&b.angle_deg));
+        let mut r = AngleSamples::default();
+        let mut t = AngleSamples::default();
+        let mut repeated = Vec::new();
+        let mut i = 0;
+        while i < rows.len() {
+            let mut j = i + 1;
+            while j < rows.len() && rows[j].angle_deg == rows[i].angle_deg {
+                j += 1;
+            }
+            let group = &rows[i..j];
+            let angle = rows[i].angle_deg;
+            let rs: Vec<f64> = group.iter().filter_map(|row| row.r).collect();
+            let ts: Vec<f64> = group.iter().filter_map(|row| row.t).collect();
+            if !rs.is_empty() {
+                r.angle_deg.push(angle);
+                r.value.push(mean(&rs));
+            }
+            if !ts.is_empty() {
+                t.angle_deg.push(angle);
+                t.value.push(mean(&ts));
+            }
+            if group.len() > 1 {
+                repeated.push(RepeatedAngle {
+                    angle_deg: angle,
+                    rows: group.len(),
+                    reflectance_spread: spread(&rs),
+                    transmittance_spread: spread(&ts),
+                });
+            }
+            i = j;
+        }
+        if r.angle_deg.is_empty() && t.angle_deg.is_empty() {
+            return Err(FitError::NoValues {
+                path: path.to_path_buf(),
+                glass: name,
+            });
+        }
+        out.push(GlassAngleTable {
+            name,
+            reflectance: (!r.angle_deg.is_empty()).then_some(r),
+            transmittance: (!t.angle_deg.is_empty()).then_some(t),
+            repeated_angles: repeated,
+        });
+    }
+    Ok(out)
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+fn spread(v: &[f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    Some(hi - lo)
+}
