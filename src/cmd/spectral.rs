@@ -1,10 +1,296 @@
-//! `glassdb spectral`: under construction (owned by the spectral work item).
+//! `glassdb spectral FILE`: a glass's spectra to per-channel factors and luminous values.
 
+use std::fmt::Write as _;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct Args {}
+use anyhow::{Context, bail};
+use glassdb_spectral::{
+    Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, Observer, ReadOptions,
+    RgbCmf, RgbSpace, SpectralData, luminous, read_spectral_file,
+};
+use serde_json::{Value, json};
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`spectral` is not built yet")
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// The paper's eqs. 15–20: ∫ρ·c̄ / ∫c̄ with RGB colour-matching functions (--cmf).
+    Paper,
+    /// RGB(value × illuminant) / RGB(illuminant) in a linear working space (default).
+    Colorimetric,
+    /// ISO 9050 / EN 410 luminous value (D65 × V(λ), 380–780 nm at 10 nm) in all channels.
+    Luminous,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CmfArg {
+    #[value(name = "wright-guild-1931")]
+    WrightGuild1931,
+    #[value(name = "stiles-burch-1955")]
+    StilesBurch1955,
+    #[value(name = "stiles-burch-1959")]
+    StilesBurch1959,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ObserverArg {
+    Cie1931,
+    Cie1964,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum IlluminantArg {
+    #[value(name = "D65", alias = "d65")]
+    D65,
+    #[value(name = "A", alias = "a")]
+    A,
+    #[value(name = "E", alias = "e")]
+    E,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SpaceArg {
+    Srgb,
+    Acescg,
+    #[value(name = "display-p3")]
+    DisplayP3,
+}
+
+/// Spectral transmittance/reflectance to per-channel and luminous values.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Spectral data: CSV (wavelength_nm or wavelength_um, T, R/Rf, Rb), LBNL Optics/IGDB text
+    /// (.DAT, .LOF, .afg, .oag, …) or IGSDB JSON.
+    pub file: PathBuf,
+    /// How a spectrum becomes three numbers.
+    #[arg(long, value_enum, default_value = "colorimetric")]
+    pub method: MethodArg,
+    /// RGB colour-matching functions for --method paper [default: wright-guild-1931].
+    #[arg(long, value_enum)]
+    pub cmf: Option<CmfArg>,
+    /// Standard observer for --method colorimetric [default: cie1931].
+    #[arg(long, value_enum)]
+    pub observer: Option<ObserverArg>,
+    /// Illuminant for --method colorimetric [default: D65].
+    #[arg(long, value_enum)]
+    pub illuminant: Option<IlluminantArg>,
+    /// Linear RGB working space for --method colorimetric [default: srgb].
+    #[arg(long, value_enum)]
+    pub space: Option<SpaceArg>,
+    /// CSV values are percent (0–100) instead of fractions.
+    #[arg(long)]
+    pub percent: bool,
+    /// Hold the spectrum's end values constant where it does not cover a method's grid
+    /// (otherwise partial coverage is an error).
+    #[arg(long)]
+    pub extrapolate: bool,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn method_of(args: &Args) -> anyhow::Result<Method> {
+    let colorimetric_flags =
+        args.observer.is_some() || args.illuminant.is_some() || args.space.is_some();
+    Ok(match args.method {
+        MethodArg::Paper => {
+            if colorimetric_flags {
+                bail!(
+                    "--observer, --illuminant and --space apply to --method colorimetric, not paper"
+                );
+            }
+            Method::Paper(match args.cmf.unwrap_or(CmfArg::WrightGuild1931) {
+                CmfArg::WrightGuild1931 => RgbCmf::WrightGuild1931,
+                CmfArg::StilesBurch1955 => RgbCmf::StilesBurch1955,
+                CmfArg::StilesBurch1959 => RgbCmf::StilesBurch1959,
+            })
+        }
+        MethodArg::Colorimetric => {
+            if args.cmf.is_some() {
+                bail!("--cmf applies to --method paper, not colorimetric");
+            }
+            Method::Colorimetric {
+                observer: match args.observer.unwrap_or(ObserverArg::Cie1931) {
+                    ObserverArg::Cie1931 => Observer::Cie1931,
+                    ObserverArg::Cie1964 => Observer::Cie1964,
+                },
+                illuminant: match args.illuminant.unwrap_or(IlluminantArg::D65) {
+                    IlluminantArg::D65 => Illuminant::D65,
+                    IlluminantArg::A => Illuminant::A,
+                    IlluminantArg::E => Illuminant::E,
+                },
+                space: match args.space.unwrap_or(SpaceArg::Srgb) {
+                    SpaceArg::Srgb => RgbSpace::Srgb,
+                    SpaceArg::Acescg => RgbSpace::AcesCg,
+                    SpaceArg::DisplayP3 => RgbSpace::DisplayP3,
+                },
+            }
+        }
+        MethodArg::Luminous => {
+            if colorimetric_flags || args.cmf.is_some() {
+                bail!(
+                    "--cmf, --observer, --illuminant and --space do not apply to --method luminous"
+                );
+            }
+            Method::Luminous
+        }
+    })
+}
+
+/// One quantity's results.
+struct QuantityResult {
+    key: &'static str,
+    label: &'static str,
+    rgb: [f64; 3],
+    luminous_iso: f64,
+    luminous_1nm: f64,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let method = method_of(&args)?;
+    let settings = IntegrationSettings {
+        method,
+        extrapolate: args.extrapolate,
+    };
+    let data = read_spectral_file(
+        &args.file,
+        &ReadOptions {
+            percent: args.percent,
+        },
+    )?;
+    let integrator = Integrator::new(&settings)?;
+    let results = integrate_all(&data, &integrator, args.extrapolate)?;
+    let out = if args.json {
+        let mut s = serde_json::to_string_pretty(&to_json(&data, &method, &results))?;
+        s.push('\n');
+        s
+    } else {
+        to_text(&data, &method, &results)
+    };
+    print!("{out}");
+    Ok(ExitCode::SUCCESS)
+}
+
+fn integrate_all(
+    data: &SpectralData,
+    integrator: &Integrator,
+    extrapolate: bool,
+) -> anyhow::Result<Vec<QuantityResult>> {
+    let quantities = [
+        ("transmittance", "transmittance", &data.transmittance),
+        (
+            "reflectance",
+            "reflectance (front)",
+            &data.reflectance_front,
+        ),
+        (
+            "reflectance_back",
+            "reflectance (back)",
+            &data.reflectance_back,
+        ),
+    ];
+    let wl = &data.wavelength_nm;
+    let mut results = Vec::new();
+    for (key, label, values) in quantities {
+        let Some(values) = values else { continue };
+        let context = || format!("{}: {label}", data.source);
+        let rgb = integrator.channels(wl, values).with_context(context)?;
+        let luminous_iso =
+            luminous(wl, values, LuminousGrid::Iso9050, extrapolate).with_context(context)?;
+        let luminous_1nm =
+            luminous(wl, values, LuminousGrid::OneNm, extrapolate).with_context(context)?;
+        results.push(QuantityResult {
+            key,
+            label,
+            rgb,
+            luminous_iso,
+            luminous_1nm,
+        });
+    }
+    Ok(results)
+}
+
+fn to_json(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> Value {
+    let (name, cmf, observer, illuminant, space) = match method {
+        Method::Paper(c) => ("paper", Some(c.name()), None, None, None),
+        Method::Colorimetric {
+            observer,
+            illuminant,
+            space,
+        } => (
+            "colorimetric",
+            None,
+            Some(observer.name()),
+            Some(illuminant.name()),
+            Some(space.name()),
+        ),
+        Method::Luminous => ("luminous", None, None, None, None),
+    };
+    let mut obj = json!({
+        "method": name,
+        "cmf": cmf,
+        "observer": observer,
+        "illuminant": illuminant,
+        "space": space,
+        "file": data.source,
+        "product": data.product,
+    });
+    if let Some(map) = obj.as_object_mut() {
+        for r in results {
+            map.insert(
+                r.key.to_owned(),
+                json!({"rgb": r.rgb, "luminous": r.luminous_iso, "luminous_1nm": r.luminous_1nm}),
+            );
+        }
+    }
+    obj
+}
+
+fn to_text(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> String {
+    let mut s = String::new();
+    let p = &data.product;
+    let _ = writeln!(s, "{}", data.source);
+    let details: Vec<String> = [
+        p.name.clone(),
+        p.manufacturer.clone(),
+        p.product_type.clone(),
+        p.coated_side.as_ref().map(|c| format!("coated side {c}")),
+        p.thickness_mm.map(|t| format!("{t} mm")),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if !details.is_empty() {
+        let _ = writeln!(s, "  {}", details.join(", "));
+    }
+    let wl = &data.wavelength_nm;
+    if let (Some(first), Some(last)) = (wl.first(), wl.last()) {
+        let _ = writeln!(s, "  {} samples, {first}–{last} nm", wl.len());
+    }
+    let method_line = match method {
+        Method::Paper(c) => format!("paper (eqs. 15–20), {c} RGB colour-matching functions"),
+        Method::Colorimetric {
+            observer,
+            illuminant,
+            space,
+        } => {
+            format!(
+                "colorimetric, observer {observer}, illuminant {illuminant}, space {space} (linear)"
+            )
+        }
+        Method::Luminous => "luminous (ISO 9050, D65 × V(λ), 380–780 nm at 10 nm)".to_owned(),
+    };
+    let _ = writeln!(s, "method: {method_line}");
+    let _ = writeln!(
+        s,
+        "{:<22}{:>10}{:>10}{:>10}{:>14}{:>14}",
+        "", "R", "G", "B", "luminous", "luminous 1nm"
+    );
+    for r in results {
+        let _ = writeln!(
+            s,
+            "{:<22}{:>10.6}{:>10.6}{:>10.6}{:>14.6}{:>14.6}",
+            r.label, r.rgb[0], r.rgb[1], r.rgb[2], r.luminous_iso, r.luminous_1nm
+        );
+    }
+    s
 }

@@ -1,0 +1,125 @@
+//! The one error type of the crate: one variant per failure a user can act on.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong reading or integrating spectral data.
+///
+/// Reader errors name the source (file name) and the 1-based line (and, for CSV, the 1-based
+/// column); integration errors describe the spectrum and say what would make it acceptable.
+#[derive(Debug, thiserror::Error)]
+pub enum SpectralError {
+    /// The file could not be opened or read.
+    #[error("{path}: cannot read")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// A syntax or content error at a known place in the file.
+    #[error("{source_name}:{line}{}: {message}", column.map(|c| format!(":{c}")).unwrap_or_default())]
+    Parse {
+        source_name: String,
+        /// 1-based line number.
+        line: usize,
+        /// 1-based column (CSV field index) when known.
+        column: Option<usize>,
+        message: String,
+    },
+
+    /// The file as a whole is unusable (no data rows, unknown format, no quantity columns).
+    #[error("{source_name}: {message}")]
+    Format {
+        source_name: String,
+        message: String,
+    },
+
+    /// Wavelength and value arrays passed to an integrator differ in length.
+    #[error("{wavelengths} wavelengths but {values} values")]
+    LengthMismatch { wavelengths: usize, values: usize },
+
+    /// A wavelength or value handed to an integrator is NaN or infinite.
+    #[error("non-finite {what} at index {index}")]
+    NonFinite { what: &'static str, index: usize },
+
+    /// Wavelengths handed to an integrator are not strictly increasing.
+    #[error(
+        "wavelengths must be strictly increasing: {previous_nm} nm is followed by {next_nm} nm at index {index}"
+    )]
+    NotIncreasing {
+        index: usize,
+        previous_nm: f64,
+        next_nm: f64,
+    },
+
+    /// Too few samples for the interpolator colour-science would use on this spacing.
+    #[error(
+        "{points} samples: {interpolator} interpolation needs at least {needed} (uniformly spaced data use Sprague, which needs 6; irregular spacing uses a cubic spline, which needs 4)"
+    )]
+    TooFewPoints {
+        points: usize,
+        needed: usize,
+        interpolator: &'static str,
+    },
+
+    /// The spectrum does not cover the wavelength range the chosen method integrates over.
+    #[error(
+        "the spectrum covers {have_start_nm}–{have_end_nm} nm but {method} integrates over {need_start_nm}–{need_end_nm} nm; pass --extrapolate (IntegrationSettings::extrapolate) to hold the end values constant outside the data"
+    )]
+    PartialCoverage {
+        method: String,
+        have_start_nm: f64,
+        have_end_nm: f64,
+        need_start_nm: f64,
+        need_end_nm: f64,
+    },
+
+    /// The spectrum does not overlap the integration range at all.
+    #[error(
+        "the spectrum ({have_start_nm}–{have_end_nm} nm) does not overlap {need_start_nm}–{need_end_nm} nm at all"
+    )]
+    NoOverlap {
+        have_start_nm: f64,
+        have_end_nm: f64,
+        need_start_nm: f64,
+        need_end_nm: f64,
+    },
+
+    /// The reference white of a method has a zero (or negative) channel, so no ratio exists.
+    #[error(
+        "the illuminant's {channel} channel in this colour space is {value}: no per-channel ratio exists"
+    )]
+    DegenerateWhite { channel: &'static str, value: f64 },
+
+    /// An embedded reference table failed to parse (a build defect, reported rather than panicking).
+    #[error("embedded table {table} is corrupt: {message}")]
+    EmbeddedTable {
+        table: &'static str,
+        message: String,
+    },
+}
+
+impl SpectralError {
+    /// Shorthand for a [`SpectralError::Parse`] error.
+    pub(crate) fn parse(
+        source_name: &str,
+        line: usize,
+        column: Option<usize>,
+        message: impl Into<String>,
+    ) -> Self {
+        SpectralError::Parse {
+            source_name: source_name.to_owned(),
+            line,
+            column,
+            message: message.into(),
+        }
+    }
+
+    /// Shorthand for a [`SpectralError::Format`] error.
+    pub(crate) fn format(source_name: &str, message: impl Into<String>) -> Self {
+        SpectralError::Format {
+            source_name: source_name.to_owned(),
+            message: message.into(),
+        }
+    }
+}

@@ -1,0 +1,641 @@
+//! Per-channel and luminous values of a spectrum (method.md "Colour", eqs. 15–20; ISO 9050 /
+//! EN 410 for the luminous values).
+//!
+//! Every method is a weighted sum over a fixed reference grid: the spectrum is resampled onto
+//! the grid (Sprague or not-a-knot spline, as colour-science does; see [`crate::interp`]) and
+//! dotted with weights precomputed once in [`Integrator::new`]. A call to
+//! [`Integrator::channels`] therefore costs one `O(n)` spline solve plus one pass over the grid
+//! and does not allocate once its thread has warmed up.
+
+use std::cell::RefCell;
+use std::fmt;
+use std::str::FromStr;
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+use crate::error::SpectralError;
+use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, validate};
+use crate::tables::{Table, tables};
+
+/// The RGB colour-matching functions of the paper's method (eqs. 15–20).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum RgbCmf {
+    /// Wright & Guild 1931 2°, 380–780 nm at 5 nm (the CIE 1931 RGB CMFs).
+    #[serde(rename = "wright-guild-1931")]
+    WrightGuild1931,
+    /// Stiles & Burch 1955 2°, 390–730 nm at 5 nm.
+    #[serde(rename = "stiles-burch-1955")]
+    StilesBurch1955,
+    /// Stiles & Burch 1959 10°, 390–830 nm at 5 nm.
+    #[serde(rename = "stiles-burch-1959")]
+    StilesBurch1959,
+}
+
+/// CIE standard colorimetric observer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Observer {
+    /// CIE 1931 2°.
+    #[serde(rename = "cie1931")]
+    Cie1931,
+    /// CIE 1964 10°.
+    #[serde(rename = "cie1964")]
+    Cie1964,
+}
+
+/// Illuminant the glass is lit by (colorimetric method).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Illuminant {
+    /// CIE D65 daylight (CIE 15:2004, 300–780 nm at 5 nm, linearly interpolated).
+    D65,
+    /// CIE A, incandescent 2856 K.
+    A,
+    /// Equal energy.
+    E,
+}
+
+/// Linear RGB working space of the renderer (colorimetric method).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RgbSpace {
+    /// ITU-R BT.709 / sRGB primaries, D65 white (IEC 61966-2-1 matrix, as colour uses it).
+    Srgb,
+    /// ACEScg (AP1 primaries, ACES white).
+    #[serde(rename = "acescg")]
+    AcesCg,
+    /// Display P3 (P3 primaries, D65 white).
+    DisplayP3,
+}
+
+/// How a spectrum becomes three numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// The paper's eqs. 15–20: `∫ρ·c̄ dλ / ∫c̄ dλ` per RGB CMF channel, on the CMF's own grid.
+    /// The CMFs have negative lobes, so a channel may exceed the largest input value or fall
+    /// below the smallest: that is the formula, not a defect.
+    Paper(RgbCmf),
+    /// `RGB(value × illuminant) / RGB(illuminant)` per channel, XYZ through the observer over
+    /// 360–780 nm at 1 nm, then the space's XYZ→RGB matrix (no chromatic adaptation).
+    Colorimetric {
+        observer: Observer,
+        illuminant: Illuminant,
+        space: RgbSpace,
+    },
+    /// ISO 9050 / EN 410 luminous value (D65 × V(λ), 380–780 nm at 10 nm) in all three channels.
+    Luminous,
+}
+
+/// Everything an [`Integrator`] needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct IntegrationSettings {
+    pub method: Method,
+    /// Hold the spectrum's end values constant where it does not cover the method's grid
+    /// (colour-science's behaviour); without it partial coverage is an error.
+    pub extrapolate: bool,
+}
+
+impl Default for IntegrationSettings {
+    fn default() -> Self {
+        IntegrationSettings {
+            method: Method::Colorimetric {
+                observer: Observer::Cie1931,
+                illuminant: Illuminant::D65,
+                space: RgbSpace::Srgb,
+            },
+            extrapolate: false,
+        }
+    }
+}
+
+/// Grid for the luminous (visible) value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LuminousGrid {
+    /// ISO 9050 / EN 410 table: 380–780 nm at 10 nm.
+    Iso9050,
+    /// 380–780 nm at 1 nm (D65 linearly interpolated, as colour-science does).
+    OneNm,
+}
+
+/// Precomputed weights for one method: cheap to apply to many spectra.
+#[derive(Debug, Clone)]
+pub struct Integrator {
+    /// Identifies the weights in the per-thread kernel cache (clones share it: same weights).
+    id: u64,
+    settings: IntegrationSettings,
+    grid_nm: Vec<f64>,
+    /// Per grid point, the weight of each channel (each channel's weights sum to 1 for a
+    /// flat spectrum to give that value back).
+    weights: Vec<[f64; 3]>,
+    label: String,
+}
+
+impl Integrator {
+    /// Builds the integrator: loads the embedded tables and precomputes the weights.
+    pub fn new(settings: &IntegrationSettings) -> Result<Self, SpectralError> {
+        let t = tables()?;
+        let (grid_nm, weights, label) = match settings.method {
+            Method::Paper(cmf) => {
+                let table = match cmf {
+                    RgbCmf::WrightGuild1931 => &t.wright_guild_1931,
+                    RgbCmf::StilesBurch1955 => &t.stiles_burch_1955,
+                    RgbCmf::StilesBurch1959 => &t.stiles_burch_1959,
+                };
+                let sums: Vec<f64> = table.columns.iter().map(|c| c.iter().sum()).collect();
+                let weights = (0..table.wavelength_nm.len())
+                    .map(|j| [0, 1, 2].map(|c| table.columns[c][j] / sums[c]))
+                    .collect();
+                (
+                    table.wavelength_nm.clone(),
+                    weights,
+                    format!("the paper method ({})", cmf.name()),
+                )
+            }
+            Method::Colorimetric {
+                observer,
+                illuminant,
+                space,
+            } => {
+                let cmfs = match observer {
+                    Observer::Cie1931 => &t.cie_1931,
+                    Observer::Cie1964 => &t.cie_1964,
+                };
+                let grid: Vec<f64> = (360..=780).map(f64::from).collect();
+                let xyz_weights = xyz_weights(cmfs, illuminant_on(&grid, illuminant)?, &grid)?;
+                let m = xyz_to_rgb(space);
+                let white_xyz = xyz_weights
+                    .iter()
+                    .fold(Vector3::zeros(), |acc, w| acc + Vector3::from(*w));
+                let white_rgb = m * white_xyz;
+                for (c, name) in ["red", "green", "blue"].iter().enumerate() {
+                    if white_rgb[c].is_nan() || white_rgb[c] <= 1e-12 * white_xyz[1].abs() {
+                        return Err(SpectralError::DegenerateWhite {
+                            channel: name,
+                            value: white_rgb[c],
+                        });
+                    }
+                }
+                let weights = xyz_weights
+                    .iter()
+                    .map(|w| {
+                        let rgb = m * Vector3::from(*w);
+                        [
+                            rgb[0] / white_rgb[0],
+                            rgb[1] / white_rgb[1],
+                            rgb[2] / white_rgb[2],
+                        ]
+                    })
+                    .collect();
+                (
+                    grid,
+                    weights,
+                    format!(
+                        "the colorimetric method ({}, {}, {})",
+                        observer.name(),
+                        illuminant.name(),
+                        space.name()
+                    ),
+                )
+            }
+            Method::Luminous => {
+                let (grid, weights) = luminous_weights(LuminousGrid::Iso9050)?;
+                (
+                    grid,
+                    weights.iter().map(|&w| [w; 3]).collect(),
+                    "the ISO 9050 luminous value".to_owned(),
+                )
+            }
+        };
+        Ok(Integrator {
+            id: NEXT_INTEGRATOR_ID.fetch_add(1, Ordering::Relaxed),
+            settings: *settings,
+            grid_nm,
+            weights,
+            label,
+        })
+    }
+
+    /// The luminous value on either grid, as an integrator (all three channels equal).
+    fn luminous_on(grid: LuminousGrid) -> Result<Self, SpectralError> {
+        let (grid_nm, weights) = luminous_weights(grid)?;
+        let label = match grid {
+            LuminousGrid::Iso9050 => "the ISO 9050 luminous value",
+            LuminousGrid::OneNm => "the 1 nm luminous value",
+        };
+        Ok(Integrator {
+            id: NEXT_INTEGRATOR_ID.fetch_add(1, Ordering::Relaxed),
+            settings: IntegrationSettings {
+                method: Method::Luminous,
+                extrapolate: false,
+            },
+            grid_nm,
+            weights: weights.iter().map(|&w| [w; 3]).collect(),
+            label: label.to_owned(),
+        })
+    }
+
+    /// Validates, checks coverage and applies the weights. Uniform data go through Sprague
+    /// directly; irregular data through the cached spline kernel of their wavelength array.
+    fn apply(
+        &self,
+        wavelength_nm: &[f64],
+        values: &[f64],
+        extrapolate: bool,
+    ) -> Result<[f64; 3], SpectralError> {
+        // Fast path: a wavelength array this thread has already validated (equality with the
+        // cached copy implies it is valid and irregular). Seen once: build its spline kernel
+        // now; kernel already built: one dot product.
+        if wavelength_nm.len() == values.len() && values.iter().all(|v| v.is_finite()) {
+            let hit = KERNELS.with(|cell| {
+                let mut cache = cell.borrow_mut();
+                let entry = cache
+                    .entries
+                    .iter_mut()
+                    .find(|e| e.id == self.id && e.wavelength_nm.as_slice() == wavelength_nm)?;
+                let kernel = entry.kernel.get_or_insert_with(|| {
+                    let mut kernel = Vec::new();
+                    spline_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
+                    kernel
+                });
+                Some(dot_kernel(kernel, values))
+            });
+            if let Some(acc) = hit {
+                check_coverage(
+                    wavelength_nm,
+                    &self.grid_nm,
+                    extrapolate,
+                    &self.description(),
+                )?;
+                return Ok(acc);
+            }
+        }
+        let uniform = validate(wavelength_nm, values)?;
+        check_coverage(
+            wavelength_nm,
+            &self.grid_nm,
+            extrapolate,
+            &self.description(),
+        )?;
+        // First sight of this wavelength array: evaluate directly (one spline solve, cheaper
+        // than building the kernel) and remember the array for next time.
+        let mut acc = [0.0f64; 3];
+        let weights = &self.weights;
+        for_each_on_grid(wavelength_nm, values, uniform, &self.grid_nm, |j, v| {
+            if let Some(w) = weights.get(j) {
+                acc[0] += v * w[0];
+                acc[1] += v * w[1];
+                acc[2] += v * w[2];
+            }
+        });
+        if !uniform {
+            KERNELS.with(|cell| {
+                let mut cache = cell.borrow_mut();
+                let entry = KernelEntry {
+                    id: self.id,
+                    wavelength_nm: wavelength_nm.to_vec(),
+                    kernel: None,
+                };
+                if cache.entries.len() < KERNEL_CACHE_SLOTS {
+                    cache.entries.push(entry);
+                } else {
+                    let slot = cache.next_slot % KERNEL_CACHE_SLOTS;
+                    cache.next_slot = slot + 1;
+                    cache.entries[slot] = entry;
+                }
+            });
+        }
+        Ok(acc)
+    }
+
+    /// The three channel values of a spectrum (`wavelength_nm` strictly increasing, values as
+    /// fractions). For [`Method::Luminous`] all three are the luminous value.
+    ///
+    /// Cost: uniform spacing evaluates Sprague on the grid directly. Irregular spacing solves
+    /// the spline directly the first time a thread sees a wavelength array, builds the spline's
+    /// linear kernel the second time (kept for the 8 most recent arrays), and from then on
+    /// another spectrum on the same wavelengths is one dot product.
+    pub fn channels(
+        &self,
+        wavelength_nm: &[f64],
+        values: &[f64],
+    ) -> Result<[f64; 3], SpectralError> {
+        self.apply(wavelength_nm, values, self.settings.extrapolate)
+    }
+
+    /// The settings this integrator was built from.
+    pub fn settings(&self) -> &IntegrationSettings {
+        &self.settings
+    }
+
+    /// The reference grid (nm) the spectrum is resampled onto.
+    pub fn grid_nm(&self) -> &[f64] {
+        &self.grid_nm
+    }
+
+    /// The grid's per-channel weights (each channel sums to 1).
+    pub fn weights(&self) -> &[[f64; 3]] {
+        &self.weights
+    }
+
+    fn description(&self) -> String {
+        let (first, last) = (
+            self.grid_nm.first().copied().unwrap_or(0.0),
+            self.grid_nm.last().copied().unwrap_or(0.0),
+        );
+        let step = self.grid_nm.get(1).map(|s| s - first).unwrap_or(0.0);
+        format!("{} on {first}–{last} nm at {step} nm", self.label)
+    }
+}
+
+/// Illuminant relative SPD on `grid` (colour's linear interpolation of the 5 nm tables; E = 100).
+fn illuminant_on(grid: &[f64], illuminant: Illuminant) -> Result<Vec<f64>, SpectralError> {
+    let t = tables()?;
+    Ok(match illuminant {
+        Illuminant::D65 => grid.iter().map(|&w| t.d65.linear(0, w)).collect(),
+        Illuminant::A => grid.iter().map(|&w| t.a.linear(0, w)).collect(),
+        Illuminant::E => vec![100.0; grid.len()],
+    })
+}
+
+/// `S(λ)·x̄(λ), S(λ)·ȳ(λ), S(λ)·z̄(λ)` on `grid` (every grid point must be a table row).
+fn xyz_weights(cmfs: &Table, spd: Vec<f64>, grid: &[f64]) -> Result<Vec<[f64; 3]>, SpectralError> {
+    grid.iter()
+        .zip(spd)
+        .map(|(&w, s)| {
+            let j = cmfs
+                .index_of(w)
+                .ok_or_else(|| SpectralError::EmbeddedTable {
+                    table: "CIE CMFs",
+                    message: format!("no row at {w} nm"),
+                })?;
+            Ok([0, 1, 2].map(|c| s * cmfs.columns[c][j]))
+        })
+        .collect()
+}
+
+/// Normalised `D65(λ)·V(λ)` weights of the luminous value on the chosen grid.
+fn luminous_weights(grid: LuminousGrid) -> Result<(Vec<f64>, Vec<f64>), SpectralError> {
+    let t = tables()?;
+    let step = match grid {
+        LuminousGrid::Iso9050 => 10,
+        LuminousGrid::OneNm => 1,
+    };
+    let grid: Vec<f64> = (380..=780).step_by(step).map(f64::from).collect();
+    let xyz = xyz_weights(&t.cie_1931, illuminant_on(&grid, Illuminant::D65)?, &grid)?;
+    let total: f64 = xyz.iter().map(|w| w[1]).sum();
+    Ok((grid, xyz.iter().map(|w| w[1] / total).collect()))
+}
+
+/// XYZ → linear RGB matrix of a working space, as colour-science 0.4.7 holds it.
+pub fn xyz_to_rgb(space: RgbSpace) -> Matrix3<f64> {
+    match space {
+        // colour uses the IEC 61966-2-1 published (rounded) matrix for sRGB.
+        RgbSpace::Srgb => Matrix3::new(
+            3.2406, -1.5372, -0.4986, -0.9689, 1.8758, 0.0415, 0.0557, -0.2040, 1.0570,
+        ),
+        RgbSpace::AcesCg => invert(normalised_primary_matrix(
+            [0.713, 0.293, 0.165, 0.830, 0.128, 0.044],
+            [0.32168, 0.33767],
+        )),
+        RgbSpace::DisplayP3 => invert(normalised_primary_matrix(
+            [0.680, 0.320, 0.265, 0.690, 0.150, 0.060],
+            [0.3127, 0.3290],
+        )),
+    }
+}
+
+fn invert(m: Matrix3<f64>) -> Matrix3<f64> {
+    // The primaries are constants with a well-conditioned matrix; identity is unreachable.
+    m.try_inverse().unwrap_or_else(Matrix3::identity)
+}
+
+/// RGB → XYZ matrix from primaries' and white's chromaticities (colour's
+/// `normalised_primary_matrix`, SMPTE RP 177).
+fn normalised_primary_matrix(xy: [f64; 6], white: [f64; 2]) -> Matrix3<f64> {
+    let p = Matrix3::new(
+        xy[0],
+        xy[2],
+        xy[4],
+        xy[1],
+        xy[3],
+        xy[5],
+        1.0 - xy[0] - xy[1],
+        1.0 - xy[2] - xy[3],
+        1.0 - xy[4] - xy[5],
+    );
+    let w = Vector3::new(
+        white[0] / white[1],
+        1.0,
+        (1.0 - white[0] - white[1]) / white[1],
+    );
+    let c = invert(p) * w;
+    p * Matrix3::from_diagonal(&c)
+}
+
+/// Visible (luminous) transmittance or reflectance per ISO 9050 / EN 410: `Σ v·D65·V / Σ D65·V`
+/// over 380–780 nm at 10 nm. The spectrum must cover 380–780 nm.
+pub fn luminous_iso9050(wavelength_nm: &[f64], values: &[f64]) -> Result<f64, SpectralError> {
+    luminous(wavelength_nm, values, LuminousGrid::Iso9050, false)
+}
+
+/// Luminous value on either grid, optionally holding end values outside the data.
+pub fn luminous(
+    wavelength_nm: &[f64],
+    values: &[f64],
+    grid: LuminousGrid,
+    extrapolate: bool,
+) -> Result<f64, SpectralError> {
+    static ISO: OnceLock<Result<Integrator, String>> = OnceLock::new();
+    static ONE: OnceLock<Result<Integrator, String>> = OnceLock::new();
+    let cell = match grid {
+        LuminousGrid::Iso9050 => &ISO,
+        LuminousGrid::OneNm => &ONE,
+    };
+    let integrator = cell
+        .get_or_init(|| Integrator::luminous_on(grid).map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|message| SpectralError::EmbeddedTable {
+            table: "luminous weights",
+            message: message.clone(),
+        })?;
+    Ok(integrator.apply(wavelength_nm, values, extrapolate)?[1])
+}
+
+/// `Σ_i kernel[i] · values[i]` per channel.
+fn dot_kernel(kernel: &[[f64; 3]], values: &[f64]) -> [f64; 3] {
+    let mut acc = [0.0f64; 3];
+    for (k, v) in kernel.iter().zip(values) {
+        acc[0] += k[0] * v;
+        acc[1] += k[1] * v;
+        acc[2] += k[2] * v;
+    }
+    acc
+}
+
+static NEXT_INTEGRATOR_ID: AtomicU64 = AtomicU64::new(0);
+
+/// Kernels kept per thread (one per integrator × wavelength array in recent use).
+const KERNEL_CACHE_SLOTS: usize = 8;
+
+struct KernelEntry {
+    id: u64,
+    wavelength_nm: Vec<f64>,
+    /// Built on the second use of the wavelength array.
+    kernel: Option<Vec<[f64; 3]>>,
+}
+
+#[derive(Default)]
+struct KernelCache {
+    entries: Vec<KernelEntry>,
+    next_slot: usize,
+}
+
+thread_local! {
+    static KERNELS: RefCell<KernelCache> = RefCell::new(KernelCache::default());
+}
+
+macro_rules! names {
+    ($ty:ty { $($variant:ident => $name:literal),+ $(,)? }) => {
+        impl $ty {
+            /// The name used on the command line and in JSON.
+            pub fn name(self) -> &'static str {
+                match self { $(<$ty>::$variant => $name),+ }
+            }
+            /// Every value, for help texts.
+            pub const ALL: &'static [$ty] = &[$(<$ty>::$variant),+];
+        }
+        impl fmt::Display for $ty {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+        impl FromStr for $ty {
+            type Err = String;
+            fn from_str(s: &str) -> Result<Self, String> {
+                $(if s.eq_ignore_ascii_case($name) { return Ok(<$ty>::$variant); })+
+                Err(format!("unknown value `{s}`; expected one of: {}", [$($name),+].join(", ")))
+            }
+        }
+    };
+}
+
+names!(RgbCmf { WrightGuild1931 => "wright-guild-1931", StilesBurch1955 => "stiles-burch-1955", StilesBurch1959 => "stiles-burch-1959" });
+names!(Observer { Cie1931 => "cie1931", Cie1964 => "cie1964" });
+names!(Illuminant { D65 => "D65", A => "A", E => "E" });
+names!(RgbSpace { Srgb => "srgb", AcesCg => "acescg", DisplayP3 => "display-p3" });
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn flat(v: f64) -> (Vec<f64>, Vec<f64>) {
+        let wl: Vec<f64> = (0..=53).map(|i| 300.0 + 10.0 * i as f64).collect();
+        (wl.clone(), vec![v; wl.len()])
+    }
+
+    #[test]
+    fn a_flat_spectrum_gives_its_value_in_every_method() {
+        let (wl, v) = flat(0.37);
+        let mut methods: Vec<Method> = RgbCmf::ALL.iter().map(|&c| Method::Paper(c)).collect();
+        for &observer in Observer::ALL {
+            for &illuminant in Illuminant::ALL {
+                for &space in RgbSpace::ALL {
+                    methods.push(Method::Colorimetric {
+                        observer,
+                        illuminant,
+                        space,
+                    });
+                }
+            }
+        }
+        methods.push(Method::Luminous);
+        for method in methods {
+            let it = Integrator::new(&IntegrationSettings {
+                method,
+                extrapolate: false,
+            })
+            .unwrap();
+            let rgb = it.channels(&wl, &v).unwrap();
+            for c in rgb {
+                assert!((c - 0.37).abs() < 1e-13, "{method:?}: {rgb:?}");
+            }
+        }
+        assert!((luminous_iso9050(&wl, &v).unwrap() - 0.37).abs() < 1e-13);
+        assert!((luminous(&wl, &v, LuminousGrid::OneNm, false).unwrap() - 0.37).abs() < 1e-13);
+    }
+
+    #[test]
+    fn srgb_of_d65_white_is_neutral_and_acescg_matrix_matches_the_aces_spec() {
+        // The sRGB matrix maps D65 (0.3127, 0.3290) to nearly equal RGB.
+        let m = xyz_to_rgb(RgbSpace::Srgb);
+        let w = m * Vector3::new(0.3127 / 0.3290, 1.0, (1.0 - 0.3127 - 0.3290) / 0.3290);
+        assert!(
+            (w[0] - 1.0).abs() < 1e-3 && (w[1] - 1.0).abs() < 1e-3 && (w[2] - 1.0).abs() < 1e-3
+        );
+        // ACEScg XYZ→AP1 from the ACES TB-2014-004 (S-2014-004) specification, 10 decimals.
+        let aces = xyz_to_rgb(RgbSpace::AcesCg);
+        let spec = Matrix3::new(
+            1.6410233797,
+            -0.3248032942,
+            -0.2364246952,
+            -0.6636628587,
+            1.6153315917,
+            0.0167563477,
+            0.0117218943,
+            -0.0082844420,
+            0.9883948585,
+        );
+        assert!((aces - spec).abs().max() < 1e-9);
+    }
+
+    #[test]
+    fn direct_kernel_build_and_cached_kernel_paths_agree() {
+        // First call: direct spline; second: builds the kernel; third: cached kernel.
+        let mut wl: Vec<f64> = (0..40).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
+        wl.extend((0..60).map(|i| 500.0 + 7.0 * f64::from(i)));
+        let v: Vec<f64> = wl.iter().map(|w| 0.5 + 0.4 * (w / 29.0).sin()).collect();
+        let it = Integrator::new(&IntegrationSettings::default()).unwrap();
+        let a = it.channels(&wl, &v).unwrap();
+        let b = it.channels(&wl, &v).unwrap();
+        let c = it.channels(&wl, &v).unwrap();
+        for k in 0..3 {
+            assert!(
+                (a[k] - b[k]).abs() < 1e-13 && (b[k] - c[k]).abs() < 1e-15,
+                "{a:?} {b:?} {c:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn names_round_trip() {
+        for &c in RgbCmf::ALL {
+            assert_eq!(c.name().parse::<RgbCmf>().unwrap(), c);
+            assert_eq!(
+                serde_json::to_string(&c).unwrap(),
+                format!("\"{}\"", c.name())
+            );
+        }
+        for &s in RgbSpace::ALL {
+            assert_eq!(
+                serde_json::to_string(&s).unwrap(),
+                format!("\"{}\"", s.name())
+            );
+        }
+        for &o in Observer::ALL {
+            assert_eq!(
+                serde_json::to_string(&o).unwrap(),
+                format!("\"{}\"", o.name())
+            );
+        }
+        for &i in Illuminant::ALL {
+            assert_eq!(
+                serde_json::to_string(&i).unwrap(),
+                format!("\"{}\"", i.name())
+            );
+        }
+        assert!("bogus".parse::<RgbSpace>().is_err());
+    }
+}
