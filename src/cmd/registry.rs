@@ -1,10 +1,271 @@
-//! `glassdb registry`: under construction (owned by the registry work item).
+//! `glassdb registry build|show|check`: the id-indexed glass table of a scene
+//! (`docs/registry.md`). All logic lives in `glassdb_registry`; this module parses arguments
+//! and formats output.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct Args {}
+use anyhow::Context;
+use glassdb_registry::{Application, BuildOptions, GlassRecord, Registry, Side};
+use glassdb_spectral::{Illuminant, IntegrationSettings, Method, Observer, RgbCmf, RgbSpace};
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`registry` is not built yet")
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, clap::Subcommand)]
+pub enum Command {
+    /// Build a registry JSON from a catalog (catalog.toml), optionally only for the ids that
+    /// the given masks use.
+    Build(BuildArgs),
+    /// Print a readable table of a registry (id, name, r0, t0, τv, ρv, fit, r/t at 0/45/60/75°).
+    Show(ShowArgs),
+    /// Validate a registry; non-zero exit on any failure.
+    Check(CheckArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct BuildArgs {
+    /// The catalog (`[[glass]]` tables; paths in it are relative to it).
+    pub catalog: PathBuf,
+    /// Output registry JSON (written atomically).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Masks of the scene: only the ids they use are built. Repeatable.
+    #[arg(long = "mask", value_name = "MASK")]
+    pub masks: Vec<PathBuf>,
+    /// Spectral method: colorimetric (default), paper or luminous.
+    #[arg(long, default_value = "colorimetric")]
+    pub method: String,
+    /// RGB colour-matching functions for --method paper.
+    #[arg(long, default_value = "wright-guild-1931")]
+    pub cmf: String,
+    /// Observer for --method colorimetric: cie1931 or cie1964.
+    #[arg(long, default_value = "cie1931")]
+    pub observer: String,
+    /// Illuminant for --method colorimetric: D65, A or E.
+    #[arg(long, default_value = "D65")]
+    pub illuminant: String,
+    /// RGB working space for --method colorimetric: srgb, acescg or display-p3.
+    #[arg(long, default_value = "srgb")]
+    pub space: String,
+    /// Hold end values where a spectrum does not cover the method's range (else an error).
+    #[arg(long)]
+    pub extrapolate: bool,
+    /// Fit tolerance on r and t (absolute).
+    #[arg(long, default_value_t = glassdb_fit::DEFAULT_TOL)]
+    pub tol: f64,
+    /// Highest polynomial degree of the angle curves.
+    #[arg(long, default_value_t = 12)]
+    pub max_degree: u32,
+    /// Apply the physical angle model per channel instead of per wavelength (for comparison).
+    #[arg(long)]
+    pub per_channel: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct ShowArgs {
+    /// Registry JSON.
+    pub registry: PathBuf,
+    /// Show back-side reflectance instead of the front.
+    #[arg(long)]
+    pub back: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct CheckArgs {
+    /// Registry JSON files.
+    #[arg(required = true)]
+    pub registries: Vec<PathBuf>,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    match args.command {
+        Command::Build(a) => build(a),
+        Command::Show(a) => show(a),
+        Command::Check(a) => check(a),
+    }
+}
+
+fn parse<T: std::str::FromStr<Err = String>>(value: &str, flag: &str) -> anyhow::Result<T> {
+    value
+        .parse::<T>()
+        .map_err(|e| anyhow::anyhow!("--{flag}: {e}"))
+}
+
+fn settings(a: &BuildArgs) -> anyhow::Result<IntegrationSettings> {
+    let method = match a.method.to_ascii_lowercase().as_str() {
+        "colorimetric" => Method::Colorimetric {
+            observer: parse::<Observer>(&a.observer, "observer")?,
+            illuminant: parse::<Illuminant>(&a.illuminant, "illuminant")?,
+            space: parse::<RgbSpace>(&a.space, "space")?,
+        },
+        "paper" => Method::Paper(parse::<RgbCmf>(&a.cmf, "cmf")?),
+        "luminous" => Method::Luminous,
+        other => anyhow::bail!(
+            "--method: unknown value `{other}`; expected one of: colorimetric, paper, luminous"
+        ),
+    };
+    Ok(IntegrationSettings {
+        method,
+        extrapolate: a.extrapolate,
+    })
+}
+
+fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
+    if !(a.tol.is_finite() && a.tol > 0.0) {
+        anyhow::bail!("--tol must be a positive number, got {}", a.tol);
+    }
+    if a.max_degree == 0 || a.max_degree > 20 {
+        anyhow::bail!("--max-degree must be 1–20, got {}", a.max_degree);
+    }
+    let mut inputs: Vec<&std::path::Path> = vec![a.catalog.as_path()];
+    inputs.extend(a.masks.iter().map(|m| m.as_path()));
+    glassdb_io::refuse_input_as_output(&a.output, inputs)?;
+    let opts = BuildOptions {
+        spectral: settings(&a)?,
+        masks: a.masks.clone(),
+        fit_tol: a.tol,
+        max_degree: a.max_degree,
+        application: if a.per_channel {
+            Application::PerChannel
+        } else {
+            Application::PerWavelength
+        },
+        ..BuildOptions::default()
+    };
+    let registry = glassdb_registry::build_registry(&a.catalog, &opts)?;
+    registry.write_json(&a.output)?;
+    let ids: Vec<String> = registry.glasses.iter().map(|g| g.id.to_string()).collect();
+    eprintln!(
+        "wrote {} ({} glass{}: id {})",
+        a.output.display(),
+        registry.glasses.len(),
+        if registry.glasses.len() == 1 {
+            ""
+        } else {
+            "es"
+        },
+        if ids.is_empty() {
+            "none".to_string()
+        } else {
+            ids.join(", ")
+        }
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn rgb(v: &[f64; 3]) -> String {
+    format!("{:.4} {:.4} {:.4}", v[0], v[1], v[2])
+}
+
+fn show(a: ShowArgs) -> anyhow::Result<ExitCode> {
+    let registry = Registry::from_json_file(&a.registry)?;
+    let side = if a.back { Side::Back } else { Side::Front };
+    let s = &registry.spectral;
+    let mut method = s.method.clone();
+    for part in [&s.cmf, &s.observer, &s.illuminant, &s.space]
+        .into_iter()
+        .flatten()
+    {
+        method.push_str(&format!(" {part}"));
+    }
+    println!(
+        "{}: schema {}, spectral method {method}, {} glasses",
+        a.registry.display(),
+        registry.schema,
+        registry.glasses.len()
+    );
+    if a.back {
+        println!("reflectance: back side (r0_back, c_r_back)");
+    }
+    println!();
+    for g in &registry.glasses {
+        print_glass(g, side);
+        println!();
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_glass(g: &GlassRecord, side: Side) {
+    let (r0, c_r) = match side {
+        Side::Front => (&g.r0, &g.c_r),
+        Side::Back => (&g.r0_back, &g.c_r_back),
+    };
+    println!("id {:>5}  {}", g.id, g.name);
+    let lum = match &g.luminous {
+        Some(l) => format!(
+            "τv {:.4}  ρv {:.4}  ρv back {:.4}",
+            l.transmittance, l.reflectance, l.reflectance_back
+        ),
+        None => "τv –  ρv – (no spectrum)".to_string(),
+    };
+    println!("  r0 (R G B) {}   t0 {}   {lum}", rgb(r0), rgb(&g.t0));
+    let m = &g.angle_model;
+    let mut model = format!("{} ({})", m.kind, m.applied);
+    if let Some(max) = m.measured_max_angle_deg {
+        model.push_str(&format!(", measured to {max}°"));
+    }
+    if let Some(c) = &m.continued_by {
+        model.push_str(&format!(", continued by {c}"));
+    }
+    if !m.chosen_by.is_empty() {
+        model.push_str(&format!("; chosen by {}", m.chosen_by));
+    }
+    println!("  angle model: {model}");
+    let fit_line = |label: &str, curves: &[glassdb_registry::CurveRecord; 3]| {
+        let parts: Vec<String> = curves
+            .iter()
+            .map(|c| {
+                format!(
+                    "deg {} max err {:.1e} at {:.0}°",
+                    c.degree, c.max_abs_error, c.max_error_angle_deg
+                )
+            })
+            .collect();
+        println!("  {label}: {}", parts.join(" | "));
+    };
+    fit_line(
+        if side == Side::Back {
+            "C_r_back"
+        } else {
+            "C_r"
+        },
+        c_r,
+    );
+    fit_line("C_t", &g.c_t);
+    println!("  {:>6}  {:>22}  {:>22}", "angle", "r (R G B)", "t (R G B)");
+    for deg in [0.0f64, 45.0, 60.0, 75.0] {
+        let (r, t) = g.eval(side, deg.to_radians().cos());
+        println!("  {:>5}°  {:>22}  {:>22}", deg, rgb(&r), rgb(&t));
+    }
+}
+
+fn check(a: CheckArgs) -> anyhow::Result<ExitCode> {
+    let mut failed = 0usize;
+    for path in &a.registries {
+        match Registry::from_json_file(path) {
+            Ok(r) => println!(
+                "{}: ok (schema {}, {} glasses)",
+                path.display(),
+                r.schema,
+                r.glasses.len()
+            ),
+            Err(e) => {
+                eprintln!("FAILED: {}", glassdb_io::ErrorChain(&e));
+                failed += 1;
+            }
+        }
+    }
+    if failed > 0 {
+        let n = a.registries.len();
+        return Err(anyhow::anyhow!(
+            "{failed} of {n} registr{} failed validation",
+            if n == 1 { "y" } else { "ies" }
+        ))
+        .context("registry check");
+    }
+    Ok(ExitCode::SUCCESS)
 }

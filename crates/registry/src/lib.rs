@@ -1,14 +1,23 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! The id-indexed glass table a glazed scene uses (method.md, "Mask" and "Angle dependence";
+//! the paper's section 5.2 and eqs. 11–14): per glass, per channel R, G, B, the normal-incidence
+//! reflectance and transmittance `r0`, `t0`, `r0_back` and the angle curves `C_r`, `C_t`,
+//! `C_r_back`, built from a catalog of real products (`catalog.toml`) and stored as a versioned
+//! JSON file (`docs/registry.md`).
+//!
+//! - [`Registry`]: the JSON schema, loading with validation, and atomic writing.
+//! - [`GlassRecord::tables_256`] / [`GlassRecord::eval`]: what the compositor looks up.
+//! - [`build_registry`] / [`default_registry`]: catalog → registry.
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+mod build;
+mod bundled;
+pub mod catalog;
+mod error;
+pub mod physics;
+mod record;
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
-}
+pub use build::{Application, BuildOptions, build_registry, curve_record, default_registry};
+pub use error::RegistryError;
+pub use record::{
+    AngleModelRecord, CHANNELS, ChannelTables, CurveRecord, FileRef, GlassRecord, LuminousRecord,
+    ProductRecord, Provenance, Registry, SCHEMA_VERSION, Side, SpectralMethodRecord,
+};

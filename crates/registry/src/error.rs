@@ -1,0 +1,176 @@
+//! The one error type of this crate: one variant per failure a user can act on, each naming the
+//! file, glass (id and name), side, channel and angle involved.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong loading, validating, building or writing a registry.
+#[derive(Debug, thiserror::Error)]
+pub enum RegistryError {
+    /// A registry or catalog file could not be read.
+    #[error("cannot read {path}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+
+    /// The registry JSON is malformed or does not follow the schema (serde names line and column).
+    #[error("{source_name}: not a valid glassdb registry")]
+    Json {
+        source_name: String,
+        source: serde_json::Error,
+    },
+
+    /// The registry was written by a different, incompatible schema version.
+    #[error(
+        "{source_name}: registry schema {found} is not supported (this build reads schema {expected})"
+    )]
+    SchemaVersion {
+        source_name: String,
+        found: u32,
+        expected: u32,
+    },
+
+    /// Id 0 is reserved for "no glass" in every mask.
+    #[error(
+        "{source_name}: glass \"{name}\" has id 0, which masks reserve for \"no glass\" (use 1–65535)"
+    )]
+    IdZero { source_name: String, name: String },
+
+    /// Two glasses share one id.
+    #[error("{source_name}: id {id} is used twice: by \"{first}\" and by \"{second}\"")]
+    DuplicateId {
+        source_name: String,
+        id: u16,
+        first: String,
+        second: String,
+    },
+
+    /// A number in a glass record is NaN or infinite.
+    #[error("{source_name}: glass {glass}: {field} is not a finite number")]
+    NonFinite {
+        source_name: String,
+        glass: String,
+        field: String,
+    },
+
+    /// A normal-incidence value is outside [0, 1] or r0 + t0 > 1.
+    #[error("{source_name}: glass {glass}: {what}")]
+    NormalValue {
+        source_name: String,
+        glass: String,
+        what: String,
+    },
+
+    /// A curve object is malformed (no terms, powers and coefficients of different lengths, …).
+    #[error("{source_name}: glass {glass}: curve {field}: {reason}")]
+    CurveShape {
+        source_name: String,
+        glass: String,
+        field: String,
+        reason: String,
+    },
+
+    /// The curves give an unphysical value at some angle (outside [0, 1] or r + t > 1) by more
+    /// than the fit tolerance recorded for the curve.
+    #[error(
+        "{source_name}: glass {glass}: {side} side, channel {channel}, at {angle_deg}°: {what} (allowed tolerance {tolerance:.2e})"
+    )]
+    Unphysical {
+        source_name: String,
+        glass: String,
+        side: &'static str,
+        channel: &'static str,
+        angle_deg: f64,
+        what: String,
+        tolerance: f64,
+    },
+
+    /// The registry could not be written (atomic write: the old file, if any, is untouched).
+    #[error(transparent)]
+    Write(#[from] glassdb_io::OutputError),
+
+    /// Serialising the registry failed (should not happen with finite numbers).
+    #[error("cannot serialise the registry: {0}")]
+    Serialize(serde_json::Error),
+
+    /// The catalog TOML is malformed, has an unknown key or a value of the wrong type
+    /// (the message names the key, line and column).
+    #[error("{path}: {message}")]
+    CatalogSyntax { path: PathBuf, message: String },
+
+    /// A catalog entry is well formed TOML but says something impossible or incomplete.
+    #[error("{path}: glass {glass}: {message}")]
+    CatalogEntry {
+        path: PathBuf,
+        glass: String,
+        message: String,
+    },
+
+    /// A spectral file named by the catalog could not be read or integrated.
+    #[error("glass {glass}: spectral file {path}: {message}")]
+    Spectral {
+        glass: String,
+        path: PathBuf,
+        message: String,
+    },
+
+    /// Integration of the per-wavelength angle model failed (e.g. partial wavelength coverage).
+    #[error("glass {glass}: spectral integration: {message}")]
+    Integration { glass: String, message: String },
+
+    /// A measured angle table named by the catalog could not be read or does not fit this glass.
+    #[error("glass {glass}: angle table {path}: {message}")]
+    AngleTable {
+        glass: String,
+        path: PathBuf,
+        message: String,
+    },
+
+    /// Fitting the angle curves failed.
+    #[error("glass {glass}: fitting {curve}: {message}")]
+    Fit {
+        glass: String,
+        curve: String,
+        message: String,
+    },
+
+    /// A mask given with `--mask` could not be read.
+    #[error("mask {path}: {message}")]
+    Mask { path: PathBuf, message: String },
+
+    /// Masks use ids that the catalog does not define.
+    #[error("{}", missing_ids_message(catalog, ids))]
+    IdsNotInCatalog {
+        catalog: PathBuf,
+        ids: Vec<(u16, u64)>,
+    },
+
+    /// An 8-bit mask (ids stored in one byte) cannot address a glass with id > 255.
+    #[error(
+        "{path}: glass \"{name}\" has id {id}, but the 8-bit mask {mask} can only hold ids 1–255 (use a 16-bit mask)"
+    )]
+    IdTooLargeForMask {
+        path: PathBuf,
+        name: String,
+        id: u16,
+        mask: PathBuf,
+    },
+
+    /// The compiled-in default catalog failed to build (a bug in the bundled data).
+    #[error("bundled default catalog: {0}")]
+    Bundled(String),
+}
+
+fn missing_ids_message(catalog: &std::path::Path, ids: &[(u16, u64)]) -> String {
+    let list: Vec<String> = ids
+        .iter()
+        .map(|(id, n)| format!("id {id} ({n} pixels)"))
+        .collect();
+    format!(
+        "the masks use {} id{} that {} does not define: {}",
+        ids.len(),
+        if ids.len() == 1 { "" } else { "s" },
+        catalog.display(),
+        list.join(", ")
+    )
+}

@@ -1,0 +1,685 @@
+//! The registry JSON (schema 1): types, loading, validation, and the evaluation the compositor
+//! uses (method.md eqs. 11–14: `r(θ) = r0·C_r(θ)`, `t(θ) = t0·C_t(θ)`, per channel).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::RegistryError;
+
+/// The registry schema version this crate reads and writes.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// Channel names, in the order of every `[_; 3]` array in the registry.
+pub const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+/// Angle step of the validation grid (degrees): 0, 0.25, …, 90.
+const VALIDATION_STEP_DEG: f64 = 0.25;
+
+/// Slack added to every recorded tolerance so that rounding in the JSON round trip never flips
+/// a check.
+const VALIDATION_EPS: f64 = 1e-9;
+
+/// The id-indexed table of glasses a scene uses.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Registry {
+    /// Schema version ([`SCHEMA_VERSION`]).
+    pub schema: u32,
+    /// The spectral method that turned spectra into per-channel values (one for the whole build).
+    pub spectral: SpectralMethodRecord,
+    /// The glasses, sorted by id.
+    pub glasses: Vec<GlassRecord>,
+}
+
+/// How spectra were reduced to channels (keys as in `glassdb spectral --json`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SpectralMethodRecord {
+    /// `colorimetric`, `paper` or `luminous`.
+    pub method: String,
+    /// RGB colour-matching functions (method `paper` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cmf: Option<String>,
+    /// CIE standard observer (method `colorimetric`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub observer: Option<String>,
+    /// Illuminant (method `colorimetric`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub illuminant: Option<String>,
+    /// RGB working space (method `colorimetric`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub space: Option<String>,
+    /// Whether spectra not covering the method's range were extrapolated (end values held).
+    #[serde(default)]
+    pub extrapolate: bool,
+}
+
+/// One glass product: normal-incidence values per channel and its angle curves.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GlassRecord {
+    /// Registration id as stored in masks (1–65535; 0 means "no glass").
+    pub id: u16,
+    /// Product name.
+    pub name: String,
+    /// Front (viewer-side) reflectance at normal incidence, per channel R, G, B.
+    pub r0: [f64; 3],
+    /// Transmittance at normal incidence, per channel (the same from both sides).
+    pub t0: [f64; 3],
+    /// Back reflectance at normal incidence, per channel (coated glass differs from the front).
+    pub r0_back: [f64; 3],
+    /// Front reflectance curves C_r per channel: `r(θ) = r0·C_r(cos θ)`.
+    pub c_r: [CurveRecord; 3],
+    /// Transmittance curves C_t per channel: `t(θ) = t0·C_t(cos θ)`.
+    pub c_t: [CurveRecord; 3],
+    /// Back reflectance curves per channel: `r_back(θ) = r0_back·C_r_back(cos θ)`.
+    pub c_r_back: [CurveRecord; 3],
+    /// Luminous (ISO 9050: D65 × V(λ)) values at normal incidence, when a spectrum was given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub luminous: Option<LuminousRecord>,
+    /// Where the angle dependence came from.
+    pub angle_model: AngleModelRecord,
+    /// Input files and their sha256, and the product as the data file describes it.
+    pub provenance: Provenance,
+}
+
+/// One angle curve `C(cos θ) = Σ_k coefficients[k]·cos^powers[k] θ` with its fit diagnostics
+/// (keys as in `glassdb fit`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CurveRecord {
+    /// `paper` (powers 1…n) or `full` (powers 0…n).
+    pub basis: String,
+    /// Exponents of cos θ.
+    pub powers: Vec<u32>,
+    /// Coefficients, one per power.
+    pub coefficients: Vec<f64>,
+    /// Polynomial degree (largest power).
+    pub degree: u32,
+    /// RMS of the absolute residual in r (or t) over the fitted samples.
+    pub rms_error: f64,
+    /// Largest absolute residual in r (or t) over the fitted samples.
+    pub max_abs_error: f64,
+    /// Angle (degrees) of the largest residual.
+    pub max_error_angle_deg: f64,
+    /// Condition number of the least-squares system solved.
+    pub condition_number: f64,
+    /// Absolute tolerance on r (or t) that validation allows beyond the physical range
+    /// (at least the fit's own max residual).
+    pub tolerance: f64,
+}
+
+/// Luminous values at normal incidence (ISO 9050 / EN 410, D65 × V(λ), 380–780 nm / 10 nm).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LuminousRecord {
+    /// τv.
+    pub transmittance: f64,
+    /// ρv, front.
+    pub reflectance: f64,
+    /// ρv, back.
+    pub reflectance_back: f64,
+}
+
+/// The physical or measured model behind the curves.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AngleModelRecord {
+    /// `measured`, `uncoated`, `coated` (clear/bronze chosen per wavelength), `coated-clear`,
+    /// `coated-bronze` or `opaque`.
+    pub kind: String,
+    /// `per-wavelength` (model applied to the spectrum before integration) or `per-channel`.
+    pub applied: String,
+    /// Complex refractive index `[n, k]` used by the `opaque` model, when given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ior: Option<[f64; 2]>,
+    /// For measured tables: the largest measured angle; beyond it the physical model continues.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured_max_angle_deg: Option<f64>,
+    /// The physical model that continues a measured table (or `null`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub continued_by: Option<String>,
+    /// Why this model: the catalog's `model` key, the file's product type, or Rf vs Rb.
+    #[serde(default)]
+    pub chosen_by: String,
+}
+
+/// Input files and the product description.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Provenance {
+    /// The catalog the glass came from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub catalog: Option<FileRef>,
+    /// The spectral data file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spectral: Option<FileRef>,
+    /// The measured angle table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angles: Option<FileRef>,
+    /// The product as the spectral file names it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub product: Option<ProductRecord>,
+}
+
+/// A file and the sha256 of its bytes (hex).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileRef {
+    pub path: String,
+    pub sha256: String,
+}
+
+/// The product as its data file describes it.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ProductRecord {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub manufacturer: Option<String>,
+    /// `Monolithic`, `Coated`, `coated-glass`, `laminate`, … as in the file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub product_type: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coated_side: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness_mm: Option<f64>,
+}
+
+/// Which face of the glass the viewer sees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// The front face (the catalog's Rf; the viewer's side in the scene).
+    Front,
+    /// The back face (Rb).
+    Back,
+}
+
+impl Side {
+    fn label(self) -> &'static str {
+        match self {
+            Side::Front => "front",
+            Side::Back => "back",
+        }
+    }
+}
+
+/// r and t of one channel at cos θ = i/255, i = 0…255, clamped to the physical range.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelTables {
+    pub r: [f32; 256],
+    pub t: [f32; 256],
+}
+
+impl CurveRecord {
+    /// `C(cos θ)`, unclamped.
+    #[inline]
+    pub fn eval(&self, cos_theta: f64) -> f64 {
+        self.powers
+            .iter()
+            .zip(&self.coefficients)
+            .map(|(&p, &c)| c * cos_theta.powi(p.min(i32::MAX as u32) as i32))
+            .sum()
+    }
+
+    /// A curve equal to `cos θ` (used where t0 = 0, so C_t never matters): C(0°) = 1, C(90°) = 0.
+    pub fn nominal_transmittance() -> CurveRecord {
+        CurveRecord {
+            basis: "paper".into(),
+            powers: vec![1],
+            coefficients: vec![1.0],
+            degree: 1,
+            rms_error: 0.0,
+            max_abs_error: 0.0,
+            max_error_angle_deg: 0.0,
+            condition_number: 1.0,
+            tolerance: 0.0,
+        }
+    }
+}
+
+/// Clamps a pair to the physical range: `0 ≤ r ≤ 1`, then `0 ≤ t ≤ 1 − r` (reflectance is the
+/// better-determined quantity near grazing, where both curves are steep).
+#[inline]
+fn clamp_physical(r: f64, t: f64) -> (f64, f64) {
+    let r = if r.is_finite() {
+        r.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0 - r)
+    } else {
+        0.0
+    };
+    (r, t)
+}
+
+impl GlassRecord {
+    /// "id 3 (\"Clear 6 mm\")", for messages.
+    pub fn label(&self) -> String {
+        format!("id {} (\"{}\")", self.id, self.name)
+    }
+
+    fn r_parts(&self, side: Side) -> (&[f64; 3], &[CurveRecord; 3]) {
+        match side {
+            Side::Front => (&self.r0, &self.c_r),
+            Side::Back => (&self.r0_back, &self.c_r_back),
+        }
+    }
+
+    /// Unclamped `(r, t)` per channel at `cos θ` (for validation and diagnostics).
+    pub fn eval_raw(&self, side: Side, cos_theta: f64) -> ([f64; 3], [f64; 3]) {
+        let (r0, c_r) = self.r_parts(side);
+        let r = std::array::from_fn(|c| r0[c] * c_r[c].eval(cos_theta));
+        let t = std::array::from_fn(|c| self.t0[c] * self.c_t[c].eval(cos_theta));
+        (r, t)
+    }
+
+    /// `(r, t)` per channel at `cos θ` (clamped to [0, 1]), clamped to the physical range
+    /// `0 ≤ r ≤ 1`, `0 ≤ t ≤ 1 − r`. Transmittance is the same from both sides.
+    pub fn eval(&self, side: Side, cos_theta: f64) -> ([f64; 3], [f64; 3]) {
+        let cos_theta = if cos_theta.is_finite() {
+            cos_theta.clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let (r, t) = self.eval_raw(side, cos_theta);
+        let mut out_r = [0.0; 3];
+        let mut out_t = [0.0; 3];
+        for c in 0..3 {
+            (out_r[c], out_t[c]) = clamp_physical(r[c], t[c]);
+        }
+        (out_r, out_t)
+    }
+
+    /// Per channel, r and t at cos θ = i/255 for i = 0…255: exact lookups for 8-bit masks.
+    pub fn tables_256(&self, side: Side) -> [ChannelTables; 3] {
+        let mut tables: [ChannelTables; 3] = std::array::from_fn(|_| ChannelTables {
+            r: [0.0; 256],
+            t: [0.0; 256],
+        });
+        for i in 0..256usize {
+            let (r, t) = self.eval(side, i as f64 / 255.0);
+            for c in 0..3 {
+                tables[c].r[i] = r[c] as f32;
+                tables[c].t[i] = t[c] as f32;
+            }
+        }
+        tables
+    }
+}
+
+impl Registry {
+    /// Reads and validates a registry JSON file.
+    pub fn from_json_file(path: &Path) -> Result<Registry, RegistryError> {
+        let text = std::fs::read_to_string(path).map_err(|source| RegistryError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Registry::from_json_str(&text, &path.display().to_string())
+    }
+
+    /// Parses and validates a registry JSON text; `source_name` names it in errors.
+    pub fn from_json_str(json: &str, source_name: &str) -> Result<Registry, RegistryError> {
+        // Check the version first, so an old or future file gets a version message rather than
+        // a missing-key one.
+        #[derive(Deserialize)]
+        struct VersionOnly {
+            schema: u32,
+        }
+        let version: VersionOnly =
+            serde_json::from_str(json).map_err(|source| RegistryError::Json {
+                source_name: source_name.to_string(),
+                source,
+            })?;
+        if version.schema != SCHEMA_VERSION {
+            return Err(RegistryError::SchemaVersion {
+                source_name: source_name.to_string(),
+                found: version.schema,
+                expected: SCHEMA_VERSION,
+            });
+        }
+        let registry: Registry =
+            serde_json::from_str(json).map_err(|source| RegistryError::Json {
+                source_name: source_name.to_string(),
+                source,
+            })?;
+        registry.validate_named(source_name)?;
+        Ok(registry)
+    }
+
+    /// Validates: schema version, ids unique and non-zero, every number finite, normal values
+    /// in [0, 1] with r0 + t0 ≤ 1, well-formed curves, and on a dense 0–90° grid per side and
+    /// channel 0 ≤ r, t ≤ 1 and r + t ≤ 1, each within the tolerance recorded for the curve.
+    pub fn validate(&self) -> Result<(), RegistryError> {
+        self.validate_named("registry")
+    }
+
+    /// [`Registry::validate`] with a name for the messages.
+    pub fn validate_named(&self, source_name: &str) -> Result<(), RegistryError> {
+        if self.schema != SCHEMA_VERSION {
+            return Err(RegistryError::SchemaVersion {
+                source_name: source_name.to_string(),
+                found: self.schema,
+                expected: SCHEMA_VERSION,
+            });
+        }
+        let mut seen: BTreeMap<u16, &str> = BTreeMap::new();
+        for g in &self.glasses {
+            if g.id == 0 {
+                return Err(RegistryError::IdZero {
+                    source_name: source_name.to_string(),
+                    name: g.name.clone(),
+                });
+            }
+            if let Some(first) = seen.insert(g.id, &g.name) {
+                return Err(RegistryError::DuplicateId {
+                    source_name: source_name.to_string(),
+                    id: g.id,
+                    first: first.to_string(),
+                    second: g.name.clone(),
+                });
+            }
+            validate_glass(g, source_name)?;
+        }
+        Ok(())
+    }
+
+    /// The glass with this registration id.
+    pub fn glass(&self, id: u16) -> Option<&GlassRecord> {
+        self.glasses.iter().find(|g| g.id == id)
+    }
+
+    /// The registry as pretty JSON text.
+    pub fn to_json_string(&self) -> Result<String, RegistryError> {
+        let mut s = serde_json::to_string_pretty(self).map_err(RegistryError::Serialize)?;
+        s.push('\n');
+        Ok(s)
+    }
+
+    /// Validates, then writes the registry JSON atomically (temporary file + rename).
+    pub fn write_json(&self, path: &Path) -> Result<(), RegistryError> {
+        self.validate_named(&path.display().to_string())?;
+        let text = self.to_json_string()?;
+        glassdb_io::write_bytes_atomic(path, text.as_bytes())?;
+        Ok(())
+    }
+}
+
+fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryError> {
+    let glass = g.label();
+    let non_finite = |field: String| RegistryError::NonFinite {
+        source_name: source_name.to_string(),
+        glass: glass.clone(),
+        field,
+    };
+    for (field, values) in [("r0", &g.r0), ("t0", &g.t0), ("r0_back", &g.r0_back)] {
+        for (c, v) in values.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(non_finite(format!("{field}[{c}] ({})", CHANNELS[c])));
+            }
+            if !(0.0..=1.0).contains(v) {
+                return Err(RegistryError::NormalValue {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    what: format!("{field} channel {} = {v} is outside [0, 1]", CHANNELS[c]),
+                });
+            }
+        }
+    }
+    if let Some(l) = &g.luminous {
+        for (field, v) in [
+            ("luminous.transmittance", l.transmittance),
+            ("luminous.reflectance", l.reflectance),
+            ("luminous.reflectance_back", l.reflectance_back),
+        ] {
+            if !v.is_finite() {
+                return Err(non_finite(field.to_string()));
+            }
+        }
+    }
+    for (field, curves) in [("c_r", &g.c_r), ("c_t", &g.c_t), ("c_r_back", &g.c_r_back)] {
+        for (c, curve) in curves.iter().enumerate() {
+            let name = format!("{field}[{c}] ({})", CHANNELS[c]);
+            let shape = |reason: String| RegistryError::CurveShape {
+                source_name: source_name.to_string(),
+                glass: glass.clone(),
+                field: name.clone(),
+                reason,
+            };
+            if curve.powers.is_empty() {
+                return Err(shape("no terms".into()));
+            }
+            if curve.powers.len() != curve.coefficients.len() {
+                return Err(shape(format!(
+                    "{} powers but {} coefficients",
+                    curve.powers.len(),
+                    curve.coefficients.len()
+                )));
+            }
+            if let Some(p) = curve.powers.iter().find(|&&p| p > 64) {
+                return Err(shape(format!("power {p} is beyond the supported 64")));
+            }
+            for (k, v) in curve.coefficients.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(non_finite(format!("{name}.coefficients[{k}]")));
+                }
+            }
+            for (key, v) in [
+                ("rms_error", curve.rms_error),
+                ("max_abs_error", curve.max_abs_error),
+                ("max_error_angle_deg", curve.max_error_angle_deg),
+                ("tolerance", curve.tolerance),
+            ] {
+                if !v.is_finite() {
+                    return Err(non_finite(format!("{name}.{key}")));
+                }
+            }
+            if curve.tolerance < 0.0 {
+                return Err(shape(format!("negative tolerance {}", curve.tolerance)));
+            }
+        }
+    }
+    let steps = (90.0 / VALIDATION_STEP_DEG).round() as usize;
+    for side in [Side::Front, Side::Back] {
+        let (_, c_r) = g.r_parts(side);
+        for i in 0..=steps {
+            let angle_deg = i as f64 * VALIDATION_STEP_DEG;
+            let cos = if i == steps {
+                0.0
+            } else {
+                angle_deg.to_radians().cos()
+            };
+            let (r, t) = g.eval_raw(side, cos);
+            for c in 0..3 {
+                let tol_r = c_r[c].tolerance + VALIDATION_EPS;
+                let tol_t = g.c_t[c].tolerance + VALIDATION_EPS;
+                let fail = |what: String, tolerance: f64| RegistryError::Unphysical {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    side: side.label(),
+                    channel: CHANNELS[c],
+                    angle_deg,
+                    what,
+                    tolerance,
+                };
+                if !r[c].is_finite() || !t[c].is_finite() {
+                    return Err(fail("r or t is not finite".into(), 0.0));
+                }
+                if r[c] < -tol_r || r[c] > 1.0 + tol_r {
+                    return Err(fail(format!("r = {:.6} is outside [0, 1]", r[c]), tol_r));
+                }
+                if t[c] < -tol_t || t[c] > 1.0 + tol_t {
+                    return Err(fail(format!("t = {:.6} is outside [0, 1]", t[c]), tol_t));
+                }
+                if r[c] + t[c] > 1.0 + tol_r + tol_t {
+                    return Err(fail(
+                        format!(
+                            "r + t = {:.6} + {:.6} = {:.6} > 1 (energy is not conserved)",
+                            r[c],
+                            t[c],
+                            r[c] + t[c]
+                        ),
+                        tol_r + tol_t,
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve(powers: Vec<u32>, coefficients: Vec<f64>) -> CurveRecord {
+        CurveRecord {
+            basis: "full".into(),
+            degree: *powers.iter().max().unwrap_or(&0),
+            powers,
+            coefficients,
+            rms_error: 0.0,
+            max_abs_error: 0.0,
+            max_error_angle_deg: 0.0,
+            condition_number: 1.0,
+            tolerance: 0.002,
+        }
+    }
+
+    /// r = 0.1·(1 + 9·(1 − cos θ)²)… a hand-made glass: C_r = 10 − 18c + 9c² reaches 1/r0 = 10
+    /// at 90°, C_t = c (paper basis), t0 = 0.8.
+    fn sample() -> Registry {
+        let cr = curve(vec![0, 1, 2], vec![10.0, -18.0, 9.0]);
+        let ct = curve(vec![1], vec![1.0]);
+        Registry {
+            schema: SCHEMA_VERSION,
+            spectral: SpectralMethodRecord {
+                method: "colorimetric".into(),
+                cmf: None,
+                observer: Some("cie1931".into()),
+                illuminant: Some("D65".into()),
+                space: Some("srgb".into()),
+                extrapolate: false,
+            },
+            glasses: vec![GlassRecord {
+                id: 4,
+                name: "hand-made".into(),
+                r0: [0.1; 3],
+                t0: [0.8, 0.7, 0.6],
+                r0_back: [0.05; 3],
+                c_r: [cr.clone(), cr.clone(), cr.clone()],
+                c_t: [ct.clone(), ct.clone(), ct],
+                c_r_back: [cr.clone(), cr.clone(), cr],
+                luminous: None,
+                angle_model: AngleModelRecord {
+                    kind: "uncoated".into(),
+                    applied: "per-channel".into(),
+                    ior: None,
+                    measured_max_angle_deg: None,
+                    continued_by: None,
+                    chosen_by: String::new(),
+                },
+                provenance: Provenance::default(),
+            }],
+        }
+    }
+
+    #[test]
+    fn eval_and_tables_agree_with_hand_values() {
+        let reg = sample();
+        reg.validate().unwrap();
+        let g = reg.glass(4).unwrap();
+        assert!(reg.glass(5).is_none());
+        // cos θ = 0.5: C_r = 10 − 9 + 2.25 = 3.25 → r = 0.325; t = 0.8·0.5 = 0.4.
+        let (r, t) = g.eval(Side::Front, 0.5);
+        assert!((r[0] - 0.325).abs() < 1e-15 && (t[0] - 0.4).abs() < 1e-15);
+        // Back: r0_back = 0.05 → 0.1625.
+        let (rb, _) = g.eval(Side::Back, 0.5);
+        assert!((rb[0] - 0.1625).abs() < 1e-15);
+        // Tables at i/255 equal eval at the same cos θ, in f32.
+        for side in [Side::Front, Side::Back] {
+            let tables = g.tables_256(side);
+            for i in [0usize, 1, 77, 128, 254, 255] {
+                let (r, t) = g.eval(side, i as f64 / 255.0);
+                for c in 0..3 {
+                    assert_eq!(tables[c].r[i], r[c] as f32);
+                    assert_eq!(tables[c].t[i], t[c] as f32);
+                }
+            }
+        }
+        // Grazing: r = 1, t = 0 exactly; out-of-range cos θ is clamped.
+        assert_eq!(g.eval(Side::Front, 0.0), ([1.0; 3], [0.0; 3]));
+        assert_eq!(g.eval(Side::Front, -0.3), g.eval(Side::Front, 0.0));
+        assert_eq!(g.eval(Side::Front, 1.7), g.eval(Side::Front, 1.0));
+        assert_eq!(g.eval(Side::Front, f64::NAN), g.eval(Side::Front, 1.0));
+    }
+
+    #[test]
+    fn clamping_keeps_r_plus_t_at_most_one() {
+        let mut reg = sample();
+        // t0 = 0.95 with r0 = 0.1: at normal incidence r + t = 1.05 (invalid, but eval must
+        // still give a physical pair).
+        reg.glasses[0].t0 = [0.95; 3];
+        let (r, t) = reg.glasses[0].eval(Side::Front, 1.0);
+        assert!((r[0] - 0.1).abs() < 1e-15 && (t[0] - 0.9).abs() < 1e-15);
+        let err = reg.validate().unwrap_err().to_string();
+        assert!(err.contains("at 0°") && err.contains("r + t"), "{err}");
+    }
+
+    #[test]
+    fn validation_names_glass_side_channel_and_angle() {
+        let mut reg = sample();
+        // Back reflectance curve too steep in channel B only: r_back = 0.05·(30 − 29c) and
+        // t = 0.6·c give r + t = 1.5 − 0.85c > 1 + 0.004 where c < 0.58353 → θ > 54.30°; the
+        // first angle of the 0.25° grid beyond is 54.5°.
+        reg.glasses[0].c_r_back[2] = curve(vec![0, 1], vec![30.0, -29.0]);
+        let err = reg.validate().unwrap_err().to_string();
+        assert!(err.contains("id 4 (\"hand-made\")"), "{err}");
+        assert!(err.contains("back side, channel B, at 54.5°"), "{err}");
+        let mut reg = sample();
+        reg.glasses[0].c_t[1].coefficients[0] = f64::NAN;
+        assert!(
+            reg.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("c_t[1] (G).coefficients[0]")
+        );
+        let mut reg = sample();
+        reg.glasses.push(reg.glasses[0].clone());
+        assert!(matches!(
+            reg.validate(),
+            Err(RegistryError::DuplicateId { id: 4, .. })
+        ));
+    }
+
+    #[test]
+    fn json_round_trip_in_memory() {
+        let reg = sample();
+        let text = reg.to_json_string().unwrap();
+        let back = Registry::from_json_str(&text, "mem").unwrap();
+        assert_eq!(back, reg);
+        assert_eq!(back.to_json_string().unwrap(), text);
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.json");
+        reg.write_json(&p).unwrap();
+        assert_eq!(Registry::from_json_file(&p).unwrap(), reg);
+        // An invalid registry is never written.
+        let mut bad = reg.clone();
+        bad.glasses[0].id = 0;
+        let q = dir.path().join("bad.json");
+        assert!(bad.write_json(&q).is_err());
+        assert!(!q.exists());
+    }
+
+    #[test]
+    fn malformed_json_errors_name_the_source() {
+        let e = Registry::from_json_str("{\"schema\": 1, \"glasses\": [}", "x.json")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("x.json:") && e.contains("line 1"), "{e}");
+        let e = Registry::from_json_str("{\"schema\": 3}", "y.json")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("schema 3 is not supported"), "{e}");
+        let e = Registry::from_json_str("[1, 2]", "z.json")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("z.json:"), "{e}");
+    }
+}
