@@ -6,7 +6,11 @@ use clap::Parser;
 use glassdb::cmd;
 
 #[derive(Parser)]
-#[command(name = "compose", version, about = "Composite reflection and transmission passes through an id + cos θ mask")]
+#[command(
+    name = "compose",
+    version,
+    about = "Composite reflection and transmission passes through an id + cos θ mask"
+)]
 struct Cli {
     #[command(flatten)]
     args: cmd::compose::Args,

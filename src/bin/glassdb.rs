@@ -6,7 +6,11 @@ use clap::{Parser, Subcommand};
 use glassdb::cmd;
 
 #[derive(Parser)]
-#[command(name = "glassdb", version, about = "Architectural glass optical data and glazing compositor")]
+#[command(
+    name = "glassdb",
+    version,
+    about = "Architectural glass optical data and glazing compositor"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -1,10 +1,391 @@
-//! `glassdb compose`: under construction (owned by the compose work item).
+//! `compose` / `glassdb compose`: reflection and transmission passes through an id + cos θ mask
+//! (docs/compose.md). All logic lives in `glassdb_compose`; this module parses arguments,
+//! prints the report and drives the progress bar.
 
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct Args {}
+use anyhow::{Context, bail};
+use glassdb_compose::io::{ExrDataType, OutputOptions, PassReadOptions, parse_exr_compression};
+use glassdb_compose::lut::GlassLut;
+use glassdb_compose::pixels::{InputTransfer, PngBits};
+use glassdb_compose::sequence::{self, FrameOutcome};
+use glassdb_compose::{ComposeJob, ComposeSettings, FrameReport, UnknownIds, compose_frame};
+use glassdb_mask::{ExrMaskChannels, MaskReadOptions};
+use glassdb_registry::Registry;
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`compose` is not built yet")
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Reflection pass (EXR or PNG). Repeat for several glass planes: the k-th is plane k of
+    /// the mask (R channel of a PNG mask, `plane` channel of an EXR mask).
+    #[arg(long, required = true, value_name = "FILE")]
+    pub refl: Vec<PathBuf>,
+    /// Transmission pass (the scene without glass); its alpha is kept.
+    #[arg(long, value_name = "FILE")]
+    pub trans: PathBuf,
+    /// Glass mask: 8-bit RGB PNG (G = id, B = cos θ·255, R = plane), 16-bit RGB PNG, EXR with
+    /// `id` and `cos_theta` channels, or a binary PNG with --glass (docs/mask.md).
+    #[arg(long, value_name = "FILE")]
+    pub mask: PathBuf,
+    /// Registry JSON (`glassdb registry build`); default: the bundled catalog.
+    #[arg(long, value_name = "JSON")]
+    pub registry: Option<PathBuf>,
+    /// Output, .exr or .png (default: beside the transmission pass, `<name>.composite.<ext>`).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// EXR layer of the passes, e.g. `ViewLayer.Combined` (default: the only RGB layer, the
+    /// bare R, G, B, or the one named …Combined).
+    #[arg(long, value_name = "NAME")]
+    pub layer: Option<String>,
+    /// How PNG passes are encoded.
+    #[arg(long, value_enum, default_value_t = TransferArg::Srgb)]
+    pub input_transfer: TransferArg,
+    /// EXR mask channel names, e.g. `id=ViewLayer.IndexMA,cos=ViewLayer.Facing` (keys id, cos,
+    /// plane, coverage).
+    #[arg(long, value_name = "KEY=NAME,...")]
+    pub mask_channels: Option<String>,
+    /// Read the mask as the paper's binary mask (white = glass, black = not) showing glass ID
+    /// at its normal-incidence values.
+    #[arg(long, value_name = "ID")]
+    pub glass: Option<u16>,
+    /// Plane K shows the glass's back face (`K=back`) or front face (`K=front`, the default).
+    #[arg(long, value_name = "K=SIDE")]
+    pub side: Vec<String>,
+    /// `planes.json` from `glassdb mirror`: the side of every plane (--side overrides it).
+    #[arg(long, value_name = "JSON")]
+    pub planes: Option<PathBuf>,
+    /// Mask ids with no registry entry: refuse (`error`) or leave the pixels as the
+    /// transmission pass (`passthrough`).
+    #[arg(long, value_enum, default_value_t = UnknownArg::Error)]
+    pub unknown: UnknownArg,
+    /// EXR output sample type (default: the transmission pass's).
+    #[arg(long, value_enum)]
+    pub data_type: Option<DataTypeArg>,
+    /// EXR output compression: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab
+    /// (default zip).
+    #[arg(long, value_name = "NAME")]
+    pub compression: Option<String>,
+    /// PNG output bits per sample (default: the transmission pass's, 8 for EXR input).
+    #[arg(long, value_parser = ["8", "16"])]
+    pub png_bits: Option<String>,
+    /// Dither for 8-bit PNG output.
+    #[arg(long, value_enum, default_value_t = DitherArg::Ordered)]
+    pub dither: DitherArg,
+    /// Frames of an animation, e.g. `1-240` or `1,5,10-20`: `####` in --refl, --trans, --mask
+    /// and -o is replaced by the zero-padded frame number.
+    #[arg(long, value_name = "LIST")]
+    pub frames: Option<String>,
+    /// Print per-stage timings, megapixels per second, per-id pixel counts and the cos θ range.
+    #[arg(long)]
+    pub stats: bool,
+    /// Refuse inputs with more pixels than this (checked before decoding).
+    #[arg(long, value_name = "N", default_value_t = glassdb_mask::DEFAULT_MAX_PIXELS)]
+    pub max_pixels: u64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TransferArg {
+    Srgb,
+    Linear,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum UnknownArg {
+    Error,
+    Passthrough,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DataTypeArg {
+    Half,
+    Float,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DitherArg {
+    Ordered,
+    None,
+}
+
+/// `--mask-channels id=…,cos=…,plane=…,coverage=…` over the defaults.
+fn parse_mask_channels(spec: &str) -> anyhow::Result<ExrMaskChannels> {
+    let mut ch = ExrMaskChannels::default();
+    for item in spec.split(',').filter(|s| !s.trim().is_empty()) {
+        let (key, name) = item.split_once('=').with_context(|| {
+            format!("--mask-channels: {item:?} is not KEY=NAME (keys: id, cos, plane, coverage)")
+        })?;
+        let name = name.trim().to_string();
+        match key.trim() {
+            "id" => ch.id = name,
+            "cos" | "cos_theta" => ch.cos_theta = name,
+            "plane" => ch.plane = name,
+            "coverage" => ch.coverage = name,
+            other => {
+                bail!("--mask-channels: unknown key {other:?} (keys: id, cos, plane, coverage)")
+            }
+        }
+    }
+    Ok(ch)
+}
+
+/// `t.exr` → `t.composite.exr` (PNG passes give a PNG), beside the transmission pass.
+fn default_output(trans: &Path) -> PathBuf {
+    let stem = trans
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let ext = match trans
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("png") => "png",
+        _ => "exr",
+    };
+    trans.with_file_name(format!("{stem}.composite.{ext}"))
+}
+
+fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
+    let (registry, label) = match &args.registry {
+        Some(p) => (Registry::from_json_file(p)?, p.display().to_string()),
+        None => (
+            glassdb_registry::default_registry()?,
+            "the bundled catalog".to_string(),
+        ),
+    };
+    let lut = GlassLut::from_registry(&registry);
+    if let Some(id) = args.glass
+        && !lut.contains(id)
+    {
+        bail!("--glass {id}: {label} has no glass with id {id}");
+    }
+    let mut plane_sides = match &args.planes {
+        Some(p) => glassdb_compose::sides_from_planes_json(p)?,
+        None => Default::default(),
+    };
+    for spec in &args.side {
+        let (k, side) = glassdb_compose::parse_side_spec(spec)?;
+        if k >= args.refl.len() {
+            bail!(
+                "--side {spec}: plane {k} has no reflection pass ({} given; planes count from 0)",
+                args.refl.len()
+            );
+        }
+        plane_sides.insert(k, side);
+    }
+    let mask = MaskReadOptions {
+        exr_channels: match &args.mask_channels {
+            Some(s) => parse_mask_channels(s)?,
+            None => ExrMaskChannels::default(),
+        },
+        binary_glass_id: args.glass,
+        max_pixels: args.max_pixels,
+    };
+    let pass = PassReadOptions {
+        layer: args.layer.clone(),
+        transfer: match args.input_transfer {
+            TransferArg::Srgb => InputTransfer::Srgb,
+            TransferArg::Linear => InputTransfer::Linear,
+        },
+        max_pixels: args.max_pixels,
+    };
+    let output = OutputOptions {
+        exr_data_type: args.data_type.map(|d| match d {
+            DataTypeArg::Half => ExrDataType::Half,
+            DataTypeArg::Float => ExrDataType::Float,
+        }),
+        exr_compression: args
+            .compression
+            .as_deref()
+            .map(parse_exr_compression)
+            .transpose()?,
+        png_bits: args.png_bits.as_deref().map(|b| {
+            if b == "16" {
+                PngBits::Sixteen
+            } else {
+                PngBits::Eight
+            }
+        }),
+        dither: args.dither == DitherArg::Ordered,
+    };
+    let settings = ComposeSettings {
+        pass,
+        mask,
+        plane_sides,
+        unknown: match args.unknown {
+            UnknownArg::Error => UnknownIds::Error,
+            UnknownArg::Passthrough => UnknownIds::Passthrough,
+        },
+        output,
+        registry_label: label,
+        protected: args.registry.iter().chain(&args.planes).cloned().collect(),
+    };
+    Ok((settings, lut))
+}
+
+fn print_stats(r: &FrameReport, lut: &GlassLut) {
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let t = &r.timings;
+    println!(
+        "image        {}×{} ({:.2} Mpixel), {} reflection pass(es)",
+        r.width,
+        r.height,
+        f64::from(r.width) * f64::from(r.height) / 1e6,
+        r.planes
+    );
+    println!(
+        "decode       {:9.1} ms  (all inputs, in parallel)",
+        ms(t.decode)
+    );
+    println!("compose      {:9.1} ms", ms(t.compose));
+    println!(
+        "encode       {:9.1} ms  ({}, {} bytes)",
+        ms(t.encode),
+        r.output.encoding,
+        r.output.bytes
+    );
+    println!(
+        "total        {:9.1} ms  ({:.1} Mpixel/s)",
+        ms(t.total()),
+        r.megapixels_per_second()
+    );
+    let glass: u64 = r.id_counts.values().sum();
+    println!("glass pixels {glass}");
+    for (id, n) in &r.id_counts {
+        let known = if lut.contains(*id) {
+            ""
+        } else {
+            "  (not in registry: passed through)"
+        };
+        println!("  id {id:5}   {n} pixels{known}");
+    }
+    match r.cos_range {
+        Some((lo, hi)) => println!(
+            "cos θ        {lo:.4} – {hi:.4}  (θ {:.1}° – {:.1}°)",
+            hi.clamp(-1.0, 1.0).acos().to_degrees(),
+            lo.clamp(-1.0, 1.0).acos().to_degrees()
+        ),
+        None => println!("cos θ        (no glass pixels)"),
+    }
+    println!(
+        "fine-table interpolation error (16-bit/float masks): {:.2e}",
+        lut.fine_table_error
+    );
+}
+
+fn report_nonfinite(r: &FrameReport, label: &str) {
+    let c = &r.counts;
+    if c.nonfinite_output > 0 {
+        eprintln!(
+            "warning: {label}{} output samples are NaN or infinite ({} from the transmission pass, {} from reflection passes); they are kept, not hidden",
+            c.nonfinite_output, c.nonfinite_trans, c.nonfinite_refl
+        );
+    }
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let (settings, lut) = settings_from(&args)?;
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.trans));
+    let job = ComposeJob {
+        refl: args.refl.clone(),
+        trans: args.trans.clone(),
+        mask: args.mask.clone(),
+        output,
+    };
+
+    let Some(frames_spec) = &args.frames else {
+        let report = compose_frame(&job, &settings, &lut)?;
+        report_nonfinite(&report, "");
+        if args.stats {
+            print_stats(&report, &lut);
+        }
+        println!(
+            "wrote {} ({}×{}, {})",
+            report.output.path.display(),
+            report.width,
+            report.height,
+            report.output.encoding
+        );
+        return Ok(ExitCode::SUCCESS);
+    };
+
+    let frames = sequence::parse_frames(frames_spec)?;
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(frames.len() as u64);
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} frames, {elapsed} elapsed, ETA {eta}",
+        ) {
+            bar.set_style(style);
+        }
+        Some(bar)
+    } else {
+        None
+    };
+    let on_done = |o: &FrameOutcome| {
+        let line = match &o.result {
+            Ok(r) => {
+                report_nonfinite(r, &format!("frame {}: ", o.frame));
+                None
+            }
+            Err(e) => Some(format!(
+                "frame {}: error: {}",
+                o.frame,
+                glassdb_io::ErrorChain(e)
+            )),
+        };
+        match (&bar, line) {
+            (Some(b), Some(l)) => b.println(l),
+            (None, Some(l)) => eprintln!("{l}"),
+            _ => {}
+        }
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    };
+    let outcomes = sequence::compose_sequence(&job, &frames, &settings, &lut, &on_done)?;
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let failed: Vec<u32> = outcomes
+        .iter()
+        .filter(|o| o.result.is_err())
+        .map(|o| o.frame)
+        .collect();
+    let done: Vec<&FrameReport> = outcomes
+        .iter()
+        .filter_map(|o| o.result.as_ref().ok())
+        .collect();
+    if args.stats {
+        for o in &outcomes {
+            if let Ok(r) = &o.result {
+                println!("--- frame {}", o.frame);
+                print_stats(r, &lut);
+            }
+        }
+    }
+    if let (Some(first), Some(last)) = (done.first(), done.last()) {
+        println!(
+            "wrote {} frame(s): {} … {}",
+            done.len(),
+            first.output.path.display(),
+            last.output.path.display()
+        );
+    }
+    if failed.is_empty() {
+        Ok(ExitCode::SUCCESS)
+    } else {
+        let list: Vec<String> = failed.iter().map(u32::to_string).collect();
+        eprintln!(
+            "error: {} of {} frame(s) failed: {}",
+            failed.len(),
+            frames.len(),
+            list.join(", ")
+        );
+        Ok(ExitCode::from(crate::cmd::EXIT_FAILURE))
+    }
 }

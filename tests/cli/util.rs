@@ -36,16 +36,31 @@ pub fn run(cmd: &mut Command) -> (Output, String, String) {
 /// Asserts success and returns stdout.
 pub fn ok(cmd: &mut Command) -> String {
     let (out, stdout, stderr) = run(cmd);
-    assert!(out.status.success(), "command failed: {:?}\nstdout:\n{stdout}\nstderr:\n{stderr}", cmd);
+    assert!(
+        out.status.success(),
+        "command failed: {:?}\nstdout:\n{stdout}\nstderr:\n{stderr}",
+        cmd
+    );
     stdout
 }
 
 /// Asserts a non-zero exit without a panic and returns stderr.
 pub fn fails(cmd: &mut Command) -> String {
     let (out, stdout, stderr) = run(cmd);
-    assert!(!out.status.success(), "command unexpectedly succeeded: {:?}\nstdout:\n{stdout}", cmd);
-    assert!(!stderr.contains("panicked"), "the binary panicked: {stderr}");
-    assert_ne!(out.status.code(), Some(101), "exit code 101 means a panic: {stderr}");
+    assert!(
+        !out.status.success(),
+        "command unexpectedly succeeded: {:?}\nstdout:\n{stdout}",
+        cmd
+    );
+    assert!(
+        !stderr.contains("panicked"),
+        "the binary panicked: {stderr}"
+    );
+    assert_ne!(
+        out.status.code(),
+        Some(101),
+        "exit code 101 means a panic: {stderr}"
+    );
     stderr
 }
 

@@ -1,0 +1,237 @@
+//! The compositor's own compact lookup structure, built once from the registry: per glass id,
+//! per side, r and t for the three channels (method.md eqs. 11–14, `r = r0·C_r(θ)`,
+//! `t = t0·C_t(θ)`, clamped to the physical range as the registry does) at
+//!
+//! - the 256 cos θ codes of an 8-bit mask (cos θ = i/255): exact, the registry's own values;
+//! - a fine table of [`FINE_STEPS`] + 1 points for 16-bit and float masks, linearly
+//!   interpolated; its largest error (measured when it is built, at every interval midpoint)
+//!   is [`GlassLut::fine_table_error`];
+//! - normal incidence from `r0`, `t0` (`r0_back` for the back side) for binary masks.
+
+use glassdb_registry::{Registry, Side};
+
+/// Intervals of the fine table over cos θ ∈ [0, 1].
+pub const FINE_STEPS: usize = 4096;
+
+/// r and t of the three channels at one cos θ.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RtTriple {
+    pub r: [f32; 3],
+    pub t: [f32; 3],
+}
+
+impl RtTriple {
+    #[inline]
+    fn lerp(a: &RtTriple, b: &RtTriple, f: f32) -> RtTriple {
+        let mut out = RtTriple::default();
+        for c in 0..3 {
+            out.r[c] = a.r[c] + (b.r[c] - a.r[c]) * f;
+            out.t[c] = a.t[c] + (b.t[c] - a.t[c]) * f;
+        }
+        out
+    }
+}
+
+/// One glass seen from one side.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GlassSideLut {
+    /// At cos θ = i/255.
+    pub q8: Vec<RtTriple>,
+    /// At cos θ = i/FINE_STEPS, i = 0…FINE_STEPS.
+    pub fine: Vec<RtTriple>,
+    /// At normal incidence (r0, t0).
+    pub normal: RtTriple,
+}
+
+impl GlassSideLut {
+    /// r and t at an arbitrary cos θ (clamped to [0, 1]; NaN → normal incidence) by linear
+    /// interpolation in the fine table.
+    #[inline]
+    pub fn at_cos(&self, cos_theta: f32) -> RtTriple {
+        let x = if cos_theta.is_nan() {
+            1.0
+        } else {
+            cos_theta.clamp(0.0, 1.0)
+        } * FINE_STEPS as f32;
+        let i = (x as usize).min(FINE_STEPS - 1);
+        let f = x - i as f32;
+        match (self.fine.get(i), self.fine.get(i + 1)) {
+            (Some(a), Some(b)) => RtTriple::lerp(a, b, f),
+            _ => self.normal,
+        }
+    }
+
+    /// At an 8-bit cos θ code: an exact table entry.
+    #[inline]
+    pub fn at_code8(&self, code: u8) -> RtTriple {
+        self.q8.get(code as usize).copied().unwrap_or(self.normal)
+    }
+}
+
+/// Per-id lookup for the kernel. Ids not in the table are "unknown".
+#[derive(Debug, Clone)]
+pub struct GlassLut {
+    /// Slot of each id (index into `slots`), or `NONE`.
+    index: Vec<u32>,
+    /// Front and back per glass.
+    slots: Vec<[GlassSideLut; 2]>,
+    /// Largest |interpolated − exact| of the fine table over all glasses, sides, channels, r
+    /// and t, at every interval midpoint.
+    pub fine_table_error: f64,
+}
+
+const NONE: u32 = u32::MAX;
+
+fn side_index(side: Side) -> usize {
+    match side {
+        Side::Front => 0,
+        Side::Back => 1,
+    }
+}
+
+impl GlassLut {
+    /// Builds the tables from any evaluator: `eval(id, side, cos θ)` returns per-channel (r, t)
+    /// and `normal(id, side)` the normal-incidence values.
+    pub fn from_fn(
+        ids: &[u16],
+        eval: impl Fn(u16, Side, f64) -> ([f64; 3], [f64; 3]),
+        normal: impl Fn(u16, Side) -> ([f64; 3], [f64; 3]),
+    ) -> GlassLut {
+        let to_triple = |(r, t): ([f64; 3], [f64; 3])| RtTriple {
+            r: r.map(|v| v as f32),
+            t: t.map(|v| v as f32),
+        };
+        let mut index = vec![NONE; 65536];
+        let mut slots = Vec::new();
+        let mut worst: f64 = 0.0;
+        for &id in ids {
+            if id == 0 || index[id as usize] != NONE {
+                continue;
+            }
+            let make = |side: Side| -> (GlassSideLut, f64) {
+                let q8 = (0..256)
+                    .map(|i| to_triple(eval(id, side, i as f64 / 255.0)))
+                    .collect();
+                let fine: Vec<RtTriple> = (0..=FINE_STEPS)
+                    .map(|i| to_triple(eval(id, side, i as f64 / FINE_STEPS as f64)))
+                    .collect();
+                let lut = GlassSideLut {
+                    q8,
+                    fine,
+                    normal: to_triple(normal(id, side)),
+                };
+                let mut err: f64 = 0.0;
+                for i in 0..FINE_STEPS {
+                    let cos = (i as f64 + 0.5) / FINE_STEPS as f64;
+                    let (r, t) = eval(id, side, cos);
+                    let got = lut.at_cos(cos as f32);
+                    for c in 0..3 {
+                        err = err
+                            .max((f64::from(got.r[c]) - r[c]).abs())
+                            .max((f64::from(got.t[c]) - t[c]).abs());
+                    }
+                }
+                (lut, err)
+            };
+            let (front, e1) = make(Side::Front);
+            let (back, e2) = make(Side::Back);
+            worst = worst.max(e1).max(e2);
+            index[id as usize] = slots.len() as u32;
+            slots.push([front, back]);
+        }
+        GlassLut {
+            index,
+            slots,
+            fine_table_error: worst,
+        }
+    }
+
+    /// Builds the tables for every glass of the registry (its `tables_256`, `eval` and normal
+    /// values).
+    pub fn from_registry(registry: &Registry) -> GlassLut {
+        let ids: Vec<u16> = registry.glasses.iter().map(|g| g.id).collect();
+        let mut lut = GlassLut::from_fn(
+            &ids,
+            |id, side, cos| {
+                registry
+                    .glass(id)
+                    .map_or(([0.0; 3], [0.0; 3]), |g| g.eval(side, cos))
+            },
+            |id, side| {
+                registry.glass(id).map_or(([0.0; 3], [0.0; 3]), |g| {
+                    let r = match side {
+                        Side::Front => g.r0,
+                        Side::Back => g.r0_back,
+                    };
+                    (r, g.t0)
+                })
+            },
+        );
+        // The 8-bit entries are the registry's own 256-entry tables, bit for bit.
+        for g in &registry.glasses {
+            let Some(&slot) = lut.index.get(g.id as usize) else {
+                continue;
+            };
+            let Some(sides) = lut.slots.get_mut(slot as usize) else {
+                continue;
+            };
+            for side in [Side::Front, Side::Back] {
+                let tables = g.tables_256(side);
+                let q8 = &mut sides[side_index(side)].q8;
+                for (i, e) in q8.iter_mut().enumerate() {
+                    for (c, table) in tables.iter().enumerate() {
+                        e.r[c] = table.r[i];
+                        e.t[c] = table.t[i];
+                    }
+                }
+            }
+        }
+        lut
+    }
+
+    /// Whether `id` has an entry.
+    pub fn contains(&self, id: u16) -> bool {
+        self.index.get(id as usize).is_some_and(|&s| s != NONE)
+    }
+
+    /// The tables of `id` seen from `side`.
+    #[inline]
+    pub fn side(&self, id: u16, side: Side) -> Option<&GlassSideLut> {
+        let slot = *self.index.get(id as usize)?;
+        self.slots.get(slot as usize).map(|s| &s[side_index(side)])
+    }
+
+    /// Slot lookup for the kernel: both sides of `id`.
+    #[inline]
+    pub(crate) fn sides(&self, id: u16) -> Option<&[GlassSideLut; 2]> {
+        let slot = *self.index.get(id as usize)?;
+        self.slots.get(slot as usize)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fine_table_error_is_small_for_a_smooth_curve() {
+        // r = 0.04 + 0.96 (1 − cos)^5 (Schlick), t = 0.9 cos: interpolation error ≤ h²/8 max|f''|.
+        let lut = GlassLut::from_fn(
+            &[3],
+            |_, _, c| ([0.04 + 0.96 * (1.0 - c).powi(5); 3], [0.9 * c; 3]),
+            |_, _| ([0.04; 3], [0.9; 3]),
+        );
+        let h = 1.0 / FINE_STEPS as f64;
+        let bound = h * h / 8.0 * 0.96 * 20.0 + 1e-7; // f'' ≤ 20·0.96, plus f32 rounding
+        assert!(
+            lut.fine_table_error <= bound,
+            "{} > {bound}",
+            lut.fine_table_error
+        );
+        let s = lut.side(3, Side::Front).unwrap();
+        assert_eq!(s.at_code8(255).r[0], 0.04);
+        assert_eq!(s.at_code8(0).r[0], 1.0);
+        assert!((s.at_cos(0.5).t[1] - 0.45).abs() < 1e-6);
+        assert!(lut.contains(3) && !lut.contains(4) && !lut.contains(0));
+    }
+}

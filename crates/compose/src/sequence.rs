@@ -1,0 +1,163 @@
+//! Animations: file patterns with a `#` run for the frame number (`r.####.exr` → `r.0007.exr`),
+//! frame lists (`1-240`, `1,5,10-20`), and every frame composed with two frames in flight at
+//! a time (so one frame's decoding overlaps another's encoding); a frame with missing or bad
+//! inputs is reported and the others go on.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use crate::lut::GlassLut;
+use crate::{ComposeError, ComposeJob, ComposeSettings, FrameReport, compose_frame};
+
+/// Whether `pattern` contains a `#` run.
+pub fn is_pattern(pattern: &Path) -> bool {
+    pattern.to_string_lossy().contains('#')
+}
+
+/// Replaces the last run of `#` in `pattern` by `frame`, zero-padded to the run's length.
+pub fn expand(pattern: &Path, frame: u32) -> Result<PathBuf, ComposeError> {
+    let s = pattern.to_string_lossy();
+    let end = s.rfind('#').ok_or_else(|| {
+        ComposeError::Sequence(format!(
+            "{} has no #### for the frame number",
+            pattern.display()
+        ))
+    })? + 1;
+    let start = s[..end].trim_end_matches('#').len();
+    let width = end - start;
+    Ok(PathBuf::from(format!(
+        "{}{:0width$}{}",
+        &s[..start],
+        frame,
+        &s[end..],
+        width = width
+    )))
+}
+
+/// Parses a frame list: `N`, `A-B`, comma-separated, e.g. `1-240` or `1,5,10-20`.
+pub fn parse_frames(spec: &str) -> Result<Vec<u32>, ComposeError> {
+    let bad = |why: &str| {
+        ComposeError::Sequence(format!(
+            "--frames {spec:?}: {why} (e.g. 1-240 or 1,5,10-20)"
+        ))
+    };
+    let mut frames = Vec::new();
+    for item in spec.split(',') {
+        let item = item.trim();
+        let (a, b) = match item.split_once('-') {
+            Some((a, b)) => (a.trim(), b.trim()),
+            None => (item, item),
+        };
+        let a: u32 = a.parse().map_err(|_| bad("not a frame number"))?;
+        let b: u32 = b.parse().map_err(|_| bad("not a frame number"))?;
+        if b < a {
+            return Err(bad("a range ends before it starts"));
+        }
+        if frames.len() as u64 + u64::from(b - a) + 1 > 1_000_000 {
+            return Err(bad("more than a million frames"));
+        }
+        frames.extend(a..=b);
+    }
+    frames.sort_unstable();
+    frames.dedup();
+    Ok(frames)
+}
+
+/// The job of frame `frame`: every path with a `#` run expanded (paths without one, such as a
+/// reflection pass reused for every frame, stay as they are).
+pub fn frame_job(pattern: &ComposeJob, frame: u32) -> Result<ComposeJob, ComposeError> {
+    let ex = |p: &Path| {
+        if is_pattern(p) {
+            expand(p, frame)
+        } else {
+            Ok(p.to_path_buf())
+        }
+    };
+    Ok(ComposeJob {
+        refl: pattern
+            .refl
+            .iter()
+            .map(|p| ex(p))
+            .collect::<Result<_, _>>()?,
+        trans: ex(&pattern.trans)?,
+        mask: ex(&pattern.mask)?,
+        output: ex(&pattern.output)?,
+    })
+}
+
+/// The result of one frame.
+#[derive(Debug)]
+pub struct FrameOutcome {
+    pub frame: u32,
+    pub result: Result<FrameReport, ComposeError>,
+}
+
+/// Frames composed at once.
+pub const FRAMES_IN_FLIGHT: usize = 2;
+
+/// Composes every frame; `on_done` is called as each finishes (from worker threads, in
+/// completion order). Returns the outcomes in frame order.
+pub fn compose_sequence(
+    pattern: &ComposeJob,
+    frames: &[u32],
+    settings: &ComposeSettings,
+    lut: &GlassLut,
+    on_done: &(dyn Fn(&FrameOutcome) + Sync),
+) -> Result<Vec<FrameOutcome>, ComposeError> {
+    if !is_pattern(&pattern.output) && frames.len() > 1 {
+        return Err(ComposeError::Sequence(format!(
+            "the output {} has no #### for the frame number, so every frame would overwrite it",
+            pattern.output.display()
+        )));
+    }
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<FrameOutcome>> = Mutex::new(Vec::with_capacity(frames.len()));
+    std::thread::scope(|scope| {
+        for _ in 0..FRAMES_IN_FLIGHT.min(frames.len()) {
+            scope.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&frame) = frames.get(k) else { break };
+                    let result = frame_job(pattern, frame)
+                        .and_then(|job| compose_frame(&job, settings, lut));
+                    let outcome = FrameOutcome { frame, result };
+                    on_done(&outcome);
+                    if let Ok(mut r) = results.lock() {
+                        r.push(outcome);
+                    }
+                }
+            });
+        }
+    });
+    let mut out = results.into_inner().unwrap_or_else(|e| e.into_inner());
+    out.sort_by_key(|o| o.frame);
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn patterns_expand_with_padding() {
+        assert_eq!(
+            expand(Path::new("r.####.exr"), 7).unwrap(),
+            PathBuf::from("r.0007.exr")
+        );
+        assert_eq!(
+            expand(Path::new("d#/t.##.png"), 123).unwrap(),
+            PathBuf::from("d#/t.123.png")
+        );
+        assert!(expand(Path::new("r.exr"), 1).is_err());
+    }
+
+    #[test]
+    fn frame_lists() {
+        assert_eq!(parse_frames("1-3").unwrap(), vec![1, 2, 3]);
+        assert_eq!(parse_frames("5, 1-2,2").unwrap(), vec![1, 2, 5]);
+        assert!(parse_frames("3-1").is_err());
+        assert!(parse_frames("a").is_err());
+        assert!(parse_frames("0-4000000").is_err());
+    }
+}

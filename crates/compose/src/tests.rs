@@ -1,0 +1,249 @@
+//! Golden images small enough to compute by hand, and the r = 0, t = 1 identity.
+
+use std::collections::BTreeMap;
+
+use glassdb_mask::{CosTheta, MaskImage};
+use proptest::prelude::*;
+
+use super::*;
+use crate::kernel::compose_in_place;
+use crate::lut::GlassLut;
+
+/// Glass 1: r = (0.1, 0.2, 0.3), t = (0.5, 0.6, 0.7) at every angle, back r = (0.4, 0.4, 0.4).
+/// Glass 2: r = 0.5·(1 − cos), t = cos (grey); normal values r0 = 0, t0 = 1.
+fn test_lut() -> GlassLut {
+    GlassLut::from_fn(
+        &[1, 2],
+        |id, side, c| match (id, side) {
+            (1, Side::Front) => ([0.1, 0.2, 0.3], [0.5, 0.6, 0.7]),
+            (1, Side::Back) => ([0.4; 3], [0.5, 0.6, 0.7]),
+            _ => ([0.5 * (1.0 - c); 3], [c; 3]),
+        },
+        |id, side| match (id, side) {
+            (1, Side::Front) => ([0.1, 0.2, 0.3], [0.5, 0.6, 0.7]),
+            (1, Side::Back) => ([0.4; 3], [0.5, 0.6, 0.7]),
+            _ => ([0.0; 3], [1.0; 3]),
+        },
+    )
+}
+
+fn mask(id: Vec<u16>, cos: CosTheta, plane: Vec<u16>, coverage: Option<Vec<f32>>) -> MaskImage {
+    let n = id.len() as u32;
+    MaskImage {
+        width: n,
+        height: 1,
+        id,
+        cos_theta: cos,
+        plane,
+        coverage,
+    }
+}
+
+fn run(
+    trans: [Vec<f32>; 3],
+    refl: &[[Vec<f32>; 3]],
+    m: &MaskImage,
+    sides: &[Side],
+) -> ([Vec<f32>; 3], KernelCounts) {
+    let lut = test_lut();
+    let refl_planes: Vec<[&[f32]; 3]> = refl
+        .iter()
+        .map(|p| [p[0].as_slice(), p[1].as_slice(), p[2].as_slice()])
+        .collect();
+    let mut out = trans;
+    let [a, b, c] = &mut out;
+    let counts = compose_in_place(
+        [a, b, c],
+        &KernelInput {
+            refl: &refl_planes,
+            plane_sides: sides,
+            mask: m,
+            lut: &lut,
+        },
+    )
+    .unwrap();
+    (out, counts)
+}
+
+#[test]
+fn golden_constant_glass_8bit_mask() {
+    // Pixel 0: no glass → trans. Pixel 1: glass 1 → trans·t + refl·r per channel.
+    let m = mask(
+        vec![0, 1],
+        CosTheta::Quantized8(vec![0, 200]),
+        vec![0, 0],
+        None,
+    );
+    let trans = [vec![1.0, 1.0], vec![2.0, 2.0], vec![4.0, 4.0]];
+    let refl = [[vec![8.0, 10.0], vec![8.0, 10.0], vec![8.0, 10.0]]];
+    let (out, counts) = run(trans, &refl, &m, &[Side::Front]);
+    // R: 1·0.5 + 10·0.1 = 1.5; G: 2·0.6 + 10·0.2 = 3.2; B: 4·0.7 + 10·0.3 = 5.8.
+    assert_eq!([out[0][0], out[1][0], out[2][0]], [1.0, 2.0, 4.0]);
+    assert!((out[0][1] - 1.5).abs() < 1e-6);
+    assert!((out[1][1] - 3.2).abs() < 1e-6);
+    assert!((out[2][1] - 5.8).abs() < 1e-6);
+    assert_eq!(counts, KernelCounts::default());
+}
+
+#[test]
+fn golden_angle_dependent_glass_each_cos_kind() {
+    // Glass 2 at cos = 0.2: t = 0.2, r = 0.4; trans 1, refl 2 → 0.2 + 0.8 = 1.0.
+    // At cos = 51/255 = 0.2 exactly (8-bit), 13107/65535 = 0.2 (16-bit), 0.2 (float).
+    for cos in [
+        CosTheta::Quantized8(vec![51]),
+        CosTheta::Quantized16(vec![13107]),
+        CosTheta::Float(vec![0.2]),
+    ] {
+        let m = mask(vec![2], cos.clone(), vec![0], None);
+        let (out, _) = run(
+            [vec![1.0], vec![1.0], vec![1.0]],
+            &[[vec![2.0], vec![2.0], vec![2.0]]],
+            &m,
+            &[Side::Front],
+        );
+        assert!((out[0][0] - 1.0).abs() < 2e-6, "{cos:?}: {}", out[0][0]);
+    }
+    // Binary mask: normal-incidence values r0 = 0, t0 = 1 → the transmission pass.
+    let m = mask(vec![2], CosTheta::Normal, vec![0], None);
+    let (out, _) = run(
+        [vec![3.0], vec![3.0], vec![3.0]],
+        &[[vec![9.0], vec![9.0], vec![9.0]]],
+        &m,
+        &[Side::Front],
+    );
+    assert_eq!(out[0][0], 3.0);
+}
+
+#[test]
+fn golden_two_planes_and_back_side() {
+    // Pixel 0 on plane 0 (front, r_R = 0.1), pixel 1 on plane 1 (back, r = 0.4).
+    let m = mask(
+        vec![1, 1],
+        CosTheta::Quantized8(vec![255, 255]),
+        vec![0, 1],
+        None,
+    );
+    let trans = [vec![0.0, 0.0], vec![0.0, 0.0], vec![0.0, 0.0]];
+    let refl = [
+        [vec![10.0, 99.0], vec![10.0, 99.0], vec![10.0, 99.0]],
+        [vec![99.0, 5.0], vec![99.0, 5.0], vec![99.0, 5.0]],
+    ];
+    let (out, _) = run(trans, &refl, &m, &[Side::Front, Side::Back]);
+    assert!((out[0][0] - 1.0).abs() < 1e-6); // 10 · 0.1
+    assert!((out[0][1] - 2.0).abs() < 1e-6); // 5 · 0.4
+}
+
+#[test]
+fn golden_coverage() {
+    // Coverage 0.25 on glass 1, R: (1 − 0.25)·2 + 0.25·(2·0.5 + 4·0.1) = 1.5 + 0.35 = 1.85.
+    let m = mask(
+        vec![1],
+        CosTheta::Float(vec![1.0]),
+        vec![0],
+        Some(vec![0.25]),
+    );
+    let (out, _) = run(
+        [vec![2.0], vec![2.0], vec![2.0]],
+        &[[vec![4.0], vec![4.0], vec![4.0]]],
+        &m,
+        &[Side::Front],
+    );
+    assert!((out[0][0] - 1.85).abs() < 1e-6, "{}", out[0][0]);
+}
+
+#[test]
+fn nan_propagates_and_is_counted() {
+    let m = mask(
+        vec![1, 0, 1],
+        CosTheta::Quantized8(vec![9; 3]),
+        vec![0; 3],
+        None,
+    );
+    let trans = [
+        vec![f32::NAN, f32::INFINITY, 1.0],
+        vec![1.0; 3],
+        vec![1.0; 3],
+    ];
+    let refl = [[vec![1.0, 1.0, f32::NAN], vec![1.0; 3], vec![1.0; 3]]];
+    let (out, counts) = run(trans, &refl, &m, &[Side::Front]);
+    assert!(out[0][0].is_nan() && out[0][1].is_infinite() && out[0][2].is_nan());
+    assert_eq!(counts.nonfinite_output, 3);
+    assert_eq!(counts.nonfinite_trans, 2);
+    assert_eq!(counts.nonfinite_refl, 1);
+}
+
+#[test]
+fn unknown_ids_pass_through_when_allowed() {
+    let m = mask(vec![9], CosTheta::Quantized8(vec![9]), vec![0], None);
+    let (out, counts) = run(
+        [vec![1.5], vec![1.5], vec![1.5]],
+        &[[vec![7.0], vec![7.0], vec![7.0]]],
+        &m,
+        &[Side::Front],
+    );
+    assert_eq!(out[0][0], 1.5);
+    assert_eq!(counts.passthrough_pixels, 1);
+}
+
+#[test]
+fn side_specs_parse() {
+    assert_eq!(parse_side_spec("2=back").unwrap(), (2, Side::Back));
+    assert_eq!(parse_side_spec("0=Front").unwrap(), (0, Side::Front));
+    assert!(parse_side_spec("x=back").is_err());
+    assert!(parse_side_spec("1=left").is_err());
+}
+
+#[test]
+fn planes_json_sides() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("planes.json");
+    std::fs::write(&p, r#"{"format":"glassdb-planes/1","planes":[{"index":0,"eye_side":"front"},{"index":1,"eye_side":"back"}]}"#).unwrap();
+    let sides = sides_from_planes_json(&p).unwrap();
+    assert_eq!(sides, BTreeMap::from([(0, Side::Front), (1, Side::Back)]));
+    std::fs::write(&p, r#"{"planes":[{"eye_side":"up"}]}"#).unwrap();
+    assert!(
+        sides_from_planes_json(&p)
+            .unwrap_err()
+            .to_string()
+            .contains("planes.json")
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, rng_seed: proptest::test_runner::RngSeed::Fixed(5), failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// r = 0, t = 1 returns the transmission pass bit for bit (every finite f32 including −0,
+    /// subnormals and huge values; any mask), through a float EXR file and back.
+    #[test]
+    fn r0_t1_is_identity_bit_exact(
+        bits in proptest::collection::vec(any::<u32>(), 3 * 12),
+        refl in proptest::collection::vec(-1e30f32..1e30, 3 * 12),
+        ids in proptest::collection::vec(0u16..3, 12),
+        codes in proptest::collection::vec(any::<u8>(), 12),
+    ) {
+        let lut = GlassLut::from_fn(&[1, 2], |_, _, _| ([0.0; 3], [1.0; 3]), |_, _| ([0.0; 3], [1.0; 3]));
+        let trans: Vec<f32> = bits.iter().map(|&b| { let v = f32::from_bits(b); if v.is_finite() { v } else { 0.5 } }).collect();
+        let planes = |v: &[f32]| [v[..12].to_vec(), v[12..24].to_vec(), v[24..].to_vec()];
+        let m = MaskImage { width: 4, height: 3, id: ids, cos_theta: CosTheta::Quantized8(codes), plane: vec![0; 12], coverage: None };
+        let dir = tempfile::tempdir().unwrap();
+        let t_path = dir.path().join("t.exr");
+        let r_path = dir.path().join("r.exr");
+        let m_path = dir.path().join("m.png");
+        let write = |p: &std::path::Path, v: &[f32]| {
+            let img = pixels::LinearImage { width: 4, height: 3, rgb: planes(v), alpha: None };
+            let src = io::PassSource::Exr { sample_type: glassdb_mask::exr_flat::ExrSampleType::Float, compression: exr::compression::Compression::ZIP16, layer: String::new() };
+            io::write_output(p, img, &src, &io::OutputOptions::default()).unwrap();
+        };
+        write(&t_path, &trans);
+        write(&r_path, &refl);
+        glassdb_mask::write_mask(&m_path, &m, glassdb_mask::MaskFormat::Png8).unwrap();
+        let job = ComposeJob { refl: vec![r_path], trans: t_path, mask: m_path, output: dir.path().join("o.exr") };
+        compose_frame(&job, &ComposeSettings::default(), &lut).unwrap();
+        let out = io::read_pass(&job.output, &PassReadOptions::default()).unwrap();
+        let got: Vec<u32> = out.image.rgb.iter().flatten().map(|v| v.to_bits()).collect();
+        let want: Vec<u32> = trans.iter().map(|v| v.to_bits()).collect();
+        prop_assert_eq!(got, want);
+        let is_float = matches!(out.source, io::PassSource::Exr { sample_type: glassdb_mask::exr_flat::ExrSampleType::Float, .. });
+        prop_assert!(is_float);
+    }
+}

@@ -1,0 +1,58 @@
+//! Running third-party decoders on untrusted bytes: a panic inside a decoder (a bug in the
+//! dependency, reached by a corrupt file) becomes an error instead of killing the process, and
+//! its message is not printed as if the program itself had crashed.
+
+use std::cell::Cell;
+use std::panic::{self, AssertUnwindSafe};
+use std::sync::Once;
+
+thread_local! {
+    /// Depth of nested [`catch_decoder_panic`] calls on this thread.
+    static IN_DECODER: Cell<u32> = const { Cell::new(0) };
+}
+
+static INSTALL_HOOK: Once = Once::new();
+
+/// Wraps the process panic hook once: panics raised while this thread is inside
+/// [`catch_decoder_panic`] are silenced (they are reported as errors by the caller); every other
+/// panic goes to the previous hook unchanged.
+fn install_quiet_hook() {
+    INSTALL_HOOK.call_once(|| {
+        let previous = panic::take_hook();
+        panic::set_hook(Box::new(move |info| {
+            if IN_DECODER.with(|d| d.get()) == 0 {
+                previous(info);
+            }
+        }));
+    });
+}
+
+/// Runs `decode`, turning a panic into `Err(message)`. Use it around every call into a decoder
+/// that sees file bytes (png, exr), on the thread that runs the decoder.
+pub fn catch_decoder_panic<T>(decode: impl FnOnce() -> T) -> Result<T, String> {
+    install_quiet_hook();
+    IN_DECODER.with(|d| d.set(d.get() + 1));
+    let result = panic::catch_unwind(AssertUnwindSafe(decode));
+    IN_DECODER.with(|d| d.set(d.get().saturating_sub(1)));
+    result.map_err(|payload| {
+        if let Some(s) = payload.downcast_ref::<&str>() {
+            (*s).to_string()
+        } else if let Some(s) = payload.downcast_ref::<String>() {
+            s.clone()
+        } else {
+            "unknown panic".to_string()
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn panic_becomes_error_with_message() {
+        let r: Result<(), String> = catch_decoder_panic(|| panic!("corrupt block 7"));
+        assert_eq!(r.unwrap_err(), "corrupt block 7");
+        assert_eq!(catch_decoder_panic(|| 5).unwrap(), 5);
+    }
+}

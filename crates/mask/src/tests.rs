@@ -1,0 +1,377 @@
+use std::path::Path;
+
+use exr::prelude::{
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
+    WritableImage,
+};
+use proptest::prelude::*;
+
+use super::*;
+
+fn opts() -> MaskReadOptions {
+    MaskReadOptions::default()
+}
+
+/// A 3×2 mask with hand-chosen values: ids 0, 7, 200 / 7, 0, 3; planes; cos codes.
+fn packed8() -> MaskImage {
+    MaskImage {
+        width: 3,
+        height: 2,
+        id: vec![0, 7, 200, 7, 0, 3],
+        cos_theta: CosTheta::Quantized8(vec![0, 255, 128, 1, 0, 51]),
+        plane: vec![0, 0, 2, 1, 0, 0],
+        coverage: None,
+    }
+}
+
+fn encode_png(
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    depth: png::BitDepth,
+    data: &[u8],
+) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut e = png::Encoder::new(&mut out, width, height);
+    e.set_color(color);
+    e.set_depth(depth);
+    let mut w = e.write_header().unwrap();
+    w.write_image_data(data).unwrap();
+    w.finish().unwrap();
+    out
+}
+
+fn exr_bytes(width: usize, height: usize, channels: Vec<(&str, Vec<f32>)>) -> Vec<u8> {
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+        .into_iter()
+        .map(|(n, v)| AnyChannel::new(n, FlatSamples::F32(v)))
+        .collect();
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    let mut out = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut out)
+        .unwrap();
+    out.into_inner()
+}
+
+#[test]
+fn packed_8bit_png_reads_green_as_id_blue_as_cos_red_as_plane() {
+    // Pixel (1, 0): R = 4 (plane), G = 9 (id), B = 255 (cos 1).
+    let data = [0, 0, 0, 4, 9, 255];
+    let bytes = encode_png(2, 1, png::ColorType::Rgb, png::BitDepth::Eight, &data);
+    let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
+    assert_eq!((m.width, m.height), (2, 1));
+    assert_eq!(m.id, vec![0, 9]);
+    assert_eq!(m.plane, vec![0, 4]);
+    assert_eq!(m.cos_theta, CosTheta::Quantized8(vec![0, 255]));
+    assert_eq!(m.cos_theta_at(1), 1.0);
+    assert_eq!(
+        m.id_pixel_counts().into_iter().collect::<Vec<_>>(),
+        vec![(9, 1)]
+    );
+}
+
+#[test]
+fn packed_16bit_png_reads_big_endian_samples() {
+    // One pixel: R = 1, G = 300, B = 32768 (cos = 32768/65535).
+    let data = [0, 1, 0x01, 0x2c, 0x80, 0x00];
+    let bytes = encode_png(1, 1, png::ColorType::Rgb, png::BitDepth::Sixteen, &data);
+    let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
+    assert_eq!(m.id, vec![300]);
+    assert_eq!(m.plane, vec![1]);
+    assert_eq!(m.cos_theta, CosTheta::Quantized16(vec![32768]));
+    assert!((m.cos_theta_at(0) - 32768.0 / 65535.0).abs() < 1e-15);
+}
+
+#[test]
+fn rgba_png_alpha_is_ignored() {
+    let data = [1, 2, 3, 0];
+    let bytes = encode_png(1, 1, png::ColorType::Rgba, png::BitDepth::Eight, &data);
+    let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
+    assert_eq!((m.id[0], m.plane[0]), (2, 1));
+}
+
+#[test]
+fn png8_round_trip_is_exact() {
+    let m = packed8();
+    let bytes = write_mask_bytes(Path::new("x.png"), &m, MaskFormat::Png8).unwrap();
+    assert_eq!(
+        read_mask_bytes(&bytes, Path::new("x.png"), &opts()).unwrap(),
+        m
+    );
+}
+
+#[test]
+fn png16_from_8bit_codes_is_exact_scaling_by_257() {
+    let m = packed8();
+    let bytes = write_mask_bytes(Path::new("x.png"), &m, MaskFormat::Png16).unwrap();
+    let back = read_mask_bytes(&bytes, Path::new("x.png"), &opts()).unwrap();
+    assert_eq!(back.id, m.id);
+    assert_eq!(
+        back.cos_theta,
+        CosTheta::Quantized16(vec![0, 65535, 128 * 257, 257, 0, 51 * 257])
+    );
+    for i in 0..6 {
+        assert_eq!(back.cos_theta_at(i), m.cos_theta_at(i));
+    }
+}
+
+#[test]
+fn exr_round_trip_keeps_float_cos_plane_and_coverage() {
+    let m = MaskImage {
+        width: 2,
+        height: 2,
+        id: vec![0, 1, 65535, 2],
+        cos_theta: CosTheta::Float(vec![0.0, 0.123_456_7, 1.0, 0.5]),
+        plane: vec![0, 3, 0, 1],
+        coverage: Some(vec![0.0, 0.25, 1.0, 0.5]),
+    };
+    let bytes = write_mask_bytes(Path::new("x.exr"), &m, MaskFormat::Exr).unwrap();
+    assert_eq!(
+        read_mask_bytes(&bytes, Path::new("x.exr"), &opts()).unwrap(),
+        m
+    );
+}
+
+#[test]
+fn exr_channel_names_are_selectable() {
+    let bytes = exr_bytes(
+        2,
+        1,
+        vec![
+            ("ViewLayer.IndexMA", vec![0.0, 4.0]),
+            ("ViewLayer.Facing", vec![0.3, 0.75]),
+            ("R", vec![1.0, 1.0]),
+        ],
+    );
+    let mut o = opts();
+    o.exr_channels.id = "ViewLayer.IndexMA".into();
+    o.exr_channels.cos_theta = "ViewLayer.Facing".into();
+    let m = read_mask_bytes(&bytes, Path::new("aov.exr"), &o).unwrap();
+    assert_eq!(m.id, vec![0, 4]);
+    assert_eq!(m.cos_theta, CosTheta::Float(vec![0.3, 0.75]));
+    assert_eq!(m.plane, vec![0, 0]);
+    assert_eq!(m.coverage, None);
+
+    let err = read_mask_bytes(&bytes, Path::new("aov.exr"), &opts())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("aov.exr") && err.contains("\"id\"") && err.contains("ViewLayer.IndexMA"),
+        "{err}"
+    );
+}
+
+#[test]
+fn exr_fractional_id_names_the_pixel() {
+    let bytes = exr_bytes(
+        3,
+        2,
+        vec![
+            ("id", vec![0.0, 1.0, 2.0, 3.0, 4.5, 0.0]),
+            ("cos_theta", vec![0.5; 6]),
+        ],
+    );
+    let err = read_mask_bytes(&bytes, Path::new("bad.exr"), &opts())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("bad.exr") && err.contains("x 1, y 1") && err.contains("4.5"),
+        "{err}"
+    );
+}
+
+#[test]
+fn exr_cos_outside_unit_interval_on_glass_is_an_error_but_ignored_off_glass() {
+    let ok = exr_bytes(
+        2,
+        1,
+        vec![("id", vec![0.0, 1.0]), ("cos_theta", vec![7.0, 1.0000001])],
+    );
+    let m = read_mask_bytes(&ok, Path::new("m.exr"), &opts()).unwrap();
+    assert_eq!(m.cos_theta_at(1), 1.0);
+    let bad = exr_bytes(
+        2,
+        1,
+        vec![("id", vec![0.0, 1.0]), ("cos_theta", vec![0.0, f32::NAN])],
+    );
+    let err = read_mask_bytes(&bad, Path::new("m.exr"), &opts())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("x 1, y 0") && err.contains("NaN"), "{err}");
+}
+
+#[test]
+fn binary_mask_white_is_the_given_glass_at_normal_incidence() {
+    let data = [0, 255, 0, 255];
+    let bytes = encode_png(4, 1, png::ColorType::Grayscale, png::BitDepth::Eight, &data);
+    let mut o = opts();
+    o.binary_glass_id = Some(12);
+    let m = read_mask_bytes(&bytes, Path::new("b.png"), &o).unwrap();
+    assert_eq!(m.id, vec![0, 12, 0, 12]);
+    assert_eq!(m.cos_theta, CosTheta::Normal);
+    assert_eq!(m.cos_theta_at(1), 1.0);
+    assert_eq!(m.coverage, None);
+    // Grey (antialiased) edges become coverage.
+    let data = [0, 0, 0, 51, 51, 51, 255, 255, 255];
+    let bytes = encode_png(3, 1, png::ColorType::Rgb, png::BitDepth::Eight, &data);
+    let m = read_mask_bytes(&bytes, Path::new("b.png"), &o).unwrap();
+    assert_eq!(m.id, vec![0, 12, 12]);
+    assert_eq!(m.coverage, Some(vec![0.0, 0.2, 1.0]));
+}
+
+#[test]
+fn grey_png_without_glass_id_is_explained() {
+    let bytes = encode_png(
+        1,
+        1,
+        png::ColorType::Grayscale,
+        png::BitDepth::Eight,
+        &[255],
+    );
+    let err = read_mask_bytes(&bytes, Path::new("g.png"), &opts())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("g.png") && err.contains("--glass"), "{err}");
+}
+
+#[test]
+fn writers_refuse_what_the_format_cannot_hold() {
+    let mut m = packed8();
+    m.id[4] = 256;
+    let err = write_mask_bytes(Path::new("o.png"), &m, MaskFormat::Png8)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("x 1, y 1") && err.contains("256"), "{err}");
+    assert!(write_mask_bytes(Path::new("o.png"), &m, MaskFormat::Png16).is_ok());
+    let mut m = packed8();
+    m.coverage = Some(vec![1.0; 6]);
+    assert!(write_mask_bytes(Path::new("o.png"), &m, MaskFormat::Png8).is_err());
+    let mut m = packed8();
+    m.plane.pop();
+    assert!(matches!(
+        write_mask_bytes(Path::new("o.exr"), &m, MaskFormat::Exr),
+        Err(MaskError::Inconsistent(_))
+    ));
+}
+
+#[test]
+fn float_cos_rounds_to_nearest_code() {
+    let m = MaskImage {
+        width: 3,
+        height: 1,
+        id: vec![1, 1, 1],
+        cos_theta: CosTheta::Float(vec![0.5, 1.0 / 255.0 * 0.49, 0.999]),
+        plane: vec![0; 3],
+        coverage: None,
+    };
+    let bytes = write_mask_bytes(Path::new("o.png"), &m, MaskFormat::Png8).unwrap();
+    let back = read_mask_bytes(&bytes, Path::new("o.png"), &opts()).unwrap();
+    assert_eq!(back.cos_theta, CosTheta::Quantized8(vec![128, 0, 255]));
+}
+
+#[test]
+fn write_mask_is_atomic_and_read_mask_names_missing_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("m.png");
+    write_mask(&p, &packed8(), MaskFormat::Png8).unwrap();
+    assert_eq!(read_mask(&p, &opts()).unwrap(), packed8());
+    let missing = dir.path().join("nope.png");
+    let err = read_mask(&missing, &opts()).unwrap_err().to_string();
+    assert!(err.contains("nope.png"), "{err}");
+    let err = write_mask(
+        &dir.path().join("no/dir/m.png"),
+        &packed8(),
+        MaskFormat::Png8,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("no/dir/m.png"), "{err}");
+}
+
+#[test]
+fn size_limit_is_checked_before_decoding() {
+    let bytes = write_mask_bytes(Path::new("x.png"), &packed8(), MaskFormat::Png8).unwrap();
+    let mut o = opts();
+    o.max_pixels = 5;
+    let err = read_mask_bytes(&bytes, Path::new("x.png"), &o)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("3×2") && err.contains("limit"), "{err}");
+    let bytes = write_mask_bytes(Path::new("x.exr"), &packed8(), MaskFormat::Exr).unwrap();
+    let err = read_mask_bytes(&bytes, Path::new("x.exr"), &o)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("3×2") && err.contains("limit"), "{err}");
+}
+
+#[test]
+fn unknown_format_shows_the_first_bytes() {
+    let err = read_mask_bytes(b"GIF89a....", Path::new("m.gif"), &opts())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("m.gif") && err.contains("47"), "{err}");
+}
+
+#[test]
+fn truncated_files_are_errors() {
+    for format in [MaskFormat::Png8, MaskFormat::Exr] {
+        let bytes = write_mask_bytes(Path::new("x"), &packed8(), format).unwrap();
+        // (A PNG cut inside its final IEND chunk still holds every pixel, so it may decode.)
+        for cut in [8, bytes.len() / 2, bytes.len() - 20] {
+            assert!(
+                read_mask_bytes(&bytes[..cut], Path::new("x"), &opts()).is_err(),
+                "{format:?} cut at {cut}"
+            );
+        }
+    }
+}
+
+fn corrupt(bytes: &[u8], flips: &[(usize, u8)], cut: usize) -> Vec<u8> {
+    let mut b = bytes.to_vec();
+    for &(pos, v) in flips {
+        if !b.is_empty() {
+            let i = pos % b.len();
+            b[i] ^= v;
+        }
+    }
+    b.truncate(cut.max(1).min(b.len()));
+    b
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, rng_seed: proptest::test_runner::RngSeed::Fixed(0x6c61_7373), failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Corrupt PNG and EXR masks never panic: each read returns a mask or an error.
+    #[test]
+    fn corrupt_masks_never_panic(
+        flips in proptest::collection::vec((any::<usize>(), 1u8..=255), 0..6),
+        cut in 0usize..4000,
+        exr in any::<bool>(),
+        binary in any::<bool>(),
+    ) {
+        let m = MaskImage {
+            width: 20,
+            height: 17,
+            id: (0..340).map(|i| (i % 5) as u16).collect(),
+            cos_theta: CosTheta::Float((0..340).map(|i| (i % 11) as f32 / 10.0).collect()),
+            plane: (0..340).map(|i| (i % 3) as u16).collect(),
+            coverage: None,
+        };
+        let format = if exr { MaskFormat::Exr } else { MaskFormat::Png16 };
+        let bytes = write_mask_bytes(Path::new("p"), &m, format).unwrap();
+        let bad = corrupt(&bytes, &flips, if flips.is_empty() { cut } else { bytes.len() });
+        let mut o = opts();
+        o.max_pixels = 1 << 16;
+        if binary && !exr {
+            o.binary_glass_id = Some(1);
+        }
+        let _ = read_mask_bytes(&bad, Path::new("p"), &o);
+    }
+}

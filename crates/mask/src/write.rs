@@ -1,0 +1,178 @@
+//! Writing masks (atomically, through `glassdb-io`).
+
+use std::io::Cursor;
+use std::path::Path;
+
+use exr::prelude::{
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
+    WritableImage,
+};
+
+use crate::{CosTheta, MaskError, MaskImage};
+
+/// The file formats a mask can be written in (see the crate docs and `docs/mask.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MaskFormat {
+    /// 8-bit RGB PNG: R = plane (0–255), G = id (1–255), B = round(cos θ·255).
+    Png8,
+    /// 16-bit RGB PNG: R = plane, G = id (1–65535), B = round(cos θ·65535).
+    Png16,
+    /// OpenEXR, ZIP-compressed float channels `id`, `cos_theta`, and `plane` (when any pixel
+    /// is on a plane other than 0) and `coverage` (when the mask has it).
+    Exr,
+}
+
+impl MaskFormat {
+    fn name(self) -> &'static str {
+        match self {
+            MaskFormat::Png8 => "8-bit PNG",
+            MaskFormat::Png16 => "16-bit PNG",
+            MaskFormat::Exr => "EXR",
+        }
+    }
+}
+
+/// Writes `mask` to `path` in `format`, atomically (a temporary file renamed into place).
+/// cos θ is quantised to the format's precision (round to nearest); ids, planes or coverage
+/// that the format cannot hold are an error naming the first pixel, never a silent loss.
+pub fn write_mask(path: &Path, mask: &MaskImage, format: MaskFormat) -> Result<(), MaskError> {
+    let bytes = write_mask_bytes(path, mask, format)?;
+    glassdb_io::write_bytes_atomic(path, &bytes)?;
+    Ok(())
+}
+
+/// Encodes `mask` in `format` into memory; `path` is only used in error messages.
+pub fn write_mask_bytes(
+    path: &Path,
+    mask: &MaskImage,
+    format: MaskFormat,
+) -> Result<Vec<u8>, MaskError> {
+    mask.check_consistent().map_err(MaskError::Inconsistent)?;
+    let w = mask.width as usize;
+    let not_representable = |i: usize, detail: String| MaskError::NotRepresentable {
+        path: path.to_path_buf(),
+        format: format.name(),
+        detail: format!("pixel (x {}, y {}): {detail}", i % w.max(1), i / w.max(1)),
+    };
+    match format {
+        MaskFormat::Png8 | MaskFormat::Png16 => {
+            if mask.coverage.is_some() {
+                return Err(MaskError::NotRepresentable {
+                    path: path.to_path_buf(),
+                    format: format.name(),
+                    detail:
+                        "a PNG mask has no coverage channel; write EXR to keep antialiased edges"
+                            .into(),
+                });
+            }
+            let (limit, scale) = if format == MaskFormat::Png8 {
+                (255u16, 255.0)
+            } else {
+                (65535u16, 65535.0)
+            };
+            let mut samples: Vec<u16> = Vec::with_capacity(mask.pixel_count() * 3);
+            for i in 0..mask.pixel_count() {
+                let id = mask.id[i];
+                let plane = mask.plane[i];
+                if id > limit {
+                    return Err(not_representable(
+                        i,
+                        format!("glass id {id} is above {limit}"),
+                    ));
+                }
+                if plane > limit {
+                    return Err(not_representable(
+                        i,
+                        format!("plane {plane} is above {limit}"),
+                    ));
+                }
+                let code = match (&mask.cos_theta, format) {
+                    (CosTheta::Quantized8(c), MaskFormat::Png8) => u16::from(c[i]),
+                    (CosTheta::Quantized8(c), _) => u16::from(c[i]) * 257,
+                    (CosTheta::Quantized16(c), MaskFormat::Png16) => c[i],
+                    (CosTheta::Normal, _) => limit,
+                    _ => {
+                        let c = mask.cos_theta_at(i);
+                        if !c.is_finite() {
+                            return Err(not_representable(i, format!("cos θ {c} is not a number")));
+                        }
+                        (c.clamp(0.0, 1.0) * scale).round() as u16
+                    }
+                };
+                samples.extend_from_slice(&[plane, id, code]);
+            }
+            encode_png_rgb(
+                path,
+                mask.width,
+                mask.height,
+                &samples,
+                format == MaskFormat::Png16,
+            )
+        }
+        MaskFormat::Exr => {
+            let n = mask.pixel_count();
+            let id: Vec<f32> = mask.id.iter().map(|&v| f32::from(v)).collect();
+            let cos: Vec<f32> = match &mask.cos_theta {
+                CosTheta::Float(c) => c.clone(),
+                _ => (0..n).map(|i| mask.cos_theta_at(i) as f32).collect(),
+            };
+            let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+            list.push(AnyChannel::new("id", FlatSamples::F32(id)));
+            list.push(AnyChannel::new("cos_theta", FlatSamples::F32(cos)));
+            if mask.plane.iter().any(|&p| p != 0) {
+                list.push(AnyChannel::new(
+                    "plane",
+                    FlatSamples::F32(mask.plane.iter().map(|&p| f32::from(p)).collect()),
+                ));
+            }
+            if let Some(c) = &mask.coverage {
+                list.push(AnyChannel::new("coverage", FlatSamples::F32(c.clone())));
+            }
+            let layer = Layer::new(
+                (w, mask.height as usize),
+                LayerAttributes::default(),
+                Encoding::SMALL_LOSSLESS,
+                AnyChannels::sort(list),
+            );
+            let image = Image::from_layer(layer);
+            let mut out = Cursor::new(Vec::new());
+            image
+                .write()
+                .to_buffered(&mut out)
+                .map_err(|e| MaskError::Encode {
+                    path: path.to_path_buf(),
+                    detail: e.to_string(),
+                })?;
+            Ok(out.into_inner())
+        }
+    }
+}
+
+/// Encodes interleaved RGB samples (each < 256 when `sixteen` is false) as a PNG.
+fn encode_png_rgb(
+    path: &Path,
+    width: u32,
+    height: u32,
+    samples: &[u16],
+    sixteen: bool,
+) -> Result<Vec<u8>, MaskError> {
+    let enc_err = |e: png::EncodingError| MaskError::Encode {
+        path: path.to_path_buf(),
+        detail: e.to_string(),
+    };
+    let mut out = Vec::new();
+    let mut encoder = png::Encoder::new(&mut out, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_compression(png::Compression::Balanced);
+    let data: Vec<u8> = if sixteen {
+        encoder.set_depth(png::BitDepth::Sixteen);
+        samples.iter().flat_map(|s| s.to_be_bytes()).collect()
+    } else {
+        encoder.set_depth(png::BitDepth::Eight);
+        samples.iter().map(|&s| s as u8).collect()
+    };
+    let mut writer = encoder.write_header().map_err(enc_err)?;
+    writer.write_image_data(&data).map_err(enc_err)?;
+    writer.finish().map_err(enc_err)?;
+    Ok(out)
+}
