@@ -1,17 +1,336 @@
-//! `glassdb mirror` and `glassdb mask`: under construction (owned by the scene work item).
+//! `glassdb mirror` (virtual scenes of the glass planes) and `glassdb mask` (the id + cos θ
+//! mask) from an OBJ scene (docs/scene.md). All logic lives in `glassdb_scene`; this module
+//! parses arguments and formats output.
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use glassdb_mask::{MaskFormat, write_mask};
+use glassdb_scene::{
+    Camera, CosEncoding, CosMode, GlassMapping, MirrorRequest, PlaneSource, PlaneTolerance,
+    PlanesFile, RasterOptions, build_mask_scene, load_obj, rasterize, to_mask_image,
+    write_virtual_scenes,
+};
 
 #[derive(Debug, clap::Args)]
-pub struct MirrorArgs {}
-
-#[derive(Debug, clap::Args)]
-pub struct MaskArgs {}
-
-pub fn run_mirror(_args: MirrorArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`mirror` is not built yet")
+pub struct MirrorArgs {
+    /// The OBJ scene (its MTL libraries are referenced, not copied).
+    pub scene: PathBuf,
+    /// Glob pattern of glass material names (e.g. "Glass*"); repeatable.
+    #[arg(long = "glass-material", value_name = "PATTERN")]
+    pub glass_material: Vec<String>,
+    /// One explicit plane a,b,c,d (a·x + b·y + c·z + d = 0) instead of detecting the planes.
+    #[arg(long, value_name = "A,B,C,D", allow_hyphen_values = true)]
+    pub plane: Option<String>,
+    /// The eye x,y,z: keeps each plane's half-space on the eye's side. Default: the side the
+    /// glass faces' normals point to.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub eye: Option<String>,
+    /// Directory for plane_<k>.obj and planes.json (created if missing).
+    #[arg(long = "out-dir", value_name = "DIR")]
+    pub out_dir: PathBuf,
+    /// Largest angle between the normals of faces on one plane, degrees.
+    #[arg(long, default_value_t = 0.1)]
+    pub angle_tolerance_deg: f64,
+    /// Largest distance of a face from its plane, scene units (default: 1e-4 of the scene's
+    /// bounding-box diagonal).
+    #[arg(long)]
+    pub distance_tolerance: Option<f64>,
 }
 
-pub fn run_mask(_args: MaskArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`mask` is not built yet")
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CosArg {
+    /// |n · d| of each pixel's centre ray.
+    Exact,
+    /// The paper's way: cos θ at the nodes of an N×N mesh per pane, interpolated (see --mesh).
+    Gouraud,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FormatArg {
+    /// 8-bit RGB PNG: R plane, G id (1–255), B cos θ·255.
+    Png8,
+    /// 16-bit RGB PNG: R plane, G id, B cos θ·65535.
+    Png16,
+    /// OpenEXR float channels id, cos_theta, plane, coverage.
+    Exr,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct MaskArgs {
+    /// The OBJ scene.
+    pub scene: PathBuf,
+    /// Camera JSON: origin, target, up, fov_x_deg, width, height (docs/scene.md).
+    #[arg(long, value_name = "CAMERA.json")]
+    pub camera: PathBuf,
+    /// PATTERN=ID: faces whose material matches the glob PATTERN are glass with registration
+    /// id ID (1–65535); repeatable, first match wins. Every other face is opaque.
+    #[arg(long = "glass", value_name = "PATTERN=ID", required = true)]
+    pub glass: Vec<String>,
+    /// Output mask: .png (8-bit unless --format png16) or .exr.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Output format, overriding the one the extension implies.
+    #[arg(long, value_enum)]
+    pub format: Option<FormatArg>,
+    /// How cos θ is computed.
+    #[arg(long, value_enum, default_value = "exact")]
+    pub cos: CosArg,
+    /// Mesh size N of --cos gouraud (N×N cells per pane).
+    #[arg(long, value_name = "N")]
+    pub mesh: Option<u32>,
+    /// K: a coverage channel from K×K sub-pixel rays (EXR output only).
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    pub samples: u32,
+    /// Take the plane indices from a planes.json of `glassdb mirror`, so that they select the
+    /// matching reflection passes. Default: detect them as `mirror` does.
+    #[arg(long, value_name = "PLANES.json")]
+    pub planes: Option<PathBuf>,
+    /// Plane grouping: largest angle between face normals, degrees.
+    #[arg(long, default_value_t = 0.1)]
+    pub angle_tolerance_deg: f64,
+    /// Plane grouping: largest distance of a face from its plane, scene units (default: 1e-4
+    /// of the scene's bounding-box diagonal, or the planes file's tolerance).
+    #[arg(long)]
+    pub distance_tolerance: Option<f64>,
+}
+
+/// Parses `n` comma-separated finite numbers.
+fn parse_numbers<const N: usize>(text: &str, what: &str) -> anyhow::Result<[f64; N]> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != N {
+        bail!(
+            "{what} {text:?}: expected {N} comma-separated numbers, found {}",
+            parts.len()
+        );
+    }
+    let mut out = [0.0; N];
+    for (k, p) in parts.iter().enumerate() {
+        out[k] = p
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .with_context(|| format!("{what} {text:?}: {p:?} is not a finite number"))?;
+    }
+    Ok(out)
+}
+
+fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+}
+
+pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
+    let plane = args
+        .plane
+        .as_deref()
+        .map(|p| parse_numbers::<4>(p, "--plane"))
+        .transpose()?;
+    let eye = args
+        .eye
+        .as_deref()
+        .map(|e| parse_numbers::<3>(e, "--eye"))
+        .transpose()?;
+    if plane.is_none() && args.glass_material.is_empty() {
+        bail!("give the glass materials (--glass-material PATTERN) or one plane (--plane a,b,c,d)");
+    }
+    let scene = load_obj(&args.scene)?;
+    print_warnings(&scene.warnings);
+    let mut tolerance = PlaneTolerance::default_for(&scene);
+    tolerance.angle_deg = args.angle_tolerance_deg;
+    if let Some(d) = args.distance_tolerance {
+        tolerance.distance = d;
+    }
+    let report = write_virtual_scenes(&MirrorRequest {
+        scene: &scene,
+        glass_patterns: args.glass_material.clone(),
+        explicit_plane: plane,
+        eye,
+        tolerance,
+        out_dir: &args.out_dir,
+    })?;
+    println!(
+        "{} glass plane{} in {} ({} triangles; tolerance {}°, {:e} units)",
+        report.planes.planes.len(),
+        if report.planes.planes.len() == 1 {
+            ""
+        } else {
+            "s"
+        },
+        args.scene.display(),
+        scene.triangle_count(),
+        tolerance.angle_deg,
+        tolerance.distance
+    );
+    for (p, stats) in report.planes.planes.iter().zip(&report.stats) {
+        let [a, b, c, d] = p.equation;
+        println!(
+            "plane {}: {a:.6}x {:+.6}y {:+.6}z {:+.6} = 0  area {:.6}  {} glass triangles  materials [{}]  eye sees the {}  -> {} ({} triangles, {} clipped, {} behind)",
+            p.index,
+            b,
+            c,
+            d,
+            p.area,
+            p.triangles,
+            p.materials.join(", "),
+            p.eye_side,
+            args.out_dir.join(&p.file).display(),
+            stats.written,
+            stats.clipped,
+            stats.behind,
+        );
+    }
+    println!("wrote {}", report.planes_path.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The mask format from `--format` or the output's extension.
+fn mask_format(output: &Path, format: Option<FormatArg>) -> anyhow::Result<MaskFormat> {
+    let ext = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let by_ext = match ext.as_deref() {
+        Some("png") => Some(MaskFormat::Png8),
+        Some("exr") => Some(MaskFormat::Exr),
+        _ => None,
+    };
+    let chosen = match format {
+        Some(FormatArg::Png8) => MaskFormat::Png8,
+        Some(FormatArg::Png16) => MaskFormat::Png16,
+        Some(FormatArg::Exr) => MaskFormat::Exr,
+        None => by_ext.with_context(|| {
+            format!(
+                "cannot tell the mask format of {}: use a .png or .exr name, or --format",
+                output.display()
+            )
+        })?,
+    };
+    match (by_ext, chosen) {
+        (Some(MaskFormat::Exr), MaskFormat::Png8 | MaskFormat::Png16)
+        | (Some(MaskFormat::Png8), MaskFormat::Exr) => {
+            bail!(
+                "--format does not match the extension of {}",
+                output.display()
+            )
+        }
+        _ => Ok(chosen),
+    }
+}
+
+pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
+    let format = mask_format(&args.output, args.format)?;
+    if args.samples >= 2 && format != MaskFormat::Exr {
+        bail!(
+            "--samples {} makes a coverage channel, which only an EXR mask holds: write a .exr",
+            args.samples
+        );
+    }
+    let cos = match (args.cos, args.mesh) {
+        (CosArg::Exact, None) => CosMode::Exact,
+        (CosArg::Exact, Some(_)) => bail!("--mesh only applies to --cos gouraud"),
+        (CosArg::Gouraud, mesh) => CosMode::Gouraud {
+            mesh: mesh.unwrap_or(8),
+        },
+    };
+    let options = RasterOptions {
+        cos,
+        samples: args.samples,
+    };
+    glassdb_scene::raster::check_options(&options)?;
+    let mappings = args
+        .glass
+        .iter()
+        .map(|g| GlassMapping::parse(g))
+        .collect::<Result<Vec<_>, _>>()?;
+    if format == MaskFormat::Png8
+        && let Some(m) = mappings.iter().find(|m| m.id > 255)
+    {
+        bail!(
+            "glass id {} ({}) does not fit an 8-bit PNG mask (ids 1-255): use --format png16 or a .exr output",
+            m.id,
+            m.pattern
+        );
+    }
+    let camera = Camera::load(&args.camera)?;
+    glassdb_io::refuse_input_as_output(
+        &args.output,
+        [args.scene.as_path(), args.camera.as_path()],
+    )?;
+
+    let t0 = Instant::now();
+    let scene = load_obj(&args.scene)?;
+    print_warnings(&scene.warnings);
+    let source = match &args.planes {
+        Some(p) => {
+            let file = PlanesFile::load(p)?;
+            let mut tolerance = file.tolerance();
+            tolerance.angle_deg = args.angle_tolerance_deg.max(tolerance.angle_deg);
+            if let Some(d) = args.distance_tolerance {
+                tolerance.distance = d;
+            }
+            PlaneSource::Given {
+                planes: file.planes(),
+                tolerance,
+            }
+        }
+        None => {
+            let mut tolerance = PlaneTolerance::default_for(&scene);
+            tolerance.angle_deg = args.angle_tolerance_deg;
+            if let Some(d) = args.distance_tolerance {
+                tolerance.distance = d;
+            }
+            PlaneSource::Detect(tolerance)
+        }
+    };
+    let labelled = build_mask_scene(
+        &scene,
+        &mappings,
+        &source,
+        matches!(cos, CosMode::Gouraud { .. }),
+    )?;
+    for p in &labelled.unmatched_patterns {
+        eprintln!("warning: --glass {p} matches no material with faces");
+    }
+    let t_load = t0.elapsed();
+    let t1 = Instant::now();
+    let out = rasterize(&labelled.raster, &camera, &options)?;
+    let t_raster = t1.elapsed();
+    let drawn = out.triangles_drawn;
+    let encoding = match format {
+        MaskFormat::Png8 => CosEncoding::Quantized8,
+        MaskFormat::Png16 => CosEncoding::Quantized16,
+        MaskFormat::Exr => CosEncoding::Float,
+    };
+    let mask = to_mask_image(out, encoding);
+    write_mask(&args.output, &mask, format)?;
+
+    println!(
+        "{}x{} mask of {} ({} triangles, {} glass on {} plane{}; {} in view) -> {}",
+        mask.width,
+        mask.height,
+        args.scene.display(),
+        scene.triangle_count(),
+        labelled.glass_triangles,
+        labelled.planes.len(),
+        if labelled.planes.len() == 1 { "" } else { "s" },
+        drawn,
+        args.output.display()
+    );
+    let counts = mask.id_pixel_counts();
+    if counts.is_empty() {
+        println!("no glass is visible from this camera");
+    }
+    for (id, n) in counts {
+        println!("id {id}: {n} pixels");
+    }
+    println!(
+        "load {:.3} s, rasterise {:.3} s",
+        t_load.as_secs_f64(),
+        t_raster.as_secs_f64()
+    );
+    Ok(ExitCode::SUCCESS)
 }

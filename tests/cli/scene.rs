@@ -1,1 +1,486 @@
-//! End-to-end tests of the scene commands.
+//! End-to-end tests of the scene commands: `glassdb mirror` and `glassdb mask` on the room
+//! fixture (fixtures/scene/README.md). Expected values are hand-computed from the fixture's
+//! geometry (planes z = 0 and x = 2, eye (0.3, 1.2, 4)).
+
+use std::path::{Path, PathBuf};
+
+use glassdb_mask::{CosTheta, MaskReadOptions, read_mask};
+
+use crate::util::{fails, glassdb, ok, repo_path, write_file};
+
+fn room() -> PathBuf {
+    repo_path("fixtures/scene/room.obj")
+}
+
+fn camera() -> PathBuf {
+    repo_path("fixtures/scene/camera.json")
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Vertex positions and `usemtl` names of an OBJ written by `mirror`.
+fn obj_summary(path: &Path) -> (Vec<[f64; 3]>, Vec<String>, Vec<String>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut v = Vec::new();
+    let mut mtls = Vec::new();
+    let mut libs = Vec::new();
+    for l in text.lines() {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        match w.first() {
+            Some(&"v") => v.push([
+                w[1].parse().unwrap(),
+                w[2].parse().unwrap(),
+                w[3].parse().unwrap(),
+            ]),
+            Some(&"usemtl") => mtls.push(w[1].to_string()),
+            Some(&"mtllib") => libs.push(w[1].to_string()),
+            _ => {}
+        }
+    }
+    (v, mtls, libs)
+}
+
+fn has_point(v: &[[f64; 3]], p: [f64; 3]) -> bool {
+    v.iter()
+        .any(|q| (0..3).all(|k| (q[k] - p[k]).abs() < 1e-12))
+}
+
+#[test]
+fn mirror_finds_both_planes_and_writes_clipped_virtual_scenes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("virtual");
+    let stdout = ok(glassdb()
+        .arg("mirror")
+        .arg(room())
+        .args([
+            "--glass-material",
+            "Clear*",
+            "--glass-material",
+            "Tinted*",
+            "--eye",
+            "0.3,1.2,4",
+            "--out-dir",
+        ])
+        .arg(&out));
+    assert!(stdout.contains("2 glass planes"), "{stdout}");
+    let planes = json(&out.join("planes.json"));
+    let p = planes["planes"].as_array().unwrap();
+    assert_eq!(p.len(), 2);
+    // Plane 0: z = 0 facing +z, area 2×2; plane 1: x = 2 facing −x, i.e. −x + 2 = 0.
+    let eq = |k: usize| -> Vec<f64> {
+        p[k]["equation"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    assert_eq!(eq(0), vec![0.0, 0.0, 1.0, 0.0]);
+    assert_eq!(eq(1), vec![-1.0, 0.0, 0.0, 2.0]);
+    assert_eq!(p[0]["area"].as_f64().unwrap(), 4.0);
+    assert_eq!(p[1]["area"].as_f64().unwrap(), 4.0);
+    assert_eq!(p[0]["materials"], serde_json::json!(["Clear_6mm"]));
+    assert_eq!(p[1]["materials"], serde_json::json!(["Tinted_Grey"]));
+    assert_eq!(p[0]["eye_side"], "front");
+    assert_eq!(p[1]["eye_side"], "front");
+    // Reflection across z = 0 is diag(1, 1, −1, 1); across x = 2 it is x ↦ 4 − x.
+    assert_eq!(
+        p[0]["reflection_matrix"],
+        serde_json::json!([
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, -1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0]
+        ])
+    );
+    assert_eq!(
+        p[1]["reflection_matrix"][0],
+        serde_json::json!([-1.0, 0.0, 0.0, 4.0])
+    );
+
+    let (v, mtls, libs) = obj_summary(&out.join(p[0]["file"].as_str().unwrap()));
+    // No glass in the virtual scene; the other materials are kept.
+    assert!(
+        !mtls
+            .iter()
+            .any(|m| m.starts_with("Clear") || m.starts_with("Tinted")),
+        "{mtls:?}"
+    );
+    assert!(mtls.contains(&"Wood".to_string()) && mtls.contains(&"Concrete".to_string()));
+    // The MTL reference resolves from the output directory.
+    assert!(out.join(&libs[0]).exists(), "{libs:?}");
+    // Everything kept was at z ≥ 0 and is now at z ≤ 0.
+    assert!(v.iter().all(|q| q[2] <= 0.0), "{v:?}");
+    // Known points: a box corner (0.3, 0.6, 1.1) ↦ (0.3, 0.6, −1.1); the floor is clipped at
+    // the plane (new corners (±3, 0, 0)) and its far half (z < 0) is gone.
+    assert!(has_point(&v, [0.3, 0.6, -1.1]));
+    assert!(has_point(&v, [3.0, 0.0, 0.0]) && has_point(&v, [-3.0, 0.0, 0.0]));
+    assert!(has_point(&v, [-3.0, 0.0, -3.0]) && !has_point(&v, [-3.0, 0.0, 3.0]));
+
+    // Plane 1 (x = 2): the floor keeps x ≤ 2, mirrored to x ≥ 2 (x ↦ 4 − x): (−3, 0, 3) ↦ (7, 0, 3).
+    let (v1, _, _) = obj_summary(&out.join(p[1]["file"].as_str().unwrap()));
+    assert!(v1.iter().all(|q| q[0] >= 2.0 - 1e-12), "{v1:?}");
+    assert!(has_point(&v1, [7.0, 0.0, 3.0]) && has_point(&v1, [2.0, 0.0, 3.0]));
+}
+
+#[test]
+fn mirror_with_an_explicit_plane_and_the_eye_behind_it() {
+    let dir = tempfile::tempdir().unwrap();
+    // The plane y = 1 (normal +y), eye below it: the kept half-space is y ≤ 1.
+    ok(glassdb()
+        .arg("mirror")
+        .arg(room())
+        .args(["--plane", "0,2,0,-2", "--eye", "0,0.5,3", "--out-dir"])
+        .arg(dir.path()));
+    let planes = json(&dir.path().join("planes.json"));
+    assert_eq!(
+        planes["planes"][0]["equation"],
+        serde_json::json!([0.0, 1.0, 0.0, -1.0])
+    );
+    assert_eq!(planes["planes"][0]["eye_side"], "back");
+    let (v, mtls, _) = obj_summary(&dir.path().join("plane_0.obj"));
+    // Without --glass-material nothing is dropped: the windows are mirrored too (y ↦ 2 − y).
+    assert!(mtls.contains(&"Clear_6mm".to_string()));
+    assert!(v.iter().all(|q| q[1] >= 1.0 - 1e-12), "{v:?}");
+    assert!(has_point(&v, [-1.0, 2.0, 0.0]) && has_point(&v, [-1.0, 1.0, 0.0]));
+}
+
+/// The ray from the fixture camera's origin towards world point `p` and the pixel it falls
+/// in, by the conventions of docs/scene.md (computed here from the camera JSON).
+fn pixel_of(p: [f64; 3]) -> (u32, u32, [f64; 3]) {
+    let o = [0.3, 1.2, 4.0];
+    let t = [0.5, 0.8, 0.0];
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let unit = |a: [f64; 3]| {
+        let n = dot(a, a).sqrt();
+        [a[0] / n, a[1] / n, a[2] / n]
+    };
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let f = unit(sub(t, o));
+    let r = unit(cross(f, [0.0, 1.0, 0.0]));
+    let u = cross(r, f);
+    let d = sub(p, o);
+    let (x, y, z) = (dot(d, r), dot(d, u), dot(d, f));
+    let tx = 35f64.to_radians().tan();
+    let ty = tx * 120.0 / 160.0;
+    let px = (x / z / tx + 1.0) * 80.0;
+    let py = (1.0 - y / z / ty) * 60.0;
+    (px.floor() as u32, py.floor() as u32, unit(d))
+}
+
+/// The exact cos θ at the centre of pixel (i, j) on a plane with normal `n`.
+fn cos_at_pixel(i: u32, j: u32, n: [f64; 3]) -> f64 {
+    let o = [0.3, 1.2, 4.0];
+    let t = [0.5, 0.8, 0.0];
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let unit = |a: [f64; 3]| {
+        let n = dot(a, a).sqrt();
+        [a[0] / n, a[1] / n, a[2] / n]
+    };
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let f = unit(sub(t, o));
+    let r = unit(cross(f, [0.0, 1.0, 0.0]));
+    let u = cross(r, f);
+    let tx = 35f64.to_radians().tan();
+    let sx = ((i as f64 + 0.5) / 80.0 - 1.0) * tx;
+    let sy = (1.0 - (j as f64 + 0.5) / 60.0) * tx * 0.75;
+    let d = unit([
+        f[0] + sx * r[0] + sy * u[0],
+        f[1] + sx * r[1] + sy * u[1],
+        f[2] + sx * r[2] + sy * u[2],
+    ]);
+    dot(d, n).abs()
+}
+
+fn mask_args(out: &Path) -> std::process::Command {
+    let mut c = glassdb();
+    c.arg("mask")
+        .arg(room())
+        .arg("--camera")
+        .arg(camera())
+        .args(["--glass", "Clear*=1", "--glass", "Tinted*=2", "-o"])
+        .arg(out);
+    c
+}
+
+#[test]
+fn mask_png_has_ids_planes_occlusion_and_exact_cos() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mask.png");
+    let stdout = ok(&mut mask_args(&out));
+    assert!(stdout.contains("160x120"), "{stdout}");
+    let m = read_mask(&out, &MaskReadOptions::default()).unwrap();
+    assert_eq!((m.width, m.height), (160, 120));
+    let CosTheta::Quantized8(codes) = &m.cos_theta else {
+        panic!("8-bit PNG gives 8-bit codes")
+    };
+    let at = |i: u32, j: u32| (j * 160 + i) as usize;
+
+    // Main window, upper part (not behind the box): id 1, plane 0, cos code = round(cos·255).
+    let (i, j, _) = pixel_of([0.5, 1.5, 0.0]);
+    assert_eq!((m.id[at(i, j)], m.plane[at(i, j)]), (1, 0));
+    let expect = (cos_at_pixel(i, j, [0.0, 0.0, 1.0]) * 255.0).round() as u8;
+    assert_eq!(codes[at(i, j)], expect);
+    // The box (in front of the window's lower middle) hides the glass: id 0.
+    let (i, j, _) = pixel_of([0.0, 0.45, 1.1]);
+    assert_eq!(m.id[at(i, j)], 0);
+    // ...but the window beside the box is glass.
+    let (i, j, _) = pixel_of([-0.8, 0.3, 0.0]);
+    assert_eq!(m.id[at(i, j)], 1);
+    // Side window: id 2 on plane 1, normal −x.
+    let (i, j, _) = pixel_of([2.0, 1.0, 0.5]);
+    assert_eq!((m.id[at(i, j)], m.plane[at(i, j)]), (2, 1));
+    let expect = (cos_at_pixel(i, j, [-1.0, 0.0, 0.0]) * 255.0).round() as u8;
+    assert_eq!(codes[at(i, j)], expect);
+    // The floor is not glass.
+    let (i, j, _) = pixel_of([0.5, 0.0, 2.0]);
+    assert_eq!(m.id[at(i, j)], 0);
+    // Every glass pixel's code is the exact cos of its centre ray on its plane.
+    let mut checked = 0;
+    for j in 0..120 {
+        for i in 0..160 {
+            let k = at(i, j);
+            let n = match m.id[k] {
+                0 => continue,
+                1 => [0.0, 0.0, 1.0],
+                _ => [-1.0, 0.0, 0.0],
+            };
+            assert_eq!(
+                codes[k],
+                (cos_at_pixel(i, j, n) * 255.0).round() as u8,
+                "pixel ({i}, {j})"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000, "{checked}");
+}
+
+#[test]
+fn mask_16_bit_and_exr_with_coverage_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("mask16.png");
+    ok(mask_args(&png).args(["--format", "png16"]));
+    let m16 = read_mask(&png, &MaskReadOptions::default()).unwrap();
+    let CosTheta::Quantized16(c16) = &m16.cos_theta else {
+        panic!("16-bit codes expected")
+    };
+    let (i, j, _) = pixel_of([0.5, 1.5, 0.0]);
+    let k = (j * 160 + i) as usize;
+    assert_eq!(
+        c16[k],
+        (cos_at_pixel(i, j, [0.0, 0.0, 1.0]) * 65535.0).round() as u16
+    );
+
+    let exr = dir.path().join("mask.exr");
+    ok(mask_args(&exr).args(["--samples", "3"]));
+    let m = read_mask(&exr, &MaskReadOptions::default()).unwrap();
+    let cov = m.coverage.as_ref().expect("coverage channel");
+    // Where the centre ray sees glass, the ids agree whatever the format; a pixel whose centre
+    // misses the glass takes the glass most of its sub-pixel rays see, with partial coverage.
+    for (k, (&a, &b)) in m.id.iter().zip(&m16.id).enumerate() {
+        assert!(b == 0 || a == b, "pixel {k}: {a} vs {b}");
+        assert!(
+            a == b || (cov[k] > 0.0 && cov[k] < 1.0),
+            "pixel {k}: {a} vs {b}, coverage {}",
+            cov[k]
+        );
+    }
+    let CosTheta::Float(c) = &m.cos_theta else {
+        panic!("float cos expected")
+    };
+    assert!((c[k] as f64 - cos_at_pixel(i, j, [0.0, 0.0, 1.0])).abs() < 1e-6);
+    // Inside the pane: full coverage; coverage is in ninths; some pixels are partly covered.
+    assert_eq!(cov[k], 1.0);
+    assert!(
+        cov.iter()
+            .all(|&x| (x * 9.0 - (x * 9.0).round()).abs() < 1e-5)
+    );
+    assert!(cov.iter().any(|&x| x > 0.0 && x < 1.0));
+}
+
+#[test]
+fn mask_gouraud_is_close_to_exact_and_uses_the_mirror_planes() {
+    let dir = tempfile::tempdir().unwrap();
+    // Plane indices from planes.json, with the planes listed in the opposite order of
+    // detection: the mask must follow the file.
+    let planes = serde_json::json!({
+        "format": "glassdb-planes/1", "source": "room.obj", "eye": null,
+        "tolerance": {"angle_deg": 0.1, "distance": 1e-6},
+        "planes": [
+            {"index": 0, "equation": [-1.0, 0.0, 0.0, 2.0], "area": 4.0, "materials": ["Tinted_Grey"], "triangles": 2,
+             "eye_side": "front", "reflection_matrix": [[-1.0,0.0,0.0,4.0],[0.0,1.0,0.0,0.0],[0.0,0.0,1.0,0.0],[0.0,0.0,0.0,1.0]],
+             "file": "plane_0.obj", "triangles_written": 0, "triangles_clipped": 0},
+            {"index": 1, "equation": [0.0, 0.0, 1.0, 0.0], "area": 4.0, "materials": ["Clear_6mm"], "triangles": 2,
+             "eye_side": "front", "reflection_matrix": [[1.0,0.0,0.0,0.0],[0.0,1.0,0.0,0.0],[0.0,0.0,-1.0,0.0],[0.0,0.0,0.0,1.0]],
+             "file": "plane_1.obj", "triangles_written": 0, "triangles_clipped": 0}
+        ]
+    });
+    let pj = write_file(dir.path(), "planes.json", planes.to_string().as_bytes());
+    let exact = dir.path().join("exact.exr");
+    let gouraud = dir.path().join("gouraud.exr");
+    ok(mask_args(&exact).arg("--planes").arg(&pj));
+    ok(mask_args(&gouraud)
+        .arg("--planes")
+        .arg(&pj)
+        .args(["--cos", "gouraud", "--mesh", "16"]));
+    let a = read_mask(&exact, &MaskReadOptions::default()).unwrap();
+    let b = read_mask(&gouraud, &MaskReadOptions::default()).unwrap();
+    let (i, j, _) = pixel_of([0.5, 1.5, 0.0]);
+    assert_eq!(
+        a.plane[(j * 160 + i) as usize],
+        1,
+        "the main window is plane 1 in this planes.json"
+    );
+    let (i, j, _) = pixel_of([2.0, 1.0, 0.5]);
+    assert_eq!(a.plane[(j * 160 + i) as usize], 0);
+    assert_eq!(a.id, b.id);
+    let (CosTheta::Float(ca), CosTheta::Float(cb)) = (&a.cos_theta, &b.cos_theta) else {
+        panic!()
+    };
+    let worst = ca
+        .iter()
+        .zip(cb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f32, f32::max);
+    // A 16×16 mesh over a 2 m pane at ~4 m: linear interpolation error well under 1/255.
+    assert!(worst > 0.0 && worst < 1.0 / 255.0, "{worst}");
+}
+
+#[test]
+fn bad_input_gives_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // OBJ syntax error: file and line.
+    let bad = write_file(
+        d,
+        "bad.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl Glass\nf 1 2 oops\n",
+    );
+    let e = fails(
+        glassdb()
+            .arg("mirror")
+            .arg(&bad)
+            .args(["--glass-material", "Glass", "--out-dir"])
+            .arg(d.join("o")),
+    );
+    assert!(e.contains("bad.obj:5:"), "{e}");
+    // No glass faces matched: the materials that exist are listed.
+    let e = fails(
+        glassdb()
+            .arg("mirror")
+            .arg(room())
+            .args(["--glass-material", "Window*", "--out-dir"])
+            .arg(d.join("o")),
+    );
+    assert!(
+        e.contains("Clear_6mm") && e.contains("Wood") && e.contains("Window*"),
+        "{e}"
+    );
+    let e = fails(&mut {
+        let mut c = glassdb();
+        c.arg("mask")
+            .arg(room())
+            .arg("--camera")
+            .arg(camera())
+            .args(["--glass", "Nope=1", "-o"])
+            .arg(d.join("m.png"));
+        c
+    });
+    assert!(e.contains("Concrete"), "{e}");
+    // Degenerate plane.
+    let e = fails(
+        glassdb()
+            .arg("mirror")
+            .arg(room())
+            .args(["--plane", "0,0,0,1", "--out-dir"])
+            .arg(d.join("o")),
+    );
+    assert!(e.contains("degenerate plane"), "{e}");
+    // Eye on a glass plane.
+    let e = fails(
+        glassdb()
+            .arg("mirror")
+            .arg(room())
+            .args(["--glass-material", "Clear*", "--eye", "0,1,0", "--out-dir"])
+            .arg(d.join("o")),
+    );
+    assert!(e.contains("lies on glass plane 0"), "{e}");
+    // Camera with up parallel to the view direction, and zero size.
+    let cam = write_file(
+        d,
+        "up.json",
+        br#"{"origin":[0,5,0],"target":[0,0,0],"up":[0,1,0],"fov_x_deg":60,"width":8,"height":8}"#,
+    );
+    let e = fails(
+        glassdb()
+            .arg("mask")
+            .arg(room())
+            .arg("--camera")
+            .arg(&cam)
+            .args(["--glass", "Clear*=1", "-o"])
+            .arg(d.join("m.png")),
+    );
+    assert!(e.contains("parallel"), "{e}");
+    let cam = write_file(
+        d,
+        "zero.json",
+        br#"{"origin":[0,1,4],"target":[0,1,0],"up":[0,1,0],"fov_x_deg":60,"width":0,"height":8}"#,
+    );
+    let e = fails(
+        glassdb()
+            .arg("mask")
+            .arg(room())
+            .arg("--camera")
+            .arg(&cam)
+            .args(["--glass", "Clear*=1", "-o"])
+            .arg(d.join("m.png")),
+    );
+    assert!(e.contains("0x8"), "{e}");
+    let cam = write_file(
+        d,
+        "typo.json",
+        br#"{"origin":[0,1,4],"target":[0,1,0],"up":[0,1,0],"fov_deg":60,"width":8,"height":8}"#,
+    );
+    let e = fails(
+        glassdb()
+            .arg("mask")
+            .arg(room())
+            .arg("--camera")
+            .arg(&cam)
+            .args(["--glass", "Clear*=1", "-o"])
+            .arg(d.join("m.png")),
+    );
+    assert!(e.contains("typo.json") && e.contains("fov_deg"), "{e}");
+    // A coverage channel cannot go into a PNG; a bad --glass mapping is named.
+    let e = fails(mask_args(&d.join("m.png")).args(["--samples", "2"]));
+    assert!(e.contains("EXR") || e.contains(".exr"), "{e}");
+    let e = fails(
+        glassdb()
+            .arg("mask")
+            .arg(room())
+            .arg("--camera")
+            .arg(camera())
+            .args(["--glass", "Clear*", "-o"])
+            .arg(d.join("m.png")),
+    );
+    assert!(e.contains("PATTERN=ID"), "{e}");
+    // Nothing was written by the failed runs.
+    assert!(!d.join("m.png").exists() && !d.join("o").join("planes.json").exists());
+}

@@ -1,14 +1,27 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! The scene side of the glassdb method (docs/method.md, "Passes"): from a plain OBJ scene,
+//! the glass planes, the mirrored *virtual scene* of each plane for the reflection pass
+//! (section 3, eqs. 4–7), and the id + cos θ mask (sections 5–6) by z-buffer rasterisation.
+//! Conventions and formats: docs/scene.md.
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+pub mod camera;
+pub mod error;
+pub mod mask;
+pub mod math;
+pub mod mirror;
+pub mod obj;
+pub mod planes;
+pub mod planes_file;
+pub mod raster;
+pub mod virtual_scene;
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
-}
+pub use camera::{Camera, CameraSpec};
+pub use error::SceneError;
+pub use mask::{
+    CosEncoding, GlassMapping, MaskScene, PlaneSource, build_mask_scene, to_mask_image,
+};
+pub use mirror::{MirrorStats, mirror_scene};
+pub use obj::{Mesh, Scene, load_obj, write_obj};
+pub use planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_planes};
+pub use planes_file::PlanesFile;
+pub use raster::{CosMode, RasterOptions, RasterOutput, RasterScene, rasterize};
+pub use virtual_scene::{MirrorReport, MirrorRequest, write_virtual_scenes};

@@ -1,0 +1,79 @@
+//! The one error type of the scene crate: one variant per failure a user can act on.
+
+use std::path::PathBuf;
+
+/// Failures of reading scenes and cameras, finding glass planes, mirroring and rasterising.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene, material library or camera file could not be read.
+    #[error("cannot read {path}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// A line of an OBJ or MTL file is malformed.
+    #[error("{path}:{line}: {message}")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    /// The OBJ loader rejected the file after validation (should not happen; names the file).
+    #[error("cannot load {path}: {message}")]
+    Load { path: PathBuf, message: String },
+    /// The scene has no triangles at all.
+    #[error("{path} contains no faces")]
+    EmptyScene { path: PathBuf },
+    /// No face uses a material matched by the glass patterns.
+    #[error(
+        "no faces of {path} use a glass material matching {patterns}; materials in the scene: {available}"
+    )]
+    NoGlassFaces {
+        path: PathBuf,
+        patterns: String,
+        available: String,
+    },
+    /// A glass pattern is not a valid glob pattern.
+    #[error("invalid glass material pattern {pattern:?}: {message}")]
+    BadPattern { pattern: String, message: String },
+    /// A `--glass PATTERN=ID` argument is malformed or its id is out of range.
+    #[error("invalid glass mapping {spec:?}: {message}")]
+    BadGlassMapping { spec: String, message: String },
+    /// A plane equation with a zero (or non-finite) normal, or glass faces that are all degenerate.
+    #[error("degenerate plane: {message}")]
+    DegeneratePlane { message: String },
+    /// The eye lies on the glass plane, so it sees neither side.
+    #[error(
+        "the eye {eye:?} lies on glass plane {plane} (distance {distance:e}); it sees neither side"
+    )]
+    EyeOnPlane {
+        eye: [f64; 3],
+        plane: usize,
+        distance: f64,
+    },
+    /// The camera JSON is malformed or describes an impossible camera.
+    #[error("camera {path}: {message}")]
+    BadCamera { path: PathBuf, message: String },
+    /// The requested image is empty or too large to allocate.
+    #[error("image size {width}x{height}: {message}")]
+    BadImageSize {
+        width: u64,
+        height: u64,
+        message: String,
+    },
+    /// A `planes.json` is malformed, or a glass face lies on none of its planes.
+    #[error("planes file {path}: {message}")]
+    BadPlanes { path: PathBuf, message: String },
+    /// An option value is out of range (tolerances, mesh size, sample count).
+    #[error("{message}")]
+    BadOption { message: String },
+    /// The output directory could not be created.
+    #[error("cannot create the output directory {path}")]
+    CreateDir {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// Writing an output failed (atomic: the target is left as it was).
+    #[error(transparent)]
+    Output(#[from] glassdb_io::OutputError),
+}

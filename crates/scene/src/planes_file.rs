@@ -1,0 +1,105 @@
+//! `planes.json`, written by `glassdb mirror` beside the virtual scenes (schema in
+//! docs/scene.md) and read back by `glassdb mask --planes` so that both agree on plane indices.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::SceneError;
+use crate::planes::{Plane, PlaneTolerance};
+
+/// Value of [`PlanesFile::format`].
+pub const PLANES_FORMAT: &str = "glassdb-planes/1";
+
+/// The whole file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanesFile {
+    pub format: String,
+    /// The OBJ the planes were found in.
+    pub source: String,
+    /// The eye given with `--eye`, if any.
+    pub eye: Option<[f64; 3]>,
+    pub tolerance: ToleranceJson,
+    pub planes: Vec<PlaneEntry>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ToleranceJson {
+    pub angle_deg: f64,
+    pub distance: f64,
+}
+
+/// One glass plane and its virtual scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlaneEntry {
+    /// 0-based; the plane index stored in masks.
+    pub index: usize,
+    /// `[a, b, c, d]` of `a·x + b·y + c·z + d = 0`, (a, b, c) a unit normal pointing to the
+    /// front of the glass (the side its faces' normals point to).
+    pub equation: [f64; 4],
+    /// Area of the glass faces on the plane, scene units².
+    pub area: f64,
+    pub materials: Vec<String>,
+    /// Glass triangles on the plane.
+    pub triangles: usize,
+    /// `"front"` or `"back"`: which face of the glass faces the eye (the kept half-space).
+    pub eye_side: String,
+    /// Row-major 4×4 reflection matrix for column vectors `[x, y, z, 1]`.
+    pub reflection_matrix: [[f64; 4]; 4],
+    /// The virtual scene's OBJ, relative to the planes file.
+    pub file: String,
+    /// Triangles written to the virtual scene.
+    pub triangles_written: usize,
+    /// Scene triangles that crossed the plane and were clipped.
+    pub triangles_clipped: usize,
+}
+
+impl PlanesFile {
+    /// Reads a planes file, validating every equation.
+    pub fn load(path: &Path) -> Result<PlanesFile, SceneError> {
+        let bad = |message: String| SceneError::BadPlanes {
+            path: path.to_path_buf(),
+            message,
+        };
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let file: PlanesFile = serde_json::from_str(&text)
+            .map_err(|e| bad(format!("line {}, column {}: {e}", e.line(), e.column())))?;
+        if file.format != PLANES_FORMAT {
+            return Err(bad(format!(
+                "format {:?} is not {PLANES_FORMAT:?}",
+                file.format
+            )));
+        }
+        if file.planes.is_empty() {
+            return Err(bad("no planes".into()));
+        }
+        for (k, p) in file.planes.iter().enumerate() {
+            if p.index != k {
+                return Err(bad(format!(
+                    "plane {k} has index {} (indices must be 0, 1, 2, ... in order)",
+                    p.index
+                )));
+            }
+            Plane::from_equation(p.equation).map_err(|e| bad(format!("plane {k}: {e}")))?;
+        }
+        Ok(file)
+    }
+
+    /// The plane equations, unit-normalised.
+    pub fn planes(&self) -> Vec<Plane> {
+        self.planes
+            .iter()
+            .filter_map(|p| Plane::from_equation(p.equation).ok())
+            .collect()
+    }
+
+    pub fn tolerance(&self) -> PlaneTolerance {
+        PlaneTolerance {
+            angle_deg: self.tolerance.angle_deg,
+            distance: self.tolerance.distance,
+        }
+    }
+}

@@ -1,0 +1,220 @@
+//! `glassdb mirror` as a library call: find the glass planes, write one virtual scene per
+//! plane and `planes.json`.
+
+use std::path::{Component, Path, PathBuf};
+
+use crate::error::SceneError;
+use crate::math::Vec3;
+use crate::mirror::{MirrorStats, mirror_scene};
+use crate::obj::{Scene, write_obj};
+use crate::planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_planes};
+use crate::planes_file::{PLANES_FORMAT, PlaneEntry, PlanesFile, ToleranceJson};
+
+/// What to mirror and where to put it.
+#[derive(Debug, Clone)]
+pub struct MirrorRequest<'a> {
+    pub scene: &'a Scene,
+    /// Glob patterns of the glass materials (may be empty with an explicit plane).
+    pub glass_patterns: Vec<String>,
+    /// One explicit plane `[a, b, c, d]` instead of detection.
+    pub explicit_plane: Option<[f64; 4]>,
+    /// The eye: selects the kept half-space of each plane. Without it, the front side.
+    pub eye: Option<Vec3>,
+    pub tolerance: PlaneTolerance,
+    pub out_dir: &'a Path,
+}
+
+/// What was written.
+#[derive(Debug, Clone)]
+pub struct MirrorReport {
+    pub planes_path: PathBuf,
+    pub planes: PlanesFile,
+    pub stats: Vec<MirrorStats>,
+}
+
+/// File name of plane `k`'s virtual scene.
+pub fn virtual_scene_name(k: usize) -> String {
+    format!("plane_{k}.obj")
+}
+
+/// `target` relative to directory `base`, when both resolve; otherwise `target` absolute.
+fn relative_to(target: &Path, base: &Path) -> String {
+    let (Ok(t), Ok(b)) = (target.canonicalize(), base.canonicalize()) else {
+        return std::path::absolute(target)
+            .unwrap_or_else(|_| target.to_path_buf())
+            .display()
+            .to_string();
+    };
+    let tc: Vec<Component> = t.components().collect();
+    let bc: Vec<Component> = b.components().collect();
+    let common = tc.iter().zip(&bc).take_while(|(x, y)| x == y).count();
+    let mut rel = PathBuf::new();
+    for _ in common..bc.len() {
+        rel.push("..");
+    }
+    for c in &tc[common..] {
+        rel.push(c.as_os_str());
+    }
+    rel.display().to_string()
+}
+
+/// Finds the planes (or takes the explicit one), writes `plane_<k>.obj` for each and
+/// `planes.json` into `out_dir` (created if missing). All glass faces are dropped from every
+/// virtual scene: reflection passes, like the transmission pass, are rendered without glass.
+pub fn write_virtual_scenes(req: &MirrorRequest) -> Result<MirrorReport, SceneError> {
+    let scene = req.scene;
+    req.tolerance.validate()?;
+    let glass_table = if req.glass_patterns.is_empty() {
+        vec![None; scene.materials.len()]
+    } else {
+        MaterialMatcher::new(&req.glass_patterns)?.require_faces(scene)?
+    };
+    let is_glass = |m: Option<usize>| {
+        m.and_then(|i| glass_table.get(i).copied().flatten())
+            .is_some()
+    };
+    let patterns = MaterialMatcher::new(&req.glass_patterns)?.describe();
+
+    let planes: Vec<GlassPlane> = match req.explicit_plane {
+        Some(eq) => {
+            let plane = Plane::from_equation(eq)?;
+            let (mut area, mut triangles, mut materials) = (0.0, 0usize, Vec::<String>::new());
+            for mesh in &scene.meshes {
+                if !is_glass(mesh.material) {
+                    continue;
+                }
+                for t in 0..mesh.triangles.len() {
+                    let c = mesh.corners(t);
+                    if c.iter()
+                        .all(|&p| plane.signed_distance(p).abs() <= req.tolerance.distance)
+                    {
+                        let a2 = crate::math::triangle_normal_area2(c[0], c[1], c[2]);
+                        area += 0.5 * crate::math::norm(a2);
+                        triangles += 1;
+                        let name = scene.material_name(mesh).to_string();
+                        if !materials.contains(&name) {
+                            materials.push(name);
+                        }
+                    }
+                }
+            }
+            vec![GlassPlane {
+                index: 0,
+                plane,
+                area,
+                materials,
+                triangles,
+            }]
+        }
+        None => {
+            if req.glass_patterns.is_empty() {
+                return Err(SceneError::BadOption {
+                    message: "give the glass materials (--glass-material PATTERN) or one plane (--plane a,b,c,d)".into(),
+                });
+            }
+            detect_planes(scene, is_glass, req.tolerance, &patterns)?.0
+        }
+    };
+    if planes.len() > u16::MAX as usize {
+        return Err(SceneError::BadOption {
+            message: format!("{} glass planes: at most 65535 fit a mask", planes.len()),
+        });
+    }
+
+    std::fs::create_dir_all(req.out_dir).map_err(|source| SceneError::CreateDir {
+        path: req.out_dir.to_path_buf(),
+        source,
+    })?;
+    let src_dir = scene
+        .source
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    let src_dir = if src_dir.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        src_dir
+    };
+    let mtllibs: Vec<String> = scene
+        .mtllibs
+        .iter()
+        .map(|lib| relative_to(&src_dir.join(lib), req.out_dir))
+        .collect();
+
+    let mut entries = Vec::with_capacity(planes.len());
+    let mut all_stats = Vec::with_capacity(planes.len());
+    for gp in &planes {
+        let (kept, eye_side) = match req.eye {
+            Some(eye) => {
+                let s = gp.plane.signed_distance(eye);
+                if s.abs() <= req.tolerance.distance {
+                    return Err(SceneError::EyeOnPlane {
+                        eye,
+                        plane: gp.index,
+                        distance: s,
+                    });
+                }
+                if s > 0.0 {
+                    (gp.plane, "front")
+                } else {
+                    (gp.plane.flipped(), "back")
+                }
+            }
+            None => (gp.plane, "front"),
+        };
+        let (meshes, stats) = mirror_scene(scene, &kept, req.tolerance.distance, |m, _| {
+            is_glass(scene.meshes[m].material)
+        });
+        let name = virtual_scene_name(gp.index);
+        let path = req.out_dir.join(&name);
+        glassdb_io::refuse_input_as_output(&path, [scene.source.as_path()])?;
+        let eq = gp.plane.equation();
+        let header = vec![
+            format!(
+                "virtual scene of {} (glassdb mirror)",
+                scene.source.display()
+            ),
+            format!(
+                "mirrored across glass plane {}: {:?}·(x, y, z, 1) = 0, eye side: {eye_side}",
+                gp.index, eq
+            ),
+            "geometry behind the plane removed, faces crossing it clipped, glass faces dropped"
+                .to_string(),
+        ];
+        write_obj(&path, &header, &mtllibs, &scene.materials, &meshes)?;
+        entries.push(PlaneEntry {
+            index: gp.index,
+            equation: eq,
+            area: gp.area,
+            materials: gp.materials.clone(),
+            triangles: gp.triangles,
+            eye_side: eye_side.to_string(),
+            reflection_matrix: gp.plane.reflection_matrix(),
+            file: name,
+            triangles_written: stats.written,
+            triangles_clipped: stats.clipped,
+        });
+        all_stats.push(stats);
+    }
+    let file = PlanesFile {
+        format: PLANES_FORMAT.to_string(),
+        source: scene.source.display().to_string(),
+        eye: req.eye,
+        tolerance: ToleranceJson {
+            angle_deg: req.tolerance.angle_deg,
+            distance: req.tolerance.distance,
+        },
+        planes: entries,
+    };
+    let planes_path = req.out_dir.join("planes.json");
+    glassdb_io::refuse_input_as_output(&planes_path, [scene.source.as_path()])?;
+    let json = serde_json::to_string_pretty(&file).map_err(|e| SceneError::BadOption {
+        message: e.to_string(),
+    })?;
+    glassdb_io::write_bytes_atomic(&planes_path, format!("{json}\n").as_bytes())?;
+    Ok(MirrorReport {
+        planes_path,
+        planes: file,
+        stats: all_stats,
+    })
+}
