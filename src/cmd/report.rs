@@ -1,10 +1,73 @@
-//! `glassdb report`: under construction (owned by the plot/report work item).
+//! `glassdb report`: regenerates `docs/accuracy.md` (speed against error of every approximation)
+//! and its figures. All the work is in `glassdb_plot::report`.
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct Args {}
+use anyhow::{Context, bail};
+use glassdb_plot::report::{ReportOptions, generate};
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`report` is not built yet")
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Where to write the page.
+    #[arg(short, long, default_value = "docs/accuracy.md")]
+    pub output: PathBuf,
+    /// Directory for the figures (PNG), linked from the page by a relative path.
+    #[arg(long, default_value = "docs/figures")]
+    pub figures: PathBuf,
+    /// Write no figures.
+    #[arg(long)]
+    pub no_figures: bool,
+    /// Repository root (holding data/ and fixtures/).
+    #[arg(long, default_value = ".")]
+    pub root: PathBuf,
+    /// Values per timing pass (more: steadier timings, slower run).
+    #[arg(long, default_value_t = 1 << 20)]
+    pub timing_values: usize,
+}
+
+/// `figures` as the page at `page` should link it: relative when it lies under the page's folder.
+fn link_to(page: &Path, figures: &Path) -> String {
+    let base = page
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let strip = |p: &Path| {
+        p.components()
+            .filter(|c| !matches!(c, std::path::Component::CurDir))
+            .collect::<PathBuf>()
+    };
+    match strip(figures).strip_prefix(strip(base)) {
+        Ok(rel) if !rel.as_os_str().is_empty() => rel.display().to_string(),
+        _ => figures.display().to_string(),
+    }
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    if !args.root.join("data/catalog.toml").is_file() {
+        bail!(
+            "{} does not look like the glassdb repository (no data/catalog.toml): run from the repository root or pass --root",
+            args.root.display()
+        );
+    }
+    if args.timing_values == 0 {
+        bail!("--timing-values must be at least 1");
+    }
+    let mut opts = ReportOptions::repository_defaults(&args.root);
+    opts.timing_values = args.timing_values;
+    opts.figures_dir = (!args.no_figures).then(|| args.figures.clone());
+    opts.figures_link = link_to(&args.output, &args.figures);
+    if cfg!(debug_assertions) {
+        eprintln!(
+            "note: a debug build; the timings will not be representative (use cargo run --release -- report)"
+        );
+    }
+    let report = generate(&opts)?;
+    glassdb_io::write_bytes_atomic(&args.output, report.markdown.as_bytes())
+        .with_context(|| format!("cannot write the report to {}", args.output.display()))?;
+    for f in &report.figures {
+        eprintln!("wrote {}", f.display());
+    }
+    eprintln!("wrote {}", args.output.display());
+    Ok(ExitCode::SUCCESS)
 }

@@ -1,14 +1,24 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! Figures for glassdb users, who review fit quality by looking rather than by reading
+//! coefficients: fitted angle curves with residuals, spectra with the colour-matching functions
+//! beneath, a registry's curves per channel, a mask's reflectance as a heat map; and the
+//! speed-against-error report (`docs/accuracy.md`).
+//!
+//! Everything renders with plotters and the embedded DejaVu Sans font (no system font
+//! library); PNG or SVG by the output extension; files are written atomically.
+
+pub mod chart;
+pub mod colormap;
+mod error;
+pub mod figure;
+pub mod font;
+pub mod heatmap;
+pub mod inspect;
+pub mod render;
+
+pub use error::PlotError;
+pub use render::{Figure, ImageFormat, save};
+pub mod plots;
+pub mod report;
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
-}
+mod tests;

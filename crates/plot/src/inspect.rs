@@ -1,0 +1,79 @@
+//! A summary of a written PNG (size, distinct colours, spread of lightness): what the tests and
+//! `glassdb report` check to know a figure is really drawn, without comparing pixels exactly.
+
+use std::path::Path;
+
+use crate::PlotError;
+
+/// What a PNG holds, in numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PngSummary {
+    pub width: u32,
+    pub height: u32,
+    /// Number of distinct RGB colours.
+    pub distinct_colours: usize,
+    /// Standard deviation of the Rec.709 luma over all pixels (0…255).
+    pub luma_std: f64,
+    /// Fraction of pixels that are not pure white.
+    pub inked_fraction: f64,
+}
+
+/// Decodes the PNG at `path` (8-bit RGB or RGBA) and summarises it.
+pub fn summarize_png(path: &Path) -> Result<PngSummary, PlotError> {
+    let bytes = std::fs::read(path).map_err(|source| PlotError::Read {
+        path: path.into(),
+        source,
+    })?;
+    let bad = |m: String| PlotError::Input {
+        path: path.into(),
+        message: m,
+    };
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = decoder
+        .read_info()
+        .map_err(|e| bad(format!("not a PNG: {e}")))?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| bad("PNG too large".into()))?;
+    let mut buf = vec![0u8; size];
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| bad(format!("corrupt PNG: {e}")))?;
+    let channels = match info.color_type {
+        png::ColorType::Rgb => 3,
+        png::ColorType::Rgba => 4,
+        png::ColorType::Grayscale => 1,
+        png::ColorType::GrayscaleAlpha => 2,
+        png::ColorType::Indexed => return Err(bad("indexed PNG after expansion".into())),
+    };
+    let data = buf
+        .get(..info.buffer_size())
+        .ok_or_else(|| bad("short PNG buffer".into()))?;
+    let mut colours = std::collections::HashSet::new();
+    let (mut sum, mut sum2, mut inked, mut n) = (0.0, 0.0, 0usize, 0usize);
+    for px in data.chunks_exact(channels) {
+        let (r, g, b) = if channels >= 3 {
+            (px[0], px[1], px[2])
+        } else {
+            (px[0], px[0], px[0])
+        };
+        colours.insert((r, g, b));
+        let l = 0.2126 * r as f64 + 0.7152 * g as f64 + 0.0722 * b as f64;
+        sum += l;
+        sum2 += l * l;
+        n += 1;
+        if (r, g, b) != (255, 255, 255) {
+            inked += 1;
+        }
+    }
+    let nf = n.max(1) as f64;
+    let mean = sum / nf;
+    Ok(PngSummary {
+        width: info.width,
+        height: info.height,
+        distinct_colours: colours.len(),
+        luma_std: (sum2 / nf - mean * mean).max(0.0).sqrt(),
+        inked_fraction: inked as f64 / nf,
+    })
+}

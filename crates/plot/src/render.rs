@@ -1,0 +1,145 @@
+//! Output of figures: PNG (plotters' bitmap backend, encoded with the `png` crate) or SVG, picked
+//! by the output file's extension, always written atomically (`glassdb_io::write_bytes_atomic`).
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::error::draw_err;
+use crate::{PlotError, font};
+
+/// Largest figure side accepted, in pixels (guards the bitmap allocation).
+pub const MAX_FIGURE_SIDE_PX: u32 = 8192;
+
+/// The file formats a figure can be written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// 8-bit RGB PNG.
+    Png,
+    /// Scalable vector graphics (text as `<text>` in the DejaVu Sans family, then sans-serif).
+    Svg,
+}
+
+impl ImageFormat {
+    /// The format named by `path`'s extension (case-insensitive `png` or `svg`).
+    pub fn from_path(path: &Path) -> Result<Self, PlotError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("png") => Ok(Self::Png),
+            Some("svg") => Ok(Self::Svg),
+            _ => Err(PlotError::UnknownFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+}
+
+/// Something that can draw itself on a plotters drawing area of any backend.
+pub trait Figure {
+    /// Figure size in pixels (width, height).
+    fn size(&self) -> (u32, u32);
+    /// A short name for error messages ("fit plot of clear_6mm", …).
+    fn describe(&self) -> String;
+    /// Draws the figure onto `root` (already filled white); `format` lets a figure keep vector
+    /// output small (e.g. fewer heat-map cells in SVG).
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        format: ImageFormat,
+    ) -> Result<(), PlotError>;
+}
+
+fn check_size(width: u32, height: u32) -> Result<(), PlotError> {
+    if width == 0 || height == 0 || width > MAX_FIGURE_SIDE_PX || height > MAX_FIGURE_SIDE_PX {
+        return Err(PlotError::BadSize {
+            width,
+            height,
+            max: MAX_FIGURE_SIDE_PX,
+        });
+    }
+    Ok(())
+}
+
+/// Runs a drawing closure, turning a panic inside plotters into [`PlotError::DrawPanic`].
+fn guarded<T>(what: &str, f: impl FnOnce() -> Result<T, PlotError>) -> Result<T, PlotError> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(_) => Err(PlotError::DrawPanic {
+            what: what.to_string(),
+        }),
+    }
+}
+
+/// Draws `fig` into an RGB8 buffer (row-major, `width * height * 3` bytes).
+pub fn render_rgb<F: Figure>(fig: &F) -> Result<(Vec<u8>, u32, u32), PlotError> {
+    font::ensure_registered()?;
+    let (w, h) = fig.size();
+    check_size(w, h)?;
+    let mut buf = vec![255u8; w as usize * h as usize * 3];
+    guarded(&fig.describe(), || {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(draw_err)?;
+        fig.draw(&root, ImageFormat::Png)?;
+        root.present().map_err(draw_err)
+    })?;
+    Ok((buf, w, h))
+}
+
+/// Draws `fig` as PNG bytes.
+pub fn render_png<F: Figure>(fig: &F) -> Result<Vec<u8>, PlotError> {
+    let (rgb, w, h) = render_rgb(fig)?;
+    encode_png_rgb(&rgb, w, h)
+}
+
+/// Draws `fig` as an SVG document.
+pub fn render_svg<F: Figure>(fig: &F) -> Result<String, PlotError> {
+    font::ensure_registered()?;
+    let (w, h) = fig.size();
+    check_size(w, h)?;
+    let mut svg = String::new();
+    guarded(&fig.describe(), || {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(draw_err)?;
+        fig.draw(&root, ImageFormat::Svg)?;
+        root.present().map_err(draw_err)
+    })?;
+    Ok(svg)
+}
+
+/// Draws `fig` and writes it to `path` atomically, in the format its extension names.
+pub fn save<F: Figure>(fig: &F, path: &Path) -> Result<ImageFormat, PlotError> {
+    let format = ImageFormat::from_path(path)?;
+    let bytes = match format {
+        ImageFormat::Png => render_png(fig)?,
+        ImageFormat::Svg => render_svg(fig)?.into_bytes(),
+    };
+    glassdb_io::write_bytes_atomic(path, &bytes)?;
+    Ok(format)
+}
+
+/// Encodes an RGB8 buffer as a PNG. Plots are mostly flat colour, so the strongest
+/// compression keeps figures small (docs/figures stay well under 200 KB).
+pub fn encode_png_rgb(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_compression(png::Compression::High);
+        let mut writer = enc
+            .write_header()
+            .map_err(|e| PlotError::Encode(e.to_string()))?;
+        writer
+            .write_image_data(rgb)
+            .map_err(|e| PlotError::Encode(e.to_string()))?;
+        writer
+            .finish()
+            .map_err(|e| PlotError::Encode(e.to_string()))?;
+    }
+    Ok(out)
+}
