@@ -1,11 +1,11 @@
 //! End-to-end tests: one binary that drives the built `glassdb` and `compose` executables.
 //! One module per area; shared helpers in `util`.
 
-
-mod fit;
-mod spectral;
-mod registry;
 mod compose;
-mod scene;
+mod fit;
 mod plot;
+mod registry;
+mod scene;
+mod spectral;
 mod util;
+mod validation;
