@@ -27,6 +27,9 @@ pub enum OutputError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// The directory the output goes into does not exist (outputs never create directories).
+    #[error("cannot write {path}: the directory {dir} does not exist")]
+    MissingDirectory { path: PathBuf, dir: PathBuf },
     /// The output path names one of the run's own inputs.
     #[error("refusing to overwrite the input file {path} with the output")]
     OutputIsInput { path: PathBuf },
@@ -43,6 +46,12 @@ where
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    if !dir.is_dir() {
+        return Err(OutputError::MissingDirectory {
+            path: path.to_path_buf(),
+            dir,
+        });
+    }
     let mut builder = tempfile::Builder::new();
     builder.prefix(".glassdb-tmp-");
     // A replaced file keeps its mode; a new one gets what any other tool would give it
@@ -145,17 +154,24 @@ mod tests {
     }
 
     #[test]
-    fn error_chain_prints_every_cause_once() {
+    fn missing_or_unusable_directory_is_named_and_each_cause_printed_once() {
         let err =
             write_bytes_atomic(Path::new("/nonexistent-dir-glassdb/x.json"), b"{}").unwrap_err();
-        let text = ErrorChain(&err).to_string();
         assert!(
-            text.starts_with(
-                "cannot create a temporary file beside /nonexistent-dir-glassdb/x.json: "
-            ),
-            "{text}"
+            matches!(err, OutputError::MissingDirectory { .. }),
+            "{err:?}"
         );
-        assert_eq!(text.matches("(os error").count(), 1, "{text}");
+        // A directory that exists but takes no new files (even for root): the OS reason once.
+        let target = Path::new("/proc/self/x.json");
+        if target.parent().is_some_and(Path::is_dir) {
+            let err = write_bytes_atomic(target, b"{}").unwrap_err();
+            let text = ErrorChain(&err).to_string();
+            assert!(
+                text.starts_with("cannot create a temporary file beside /proc/self/x.json: "),
+                "{text}"
+            );
+            assert_eq!(text.matches("(os error").count(), 1, "{text}");
+        }
     }
 
     #[test]
