@@ -56,6 +56,9 @@ pub enum FormatArg {
     Png16,
     /// OpenEXR float channels id, cos_theta, plane, coverage.
     Exr,
+    /// The paper's binary mask: grey PNG, white = glass (one glass, one plane, no angle;
+    /// grey = partial coverage with --samples); compose reads it with --glass ID.
+    Binary,
 }
 
 #[derive(Debug, clap::Args)]
@@ -69,7 +72,7 @@ pub struct MaskArgs {
     /// id ID (1–65535); repeatable, first match wins. Every other face is opaque.
     #[arg(long = "glass", value_name = "PATTERN=ID", required = true)]
     pub glass: Vec<String>,
-    /// Output mask: .png (8-bit unless --format png16) or .exr.
+    /// Output mask: .png (8-bit packed unless --format png16 or binary) or .exr.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Output format, overriding the one the extension implies.
@@ -81,7 +84,7 @@ pub struct MaskArgs {
     /// Mesh size N of --cos gouraud (N×N cells per pane).
     #[arg(long, value_name = "N")]
     pub mesh: Option<u32>,
-    /// K: a coverage channel from K×K sub-pixel rays (EXR output only).
+    /// K: a coverage channel from K×K sub-pixel rays (EXR output, or grey edges of a binary mask).
     #[arg(long, value_name = "K", default_value_t = 1)]
     pub samples: u32,
     /// Take the plane indices from a planes.json of `glassdb mirror`, so that they select the
@@ -202,6 +205,7 @@ fn mask_format(output: &Path, format: Option<FormatArg>) -> anyhow::Result<MaskF
         Some(FormatArg::Png8) => MaskFormat::Png8,
         Some(FormatArg::Png16) => MaskFormat::Png16,
         Some(FormatArg::Exr) => MaskFormat::Exr,
+        Some(FormatArg::Binary) => MaskFormat::Binary,
         None => by_ext.with_context(|| {
             format!(
                 "cannot tell the mask format of {}: use a .png or .exr name, or --format",
@@ -210,7 +214,7 @@ fn mask_format(output: &Path, format: Option<FormatArg>) -> anyhow::Result<MaskF
         })?,
     };
     match (by_ext, chosen) {
-        (Some(MaskFormat::Exr), MaskFormat::Png8 | MaskFormat::Png16)
+        (Some(MaskFormat::Exr), MaskFormat::Png8 | MaskFormat::Png16 | MaskFormat::Binary)
         | (Some(MaskFormat::Png8), MaskFormat::Exr) => {
             bail!(
                 "--format does not match the extension of {}",
@@ -223,9 +227,10 @@ fn mask_format(output: &Path, format: Option<FormatArg>) -> anyhow::Result<MaskF
 
 pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
     let format = mask_format(&args.output, args.format)?;
-    if args.samples >= 2 && format != MaskFormat::Exr {
+    if args.samples >= 2 && !matches!(format, MaskFormat::Exr | MaskFormat::Binary) {
         bail!(
-            "--samples {} makes a coverage channel, which only an EXR mask holds: write a .exr",
+            "--samples {} makes a coverage channel, which only an EXR or a binary mask holds: \
+             write a .exr or use --format binary",
             args.samples
         );
     }
@@ -253,6 +258,13 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             "glass id {} ({}) does not fit an 8-bit PNG mask (ids 1-255): use --format png16 or a .exr output",
             m.id,
             m.pattern
+        );
+    }
+    if format == MaskFormat::Binary && mappings.len() > 1 {
+        bail!(
+            "a binary mask shows one glass, but {} --glass mappings were given: \
+             write a packed PNG or EXR mask for several",
+            mappings.len()
         );
     }
     let camera = Camera::load(&args.camera)?;
@@ -301,7 +313,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
     let t_raster = t1.elapsed();
     let drawn = out.triangles_drawn;
     let encoding = match format {
-        MaskFormat::Png8 => CosEncoding::Quantized8,
+        MaskFormat::Png8 | MaskFormat::Binary => CosEncoding::Quantized8,
         MaskFormat::Png16 => CosEncoding::Quantized16,
         MaskFormat::Exr => CosEncoding::Float,
     };

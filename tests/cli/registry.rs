@@ -327,7 +327,7 @@ fn build_show_check_and_json_round_trip() {
 fn write_mask(path: &Path, ids: &[u16], format: MaskFormat) {
     let n = ids.len();
     let cos = match format {
-        MaskFormat::Png8 => CosTheta::Quantized8(vec![255; n]),
+        MaskFormat::Png8 | MaskFormat::Binary => CosTheta::Quantized8(vec![255; n]),
         MaskFormat::Png16 => CosTheta::Quantized16(vec![65535; n]),
         MaskFormat::Exr => CosTheta::Float(vec![1.0; n]),
     };

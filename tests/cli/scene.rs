@@ -316,6 +316,64 @@ fn mask_16_bit_and_exr_with_coverage_round_trip() {
 }
 
 #[test]
+fn mask_binary_is_the_papers_white_on_black_for_one_glass() {
+    let dir = tempfile::tempdir().unwrap();
+    let clear_only = |out: &Path| {
+        let mut c = glassdb();
+        c.arg("mask")
+            .arg(room())
+            .arg("--camera")
+            .arg(camera())
+            .args(["--glass", "Clear*=1", "-o"])
+            .arg(out);
+        c
+    };
+    let packed = dir.path().join("packed.png");
+    ok(&mut clear_only(&packed));
+    let binary = dir.path().join("binary.png");
+    ok(clear_only(&binary).args(["--format", "binary"]));
+    let want = read_mask(&packed, &MaskReadOptions::default()).unwrap();
+    let as_glass = |id| MaskReadOptions {
+        binary_glass_id: Some(id),
+        ..MaskReadOptions::default()
+    };
+    let got = read_mask(&binary, &as_glass(1)).unwrap();
+    assert_eq!(
+        got.id, want.id,
+        "white exactly where the packed mask has glass 1"
+    );
+    assert_eq!(got.cos_theta, CosTheta::Normal);
+    assert!(
+        got.coverage.is_none(),
+        "one sample per pixel: pure black and white"
+    );
+    assert!(want.id.iter().filter(|&&i| i == 1).count() > 1000);
+
+    // With sub-pixel samples the pane's edges are grey (coverage), the inside white.
+    let soft = dir.path().join("soft.png");
+    ok(clear_only(&soft).args(["--format", "binary", "--samples", "3"]));
+    let got = read_mask(&soft, &as_glass(1)).unwrap();
+    let cov = got.coverage.expect("grey edges");
+    assert!(cov.iter().any(|&c| c > 0.0 && c < 1.0));
+    let (i, j, _) = pixel_of([0.5, 1.5, 0.0]);
+    assert_eq!(cov[(j * 160 + i) as usize], 1.0);
+
+    // Two glasses, or one glass on two planes, do not fit a binary mask.
+    let err = fails(mask_args(&dir.path().join("two.png")).args(["--format", "binary"]));
+    assert!(err.contains("one glass"), "{err}");
+    let mut both_planes = glassdb();
+    both_planes
+        .arg("mask")
+        .arg(room())
+        .arg("--camera")
+        .arg(camera())
+        .args(["--glass", "*_*=1", "--format", "binary", "-o"])
+        .arg(dir.path().join("planes.png"));
+    let err = fails(&mut both_planes);
+    assert!(err.contains("one plane"), "{err}");
+}
+
+#[test]
 fn mask_gouraud_is_close_to_exact_and_uses_the_mirror_planes() {
     let dir = tempfile::tempdir().unwrap();
     // Plane indices from planes.json, with the planes listed in the opposite order of

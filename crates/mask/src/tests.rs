@@ -262,6 +262,47 @@ fn writers_refuse_what_the_format_cannot_hold() {
 }
 
 #[test]
+fn binary_round_trip_keeps_the_glass_and_its_coverage_and_refuses_two_glasses() {
+    let m = MaskImage {
+        width: 4,
+        height: 1,
+        id: vec![0, 7, 7, 7],
+        cos_theta: CosTheta::Float(vec![0.0, 0.3, 0.6, 0.9]),
+        plane: vec![0; 4],
+        coverage: Some(vec![0.0, 1.0, 0.5, 0.001]),
+    };
+    let bytes = write_mask_bytes(Path::new("b.png"), &m, MaskFormat::Binary).unwrap();
+    let read_opts = MaskReadOptions {
+        binary_glass_id: Some(7),
+        ..opts()
+    };
+    let back = read_mask_bytes(&bytes, Path::new("b.png"), &read_opts).unwrap();
+    assert_eq!(back.id, vec![0, 7, 7, 7]);
+    assert_eq!(back.cos_theta, CosTheta::Normal);
+    // Coverage survives to 1/255; a sliver of glass stays glass (never rounds to black).
+    let cov = back.coverage.expect("partial coverage is kept as grey");
+    assert_eq!(cov, vec![0.0, 1.0, 128.0 / 255.0, 1.0 / 255.0]);
+    let mut two = m.clone();
+    two.id[3] = 8;
+    let err = write_mask_bytes(Path::new("b.png"), &two, MaskFormat::Binary)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("x 3, y 0") && err.contains("one glass"),
+        "{err}"
+    );
+    let mut planes = m.clone();
+    planes.plane[2] = 1;
+    let err = write_mask_bytes(Path::new("b.png"), &planes, MaskFormat::Binary)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("x 2, y 0") && err.contains("one plane"),
+        "{err}"
+    );
+}
+
+#[test]
 fn float_cos_rounds_to_nearest_code() {
     let m = MaskImage {
         width: 3,

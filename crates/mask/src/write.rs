@@ -20,6 +20,10 @@ pub enum MaskFormat {
     /// OpenEXR, ZIP-compressed float channels `id`, `cos_theta`, and `plane` (when any pixel
     /// is on a plane other than 0) and `coverage` (when the mask has it).
     Exr,
+    /// The paper's binary mask (section 5.1): 8-bit grey PNG, 255 = glass, 0 = not, grey =
+    /// partial coverage. It holds one glass on one plane and no angle: `compose --glass ID`
+    /// shows it at normal incidence.
+    Binary,
 }
 
 impl MaskFormat {
@@ -28,6 +32,7 @@ impl MaskFormat {
             MaskFormat::Png8 => "8-bit PNG",
             MaskFormat::Png16 => "16-bit PNG",
             MaskFormat::Exr => "EXR",
+            MaskFormat::Binary => "binary PNG",
         }
     }
 }
@@ -109,6 +114,49 @@ pub fn write_mask_bytes(
                 format == MaskFormat::Png16,
             )
         }
+        MaskFormat::Binary => {
+            let mut glass_id = None;
+            let mut grey = Vec::with_capacity(mask.pixel_count());
+            for i in 0..mask.pixel_count() {
+                let id = mask.id[i];
+                if id == 0 {
+                    grey.push(0u8);
+                    continue;
+                }
+                match glass_id {
+                    None => glass_id = Some(id),
+                    Some(first) if first != id => {
+                        return Err(not_representable(
+                            i,
+                            format!(
+                                "glass id {id} after id {first}: a binary mask shows one glass; \
+                                 write a packed PNG or EXR mask for several"
+                            ),
+                        ));
+                    }
+                    Some(_) => {}
+                }
+                if mask.plane[i] != 0 {
+                    return Err(not_representable(
+                        i,
+                        format!(
+                            "plane {}: a binary mask has one plane; write a packed PNG or EXR mask",
+                            mask.plane[i]
+                        ),
+                    ));
+                }
+                let c = mask.coverage.as_ref().map_or(1.0, |c| c[i]);
+                if !c.is_finite() {
+                    return Err(not_representable(
+                        i,
+                        format!("coverage {c} is not a number"),
+                    ));
+                }
+                // A glass pixel never turns black: black means "no glass" to the reader.
+                grey.push(((c.clamp(0.0, 1.0) * 255.0).round() as u8).max(1));
+            }
+            encode_png_grey(path, mask.width, mask.height, &grey)
+        }
         MaskFormat::Exr => {
             let n = mask.pixel_count();
             let id: Vec<f32> = mask.id.iter().map(|&v| f32::from(v)).collect();
@@ -146,6 +194,28 @@ pub fn write_mask_bytes(
             Ok(out.into_inner())
         }
     }
+}
+
+/// Encodes 8-bit grey samples as a PNG.
+fn encode_png_grey(
+    path: &Path,
+    width: u32,
+    height: u32,
+    grey: &[u8],
+) -> Result<Vec<u8>, MaskError> {
+    let enc_err = |e: png::EncodingError| MaskError::Encode {
+        path: path.to_path_buf(),
+        detail: e.to_string(),
+    };
+    let mut out = Vec::new();
+    let mut encoder = png::Encoder::new(&mut out, width, height);
+    encoder.set_color(png::ColorType::Grayscale);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Balanced);
+    let mut writer = encoder.write_header().map_err(enc_err)?;
+    writer.write_image_data(grey).map_err(enc_err)?;
+    writer.finish().map_err(enc_err)?;
+    Ok(out)
 }
 
 /// Encodes interleaved RGB samples (each < 256 when `sixteen` is false) as a PNG.
