@@ -10,11 +10,9 @@ use glassdb_plot::plots::fit::{FitPlotOptions, fit_figure_from_fit_file, fit_fig
 use glassdb_plot::plots::mask::{MaskChannel, MaskPlotOptions, MaskQuantity, mask_figure};
 use glassdb_plot::plots::registry::{RegistryPlotOptions, registry_figure};
 use glassdb_plot::plots::spectral::{SpectralPlotOptions, spectral_figure};
-use glassdb_spectral::{
-    Illuminant, IntegrationSettings, Method, Observer, ReadOptions, RgbCmf, RgbSpace,
-};
+use glassdb_spectral::{IntegrationSettings, ReadOptions};
 
-use crate::cmd::spectral::{CmfArg, IlluminantArg, MethodArg, ObserverArg, SpaceArg};
+use crate::cmd::spectral::MethodArgs;
 use glassdb_plot::{Figure, save};
 
 #[derive(Debug, clap::Args)]
@@ -128,21 +126,8 @@ pub struct MaskArgs {
 pub struct SpectralArgs {
     /// Spectral data (any format `glassdb spectral` reads).
     pub file: PathBuf,
-    /// How a spectrum becomes three numbers.
-    #[arg(long, value_enum, default_value = "colorimetric")]
-    pub method: MethodArg,
-    /// RGB colour-matching functions for --method paper [default: wright-guild-1931].
-    #[arg(long, value_enum)]
-    pub cmf: Option<CmfArg>,
-    /// Standard observer for --method colorimetric [default: cie1931].
-    #[arg(long, value_enum)]
-    pub observer: Option<ObserverArg>,
-    /// Illuminant for --method colorimetric [default: D65].
-    #[arg(long, value_enum)]
-    pub illuminant: Option<IlluminantArg>,
-    /// Linear RGB working space for --method colorimetric [default: srgb].
-    #[arg(long, value_enum)]
-    pub space: Option<SpaceArg>,
+    #[command(flatten)]
+    pub method: MethodArgs,
     /// CSV values are percent (0–100).
     #[arg(long)]
     pub percent: bool,
@@ -287,58 +272,11 @@ fn run_mask(a: MaskArgs) -> anyhow::Result<ExitCode> {
     write(&fig, &output, &[&a.mask, &a.registry])
 }
 
-fn spectral_method(a: &SpectralArgs) -> anyhow::Result<Method> {
-    let colorimetric_flags = a.observer.is_some() || a.illuminant.is_some() || a.space.is_some();
-    Ok(match a.method {
-        MethodArg::Paper => {
-            if colorimetric_flags {
-                bail!(
-                    "--observer, --illuminant and --space apply to --method colorimetric, not paper"
-                );
-            }
-            Method::Paper(match a.cmf.unwrap_or(CmfArg::WrightGuild1931) {
-                CmfArg::WrightGuild1931 => RgbCmf::WrightGuild1931,
-                CmfArg::StilesBurch1955 => RgbCmf::StilesBurch1955,
-                CmfArg::StilesBurch1959 => RgbCmf::StilesBurch1959,
-            })
-        }
-        MethodArg::Colorimetric => {
-            if a.cmf.is_some() {
-                bail!("--cmf applies to --method paper, not colorimetric");
-            }
-            Method::Colorimetric {
-                observer: match a.observer.unwrap_or(ObserverArg::Cie1931) {
-                    ObserverArg::Cie1931 => Observer::Cie1931,
-                    ObserverArg::Cie1964 => Observer::Cie1964,
-                },
-                illuminant: match a.illuminant.unwrap_or(IlluminantArg::D65) {
-                    IlluminantArg::D65 => Illuminant::D65,
-                    IlluminantArg::A => Illuminant::A,
-                    IlluminantArg::E => Illuminant::E,
-                },
-                space: match a.space.unwrap_or(SpaceArg::Srgb) {
-                    SpaceArg::Srgb => RgbSpace::Srgb,
-                    SpaceArg::Acescg => RgbSpace::AcesCg,
-                    SpaceArg::DisplayP3 => RgbSpace::DisplayP3,
-                },
-            }
-        }
-        MethodArg::Luminous => {
-            if colorimetric_flags || a.cmf.is_some() {
-                bail!(
-                    "--cmf, --observer, --illuminant and --space do not apply to --method luminous"
-                );
-            }
-            Method::Luminous
-        }
-    })
-}
-
 fn run_spectral(a: SpectralArgs) -> anyhow::Result<ExitCode> {
     let output = output_path(&a.out, &a.file, "spectral");
     let opts = SpectralPlotOptions {
         settings: IntegrationSettings {
-            method: spectral_method(&a)?,
+            method: a.method.method()?,
             extrapolate: a.extrapolate,
         },
         read: ReadOptions { percent: a.percent },

@@ -55,12 +55,10 @@ pub enum SpaceArg {
     DisplayP3,
 }
 
-/// Spectral transmittance/reflectance to per-channel and luminous values.
+/// How a spectrum becomes three numbers: the method and its options (shared by
+/// `glassdb spectral` and `glassdb plot spectral`).
 #[derive(Debug, clap::Args)]
-pub struct Args {
-    /// Spectral data: CSV (wavelength_nm or wavelength_um, T, R/Rf, Rb), LBNL Optics/IGDB text
-    /// (.DAT, .LOF, .afg, .oag, …) or IGSDB JSON.
-    pub file: PathBuf,
+pub struct MethodArgs {
     /// How a spectrum becomes three numbers.
     #[arg(long, value_enum, default_value = "colorimetric")]
     pub method: MethodArg,
@@ -76,6 +74,16 @@ pub struct Args {
     /// Linear RGB working space for --method colorimetric [default: srgb].
     #[arg(long, value_enum)]
     pub space: Option<SpaceArg>,
+}
+
+/// Spectral transmittance/reflectance to per-channel and luminous values.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Spectral data: CSV (wavelength_nm or wavelength_um, T, R/Rf, Rb), LBNL Optics/IGDB text
+    /// (.DAT, .LOF, .afg, .oag, …) or IGSDB JSON.
+    pub file: PathBuf,
+    #[command(flatten)]
+    pub method: MethodArgs,
     /// CSV values are percent (0–100) instead of fractions.
     #[arg(long)]
     pub percent: bool,
@@ -88,52 +96,55 @@ pub struct Args {
     pub json: bool,
 }
 
-fn method_of(args: &Args) -> anyhow::Result<Method> {
-    let colorimetric_flags =
-        args.observer.is_some() || args.illuminant.is_some() || args.space.is_some();
-    Ok(match args.method {
-        MethodArg::Paper => {
-            if colorimetric_flags {
-                bail!(
-                    "--observer, --illuminant and --space apply to --method colorimetric, not paper"
-                );
+impl MethodArgs {
+    /// The library's [`Method`], refusing options that do not apply to the chosen method.
+    pub fn method(&self) -> anyhow::Result<Method> {
+        let colorimetric_flags =
+            self.observer.is_some() || self.illuminant.is_some() || self.space.is_some();
+        Ok(match self.method {
+            MethodArg::Paper => {
+                if colorimetric_flags {
+                    bail!(
+                        "--observer, --illuminant and --space apply to --method colorimetric, not paper"
+                    );
+                }
+                Method::Paper(match self.cmf.unwrap_or(CmfArg::WrightGuild1931) {
+                    CmfArg::WrightGuild1931 => RgbCmf::WrightGuild1931,
+                    CmfArg::StilesBurch1955 => RgbCmf::StilesBurch1955,
+                    CmfArg::StilesBurch1959 => RgbCmf::StilesBurch1959,
+                })
             }
-            Method::Paper(match args.cmf.unwrap_or(CmfArg::WrightGuild1931) {
-                CmfArg::WrightGuild1931 => RgbCmf::WrightGuild1931,
-                CmfArg::StilesBurch1955 => RgbCmf::StilesBurch1955,
-                CmfArg::StilesBurch1959 => RgbCmf::StilesBurch1959,
-            })
-        }
-        MethodArg::Colorimetric => {
-            if args.cmf.is_some() {
-                bail!("--cmf applies to --method paper, not colorimetric");
+            MethodArg::Colorimetric => {
+                if self.cmf.is_some() {
+                    bail!("--cmf applies to --method paper, not colorimetric");
+                }
+                Method::Colorimetric {
+                    observer: match self.observer.unwrap_or(ObserverArg::Cie1931) {
+                        ObserverArg::Cie1931 => Observer::Cie1931,
+                        ObserverArg::Cie1964 => Observer::Cie1964,
+                    },
+                    illuminant: match self.illuminant.unwrap_or(IlluminantArg::D65) {
+                        IlluminantArg::D65 => Illuminant::D65,
+                        IlluminantArg::A => Illuminant::A,
+                        IlluminantArg::E => Illuminant::E,
+                    },
+                    space: match self.space.unwrap_or(SpaceArg::Srgb) {
+                        SpaceArg::Srgb => RgbSpace::Srgb,
+                        SpaceArg::Acescg => RgbSpace::AcesCg,
+                        SpaceArg::DisplayP3 => RgbSpace::DisplayP3,
+                    },
+                }
             }
-            Method::Colorimetric {
-                observer: match args.observer.unwrap_or(ObserverArg::Cie1931) {
-                    ObserverArg::Cie1931 => Observer::Cie1931,
-                    ObserverArg::Cie1964 => Observer::Cie1964,
-                },
-                illuminant: match args.illuminant.unwrap_or(IlluminantArg::D65) {
-                    IlluminantArg::D65 => Illuminant::D65,
-                    IlluminantArg::A => Illuminant::A,
-                    IlluminantArg::E => Illuminant::E,
-                },
-                space: match args.space.unwrap_or(SpaceArg::Srgb) {
-                    SpaceArg::Srgb => RgbSpace::Srgb,
-                    SpaceArg::Acescg => RgbSpace::AcesCg,
-                    SpaceArg::DisplayP3 => RgbSpace::DisplayP3,
-                },
+            MethodArg::Luminous => {
+                if colorimetric_flags || self.cmf.is_some() {
+                    bail!(
+                        "--cmf, --observer, --illuminant and --space do not apply to --method luminous"
+                    );
+                }
+                Method::Luminous
             }
-        }
-        MethodArg::Luminous => {
-            if colorimetric_flags || args.cmf.is_some() {
-                bail!(
-                    "--cmf, --observer, --illuminant and --space do not apply to --method luminous"
-                );
-            }
-            Method::Luminous
-        }
-    })
+        })
+    }
 }
 
 /// One quantity's results.
@@ -146,7 +157,7 @@ struct QuantityResult {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let method = method_of(&args)?;
+    let method = args.method.method()?;
     let settings = IntegrationSettings {
         method,
         extrapolate: args.extrapolate,

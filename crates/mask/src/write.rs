@@ -196,28 +196,6 @@ pub fn write_mask_bytes(
     }
 }
 
-/// Encodes 8-bit grey samples as a PNG.
-fn encode_png_grey(
-    path: &Path,
-    width: u32,
-    height: u32,
-    grey: &[u8],
-) -> Result<Vec<u8>, MaskError> {
-    let enc_err = |e: png::EncodingError| MaskError::Encode {
-        path: path.to_path_buf(),
-        detail: e.to_string(),
-    };
-    let mut out = Vec::new();
-    let mut encoder = png::Encoder::new(&mut out, width, height);
-    encoder.set_color(png::ColorType::Grayscale);
-    encoder.set_depth(png::BitDepth::Eight);
-    encoder.set_compression(png::Compression::Balanced);
-    let mut writer = encoder.write_header().map_err(enc_err)?;
-    writer.write_image_data(grey).map_err(enc_err)?;
-    writer.finish().map_err(enc_err)?;
-    Ok(out)
-}
-
 /// Encodes interleaved RGB samples (each < 256 when `sixteen` is false) as a PNG.
 fn encode_png_rgb(
     path: &Path,
@@ -226,23 +204,55 @@ fn encode_png_rgb(
     samples: &[u16],
     sixteen: bool,
 ) -> Result<Vec<u8>, MaskError> {
+    let (depth, data): (_, Vec<u8>) = if sixteen {
+        let bytes = samples.iter().flat_map(|s| s.to_be_bytes()).collect();
+        (png::BitDepth::Sixteen, bytes)
+    } else {
+        (
+            png::BitDepth::Eight,
+            samples.iter().map(|&s| s as u8).collect(),
+        )
+    };
+    encode_png(path, width, height, png::ColorType::Rgb, depth, &data)
+}
+
+/// Encodes 8-bit grey samples as a PNG.
+fn encode_png_grey(
+    path: &Path,
+    width: u32,
+    height: u32,
+    grey: &[u8],
+) -> Result<Vec<u8>, MaskError> {
+    encode_png(
+        path,
+        width,
+        height,
+        png::ColorType::Grayscale,
+        png::BitDepth::Eight,
+        grey,
+    )
+}
+
+/// Encodes raw PNG sample bytes (big-endian when 16-bit).
+fn encode_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    depth: png::BitDepth,
+    data: &[u8],
+) -> Result<Vec<u8>, MaskError> {
     let enc_err = |e: png::EncodingError| MaskError::Encode {
         path: path.to_path_buf(),
         detail: e.to_string(),
     };
     let mut out = Vec::new();
     let mut encoder = png::Encoder::new(&mut out, width, height);
-    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_color(color);
+    encoder.set_depth(depth);
     encoder.set_compression(png::Compression::Balanced);
-    let data: Vec<u8> = if sixteen {
-        encoder.set_depth(png::BitDepth::Sixteen);
-        samples.iter().flat_map(|s| s.to_be_bytes()).collect()
-    } else {
-        encoder.set_depth(png::BitDepth::Eight);
-        samples.iter().map(|&s| s as u8).collect()
-    };
     let mut writer = encoder.write_header().map_err(enc_err)?;
-    writer.write_image_data(&data).map_err(enc_err)?;
+    writer.write_image_data(data).map_err(enc_err)?;
     writer.finish().map_err(enc_err)?;
     Ok(out)
 }
