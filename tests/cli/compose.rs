@@ -456,6 +456,33 @@ fn half_output_and_every_compression_round_trip() {
     }
     let err = fails(g.cmd(&m, &g.path("x.exr")).args(["--compression", "lzw"]));
     assert!(err.contains("lzw") && err.contains("piz"), "{err}");
+    // ZIP levels: the same pixels at every level, stated in the report; a level without a
+    // zip compression, or out of range, is refused.
+    for (comp, level) in [("zip", "0"), ("zip", "1"), ("zips", "9")] {
+        let out = g.path(&format!("o_{comp}_{level}.exr"));
+        let stdout = ok(g.cmd(&m, &out).args([
+            "--data-type",
+            "float",
+            "--compression",
+            comp,
+            "--zip-level",
+            level,
+        ]));
+        assert!(
+            stdout.contains(&format!("{comp} level {level}")),
+            "{stdout}"
+        );
+        let px = read_rgb(&out);
+        assert_close(px[1], GLASS1, comp);
+        assert_eq!(px[0], CLEAR, "{comp} level {level}");
+    }
+    let err = fails(
+        g.cmd(&m, &g.path("x.exr"))
+            .args(["--compression", "piz", "--zip-level", "3"]),
+    );
+    assert!(err.contains("zip") && err.contains("piz"), "{err}");
+    fails(g.cmd(&m, &g.path("x.exr")).args(["--zip-level", "10"]));
+    assert!(!g.path("x.exr").exists());
 }
 
 #[test]

@@ -265,8 +265,8 @@ pub fn exr_compression_name(c: exr::compression::Compression) -> &'static str {
         .map_or("other", |(n, _)| n)
 }
 
-/// The default output compression: ZIP (16-line blocks), which `exr` compresses in parallel
-/// and every reader supports; see docs/performance.md for the measured alternatives.
+/// The default output compression: ZIP (16-line blocks), compressed in parallel by zlib-rs
+/// (`exr_zip`) and read by every EXR reader; docs/performance.md has the measured alternatives.
 pub const DEFAULT_EXR_COMPRESSION: exr::compression::Compression =
     exr::compression::Compression::ZIP16;
 
@@ -297,6 +297,8 @@ pub fn output_format(path: &Path) -> Result<OutputFormat, ComposeError> {
 pub struct OutputOptions {
     pub exr_data_type: Option<ExrDataType>,
     pub exr_compression: Option<exr::compression::Compression>,
+    /// zlib level (0–9) of ZIP/ZIPS output; `None`: OpenEXR's default, 4.
+    pub exr_zip_level: Option<u32>,
     pub png_bits: Option<PngBits>,
     /// Ordered dither for 8-bit PNG output.
     pub dither: bool,
@@ -307,6 +309,7 @@ impl Default for OutputOptions {
         OutputOptions {
             exr_data_type: None,
             exr_compression: None,
+            exr_zip_level: None,
             png_bits: None,
             dither: true,
         }
@@ -349,13 +352,36 @@ pub fn write_output(
                 } => ExrDataType::Float,
             });
             let compression = opts.exr_compression.unwrap_or(DEFAULT_EXR_COMPRESSION);
-            let n = write_exr(path, image, data_type, compression)?;
+            let zip_level = match (
+                crate::exr_zip::zip_block_lines(compression),
+                opts.exr_zip_level,
+            ) {
+                (Some(_), level) => Some(level.unwrap_or(crate::exr_zip::DEFAULT_ZIP_LEVEL)),
+                (None, None) => None,
+                (None, Some(_)) => {
+                    return Err(ComposeError::BadOption(format!(
+                        "a zip level applies to zip and zips output, not {}",
+                        exr_compression_name(compression)
+                    )));
+                }
+            };
+            if let Some(level) = zip_level.filter(|&l| l > 9) {
+                return Err(ComposeError::BadOption(format!(
+                    "zip level {level} is out of range (0–9)"
+                )));
+            }
+            let n = write_exr(path, image, data_type, compression, zip_level)?;
             let ty = if data_type == ExrDataType::Half {
                 "half"
             } else {
                 "float"
             };
-            (n, format!("{ty}, {}", exr_compression_name(compression)))
+            let name = exr_compression_name(compression);
+            let encoding = match zip_level {
+                Some(level) => format!("{ty}, {name} level {level}"),
+                None => format!("{ty}, {name}"),
+            };
+            (n, encoding)
         }
         OutputFormat::Png => {
             let bits = opts.png_bits.unwrap_or(match source {
@@ -393,6 +419,7 @@ fn write_exr(
     image: LinearImage,
     data_type: ExrDataType,
     compression: exr::compression::Compression,
+    zip_level: Option<u32>,
 ) -> Result<u64, ComposeError> {
     let (w, h) = (image.width as usize, image.height as usize);
     let LinearImage {
@@ -433,10 +460,12 @@ fn write_exr(
             pos: 0,
             len: 0,
         };
-        image
-            .write()
-            .to_buffered(&mut counting)
-            .map_err(|e| std::io::Error::other(e.to_string()))?;
+        match zip_level {
+            // ZIP/ZIPS: our own deflate at the chosen level (exr_zip.rs).
+            Some(level) => crate::exr_zip::write_zip_image(&image, level, &mut counting),
+            None => image.write().to_buffered(&mut counting),
+        }
+        .map_err(|e| std::io::Error::other(e.to_string()))?;
         size = counting.len;
         Ok(())
     })?;
