@@ -208,15 +208,19 @@ fn cos_at_pixel(i: u32, j: u32, n: [f64; 3]) -> f64 {
     dot(d, n).abs()
 }
 
-fn mask_args(out: &Path) -> std::process::Command {
+/// `glassdb mask` of the room from `camera` with `--glass` mappings `glass`, into `out`.
+fn mask_cmd(camera: &Path, glass: &[&str], out: &Path) -> std::process::Command {
     let mut c = glassdb();
-    c.arg("mask")
-        .arg(room())
-        .arg("--camera")
-        .arg(camera())
-        .args(["--glass", "Clear*=1", "--glass", "Tinted*=2", "-o"])
-        .arg(out);
+    c.arg("mask").arg(room()).arg("--camera").arg(camera);
+    for g in glass {
+        c.args(["--glass", g]);
+    }
+    c.arg("-o").arg(out);
     c
+}
+
+fn mask_args(out: &Path) -> std::process::Command {
+    mask_cmd(&camera(), &["Clear*=1", "Tinted*=2"], out)
 }
 
 #[test]
@@ -318,16 +322,7 @@ fn mask_16_bit_and_exr_with_coverage_round_trip() {
 #[test]
 fn mask_binary_is_the_papers_white_on_black_for_one_glass() {
     let dir = tempfile::tempdir().unwrap();
-    let clear_only = |out: &Path| {
-        let mut c = glassdb();
-        c.arg("mask")
-            .arg(room())
-            .arg("--camera")
-            .arg(camera())
-            .args(["--glass", "Clear*=1", "-o"])
-            .arg(out);
-        c
-    };
+    let clear_only = |out: &Path| mask_cmd(&camera(), &["Clear*=1"], out);
     let packed = dir.path().join("packed.png");
     ok(&mut clear_only(&packed));
     let binary = dir.path().join("binary.png");
@@ -361,15 +356,8 @@ fn mask_binary_is_the_papers_white_on_black_for_one_glass() {
     // Two glasses, or one glass on two planes, do not fit a binary mask.
     let err = fails(mask_args(&dir.path().join("two.png")).args(["--format", "binary"]));
     assert!(err.contains("one glass"), "{err}");
-    let mut both_planes = glassdb();
-    both_planes
-        .arg("mask")
-        .arg(room())
-        .arg("--camera")
-        .arg(camera())
-        .args(["--glass", "*_*=1", "--format", "binary", "-o"])
-        .arg(dir.path().join("planes.png"));
-    let err = fails(&mut both_planes);
+    let planes = dir.path().join("planes.png");
+    let err = fails(mask_cmd(&camera(), &["*_*=1"], &planes).args(["--format", "binary"]));
     assert!(err.contains("one plane"), "{err}");
 }
 
@@ -486,45 +474,21 @@ fn bad_input_gives_clear_errors() {
         "up.json",
         br#"{"origin":[0,5,0],"target":[0,0,0],"up":[0,1,0],"fov_x_deg":60,"width":8,"height":8}"#,
     );
-    let e = fails(
-        glassdb()
-            .arg("mask")
-            .arg(room())
-            .arg("--camera")
-            .arg(&cam)
-            .args(["--glass", "Clear*=1", "-o"])
-            .arg(d.join("m.png")),
-    );
+    let e = fails(&mut mask_cmd(&cam, &["Clear*=1"], &d.join("m.png")));
     assert!(e.contains("parallel"), "{e}");
     let cam = write_file(
         d,
         "zero.json",
         br#"{"origin":[0,1,4],"target":[0,1,0],"up":[0,1,0],"fov_x_deg":60,"width":0,"height":8}"#,
     );
-    let e = fails(
-        glassdb()
-            .arg("mask")
-            .arg(room())
-            .arg("--camera")
-            .arg(&cam)
-            .args(["--glass", "Clear*=1", "-o"])
-            .arg(d.join("m.png")),
-    );
+    let e = fails(&mut mask_cmd(&cam, &["Clear*=1"], &d.join("m.png")));
     assert!(e.contains("0x8"), "{e}");
     let cam = write_file(
         d,
         "typo.json",
         br#"{"origin":[0,1,4],"target":[0,1,0],"up":[0,1,0],"fov_deg":60,"width":8,"height":8}"#,
     );
-    let e = fails(
-        glassdb()
-            .arg("mask")
-            .arg(room())
-            .arg("--camera")
-            .arg(&cam)
-            .args(["--glass", "Clear*=1", "-o"])
-            .arg(d.join("m.png")),
-    );
+    let e = fails(&mut mask_cmd(&cam, &["Clear*=1"], &d.join("m.png")));
     assert!(e.contains("typo.json") && e.contains("fov_deg"), "{e}");
     // A coverage channel cannot go into a PNG; a bad --glass mapping is named.
     let e = fails(mask_args(&d.join("m.png")).args(["--samples", "2"]));
