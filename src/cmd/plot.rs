@@ -10,9 +10,8 @@ use glassdb_plot::plots::fit::{FitPlotOptions, fit_figure_from_fit_file, fit_fig
 use glassdb_plot::plots::mask::{MaskChannel, MaskPlotOptions, MaskQuantity, mask_figure};
 use glassdb_plot::plots::registry::{RegistryPlotOptions, registry_figure};
 use glassdb_plot::plots::spectral::{SpectralPlotOptions, spectral_figure};
-use glassdb_spectral::{IntegrationSettings, ReadOptions};
 
-use crate::cmd::spectral::MethodArgs;
+use crate::cmd::spectral::SpectralSettingsArgs;
 use glassdb_plot::{Figure, save};
 
 #[derive(Debug, clap::Args)]
@@ -127,13 +126,7 @@ pub struct SpectralArgs {
     /// Spectral data (any format `glassdb spectral` reads).
     pub file: PathBuf,
     #[command(flatten)]
-    pub method: MethodArgs,
-    /// CSV values are percent (0–100).
-    #[arg(long)]
-    pub percent: bool,
-    /// Hold end values constant where the spectrum does not cover the method's grid.
-    #[arg(long)]
-    pub extrapolate: bool,
+    pub settings: SpectralSettingsArgs,
     #[command(flatten)]
     pub out: OutputArgs,
 }
@@ -275,11 +268,8 @@ fn run_mask(a: MaskArgs) -> anyhow::Result<ExitCode> {
 fn run_spectral(a: SpectralArgs) -> anyhow::Result<ExitCode> {
     let output = output_path(&a.out, &a.file, "spectral");
     let opts = SpectralPlotOptions {
-        settings: IntegrationSettings {
-            method: a.method.method()?,
-            extrapolate: a.extrapolate,
-        },
-        read: ReadOptions { percent: a.percent },
+        settings: a.settings.settings()?,
+        read: a.settings.read_options(),
     };
     let fig = spectral_figure(&a.file, &opts)?;
     write(&fig, &output, &[&a.file])

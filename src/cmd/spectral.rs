@@ -55,10 +55,10 @@ pub enum SpaceArg {
     DisplayP3,
 }
 
-/// How a spectrum becomes three numbers: the method and its options (shared by
-/// `glassdb spectral` and `glassdb plot spectral`).
+/// How a spectral file is read and becomes three numbers: the method, its options and the
+/// input flags (shared by `glassdb spectral` and `glassdb plot spectral`).
 #[derive(Debug, clap::Args)]
-pub struct MethodArgs {
+pub struct SpectralSettingsArgs {
     /// How a spectrum becomes three numbers.
     #[arg(long, value_enum, default_value = "colorimetric")]
     pub method: MethodArg,
@@ -74,6 +74,13 @@ pub struct MethodArgs {
     /// Linear RGB working space for --method colorimetric [default: srgb].
     #[arg(long, value_enum)]
     pub space: Option<SpaceArg>,
+    /// CSV values are percent (0–100) instead of fractions.
+    #[arg(long)]
+    pub percent: bool,
+    /// Hold the spectrum's end values constant where it does not cover a method's grid
+    /// (otherwise partial coverage is an error).
+    #[arg(long)]
+    pub extrapolate: bool,
 }
 
 /// Spectral transmittance/reflectance to per-channel and luminous values.
@@ -83,20 +90,28 @@ pub struct Args {
     /// (.DAT, .LOF, .afg, .oag, …) or IGSDB JSON.
     pub file: PathBuf,
     #[command(flatten)]
-    pub method: MethodArgs,
-    /// CSV values are percent (0–100) instead of fractions.
-    #[arg(long)]
-    pub percent: bool,
-    /// Hold the spectrum's end values constant where it does not cover a method's grid
-    /// (otherwise partial coverage is an error).
-    #[arg(long)]
-    pub extrapolate: bool,
+    pub settings: SpectralSettingsArgs,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
 }
 
-impl MethodArgs {
+impl SpectralSettingsArgs {
+    /// Integration settings: the method and whether to extrapolate.
+    pub fn settings(&self) -> anyhow::Result<IntegrationSettings> {
+        Ok(IntegrationSettings {
+            method: self.method()?,
+            extrapolate: self.extrapolate,
+        })
+    }
+
+    /// How to read the file.
+    pub fn read_options(&self) -> ReadOptions {
+        ReadOptions {
+            percent: self.percent,
+        }
+    }
+
     /// The library's [`Method`], refusing options that do not apply to the chosen method.
     pub fn method(&self) -> anyhow::Result<Method> {
         let colorimetric_flags =
@@ -157,19 +172,11 @@ struct QuantityResult {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let method = args.method.method()?;
-    let settings = IntegrationSettings {
-        method,
-        extrapolate: args.extrapolate,
-    };
-    let data = read_spectral_file(
-        &args.file,
-        &ReadOptions {
-            percent: args.percent,
-        },
-    )?;
+    let settings = args.settings.settings()?;
+    let method = settings.method;
+    let data = read_spectral_file(&args.file, &args.settings.read_options())?;
     let integrator = Integrator::new(&settings)?;
-    let results = integrate_all(&data, &integrator, args.extrapolate)?;
+    let results = integrate_all(&data, &integrator, settings.extrapolate)?;
     let out = if args.json {
         let mut s = serde_json::to_string_pretty(&to_json(&data, &method, &results))?;
         s.push('\n');

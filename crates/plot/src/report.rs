@@ -21,8 +21,8 @@ use glassdb_scene::{
     build_mask_scene, load_obj, rasterize, to_mask_image,
 };
 use glassdb_spectral::{
-    Illuminant, IntegrationSettings, Integrator, Method, Observer, ReadOptions, RgbCmf, RgbSpace,
-    SpectralData, luminous_iso9050, read_spectral_file,
+    IntegrationSettings, Integrator, Method, ReadOptions, RgbCmf, SpectralData, luminous_iso9050,
+    read_spectral_file,
 };
 
 use crate::PlotError;
@@ -679,14 +679,8 @@ fn spectral_methods() -> (Vec<(RgbCmf, &'static str)>, IntegrationSettings) {
             (RgbCmf::StilesBurch1955, "SB 1955"),
             (RgbCmf::StilesBurch1959, "SB 1959"),
         ],
-        IntegrationSettings {
-            method: Method::Colorimetric {
-                observer: Observer::Cie1931,
-                illuminant: Illuminant::D65,
-                space: RgbSpace::Srgb,
-            },
-            extrapolate: false,
-        },
+        // Colorimetric: CIE 1931, D65, linear sRGB, no extrapolation.
+        IntegrationSettings::default(),
     )
 }
 
