@@ -28,7 +28,7 @@ pub struct MirrorArgs {
     /// glass faces' normals point to.
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub eye: Option<String>,
-    /// Directory for plane_<k>.obj and planes.json (created if missing).
+    /// Directory for `plane_<k>.obj` and `planes.json` (created if missing).
     #[arg(long = "out-dir", value_name = "DIR")]
     pub out_dir: PathBuf,
     /// Largest angle between the normals of faces on one plane, degrees.

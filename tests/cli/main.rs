@@ -3,6 +3,7 @@
 
 mod compose;
 mod fit;
+mod fixtures;
 mod plot;
 mod registry;
 mod scene;

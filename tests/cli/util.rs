@@ -95,3 +95,162 @@ pub fn run_oracle(script: &str, args: &[&std::ffi::OsStr]) -> String {
     assert!(out.status.success(), "oracle {script} failed:\n{stderr}");
     stdout
 }
+
+/// Whether committed reference files are to be regenerated instead of checked
+/// (`GLASSDB_MAKE_REF=1 cargo test …`, resvg's `MAKE_REF` convention). A test that honours it
+/// writes what it measured or produced over the committed file and passes; `git diff` then shows
+/// what changed.
+pub fn make_ref() -> bool {
+    std::env::var_os("GLASSDB_MAKE_REF").is_some_and(|v| v == "1")
+}
+
+/// Where failing image comparisons leave their diff images (`target/test-diffs/`).
+pub fn diff_dir() -> PathBuf {
+    let dir = repo_path("target/test-diffs");
+    std::fs::create_dir_all(&dir).expect("create target/test-diffs");
+    dir
+}
+
+/// An image to compare: planar channels of `width * height` samples each, row 0 at the top.
+pub struct Planes {
+    pub width: usize,
+    pub height: usize,
+    /// Channel names, for messages.
+    pub names: Vec<String>,
+    pub channels: Vec<Vec<f64>>,
+}
+
+/// Asserts that `got` and `want` have the same size and channels and that every sample agrees
+/// within `tolerance`. On failure writes `target/test-diffs/<name>.png`: per pixel the largest
+/// channel difference, white where it exceeds the tolerance, grey scaled to the tolerance below
+/// it, so the failing region can be seen.
+pub fn assert_images_match(name: &str, got: &Planes, want: &Planes, tolerance: f64) {
+    assert_eq!(
+        (got.width, got.height),
+        (want.width, want.height),
+        "{name}: image sizes differ"
+    );
+    assert_eq!(got.names, want.names, "{name}: channels differ");
+    let n = got.width * got.height;
+    let mut worst = vec![0.0f64; n];
+    let mut first_bad: Option<(usize, usize, f64, f64)> = None;
+    let mut bad = 0usize;
+    for (c, (g, w)) in got.channels.iter().zip(&want.channels).enumerate() {
+        assert_eq!((g.len(), w.len()), (n, n), "{name}: channel {c} length");
+        for i in 0..n {
+            let d = (g[i] - w[i]).abs();
+            let d = if d.is_nan() { f64::INFINITY } else { d };
+            if d > tolerance {
+                bad += 1;
+                first_bad.get_or_insert((i, c, g[i], w[i]));
+            }
+            worst[i] = worst[i].max(d);
+        }
+    }
+    let Some((i, c, g, w)) = first_bad else {
+        return;
+    };
+    let path = diff_dir().join(format!("{name}.png"));
+    let grey: Vec<u8> = worst
+        .iter()
+        .map(|&d| {
+            if d > tolerance {
+                255
+            } else if tolerance > 0.0 {
+                (d / tolerance * 200.0).round() as u8
+            } else {
+                0
+            }
+        })
+        .collect();
+    let file = std::fs::File::create(&path).expect("create the diff image");
+    let mut enc = png::Encoder::new(
+        std::io::BufWriter::new(file),
+        got.width as u32,
+        got.height as u32,
+    );
+    enc.set_color(png::ColorType::Grayscale);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.write_header()
+        .and_then(|mut w| w.write_image_data(&grey))
+        .expect("write the diff image");
+    panic!(
+        "{name}: {bad} samples differ by more than {tolerance}; first at pixel (x {}, y {}) \
+         channel {}: got {g}, want {w}; diff image: {}",
+        i % got.width,
+        i / got.width,
+        got.names[c],
+        path.display()
+    );
+}
+
+/// Every channel of an EXR's first layer as f64 planes, read with the `exr` crate (not with
+/// glassdb's own codecs), sorted by channel name.
+pub fn read_exr_planes(path: &Path) -> Planes {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .unwrap_or_else(|e| panic!("reading {} with the exr crate: {e}", path.display()));
+    let layer = &image.layer_data;
+    let size = layer.size;
+    let mut names = Vec::new();
+    let mut channels = Vec::new();
+    for ch in &layer.channel_data.list {
+        names.push(ch.name.to_string());
+        channels.push(ch.sample_data.values_as_f32().map(f64::from).collect());
+    }
+    Planes {
+        width: size.width(),
+        height: size.height(),
+        names,
+        channels,
+    }
+}
+
+/// A PNG's samples as planes (grey, grey+alpha, RGB or RGBA; 8 or 16 bits, values as stored),
+/// read with the `png` crate (not with glassdb's own codecs).
+pub fn read_png_planes(path: &Path) -> Planes {
+    let file =
+        std::fs::File::open(path).unwrap_or_else(|e| panic!("opening {}: {e}", path.display()));
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .unwrap_or_else(|e| panic!("{}: PNG header: {e}", path.display()));
+    let mut buf = vec![0; reader.output_buffer_size().expect("PNG size")];
+    let info = reader
+        .next_frame(&mut buf)
+        .unwrap_or_else(|e| panic!("{}: PNG data: {e}", path.display()));
+    let names: Vec<String> = match info.color_type {
+        png::ColorType::Grayscale => vec!["Y"],
+        png::ColorType::GrayscaleAlpha => vec!["Y", "A"],
+        png::ColorType::Rgb => vec!["R", "G", "B"],
+        png::ColorType::Rgba => vec!["R", "G", "B", "A"],
+        png::ColorType::Indexed => panic!("{}: indexed PNG", path.display()),
+    }
+    .into_iter()
+    .map(String::from)
+    .collect();
+    let (w, h) = (info.width as usize, info.height as usize);
+    let k = names.len();
+    let samples: Vec<f64> = match info.bit_depth {
+        png::BitDepth::Eight => buf[..w * h * k].iter().map(|&b| f64::from(b)).collect(),
+        png::BitDepth::Sixteen => buf[..w * h * k * 2]
+            .chunks_exact(2)
+            .map(|b| f64::from(u16::from_be_bytes([b[0], b[1]])))
+            .collect(),
+        other => panic!("{}: {other:?}-bit PNG", path.display()),
+    };
+    let channels = (0..k)
+        .map(|c| samples.iter().skip(c).step_by(k).copied().collect())
+        .collect();
+    Planes {
+        width: w,
+        height: h,
+        names,
+        channels,
+    }
+}

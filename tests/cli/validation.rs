@@ -16,7 +16,7 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
-use crate::util::{compose, glassdb, ok, repo_path};
+use crate::util::{compose, glassdb, make_ref, ok, repo_path};
 
 /// Number of reflection passes (glass planes) of the atrium, in `planes.json` order.
 const PLANES: usize = 3;
@@ -106,7 +106,7 @@ fn regions(w: usize, h: usize, mask: &[[u8; 3]]) -> Regions {
 }
 
 /// PSNR (peak 1.0), mean and max absolute error over the channels of the selected pixels.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 struct Errors {
     psnr_db: f64,
     mean_abs: f64,
@@ -223,9 +223,16 @@ fn atrium_composite_against_path_traced_reference() {
     let overall = errors(&out, &reference, |_| true);
     let glass = errors(&out, &reference, |i| reg.glass[i]);
     let edges = errors(&out, &reference, |i| reg.edge[i]);
-    assert_floor("overall", overall, MEASURED_OVERALL);
-    assert_floor("glass", glass, MEASURED_GLASS);
-    assert_floor("pane edges", edges, MEASURED_EDGES);
+    if make_ref() {
+        record_measured("overall", rounded(overall));
+        record_measured("glass", rounded(glass));
+        record_measured("pane_edges", rounded(edges));
+        return;
+    }
+    let m = measured();
+    assert_floor("overall", overall, m.overall);
+    assert_floor("glass", glass, m.glass);
+    assert_floor("pane edges", edges, m.pane_edges);
 }
 
 #[test]
@@ -266,12 +273,17 @@ fn reference_noise_bounds_the_measurable_psnr() {
     let e = errors(&a, &b, |_| true);
     let noise_bound_db = e.psnr_db + 10.0 * 2f64.log10();
     eprintln!("reference vs second seed: {e:?}; noise bound {noise_bound_db:.2} dB");
+    if make_ref() {
+        record_measured("noise_bound_db", serde_json::json!(sig5(noise_bound_db)));
+        return;
+    }
+    let m = measured();
     assert!(
-        (noise_bound_db - MEASURED_NOISE_BOUND_DB).abs() < 0.05,
+        (noise_bound_db - m.noise_bound_db).abs() < 0.05,
         "the committed references changed"
     );
     assert!(
-        noise_bound_db > MEASURED_OVERALL.psnr_db + 3.0,
+        noise_bound_db > m.overall.psnr_db + 3.0,
         "the reference is too noisy to validate the composite ({noise_bound_db:.1} dB)"
     );
 }
@@ -339,20 +351,55 @@ fn readme_main_job_composes_the_atrium_with_the_bundled_catalog() {
     );
 }
 
-const fn e(psnr_db: f64, mean_abs: f64, max_abs: f64, pixels: usize) -> Errors {
-    Errors {
-        psnr_db,
-        mean_abs,
-        max_abs,
-        pixels,
-    }
+/// What this test measured when the fixtures were made (`fixtures/atrium/analysis/measured.json`,
+/// docs/validation.md "Results"). `GLASSDB_MAKE_REF=1` rewrites that file from the values
+/// measured now; it is never edited by hand.
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
+struct Measured {
+    overall: Errors,
+    glass: Errors,
+    pane_edges: Errors,
+    noise_bound_db: f64,
 }
 
-// Measured when the fixtures were made (docs/validation.md, "Results").
-const MEASURED_OVERALL: Errors = e(42.384, 0.004436, 0.10628, 76800);
-const MEASURED_GLASS: Errors = e(39.528, 0.006506, 0.10628, 13543);
-const MEASURED_EDGES: Errors = e(41.881, 0.004494, 0.08861, 3409);
-const MEASURED_NOISE_BOUND_DB: f64 = 51.117;
+fn measured_path() -> std::path::PathBuf {
+    atrium("analysis/measured.json")
+}
+
+fn measured() -> Measured {
+    let text =
+        std::fs::read_to_string(measured_path()).expect("fixtures/atrium/analysis/measured.json");
+    serde_json::from_str(&text).expect("measured.json: overall, glass, pane_edges, noise_bound_db")
+}
+
+/// Rounds to 5 significant digits, as the committed file keeps them.
+fn sig5(v: f64) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(4 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
+}
+
+/// Under `GLASSDB_MAKE_REF=1`, replaces one entry of measured.json with `value`.
+fn record_measured(key: &str, value: serde_json::Value) {
+    // Tests run in parallel threads: one read-modify-write at a time.
+    static FILE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _guard = FILE.lock().unwrap_or_else(|e| e.into_inner());
+    let path = measured_path();
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    json[key] = value;
+    std::fs::write(&path, serde_json::to_string_pretty(&json).unwrap() + "\n").unwrap();
+}
+
+fn rounded(e: Errors) -> serde_json::Value {
+    serde_json::json!({
+        "psnr_db": sig5(e.psnr_db), "mean_abs": sig5(e.mean_abs),
+        "max_abs": sig5(e.max_abs), "pixels": e.pixels
+    })
+}
+
 // Not measured but derived: the registry's fits of these glasses stay within 1.7e-3 of the
 // exact r, t (`glassdb registry show`), the passes' radiance in the glass is below 1, and the
 // oracle is stored as half (relative rounding 2^-11): |diff| ≤ 1.7e-3 + 0.5e-3 < 2.5e-3. The
