@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 use glassdb_plot::inspect::summarize_png;
 
-use crate::util::{fails, glassdb, ok, repo_path, write_file};
+use crate::util::{
+    assert_images_match, fails, glassdb, ok, read_png_planes, repo_path, write_file,
+};
 
 /// Asserts a PNG figure is really drawn: plausible size and many colours with contrast.
 fn assert_drawn_png(path: &Path, min_bytes: u64) {
@@ -531,4 +533,121 @@ fn committed_figures_are_small_and_drawn() {
         n += 1;
     }
     assert!(n >= 6, "only {n} figures embedded in docs/accuracy.md");
+}
+
+/// docs/accuracy.md with what varies from run to run blanked: the machine line, the timing
+/// columns and values, the number of timed values and the figures' file sizes (the PNG encoder's
+/// output size differs between builds; the pixels do not). What is left, every error and every
+/// figure caption, must be what `glassdb report` computes now.
+fn accuracy_page_without_timings(md: &str) -> String {
+    let mut out = Vec::new();
+    let mut timed_columns: Vec<usize> = Vec::new();
+    for line in md.lines() {
+        if line.starts_with("Machine of this run") {
+            out.push("Machine of this run: …".to_string());
+            continue;
+        }
+        if line.contains("timings are measured on every run") {
+            let mut blanked = String::new();
+            for c in line.chars() {
+                if !c.is_ascii_digit() {
+                    blanked.push(c);
+                } else if !blanked.ends_with('#') {
+                    blanked.push('#');
+                }
+            }
+            out.push(blanked);
+            continue;
+        }
+        if line.starts_with('|') {
+            // `\|` inside a cell (|Δr|) is not a column separator.
+            let escaped = line.replace("\\|", "\u{1}");
+            let cells: Vec<String> = escaped
+                .split('|')
+                .map(|c| c.replace('\u{1}', "\\|"))
+                .collect();
+            if cells
+                .iter()
+                .any(|c| c.contains("ns/value") || c.contains(" ms "))
+            {
+                timed_columns = (0..cells.len())
+                    .filter(|&k| cells[k].contains("ns/value") || cells[k].contains(" ms "))
+                    .collect();
+            }
+            let cells: Vec<String> = cells
+                .iter()
+                .enumerate()
+                .map(|(k, c)| {
+                    let header_or_rule =
+                        c.contains("ns/value") || c.contains(" ms ") || c.contains("---");
+                    if timed_columns.contains(&k) && !header_or_rule {
+                        " t ".to_string()
+                    } else {
+                        c.to_string()
+                    }
+                })
+                .collect();
+            out.push(cells.join("|"));
+            continue;
+        }
+        timed_columns.clear();
+        let mut line = line.to_string();
+        if let Some(end) = line.find(" ns per pixel") {
+            let start = line[..end].rfind(' ').map_or(0, |s| s + 1);
+            line.replace_range(start..end, "t");
+        }
+        if line.ends_with(" KB)") {
+            if let Some(start) = line.rfind(" (") {
+                line.replace_range(start.., " (size)");
+            }
+        }
+        out.push(line);
+    }
+    out.join("\n")
+}
+
+#[test]
+fn docs_accuracy_page_and_figures_are_fresh() {
+    // The committed page and figures are what `glassdb report` makes of today's code (timings
+    // aside): a change to any approximation that the page measures must come with the page.
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("accuracy.md");
+    let figs = dir.path().join("figures");
+    ok(glassdb()
+        .arg("report")
+        .arg("--root")
+        .arg(repo_path(""))
+        .arg("-o")
+        .arg(&page)
+        .arg("--figures")
+        .arg(&figs)
+        .args(["--timing-values", "2048"]));
+    let fresh = accuracy_page_without_timings(&std::fs::read_to_string(&page).unwrap());
+    let committed = accuracy_page_without_timings(
+        &std::fs::read_to_string(repo_path("docs/accuracy.md")).unwrap(),
+    );
+    let stale: Vec<String> = fresh
+        .lines()
+        .zip(committed.lines())
+        .enumerate()
+        .filter(|(_, (f, c))| f != c)
+        .map(|(k, (f, c))| format!("line {}:\n  committed: {c}\n  now:       {f}", k + 1))
+        .take(5)
+        .collect();
+    assert!(
+        stale.is_empty() && fresh.lines().count() == committed.lines().count(),
+        "docs/accuracy.md is stale; regenerate it with `cargo run --release -- report`:\n{}",
+        stale.join("\n")
+    );
+    for entry in std::fs::read_dir(&figs).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let stem = name.trim_end_matches(".png");
+        assert_images_match(
+            &format!("docs_figure_{stem}"),
+            &read_png_planes(&path),
+            &read_png_planes(&repo_path("docs/figures").join(&name)),
+            0.0,
+        );
+    }
 }
