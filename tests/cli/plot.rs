@@ -596,10 +596,8 @@ fn accuracy_page_without_timings(md: &str) -> String {
             let start = line[..end].rfind(' ').map_or(0, |s| s + 1);
             line.replace_range(start..end, "t");
         }
-        if line.ends_with(" KB)") {
-            if let Some(start) = line.rfind(" (") {
-                line.replace_range(start.., " (size)");
-            }
+        if let Some(start) = line.rfind(" (").filter(|_| line.ends_with(" KB)")) {
+            line.replace_range(start.., " (size)");
         }
         out.push(line);
     }
