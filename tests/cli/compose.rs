@@ -118,6 +118,11 @@ fn mask8(w: u32, h: u32, id: Vec<u16>, cos: Vec<u8>, plane: Vec<u16>) -> MaskIma
     }
 }
 
+/// Writes `mask` as the paper's 8-bit packed PNG.
+fn write_mask8(path: &Path, mask: MaskImage) {
+    write_mask(path, &mask, MaskFormat::Png8).unwrap();
+}
+
 fn assert_close(got: [f32; 3], want: [f32; 3], what: &str) {
     for c in 0..3 {
         assert!(
@@ -158,15 +163,24 @@ impl Golden {
     fn path(&self, name: &str) -> PathBuf {
         self.dir.path().join(name)
     }
+    /// `compose` of this golden's passes with `mask` into `out`.
     fn cmd(&self, mask: &Path, out: &Path) -> std::process::Command {
+        self.cmd_with(&self.refl, &self.trans, mask, out)
+    }
+    /// `compose` of the given passes and mask with this golden's registry into `out`.
+    fn cmd_with(
+        &self,
+        refl: impl AsRef<Path>,
+        trans: impl AsRef<Path>,
+        mask: impl AsRef<Path>,
+        out: impl AsRef<Path>,
+    ) -> std::process::Command {
         let mut c = compose();
-        c.arg("--refl")
-            .arg(&self.refl)
-            .arg("--trans")
-            .arg(&self.trans)
-            .arg("--mask")
-            .arg(mask);
-        c.arg("--registry").arg(&self.registry).arg("-o").arg(out);
+        c.arg("--refl").arg(refl.as_ref());
+        c.arg("--trans").arg(trans.as_ref());
+        c.arg("--mask").arg(mask.as_ref());
+        c.arg("--registry").arg(&self.registry);
+        c.arg("-o").arg(out.as_ref());
         c
     }
 }
@@ -175,12 +189,7 @@ impl Golden {
 fn golden_8bit_packed_mask_exr_in_and_out() {
     let g = golden();
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0, 1, 1], vec![0, 255, 7], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![0, 1, 1], vec![0, 255, 7], vec![0; 3]));
     let out = g.path("o.exr");
     let stdout = ok(&mut g.cmd(&m, &out));
     assert!(stdout.contains("o.exr"), "{stdout}");
@@ -314,12 +323,7 @@ fn golden_two_planes_with_back_side() {
     let r2 = g.path("r2.exr");
     write_image(&r2, 3, 1, &[[2.0; 3]; 3]);
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0, 0, 1]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0, 0, 1]));
     let out = g.path("o.exr");
     ok(g.cmd(&m, &out)
         .arg("--refl")
@@ -398,23 +402,10 @@ fn png_in_and_out_are_srgb_encoded() {
     )
     .unwrap();
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(2, 1, vec![2, 0], vec![255, 0], vec![0; 2]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(2, 1, vec![2, 0], vec![255, 0], vec![0; 2]));
     let out = g.path("o.png");
-    let mut c = compose();
-    c.arg("--refl")
-        .arg(&r)
-        .arg("--trans")
-        .arg(&t)
-        .arg("--mask")
-        .arg(&m)
-        .arg("--registry")
-        .arg(&g.registry);
-    c.arg("-o").arg(&out).args(["--dither", "none"]);
+    let mut c = g.cmd_with(&r, &t, &m, &out);
+    c.args(["--dither", "none"]);
     ok(&mut c);
     let decoded = read_png_planes(&out);
     assert_eq!(decoded.channels.len(), 3);
@@ -423,33 +414,15 @@ fn png_in_and_out_are_srgb_encoded() {
         (188.0, 255.0)
     );
     let out16 = g.path("o16.png");
-    let mut c = compose();
-    c.arg("--refl")
-        .arg(&r)
-        .arg("--trans")
-        .arg(&t)
-        .arg("--mask")
-        .arg(&m)
-        .arg("--registry")
-        .arg(&g.registry);
-    c.arg("-o").arg(&out16).args(["--png-bits", "16"]);
+    let mut c = g.cmd_with(&r, &t, &m, &out16);
+    c.args(["--png-bits", "16"]);
     ok(&mut c);
     let decoded = read_png_planes(&out16);
     assert_eq!(decoded.channels[0][0], 48192.0);
     // --input-transfer linear: code 255 is still 1; a mid code 128 would be 128/255.
     let exr_out = g.path("lin.exr");
-    let mut c = compose();
-    c.arg("--refl")
-        .arg(&r)
-        .arg("--trans")
-        .arg(&t)
-        .arg("--mask")
-        .arg(&m)
-        .arg("--registry")
-        .arg(&g.registry);
-    c.arg("-o")
-        .arg(&exr_out)
-        .args(["--input-transfer", "linear", "--data-type", "float"]);
+    let mut c = g.cmd_with(&r, &t, &m, &exr_out);
+    c.args(["--input-transfer", "linear", "--data-type", "float"]);
     ok(&mut c);
     assert_eq!(read_rgb(&exr_out)[0], [0.5; 3]);
 }
@@ -458,12 +431,7 @@ fn png_in_and_out_are_srgb_encoded() {
 fn half_output_and_every_compression_round_trip() {
     let g = golden();
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0, 1, 1], vec![0, 255, 7], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![0, 1, 1], vec![0, 255, 7], vec![0; 3]));
     for comp in ["none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a"] {
         let out = g.path(&format!("o_{comp}.exr"));
         ok(g.cmd(&m, &out)
@@ -531,23 +499,9 @@ fn multi_layer_exr_pass_chosen_by_name() {
     );
     Image::from_layer(layer).write().to_file(&t).unwrap();
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0, 1, 0], vec![255; 3], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![0, 1, 0], vec![255; 3], vec![0; 3]));
     let run_with = |layer: Option<&str>, out: &Path| {
-        let mut c = compose();
-        c.arg("--refl")
-            .arg(&g.refl)
-            .arg("--trans")
-            .arg(&t)
-            .arg("--mask")
-            .arg(&m)
-            .arg("--registry")
-            .arg(&g.registry);
-        c.arg("-o").arg(out);
+        let mut c = g.cmd_with(&g.refl, &t, &m, out);
         if let Some(l) = layer {
             c.args(["--layer", l]);
         }
@@ -610,12 +564,10 @@ fn default_registry_and_default_output_name_on_the_bundled_example() {
 fn sequences_report_bad_frames_and_go_on() {
     let g = golden();
     for f in [1, 2, 4] {
-        write_mask(
+        write_mask8(
             &g.path(&format!("m.{f:04}.png")),
-            &mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]),
-            MaskFormat::Png8,
-        )
-        .unwrap();
+            mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]),
+        );
         write_image(
             &g.path(&format!("t.{f:04}.exr")),
             3,
@@ -625,17 +577,13 @@ fn sequences_report_bad_frames_and_go_on() {
     }
     // Frame 3 has no inputs; frame 4's mask is corrupt.
     std::fs::write(g.path("m.0004.png"), b"\x89PNG\r\n\x1a\nbroken").unwrap();
-    let mut c = compose();
-    c.arg("--refl").arg(&g.refl);
-    c.arg("--trans")
-        .arg(g.path("t.####.exr"))
-        .arg("--mask")
-        .arg(g.path("m.####.png"));
-    c.arg("--registry")
-        .arg(&g.registry)
-        .arg("-o")
-        .arg(g.path("o.####.exr"))
-        .args(["--frames", "1-4"]);
+    let mut c = g.cmd_with(
+        &g.refl,
+        g.path("t.####.exr"),
+        g.path("m.####.png"),
+        g.path("o.####.exr"),
+    );
+    c.args(["--frames", "1-4"]);
     let err = fails(&mut c);
     assert!(
         err.contains("frame 3") && err.contains("t.0003.exr"),
@@ -652,32 +600,23 @@ fn sequences_report_bad_frames_and_go_on() {
     }
     assert!(!g.path("o.0003.exr").exists() && !g.path("o.0004.exr").exists());
     // All good frames → exit 0.
-    let mut c = compose();
-    c.arg("--refl").arg(&g.refl);
-    c.arg("--trans")
-        .arg(g.path("t.####.exr"))
-        .arg("--mask")
-        .arg(g.path("m.####.png"));
-    c.arg("--registry")
-        .arg(&g.registry)
-        .arg("-o")
-        .arg(g.path("p.####.exr"))
-        .args(["--frames", "1-2"]);
+    let mut c = g.cmd_with(
+        &g.refl,
+        g.path("t.####.exr"),
+        g.path("m.####.png"),
+        g.path("p.####.exr"),
+    );
+    c.args(["--frames", "1-2"]);
     let stdout = ok(&mut c);
     assert!(stdout.contains("2 frame(s)"), "{stdout}");
     // An output without #### would be overwritten by every frame.
-    let mut c = compose();
-    c.arg("--refl")
-        .arg(&g.refl)
-        .arg("--trans")
-        .arg(g.path("t.####.exr"))
-        .arg("--mask")
-        .arg(g.path("m.####.png"));
-    c.arg("--registry")
-        .arg(&g.registry)
-        .arg("-o")
-        .arg(g.path("same.exr"))
-        .args(["--frames", "1-2"]);
+    let mut c = g.cmd_with(
+        &g.refl,
+        g.path("t.####.exr"),
+        g.path("m.####.png"),
+        g.path("same.exr"),
+    );
+    c.args(["--frames", "1-2"]);
     let err = fails(&mut c);
     assert!(err.contains("####"), "{err}");
 }
@@ -688,23 +627,8 @@ fn passes_of_different_sizes_name_both_files_and_sizes() {
     let small = g.path("small.exr");
     write_image(&small, 2, 1, &[[1.0; 3]; 2]);
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0; 3], vec![0; 3], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
-    let mut c = compose();
-    c.arg("--refl")
-        .arg(&small)
-        .arg("--trans")
-        .arg(&g.trans)
-        .arg("--mask")
-        .arg(&m);
-    c.arg("--registry")
-        .arg(&g.registry)
-        .arg("-o")
-        .arg(g.path("o.exr"));
+    write_mask8(&m, mask8(3, 1, vec![0; 3], vec![0; 3], vec![0; 3]));
+    let mut c = g.cmd_with(&small, &g.trans, &m, g.path("o.exr"));
     let err = fails(&mut c);
     assert!(
         err.contains("t.exr")
@@ -715,12 +639,7 @@ fn passes_of_different_sizes_name_both_files_and_sizes() {
     );
     // A mask of a different size.
     let m2 = g.path("m2.png");
-    write_mask(
-        &m2,
-        &mask8(1, 1, vec![0], vec![0], vec![0]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m2, mask8(1, 1, vec![0], vec![0], vec![0]));
     let err = fails(&mut g.cmd(&m2, &g.path("o.exr")));
     assert!(err.contains("m2.png") && err.contains("1×1"), "{err}");
     assert!(!g.path("o.exr").exists());
@@ -730,12 +649,7 @@ fn passes_of_different_sizes_name_both_files_and_sizes() {
 fn unknown_ids_are_listed_with_pixel_counts_unless_passed_through() {
     let g = golden();
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![7, 1, 7], vec![255; 3], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![7, 1, 7], vec![255; 3], vec![0; 3]));
     let out = g.path("o.exr");
     let err = fails(&mut g.cmd(&m, &out));
     assert!(
@@ -766,12 +680,7 @@ fn nan_in_a_pass_is_counted_reported_and_propagated() {
         &[[8.0; 3], [f32::INFINITY, 8.0, 8.0], [8.0; 3]],
     );
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]));
     let out = g.path("o.exr");
     let (o, _stdout, stderr) = run(&mut g.cmd(&m, &out));
     assert!(o.status.success(), "{stderr}");
@@ -790,23 +699,10 @@ fn nan_in_a_pass_is_counted_reported_and_propagated() {
 fn unreadable_truncated_and_corrupt_inputs_fail_cleanly() {
     let g = golden();
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]));
     let out = g.path("o.exr");
     // Missing pass.
-    let mut c = compose();
-    c.arg("--refl")
-        .arg(g.path("missing.exr"))
-        .arg("--trans")
-        .arg(&g.trans)
-        .arg("--mask")
-        .arg(&m);
-    c.arg("--registry").arg(&g.registry).arg("-o").arg(&out);
-    let err = fails(&mut c);
+    let err = fails(&mut g.cmd_with(g.path("missing.exr"), &g.trans, &m, &out));
     assert!(err.contains("missing.exr"), "{err}");
     // Truncated transmission pass, at several lengths.
     let bytes = std::fs::read(&g.trans).unwrap();
@@ -833,12 +729,7 @@ fn unreadable_truncated_and_corrupt_inputs_fail_cleanly() {
 fn refuses_to_overwrite_an_input_and_keeps_old_output_on_failure() {
     let g = golden();
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]));
     let before = std::fs::read(&g.trans).unwrap();
     let err = fails(&mut g.cmd(&m, &g.trans));
     assert!(
@@ -859,12 +750,7 @@ fn corrupt_pass_and_mask_bytes_never_panic() {
     // Fixed-seed byte flips over a valid EXR, PNG pass and mask; every run must exit cleanly.
     let g = golden();
     let m = g.path("m.png");
-    write_mask(
-        &m,
-        &mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]),
-        MaskFormat::Png8,
-    )
-    .unwrap();
+    write_mask8(&m, mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]));
     let originals: Vec<(PathBuf, Vec<u8>)> = [&g.trans, &m]
         .iter()
         .map(|p| (p.to_path_buf(), std::fs::read(p).unwrap()))
