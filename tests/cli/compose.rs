@@ -7,7 +7,7 @@ use glassdb_compose::io::{
     ExrDataType, OutputOptions, PassReadOptions, PassSource, read_pass, write_output,
 };
 use glassdb_compose::pixels::{LinearImage, PngBits};
-use glassdb_mask::exr_flat::ExrSampleType;
+use glassdb_image::ExrSampleType;
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 
 use crate::util::{compose, fails, glassdb, ok, repo_path, run};
@@ -397,8 +397,7 @@ fn png_in_and_out_are_srgb_encoded() {
         .arg(&g.registry);
     c.arg("-o").arg(&out).args(["--dither", "none"]);
     ok(&mut c);
-    let decoded =
-        glassdb_mask::png_flat::decode_png(&std::fs::read(&out).unwrap(), 1 << 20).unwrap();
+    let decoded = glassdb_image::decode_png(&std::fs::read(&out).unwrap(), 1 << 20).unwrap();
     assert_eq!(decoded.channels, 3);
     assert_eq!((decoded.sample(0, 0), decoded.sample(1, 0)), (188, 255));
     let out16 = g.path("o16.png");
@@ -413,8 +412,7 @@ fn png_in_and_out_are_srgb_encoded() {
         .arg(&g.registry);
     c.arg("-o").arg(&out16).args(["--png-bits", "16"]);
     ok(&mut c);
-    let decoded =
-        glassdb_mask::png_flat::decode_png(&std::fs::read(&out16).unwrap(), 1 << 20).unwrap();
+    let decoded = glassdb_image::decode_png(&std::fs::read(&out16).unwrap(), 1 << 20).unwrap();
     assert_eq!(decoded.sample(0, 0), 48192);
     // --input-transfer linear: code 255 is still 1; a mid code 128 would be 128/255.
     let exr_out = g.path("lin.exr");
