@@ -4,16 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use exr::prelude::{
-    AnyChannel, AnyChannels, Blocks, Encoding, FlatSamples, Image, Layer, LayerAttributes,
-    LineOrder, SmallVec, WritableImage,
-};
 use glassdb_image::{
-    ExrFile, ExrPart, ExrSampleType, ImageError, ImageFile, PngColor, PngCompression,
-    PngEncodeOptions, PngPixels, PngSampleSlice, PngSamples,
+    ExrFile, ExrPart, ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions, ImageError, ImageFile,
+    PngColor, PngCompression, PngEncodeOptions, PngPixels, PngSampleSlice, PngSamples,
 };
-use half::slice::HalfFloatSliceExt;
-use rayon::prelude::*;
 
 use crate::ComposeError;
 use crate::pixels::{EncodedImage, EncodedSamples, InputTransfer, LinearImage, PngBits};
@@ -270,7 +264,7 @@ pub fn exr_compression_name(c: exr::compression::Compression) -> &'static str {
 }
 
 /// The default output compression: ZIP (16-line blocks), compressed in parallel by zlib-rs
-/// (`exr_zip`) and read by every EXR reader; docs/performance.md has the measured alternatives.
+/// (glassdb-image's `exr_zip`) and read by every EXR reader; docs/performance.md has the measured alternatives.
 pub const DEFAULT_EXR_COMPRESSION: exr::compression::Compression =
     exr::compression::Compression::ZIP16;
 
@@ -357,10 +351,10 @@ pub fn write_output(
             });
             let compression = opts.exr_compression.unwrap_or(DEFAULT_EXR_COMPRESSION);
             let zip_level = match (
-                crate::exr_zip::zip_block_lines(compression),
+                glassdb_image::zip_block_lines(compression),
                 opts.exr_zip_level,
             ) {
-                (Some(_), level) => Some(level.unwrap_or(crate::exr_zip::DEFAULT_ZIP_LEVEL)),
+                (Some(_), level) => Some(level.unwrap_or(glassdb_image::DEFAULT_ZIP_LEVEL)),
                 (None, None) => None,
                 (None, Some(_)) => {
                     return Err(ComposeError::BadOption(format!(
@@ -410,14 +404,6 @@ pub fn write_output(
     })
 }
 
-fn to_half(v: &[f32]) -> Vec<half::f16> {
-    let mut out = vec![half::f16::ZERO; v.len()];
-    out.par_chunks_mut(1 << 16)
-        .zip(v.par_chunks(1 << 16))
-        .for_each(|(d, s)| d.convert_from_f32_slice(s));
-    out
-}
-
 fn write_exr(
     path: &Path,
     image: LinearImage,
@@ -431,32 +417,26 @@ fn write_exr(
         alpha,
         ..
     } = image;
-    let samples = |v: Vec<f32>| match data_type {
-        ExrDataType::Float => FlatSamples::F32(v),
-        ExrDataType::Half => FlatSamples::F16(to_half(&v)),
-    };
-    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
-    list.push(AnyChannel::new("R", samples(r)));
-    list.push(AnyChannel::new("G", samples(g)));
-    list.push(AnyChannel::new("B", samples(b)));
+    let mut planes = vec![
+        ExrPlane::new("R", r),
+        ExrPlane::new("G", g),
+        ExrPlane::new("B", b),
+    ];
     if let Some(a) = alpha {
         // Alpha is linear data: quantise it linearly in lossy compressions.
-        let mut ch = AnyChannel::new("A", samples(a));
-        ch.quantize_linearly = true;
-        list.push(ch);
+        planes.push(ExrPlane {
+            linear: true,
+            ..ExrPlane::new("A", a)
+        });
     }
-    let encoding = Encoding {
+    let options = ExrWriteOptions {
+        storage: match data_type {
+            ExrDataType::Half => ExrStorage::Half,
+            ExrDataType::Float => ExrStorage::Float,
+        },
         compression,
-        blocks: Blocks::ScanLines,
-        line_order: LineOrder::Increasing,
+        zip_level,
     };
-    let layer = Layer::new(
-        (w, h),
-        LayerAttributes::default(),
-        encoding,
-        AnyChannels::sort(list),
-    );
-    let image = Image::from_layer(layer);
     let mut size = 0u64;
     glassdb_io::write_atomic(path, |out| {
         let mut counting = CountingWriter {
@@ -464,12 +444,8 @@ fn write_exr(
             pos: 0,
             len: 0,
         };
-        match zip_level {
-            // ZIP/ZIPS: our own deflate at the chosen level (exr_zip.rs).
-            Some(level) => crate::exr_zip::write_zip_image(&image, level, &mut counting),
-            None => image.write().to_buffered(&mut counting),
-        }
-        .map_err(std::io::Error::other)?;
+        glassdb_image::write_exr_planes(&mut counting, w, h, planes, options)
+            .map_err(std::io::Error::other)?;
         size = counting.len;
         Ok(())
     })?;

@@ -1,6 +1,6 @@
 //! Image files for passes, masks and plots: PNG and OpenEXR decoding into flat buffers (EXR:
 //! one `f32` plane per channel; PNG: interleaved 8- or 16-bit samples), the one PNG encoder
-//! and an EXR encoder, all behind one error type, [`ImageError`], whose
+//! and the one EXR encoder (ZIP deflated in parallel by zlib-rs), all behind one error type, [`ImageError`], whose
 //! [`kind`](ImageError::kind) is the class a user can act on.
 //!
 //! Every call into a codec runs under a panic guard: a panic becomes
@@ -9,6 +9,7 @@
 mod error;
 pub mod exr_read;
 mod exr_write;
+mod exr_zip;
 mod guard;
 pub mod png_read;
 mod png_write;
@@ -18,7 +19,8 @@ pub use exr_read::{
     ExrChannelInfo, ExrPart, ExrSampleType, all_channel_names, find_channel, read_exr_channels,
     read_exr_headers,
 };
-pub use exr_write::encode_exr_f32;
+pub use exr_write::{ExrPlane, ExrStorage, ExrWriteOptions, encode_exr_f32, write_exr_planes};
+pub use exr_zip::{DEFAULT_ZIP_LEVEL, zip_block_lines};
 pub use png_read::{PngPixels, PngSamples, decode_png};
 pub use png_write::{PngColor, PngCompression, PngEncodeOptions, PngSampleSlice, encode_png};
 
