@@ -92,6 +92,20 @@ pub enum ComposeError {
     Sequence(String),
 }
 
+impl ComposeError {
+    /// The image-level class of a decoding or encoding failure, of a pass or of the mask
+    /// (`None` for the compositor's own errors).
+    pub fn image_error_kind(&self) -> Option<glassdb_image::ImageErrorKind> {
+        match self {
+            ComposeError::Decode { source, .. } | ComposeError::Encode { source, .. } => {
+                Some(source.kind())
+            }
+            ComposeError::Mask(mask) => mask.image_error_kind(),
+            _ => None,
+        }
+    }
+}
+
 fn list_counts(ids: &[(u16, u64)]) -> String {
     ids.iter()
         .map(|(id, n)| format!("id {id} ({n} pixels)"))
