@@ -1,6 +1,6 @@
 //! Reading passes (through glassdb-image's one reader: EXR into flat per-channel buffers, PNG
-//! into samples) and writing the result (EXR through `exr`, PNG through glassdb-image's
-//! encoder), atomically.
+//! into samples), choosing a pass's RGB layer, and writing the result through glassdb-image's
+//! EXR and PNG encoders, atomically.
 
 use std::path::{Path, PathBuf};
 

@@ -9,7 +9,8 @@
 //! | EXR, float channels (names selectable) | `id` | `cos_theta` | `plane` (optional) | `coverage` (optional) |
 //! | binary PNG (method.md, binary form), with [`MaskReadOptions::binary_glass_id`] | the given id where not black | 1 (normal incidence) | 0 | grey level |
 //!
-//! Id 0 means "no glass" everywhere.
+//! Id 0 means "no glass" everywhere. Decoding and encoding the files is glassdb-image's job;
+//! this crate maps the formats' layouts to and from [`MaskImage`].
 
 mod error;
 mod read;
