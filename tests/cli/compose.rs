@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glassdb_compose::io::{ExrDataType, OutputOptions, PassSource, write_output};
 use glassdb_compose::pixels::{LinearImage, PngBits};
-use glassdb_mask::exr_flat::ExrSampleType;
+use glassdb_image::ExrSampleType;
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 
 use crate::util::{

@@ -6,22 +6,19 @@ use std::path::PathBuf;
 /// Everything that can go wrong composing one image or a sequence.
 #[derive(Debug, thiserror::Error)]
 pub enum ComposeError {
-    #[error("cannot read {path}: {cause}")]
+    #[error("cannot read {path}")]
     Read {
         path: PathBuf,
+        #[source]
         cause: std::io::Error,
     },
-    #[error("{path} is neither PNG nor OpenEXR (it starts with bytes {start:02x?})")]
-    UnknownFormat { path: PathBuf, start: Vec<u8> },
-    #[error("{path}: {cause}")]
-    Png {
+    /// A pass that is not a PNG or EXR this reader can decode (the source's class says whether
+    /// it is corrupt, unsupported or too large).
+    #[error("{path}")]
+    Decode {
         path: PathBuf,
-        cause: glassdb_mask::png_flat::PngFlatError,
-    },
-    #[error("{path}: {cause}")]
-    Exr {
-        path: PathBuf,
-        cause: glassdb_mask::exr_flat::ExrFlatError,
+        #[source]
+        source: glassdb_image::ImageError,
     },
     #[error(transparent)]
     Mask(#[from] glassdb_mask::MaskError),
@@ -81,14 +78,32 @@ pub enum ComposeError {
     PlanesFile { path: PathBuf, detail: String },
     #[error("cannot tell the output format of {path}: use a .exr or .png extension")]
     OutputExtension { path: PathBuf },
-    #[error("cannot encode {path}: {detail}")]
-    Encode { path: PathBuf, detail: String },
+    #[error("cannot encode {path}")]
+    Encode {
+        path: PathBuf,
+        #[source]
+        source: glassdb_image::ImageError,
+    },
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),
     #[error(transparent)]
     Kernel(#[from] crate::kernel::KernelShapeError),
     #[error("{0}")]
     Sequence(String),
+}
+
+impl ComposeError {
+    /// The image-level class of a decoding or encoding failure, of a pass or of the mask
+    /// (`None` for the compositor's own errors).
+    pub fn image_error_kind(&self) -> Option<glassdb_image::ImageErrorKind> {
+        match self {
+            ComposeError::Decode { source, .. } | ComposeError::Encode { source, .. } => {
+                Some(source.kind())
+            }
+            ComposeError::Mask(mask) => mask.image_error_kind(),
+            _ => None,
+        }
+    }
 }
 
 fn list_counts(ids: &[(u16, u64)]) -> String {

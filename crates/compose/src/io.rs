@@ -1,18 +1,13 @@
-//! Reading passes (OpenEXR through `exr`'s block API into flat per-channel buffers, PNG through
-//! `png`) and writing the result (EXR through `exr`, PNG through `png`), atomically.
+//! Reading passes (through glassdb-image's one reader: EXR into flat per-channel buffers, PNG
+//! into samples), choosing a pass's RGB layer, and writing the result through glassdb-image's
+//! EXR and PNG encoders, atomically.
 
-use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
-use exr::prelude::{
-    AnyChannel, AnyChannels, Blocks, Encoding, FlatSamples, Image, Layer, LayerAttributes,
-    LineOrder, SmallVec, WritableImage,
+use glassdb_image::{
+    ExrFile, ExrPart, ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions, ImageError, ImageFile,
+    PngColor, PngCompression, PngEncodeOptions, PngPixels, PngSampleSlice, PngSamples,
 };
-use glassdb_mask::exr_flat::{self, ExrPart, ExrSampleType};
-use glassdb_mask::png_flat::{self, PngSamples};
-use glassdb_mask::{ImageFileKind, sniff_image_kind};
-use half::slice::HalfFloatSliceExt;
-use rayon::prelude::*;
 
 use crate::ComposeError;
 use crate::pixels::{EncodedImage, EncodedSamples, InputTransfer, LinearImage, PngBits};
@@ -34,7 +29,7 @@ impl Default for PassReadOptions {
         PassReadOptions {
             layer: None,
             transfer: InputTransfer::Srgb,
-            max_pixels: glassdb_mask::DEFAULT_MAX_PIXELS,
+            max_pixels: glassdb_image::DEFAULT_MAX_PIXELS,
         }
     }
 }
@@ -74,37 +69,39 @@ pub fn read_pass_bytes(
     path: &Path,
     opts: &PassReadOptions,
 ) -> Result<Pass, ComposeError> {
-    match sniff_image_kind(bytes) {
-        Some(ImageFileKind::Png) => {
-            let png = png_flat::decode_png(bytes, opts.max_pixels).map_err(|cause| {
-                ComposeError::Png {
-                    path: path.to_path_buf(),
-                    cause,
-                }
-            })?;
-            let bits = match png.samples {
-                PngSamples::U8(_) => PngBits::Eight,
-                PngSamples::U16(_) => PngBits::Sixteen,
-            };
-            let encoded = EncodedImage {
-                width: png.width,
-                height: png.height,
-                channels: png.channels,
-                samples: match png.samples {
-                    PngSamples::U8(v) => EncodedSamples::U8(v),
-                    PngSamples::U16(v) => EncodedSamples::U16(v),
-                },
-            };
-            Ok(Pass {
-                image: encoded.to_linear(opts.transfer),
-                source: PassSource::Png { bits },
-            })
-        }
-        Some(ImageFileKind::Exr) => read_exr_pass(bytes, path, opts),
-        None => Err(ComposeError::UnknownFormat {
-            path: path.to_path_buf(),
-            start: bytes.iter().take(8).copied().collect(),
-        }),
+    let decoded = glassdb_image::open_image(bytes, opts.max_pixels)
+        .map_err(|source| decode_err(path, source))?;
+    match decoded {
+        ImageFile::Png(png) => Ok(pass_from_png(png, opts.transfer)),
+        ImageFile::Exr(exr) => read_exr_pass(&exr, path, opts),
+    }
+}
+
+fn decode_err(path: &Path, source: ImageError) -> ComposeError {
+    ComposeError::Decode {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// A PNG pass: its samples mapped to linear light by `transfer`.
+fn pass_from_png(png: PngPixels, transfer: InputTransfer) -> Pass {
+    let bits = match png.samples {
+        PngSamples::U8(_) => PngBits::Eight,
+        PngSamples::U16(_) => PngBits::Sixteen,
+    };
+    let encoded = EncodedImage {
+        width: png.width,
+        height: png.height,
+        channels: png.channels,
+        samples: match png.samples {
+            PngSamples::U8(v) => EncodedSamples::U8(v),
+            PngSamples::U16(v) => EncodedSamples::U16(v),
+        },
+    };
+    Pass {
+        image: encoded.to_linear(transfer),
+        source: PassSource::Png { bits },
     }
 }
 
@@ -136,13 +133,13 @@ fn rgb_layers(parts: &[ExrPart]) -> Vec<(String, usize, [usize; 3], Option<usize
     out
 }
 
-fn read_exr_pass(bytes: &[u8], path: &Path, opts: &PassReadOptions) -> Result<Pass, ComposeError> {
-    let exr_err = |cause| ComposeError::Exr {
-        path: path.to_path_buf(),
-        cause,
-    };
-    let parts = exr_flat::read_exr_headers(bytes).map_err(exr_err)?;
-    let layers = rgb_layers(&parts);
+fn read_exr_pass(
+    exr: &ExrFile<'_>,
+    path: &Path,
+    opts: &PassReadOptions,
+) -> Result<Pass, ComposeError> {
+    let parts = exr.parts();
+    let layers = rgb_layers(parts);
     let candidates: Vec<String> = layers
         .iter()
         .map(|l| {
@@ -169,7 +166,7 @@ fn read_exr_pass(bytes: &[u8], path: &Path, opts: &PassReadOptions) -> Result<Pa
             [] => {
                 return Err(ComposeError::NoRgb {
                     path: path.to_path_buf(),
-                    available: exr_flat::all_channel_names(&parts),
+                    available: glassdb_image::all_channel_names(parts),
                 });
             }
             [only] => only,
@@ -191,8 +188,9 @@ fn read_exr_pass(bytes: &[u8], path: &Path, opts: &PassReadOptions) -> Result<Pa
     let (layer, part, rgb, alpha) = chosen.clone();
     let mut channels = rgb.to_vec();
     channels.extend(alpha);
-    let (info, mut buffers) =
-        exr_flat::read_exr_channels(bytes, part, &channels, opts.max_pixels).map_err(exr_err)?;
+    let (info, mut buffers) = exr
+        .read_channels(part, &channels)
+        .map_err(|source| decode_err(path, source))?;
     let sample_type = info
         .channels
         .get(rgb[0])
@@ -266,7 +264,7 @@ pub fn exr_compression_name(c: exr::compression::Compression) -> &'static str {
 }
 
 /// The default output compression: ZIP (16-line blocks), compressed in parallel by zlib-rs
-/// (`exr_zip`) and read by every EXR reader; docs/performance.md has the measured alternatives.
+/// (glassdb-image's `exr_zip`) and read by every EXR reader; docs/performance.md has the measured alternatives.
 pub const DEFAULT_EXR_COMPRESSION: exr::compression::Compression =
     exr::compression::Compression::ZIP16;
 
@@ -353,10 +351,10 @@ pub fn write_output(
             });
             let compression = opts.exr_compression.unwrap_or(DEFAULT_EXR_COMPRESSION);
             let zip_level = match (
-                crate::exr_zip::zip_block_lines(compression),
+                glassdb_image::zip_block_lines(compression),
                 opts.exr_zip_level,
             ) {
-                (Some(_), level) => Some(level.unwrap_or(crate::exr_zip::DEFAULT_ZIP_LEVEL)),
+                (Some(_), level) => Some(level.unwrap_or(glassdb_image::DEFAULT_ZIP_LEVEL)),
                 (None, None) => None,
                 (None, Some(_)) => {
                     return Err(ComposeError::BadOption(format!(
@@ -406,14 +404,6 @@ pub fn write_output(
     })
 }
 
-fn to_half(v: &[f32]) -> Vec<half::f16> {
-    let mut out = vec![half::f16::ZERO; v.len()];
-    out.par_chunks_mut(1 << 16)
-        .zip(v.par_chunks(1 << 16))
-        .for_each(|(d, s)| d.convert_from_f32_slice(s));
-    out
-}
-
 fn write_exr(
     path: &Path,
     image: LinearImage,
@@ -427,32 +417,26 @@ fn write_exr(
         alpha,
         ..
     } = image;
-    let samples = |v: Vec<f32>| match data_type {
-        ExrDataType::Float => FlatSamples::F32(v),
-        ExrDataType::Half => FlatSamples::F16(to_half(&v)),
-    };
-    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
-    list.push(AnyChannel::new("R", samples(r)));
-    list.push(AnyChannel::new("G", samples(g)));
-    list.push(AnyChannel::new("B", samples(b)));
+    let mut planes = vec![
+        ExrPlane::new("R", r),
+        ExrPlane::new("G", g),
+        ExrPlane::new("B", b),
+    ];
     if let Some(a) = alpha {
         // Alpha is linear data: quantise it linearly in lossy compressions.
-        let mut ch = AnyChannel::new("A", samples(a));
-        ch.quantize_linearly = true;
-        list.push(ch);
+        planes.push(ExrPlane {
+            linear: true,
+            ..ExrPlane::new("A", a)
+        });
     }
-    let encoding = Encoding {
+    let options = ExrWriteOptions {
+        storage: match data_type {
+            ExrDataType::Half => ExrStorage::Half,
+            ExrDataType::Float => ExrStorage::Float,
+        },
         compression,
-        blocks: Blocks::ScanLines,
-        line_order: LineOrder::Increasing,
+        zip_level,
     };
-    let layer = Layer::new(
-        (w, h),
-        LayerAttributes::default(),
-        encoding,
-        AnyChannels::sort(list),
-    );
-    let image = Image::from_layer(layer);
     let mut size = 0u64;
     glassdb_io::write_atomic(path, |out| {
         let mut counting = CountingWriter {
@@ -460,12 +444,8 @@ fn write_exr(
             pos: 0,
             len: 0,
         };
-        match zip_level {
-            // ZIP/ZIPS: our own deflate at the chosen level (exr_zip.rs).
-            Some(level) => crate::exr_zip::write_zip_image(&image, level, &mut counting),
-            None => image.write().to_buffered(&mut counting),
-        }
-        .map_err(|e| std::io::Error::other(e.to_string()))?;
+        glassdb_image::write_exr_planes(&mut counting, w, h, planes, options)
+            .map_err(std::io::Error::other)?;
         size = counting.len;
         Ok(())
     })?;
@@ -498,36 +478,27 @@ impl<W: std::io::Seek> std::io::Seek for CountingWriter<W> {
     }
 }
 
+/// Composited output is large: fast deflate, and an `sRGB` chunk (the samples are sRGB-encoded).
+const OUTPUT_PNG: PngEncodeOptions = PngEncodeOptions {
+    compression: PngCompression::Fast,
+    srgb_chunk: true,
+};
+
 fn write_png(path: &Path, image: &EncodedImage) -> Result<u64, ComposeError> {
-    let enc_err = |e: png::EncodingError| ComposeError::Encode {
-        path: path.to_path_buf(),
-        detail: e.to_string(),
+    let color = if image.channels == 4 {
+        PngColor::Rgba
+    } else {
+        PngColor::Rgb
     };
-    let mut out = Cursor::new(Vec::new());
-    {
-        let mut encoder = png::Encoder::new(&mut out, image.width, image.height);
-        encoder.set_color(if image.channels == 4 {
-            png::ColorType::Rgba
-        } else {
-            png::ColorType::Rgb
-        });
-        encoder.set_compression(png::Compression::Fast);
-        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        let data: Vec<u8> = match &image.samples {
-            EncodedSamples::U8(v) => {
-                encoder.set_depth(png::BitDepth::Eight);
-                v.clone()
-            }
-            EncodedSamples::U16(v) => {
-                encoder.set_depth(png::BitDepth::Sixteen);
-                v.iter().flat_map(|s| s.to_be_bytes()).collect()
-            }
-        };
-        let mut writer = encoder.write_header().map_err(enc_err)?;
-        writer.write_image_data(&data).map_err(enc_err)?;
-        writer.finish().map_err(enc_err)?;
-    }
-    let bytes = out.into_inner();
+    let samples = match &image.samples {
+        EncodedSamples::U8(v) => PngSampleSlice::U8(v),
+        EncodedSamples::U16(v) => PngSampleSlice::U16(v),
+    };
+    let bytes = glassdb_image::encode_png(image.width, image.height, color, samples, OUTPUT_PNG)
+        .map_err(|source| ComposeError::Encode {
+            path: path.to_path_buf(),
+            source,
+        })?;
     glassdb_io::write_bytes_atomic(path, &bytes)?;
     Ok(bytes.len() as u64)
 }

@@ -11,7 +11,6 @@
 //! - [`compose_frame`]: one image end to end, with per-stage timings for `--stats`.
 
 pub mod error;
-pub mod exr_zip;
 pub mod io;
 pub mod kernel;
 pub mod lut;

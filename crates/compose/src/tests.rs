@@ -231,7 +231,7 @@ proptest! {
         let m_path = dir.path().join("m.png");
         let write = |p: &std::path::Path, v: &[f32]| {
             let img = pixels::LinearImage { width: 4, height: 3, rgb: planes(v), alpha: None };
-            let src = io::PassSource::Exr { sample_type: glassdb_mask::exr_flat::ExrSampleType::Float, compression: exr::compression::Compression::ZIP16, layer: String::new() };
+            let src = io::PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, compression: exr::compression::Compression::ZIP16, layer: String::new() };
             io::write_output(p, img, &src, &io::OutputOptions::default()).unwrap();
         };
         write(&t_path, &trans);
@@ -243,7 +243,7 @@ proptest! {
         let got: Vec<u32> = out.image.rgb.iter().flatten().map(|v| v.to_bits()).collect();
         let want: Vec<u32> = trans.iter().map(|v| v.to_bits()).collect();
         prop_assert_eq!(got, want);
-        let is_float = matches!(out.source, io::PassSource::Exr { sample_type: glassdb_mask::exr_flat::ExrSampleType::Float, .. });
+        let is_float = matches!(out.source, io::PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, .. });
         prop_assert!(is_float);
     }
 }

@@ -1,9 +1,6 @@
 use std::path::Path;
 
-use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
-    WritableImage,
-};
+use glassdb_image::{ImageErrorKind, PngColor, PngCompression, PngEncodeOptions, PngSampleSlice};
 use proptest::prelude::*;
 
 use super::*;
@@ -24,47 +21,54 @@ fn packed8() -> MaskImage {
     }
 }
 
-fn encode_png(
-    width: u32,
-    height: u32,
-    color: png::ColorType,
-    depth: png::BitDepth,
-    data: &[u8],
-) -> Vec<u8> {
-    let mut out = Vec::new();
-    let mut e = png::Encoder::new(&mut out, width, height);
-    e.set_color(color);
-    e.set_depth(depth);
-    let mut w = e.write_header().unwrap();
-    w.write_image_data(data).unwrap();
-    w.finish().unwrap();
-    out
+/// Test PNG depth: 8-bit samples as given, or 16-bit samples from big-endian byte pairs.
+#[derive(Clone, Copy)]
+enum Depth {
+    Eight,
+    Sixteen,
+}
+
+fn encode_png(width: u32, height: u32, color: PngColor, depth: Depth, data: &[u8]) -> Vec<u8> {
+    let options = PngEncodeOptions {
+        compression: PngCompression::Fast,
+        srgb_chunk: false,
+    };
+    match depth {
+        Depth::Eight => {
+            glassdb_image::encode_png(width, height, color, PngSampleSlice::U8(data), options)
+        }
+        Depth::Sixteen => {
+            let wide: Vec<u16> = data
+                .chunks_exact(2)
+                .map(|b| u16::from_be_bytes([b[0], b[1]]))
+                .collect();
+            glassdb_image::encode_png(width, height, color, PngSampleSlice::U16(&wide), options)
+        }
+    }
+    .unwrap()
 }
 
 fn exr_bytes(width: usize, height: usize, channels: Vec<(&str, Vec<f32>)>) -> Vec<u8> {
-    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
-        .into_iter()
-        .map(|(n, v)| AnyChannel::new(n, FlatSamples::F32(v)))
-        .collect();
-    let layer = Layer::new(
-        (width, height),
-        LayerAttributes::default(),
-        Encoding::SMALL_LOSSLESS,
-        AnyChannels::sort(list),
-    );
-    let mut out = std::io::Cursor::new(Vec::new());
-    Image::from_layer(layer)
-        .write()
-        .to_buffered(&mut out)
-        .unwrap();
-    out.into_inner()
+    glassdb_image::encode_exr_f32(width, height, channels).unwrap()
+}
+
+/// The whole error chain, as the command line prints it.
+fn chain(err: &dyn std::error::Error) -> String {
+    let mut text = err.to_string();
+    let mut source = err.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
 }
 
 #[test]
 fn packed_8bit_png_reads_green_as_id_blue_as_cos_red_as_plane() {
     // Pixel (1, 0): R = 4 (plane), G = 9 (id), B = 255 (cos 1).
     let data = [0, 0, 0, 4, 9, 255];
-    let bytes = encode_png(2, 1, png::ColorType::Rgb, png::BitDepth::Eight, &data);
+    let bytes = encode_png(2, 1, PngColor::Rgb, Depth::Eight, &data);
     let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
     assert_eq!((m.width, m.height), (2, 1));
     assert_eq!(m.id, vec![0, 9]);
@@ -81,7 +85,7 @@ fn packed_8bit_png_reads_green_as_id_blue_as_cos_red_as_plane() {
 fn packed_16bit_png_reads_big_endian_samples() {
     // One pixel: R = 1, G = 300, B = 32768 (cos = 32768/65535).
     let data = [0, 1, 0x01, 0x2c, 0x80, 0x00];
-    let bytes = encode_png(1, 1, png::ColorType::Rgb, png::BitDepth::Sixteen, &data);
+    let bytes = encode_png(1, 1, PngColor::Rgb, Depth::Sixteen, &data);
     let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
     assert_eq!(m.id, vec![300]);
     assert_eq!(m.plane, vec![1]);
@@ -92,7 +96,7 @@ fn packed_16bit_png_reads_big_endian_samples() {
 #[test]
 fn rgba_png_alpha_is_ignored() {
     let data = [1, 2, 3, 0];
-    let bytes = encode_png(1, 1, png::ColorType::Rgba, png::BitDepth::Eight, &data);
+    let bytes = encode_png(1, 1, PngColor::Rgba, Depth::Eight, &data);
     let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
     assert_eq!((m.id[0], m.plane[0]), (2, 1));
 }
@@ -210,7 +214,7 @@ fn exr_cos_outside_unit_interval_on_glass_is_an_error_but_ignored_off_glass() {
 #[test]
 fn binary_mask_white_is_the_given_glass_at_normal_incidence() {
     let data = [0, 255, 0, 255];
-    let bytes = encode_png(4, 1, png::ColorType::Grayscale, png::BitDepth::Eight, &data);
+    let bytes = encode_png(4, 1, PngColor::Grey, Depth::Eight, &data);
     let mut o = opts();
     o.binary_glass_id = Some(12);
     let m = read_mask_bytes(&bytes, Path::new("b.png"), &o).unwrap();
@@ -220,7 +224,7 @@ fn binary_mask_white_is_the_given_glass_at_normal_incidence() {
     assert_eq!(m.coverage, None);
     // Grey (antialiased) edges become coverage.
     let data = [0, 0, 0, 51, 51, 51, 255, 255, 255];
-    let bytes = encode_png(3, 1, png::ColorType::Rgb, png::BitDepth::Eight, &data);
+    let bytes = encode_png(3, 1, PngColor::Rgb, Depth::Eight, &data);
     let m = read_mask_bytes(&bytes, Path::new("b.png"), &o).unwrap();
     assert_eq!(m.id, vec![0, 12, 12]);
     assert_eq!(m.coverage, Some(vec![0.0, 0.2, 1.0]));
@@ -228,13 +232,7 @@ fn binary_mask_white_is_the_given_glass_at_normal_incidence() {
 
 #[test]
 fn grey_png_without_glass_id_is_explained() {
-    let bytes = encode_png(
-        1,
-        1,
-        png::ColorType::Grayscale,
-        png::BitDepth::Eight,
-        &[255],
-    );
+    let bytes = encode_png(1, 1, PngColor::Grey, Depth::Eight, &[255]);
     let err = read_mask_bytes(&bytes, Path::new("g.png"), &opts())
         .unwrap_err()
         .to_string();
@@ -341,22 +339,20 @@ fn size_limit_is_checked_before_decoding() {
     let bytes = write_mask_bytes(Path::new("x.png"), &packed8(), MaskFormat::Png8).unwrap();
     let mut o = opts();
     o.max_pixels = 5;
-    let err = read_mask_bytes(&bytes, Path::new("x.png"), &o)
-        .unwrap_err()
-        .to_string();
+    let err = read_mask_bytes(&bytes, Path::new("x.png"), &o).unwrap_err();
+    assert_eq!(err.image_error_kind(), Some(ImageErrorKind::Limits));
+    let err = chain(&err);
     assert!(err.contains("3×2") && err.contains("limit"), "{err}");
     let bytes = write_mask_bytes(Path::new("x.exr"), &packed8(), MaskFormat::Exr).unwrap();
-    let err = read_mask_bytes(&bytes, Path::new("x.exr"), &o)
-        .unwrap_err()
-        .to_string();
+    let err = read_mask_bytes(&bytes, Path::new("x.exr"), &o).unwrap_err();
+    let err = chain(&err);
     assert!(err.contains("3×2") && err.contains("limit"), "{err}");
 }
 
 #[test]
 fn unknown_format_shows_the_first_bytes() {
-    let err = read_mask_bytes(b"GIF89a....", Path::new("m.gif"), &opts())
-        .unwrap_err()
-        .to_string();
+    let err = read_mask_bytes(b"GIF89a....", Path::new("m.gif"), &opts()).unwrap_err();
+    let err = chain(&err);
     assert!(err.contains("m.gif") && err.contains("47"), "{err}");
 }
 
@@ -369,6 +365,16 @@ fn truncated_files_are_errors() {
             assert!(
                 read_mask_bytes(&bytes[..cut], Path::new("x"), &opts()).is_err(),
                 "{format:?} cut at {cut}"
+            );
+        }
+        for cut in 0..bytes.len() - 20 {
+            let err = read_mask_bytes(&bytes[..cut], Path::new("x"), &opts()).unwrap_err();
+            assert!(
+                matches!(
+                    err.image_error_kind(),
+                    Some(ImageErrorKind::Invalid | ImageErrorKind::Unsupported)
+                ),
+                "{format:?} cut at {cut}: {err:?}"
             );
         }
     }

@@ -1,12 +1,8 @@
 //! Writing masks (atomically, through `glassdb-io`).
 
-use std::io::Cursor;
 use std::path::Path;
 
-use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
-    WritableImage,
-};
+use glassdb_image::{ImageError, PngColor, PngCompression, PngEncodeOptions, PngSampleSlice};
 
 use crate::{CosTheta, MaskError, MaskImage};
 
@@ -164,37 +160,32 @@ pub fn write_mask_bytes(
                 CosTheta::Float(c) => c.clone(),
                 _ => (0..n).map(|i| mask.cos_theta_at(i) as f32).collect(),
             };
-            let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
-            list.push(AnyChannel::new("id", FlatSamples::F32(id)));
-            list.push(AnyChannel::new("cos_theta", FlatSamples::F32(cos)));
+            let mut channels = vec![("id", id), ("cos_theta", cos)];
             if mask.plane.iter().any(|&p| p != 0) {
-                list.push(AnyChannel::new(
-                    "plane",
-                    FlatSamples::F32(mask.plane.iter().map(|&p| f32::from(p)).collect()),
-                ));
+                channels.push(("plane", mask.plane.iter().map(|&p| f32::from(p)).collect()));
             }
             if let Some(c) = &mask.coverage {
-                list.push(AnyChannel::new("coverage", FlatSamples::F32(c.clone())));
+                channels.push(("coverage", c.clone()));
             }
-            let layer = Layer::new(
-                (w, mask.height as usize),
-                LayerAttributes::default(),
-                Encoding::SMALL_LOSSLESS,
-                AnyChannels::sort(list),
-            );
-            let image = Image::from_layer(layer);
-            let mut out = Cursor::new(Vec::new());
-            image
-                .write()
-                .to_buffered(&mut out)
-                .map_err(|e| MaskError::Encode {
-                    path: path.to_path_buf(),
-                    detail: e.to_string(),
-                })?;
-            Ok(out.into_inner())
+            glassdb_image::encode_exr_f32(w, mask.height as usize, channels)
+                .map_err(|source| encode_err(path, source))
         }
     }
 }
+
+fn encode_err(path: &Path, source: ImageError) -> MaskError {
+    MaskError::Encode {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Masks are small and written once: balanced deflate, no colour chunk (the samples are codes,
+/// not light).
+const MASK_PNG: PngEncodeOptions = PngEncodeOptions {
+    compression: PngCompression::Balanced,
+    srgb_chunk: false,
+};
 
 /// Encodes interleaved RGB samples (each < 256 when `sixteen` is false) as a PNG.
 fn encode_png_rgb(
@@ -204,16 +195,15 @@ fn encode_png_rgb(
     samples: &[u16],
     sixteen: bool,
 ) -> Result<Vec<u8>, MaskError> {
-    let (depth, data): (_, Vec<u8>) = if sixteen {
-        let bytes = samples.iter().flat_map(|s| s.to_be_bytes()).collect();
-        (png::BitDepth::Sixteen, bytes)
+    let eight: Vec<u8>;
+    let data = if sixteen {
+        PngSampleSlice::U16(samples)
     } else {
-        (
-            png::BitDepth::Eight,
-            samples.iter().map(|&s| s as u8).collect(),
-        )
+        eight = samples.iter().map(|&s| s as u8).collect();
+        PngSampleSlice::U8(&eight)
     };
-    encode_png(path, width, height, png::ColorType::Rgb, depth, &data)
+    glassdb_image::encode_png(width, height, PngColor::Rgb, data, MASK_PNG)
+        .map_err(|source| encode_err(path, source))
 }
 
 /// Encodes 8-bit grey samples as a PNG.
@@ -223,36 +213,12 @@ fn encode_png_grey(
     height: u32,
     grey: &[u8],
 ) -> Result<Vec<u8>, MaskError> {
-    encode_png(
-        path,
+    glassdb_image::encode_png(
         width,
         height,
-        png::ColorType::Grayscale,
-        png::BitDepth::Eight,
-        grey,
+        PngColor::Grey,
+        PngSampleSlice::U8(grey),
+        MASK_PNG,
     )
-}
-
-/// Encodes raw PNG sample bytes (big-endian when 16-bit).
-fn encode_png(
-    path: &Path,
-    width: u32,
-    height: u32,
-    color: png::ColorType,
-    depth: png::BitDepth,
-    data: &[u8],
-) -> Result<Vec<u8>, MaskError> {
-    let enc_err = |e: png::EncodingError| MaskError::Encode {
-        path: path.to_path_buf(),
-        detail: e.to_string(),
-    };
-    let mut out = Vec::new();
-    let mut encoder = png::Encoder::new(&mut out, width, height);
-    encoder.set_color(color);
-    encoder.set_depth(depth);
-    encoder.set_compression(png::Compression::Balanced);
-    let mut writer = encoder.write_header().map_err(enc_err)?;
-    writer.write_image_data(data).map_err(enc_err)?;
-    writer.finish().map_err(enc_err)?;
-    Ok(out)
+    .map_err(|source| encode_err(path, source))
 }

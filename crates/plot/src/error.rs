@@ -21,8 +21,15 @@ pub enum PlotError {
     #[error("the plotting library failed internally while drawing {what}")]
     DrawPanic { what: String },
     /// Encoding the PNG failed.
-    #[error("encoding the PNG failed: {0}")]
-    Encode(String),
+    #[error("encoding the PNG failed")]
+    Encode(#[source] glassdb_image::ImageError),
+    /// An image file (a written figure) could not be decoded.
+    #[error("cannot decode {path}")]
+    Decode {
+        path: PathBuf,
+        #[source]
+        source: glassdb_image::ImageError,
+    },
     /// Writing the output failed (directory missing, permission, disk full).
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),

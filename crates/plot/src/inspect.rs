@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use glassdb_image::PngSamples;
+
 use crate::PlotError;
 
 /// What a PNG holds, in numbers.
@@ -18,38 +20,26 @@ pub struct PngSummary {
     pub inked_fraction: f64,
 }
 
-/// Decodes the PNG at `path` (8-bit RGB or RGBA) and summarises it.
+/// Decodes the PNG at `path` (grey, RGB or RGBA; 16-bit samples as their high byte) and
+/// summarises it.
 pub fn summarize_png(path: &Path) -> Result<PngSummary, PlotError> {
     let bytes = std::fs::read(path).map_err(|source| PlotError::Read {
         path: path.into(),
         source,
     })?;
-    let bad = |m: String| PlotError::Input {
-        path: path.into(),
-        message: m,
+    let png =
+        glassdb_image::decode_png(&bytes, glassdb_image::DEFAULT_MAX_PIXELS).map_err(|source| {
+            PlotError::Decode {
+                path: path.into(),
+                source,
+            }
+        })?;
+    let channels = png.channels;
+    // 16-bit samples keep their high byte, as 8-bit colours.
+    let data: Vec<u8> = match png.samples {
+        PngSamples::U8(v) => v,
+        PngSamples::U16(v) => v.iter().map(|s| (s >> 8) as u8).collect(),
     };
-    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = decoder
-        .read_info()
-        .map_err(|e| bad(format!("not a PNG: {e}")))?;
-    let size = reader
-        .output_buffer_size()
-        .ok_or_else(|| bad("PNG too large".into()))?;
-    let mut buf = vec![0u8; size];
-    let info = reader
-        .next_frame(&mut buf)
-        .map_err(|e| bad(format!("corrupt PNG: {e}")))?;
-    let channels = match info.color_type {
-        png::ColorType::Rgb => 3,
-        png::ColorType::Rgba => 4,
-        png::ColorType::Grayscale => 1,
-        png::ColorType::GrayscaleAlpha => 2,
-        png::ColorType::Indexed => return Err(bad("indexed PNG after expansion".into())),
-    };
-    let data = buf
-        .get(..info.buffer_size())
-        .ok_or_else(|| bad("short PNG buffer".into()))?;
     let mut colours = std::collections::HashSet::new();
     let (mut sum, mut sum2, mut inked, mut n) = (0.0, 0.0, 0usize, 0usize);
     for px in data.chunks_exact(channels) {
@@ -70,8 +60,8 @@ pub fn summarize_png(path: &Path) -> Result<PngSummary, PlotError> {
     let nf = n.max(1) as f64;
     let mean = sum / nf;
     Ok(PngSummary {
-        width: info.width,
-        height: info.height,
+        width: png.width,
+        height: png.height,
         distinct_colours: colours.len(),
         luma_std: (sum2 / nf - mean * mean).max(0.0).sqrt(),
         inked_fraction: inked as f64 / nf,

@@ -1,4 +1,4 @@
-//! Output of figures: PNG (plotters' bitmap backend, encoded with the `png` crate) or SVG, picked
+//! Output of figures: PNG (plotters' bitmap backend, encoded by glassdb-image) or SVG, picked
 //! by the output file's extension, always written atomically (`glassdb_io::write_bytes_atomic`).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -125,21 +125,16 @@ pub fn save<F: Figure>(fig: &F, path: &Path) -> Result<ImageFormat, PlotError> {
 /// Encodes an RGB8 buffer as a PNG. Plots are mostly flat colour, so the strongest
 /// compression keeps figures small (docs/figures stay well under 200 KB).
 pub fn encode_png_rgb(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
-    let mut out = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut out, width, height);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        enc.set_compression(png::Compression::High);
-        let mut writer = enc
-            .write_header()
-            .map_err(|e| PlotError::Encode(e.to_string()))?;
-        writer
-            .write_image_data(rgb)
-            .map_err(|e| PlotError::Encode(e.to_string()))?;
-        writer
-            .finish()
-            .map_err(|e| PlotError::Encode(e.to_string()))?;
-    }
-    Ok(out)
+    let options = glassdb_image::PngEncodeOptions {
+        compression: glassdb_image::PngCompression::High,
+        srgb_chunk: false,
+    };
+    glassdb_image::encode_png(
+        width,
+        height,
+        glassdb_image::PngColor::Rgb,
+        glassdb_image::PngSampleSlice::U8(rgb),
+        options,
+    )
+    .map_err(PlotError::Encode)
 }

@@ -197,11 +197,7 @@ fn mask_filter(
     }
     let mut counts: BTreeMap<u16, u64> = BTreeMap::new();
     for path in &opts.masks {
-        let mask =
-            glassdb_mask::read_mask(path, &opts.mask_options).map_err(|e| RegistryError::Mask {
-                path: path.clone(),
-                message: e.to_string(),
-            })?;
+        let mask = glassdb_mask::read_mask(path, &opts.mask_options)?;
         if matches!(mask.cos_theta, glassdb_mask::CosTheta::Quantized8(_))
             && let Some(big) = specs.iter().find(|s| s.id > 255)
         {

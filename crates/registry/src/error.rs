@@ -134,9 +134,9 @@ pub enum RegistryError {
         message: String,
     },
 
-    /// A mask given with `--mask` could not be read.
-    #[error("mask {path}: {message}")]
-    Mask { path: PathBuf, message: String },
+    /// A mask given with `--mask` could not be read (the mask error names the file).
+    #[error(transparent)]
+    Mask(#[from] glassdb_mask::MaskError),
 
     /// Masks use ids that the catalog does not define.
     #[error("{}", missing_ids_message(catalog, ids))]

@@ -1,29 +1,11 @@
 //! PNG decoding into interleaved 8- or 16-bit samples with the `png` crate: the size is checked
 //! from the header before the pixel buffer is allocated, palettes and low bit depths are
-//! expanded, and a decoder panic becomes an error. Used for masks here and for passes by
-//! `glassdb-compose`.
+//! expanded, and a decoder panic becomes an `Internal` error. Used for masks, passes and plots.
 
 use std::io::Cursor;
 
-use crate::guard::catch_decoder_panic;
-
-/// Why a PNG could not be decoded (the caller adds the file name).
-#[derive(Debug, thiserror::Error)]
-pub enum PngFlatError {
-    /// The `png` crate rejected the file (corrupt, truncated or unsupported).
-    #[error("{0}")]
-    Decode(String),
-    /// The decoder panicked on this file's bytes.
-    #[error("the PNG decoder crashed on this file ({0}); the file is probably corrupt")]
-    DecoderPanic(String),
-    /// Larger than the allowed number of pixels (checked from the header).
-    #[error("{width}×{height} pixels exceeds the limit of {max_pixels} pixels")]
-    TooLarge {
-        width: u32,
-        height: u32,
-        max_pixels: u64,
-    },
-}
+use crate::guard::catch_codec_panic;
+use crate::{Codec, ImageError};
 
 /// Decoded samples, interleaved, row-major, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,30 +45,31 @@ impl PngPixels {
 
 /// Decodes a PNG held in memory. Palette images become RGB(A), grey images below 8 bits
 /// become 8-bit grey, 16-bit samples are returned as `u16`.
-pub fn decode_png(bytes: &[u8], max_pixels: u64) -> Result<PngPixels, PngFlatError> {
-    catch_decoder_panic(|| decode_png_inner(bytes, max_pixels))
-        .map_err(PngFlatError::DecoderPanic)?
+pub fn decode_png(bytes: &[u8], max_pixels: u64) -> Result<PngPixels, ImageError> {
+    catch_codec_panic(Codec::Png, || decode_png_inner(bytes, max_pixels))?
 }
 
-fn decode_png_inner(bytes: &[u8], max_pixels: u64) -> Result<PngPixels, PngFlatError> {
-    let err = |e: png::DecodingError| PngFlatError::Decode(e.to_string());
+fn decode_png_inner(bytes: &[u8], max_pixels: u64) -> Result<PngPixels, ImageError> {
+    let err = ImageError::PngDecode;
     let mut decoder = png::Decoder::new(Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND);
     let header = decoder.read_header_info().map_err(err)?;
     let (width, height) = (header.width, header.height);
     if u64::from(width) * u64::from(height) > max_pixels {
-        return Err(PngFlatError::TooLarge {
-            width,
-            height,
+        return Err(ImageError::TooLarge {
+            width: width.into(),
+            height: height.into(),
             max_pixels,
         });
     }
     let mut reader = decoder.read_info().map_err(err)?;
     let (color, depth) = reader.output_color_type();
     let channels = color.samples();
-    let size = reader
-        .output_buffer_size()
-        .ok_or_else(|| PngFlatError::Decode("image too large for this machine".into()))?;
+    let size = reader.output_buffer_size().ok_or(ImageError::TooLarge {
+        width: width.into(),
+        height: height.into(),
+        max_pixels,
+    })?;
     let mut buf = vec![0u8; size];
     let frame = reader.next_frame(&mut buf).map_err(err)?;
     buf.truncate(frame.buffer_size());
@@ -116,9 +99,9 @@ fn decode_png_inner(bytes: &[u8], max_pixels: u64) -> Result<PngPixels, PngFlatE
             }
         }
         other => {
-            return Err(PngFlatError::Decode(format!(
-                "unexpected bit depth {other:?} after expansion"
-            )));
+            return Err(ImageError::Unsupported {
+                feature: format!("bit depth {other:?} after expansion"),
+            });
         }
     };
     let expected = row_samples * height as usize;
@@ -127,9 +110,9 @@ fn decode_png_inner(bytes: &[u8], max_pixels: u64) -> Result<PngPixels, PngFlatE
         PngSamples::U16(v) => v.len(),
     };
     if got != expected {
-        return Err(PngFlatError::Decode(format!(
-            "decoded {got} samples, expected {expected}"
-        )));
+        return Err(ImageError::Incomplete {
+            detail: format!("decoded {got} samples, expected {expected}"),
+        });
     }
     Ok(PngPixels {
         width,

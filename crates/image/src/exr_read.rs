@@ -1,8 +1,7 @@
 //! OpenEXR decoding into flat per-channel `f32` buffers, built on the `exr` crate's block API:
 //! only the chosen part (layer) is decompressed, blocks are decompressed in parallel (rayon,
 //! one task per band of rows) and written straight into the output buffers, and a panic in the
-//! decoder on a corrupt block becomes an error. Used for masks here and for passes by
-//! `glassdb-compose`.
+//! decoder on a corrupt block becomes an `Internal` error. Used for masks and for passes.
 
 use std::io::Cursor;
 
@@ -14,32 +13,8 @@ use exr::meta::attribute::SampleType;
 use exr::meta::header::Header;
 use rayon::prelude::*;
 
-use crate::guard::catch_decoder_panic;
-
-/// Why an EXR could not be decoded (the caller adds the file name).
-#[derive(Debug, thiserror::Error)]
-pub enum ExrFlatError {
-    /// The `exr` crate rejected the file (corrupt, truncated or unsupported).
-    #[error("{0}")]
-    Decode(String),
-    /// The decoder panicked on this file's bytes (a corrupt file reaching a bug in `exr`).
-    #[error("the EXR decoder crashed on this file ({0}); the file is probably corrupt")]
-    DecoderPanic(String),
-    /// The image is larger than the allowed number of pixels (checked from the header before
-    /// anything is allocated).
-    #[error("{width}×{height} pixels exceeds the limit of {max_pixels} pixels")]
-    TooLarge {
-        width: usize,
-        height: usize,
-        max_pixels: u64,
-    },
-    /// A feature this reader does not handle (deep data, subsampled channels, empty image).
-    #[error("{0}")]
-    Unsupported(String),
-    /// Blocks are missing or overlap: the file is truncated or corrupt.
-    #[error("pixel data incomplete: {0}")]
-    Incomplete(String),
-}
+use crate::guard::catch_codec_panic;
+use crate::{Codec, ImageError};
 
 /// The sample type of one EXR channel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -144,12 +119,22 @@ fn part_from_header(h: &Header) -> ExrPart {
 }
 
 /// Reads only the headers of an EXR held in memory (no pixel data is touched or allocated).
-pub fn read_exr_headers(bytes: &[u8]) -> Result<Vec<ExrPart>, ExrFlatError> {
-    let meta =
-        catch_decoder_panic(|| exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false))
-            .map_err(ExrFlatError::DecoderPanic)?
-            .map_err(|e| ExrFlatError::Decode(e.to_string()))?;
+pub fn read_exr_headers(bytes: &[u8]) -> Result<Vec<ExrPart>, ImageError> {
+    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false))?;
     Ok(meta.headers.iter().map(part_from_header).collect())
+}
+
+/// Runs an `exr` call that sees file bytes: a panic becomes `CodecPanic`, an error `ExrDecode`.
+fn guarded<T>(decode: impl FnOnce() -> exr::error::Result<T>) -> Result<T, ImageError> {
+    catch_codec_panic(Codec::Exr, decode)?.map_err(ImageError::ExrDecode)
+}
+
+fn incomplete(detail: String) -> ImageError {
+    ImageError::Incomplete { detail }
+}
+
+fn unsupported(feature: String) -> ImageError {
+    ImageError::Unsupported { feature }
 }
 
 /// Decodes channels `channels` (indices into the part's channel list) of part `part` into
@@ -160,89 +145,126 @@ pub fn read_exr_channels(
     part: usize,
     channels: &[usize],
     max_pixels: u64,
-) -> Result<(ExrPart, Vec<Vec<f32>>), ExrFlatError> {
-    let decode_err = |e: exr::error::Error| ExrFlatError::Decode(e.to_string());
+) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
     // Headers first, so that the size limit is enforced before the offset tables are read.
     let parts = read_exr_headers(bytes)?;
     let info = parts
         .get(part)
         .cloned()
-        .ok_or_else(|| ExrFlatError::Unsupported(format!("the file has no part {part}")))?;
-    let (width, height) = (info.width, info.height);
-    let pixels = (width as u64).saturating_mul(height as u64);
-    if pixels > max_pixels {
-        return Err(ExrFlatError::TooLarge {
-            width,
-            height,
-            max_pixels,
-        });
-    }
-    if pixels == 0 {
-        return Err(ExrFlatError::Unsupported("the image has no pixels".into()));
-    }
-    if info.deep {
-        return Err(ExrFlatError::Unsupported(
-            "deep EXR data is not supported".into(),
-        ));
-    }
-    for &c in channels {
-        let ch = info
-            .channels
-            .get(c)
-            .ok_or_else(|| ExrFlatError::Unsupported(format!("the part has no channel {c}")))?;
-        if ch.sampling != (1, 1) {
-            return Err(ExrFlatError::Unsupported(format!(
-                "channel {} is subsampled ({}×{}); only full-resolution channels are supported",
-                ch.name, ch.sampling.0, ch.sampling.1
-            )));
-        }
-    }
+        .ok_or_else(|| unsupported(format!("part {part} (the file has {})", parts.len())))?;
+    check_readable(&info, channels, max_pixels)?;
 
-    let reader = catch_decoder_panic(|| exr::block::read(Cursor::new(bytes), false))
-        .map_err(ExrFlatError::DecoderPanic)?
-        .map_err(decode_err)?;
+    let reader = guarded(|| exr::block::read(Cursor::new(bytes), false))?;
     let meta = reader.meta_data().clone();
     let header = meta
         .headers
         .get(part)
-        .ok_or_else(|| ExrFlatError::Unsupported(format!("the file has no part {part}")))?
+        .ok_or_else(|| unsupported(format!("part {part}")))?
         .clone();
     let band_height = match header.blocks {
         BlockDescription::ScanLines => header.compression.scan_lines_per_block(),
         BlockDescription::Tiles(t) => t.tile_size.height(),
     };
     if band_height == 0 {
-        return Err(ExrFlatError::Unsupported("tile height 0".into()));
+        return Err(unsupported("tile height 0".into()));
     }
-    let band_count = height.div_ceil(band_height);
-
-    let all_chunks: Vec<Chunk> = catch_decoder_panic(|| {
+    let chunks = guarded(|| {
         reader
             .filter_chunks(false, |_, tile, block| {
                 block.layer == part && tile.level_index == Vec2(0, 0)
             })?
             .collect::<exr::error::Result<Vec<Chunk>>>()
-    })
-    .map_err(ExrFlatError::DecoderPanic)?
-    .map_err(decode_err)?;
+    })?;
+    let band_chunks = chunks_by_band(chunks, &header, info.height.div_ceil(band_height))?;
+    let layout = BandLayout {
+        width: info.width,
+        height: info.height,
+        band_height,
+    };
+    let outputs = decode_bands(&meta, &header, &info, channels, band_chunks, &layout)?;
+    Ok((info, outputs))
+}
 
-    let mut band_chunks: Vec<Vec<Chunk>> = (0..band_count).map(|_| Vec::new()).collect();
-    for chunk in all_chunks {
-        let tile = catch_decoder_panic(|| header.get_block_data_indices(&chunk.compressed_block))
-            .map_err(ExrFlatError::DecoderPanic)?
-            .map_err(decode_err)?;
+/// Refuses what this reader cannot decode, from the header alone: too many pixels, no pixels,
+/// deep data, a missing or subsampled channel.
+fn check_readable(info: &ExrPart, channels: &[usize], max_pixels: u64) -> Result<(), ImageError> {
+    let (width, height) = (info.width as u64, info.height as u64);
+    let pixels = width.saturating_mul(height);
+    if pixels > max_pixels {
+        return Err(ImageError::TooLarge {
+            width,
+            height,
+            max_pixels,
+        });
+    }
+    if pixels == 0 {
+        return Err(unsupported("an image without pixels".into()));
+    }
+    if info.deep {
+        return Err(unsupported("deep EXR data".into()));
+    }
+    for &c in channels {
+        let ch = info.channels.get(c).ok_or_else(|| {
+            unsupported(format!(
+                "channel {c} (the part has {})",
+                info.channels.len()
+            ))
+        })?;
+        if ch.sampling != (1, 1) {
+            return Err(unsupported(format!(
+                "subsampled channel {} ({}×{}); only full-resolution channels are read",
+                ch.name, ch.sampling.0, ch.sampling.1
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Sorts the part's compressed chunks into bands of rows (one band per block row).
+fn chunks_by_band(
+    chunks: Vec<Chunk>,
+    header: &Header,
+    band_count: usize,
+) -> Result<Vec<Vec<Chunk>>, ImageError> {
+    let mut bands: Vec<Vec<Chunk>> = (0..band_count).map(|_| Vec::new()).collect();
+    for chunk in chunks {
+        let tile = guarded(|| header.get_block_data_indices(&chunk.compressed_block))?;
         if tile.level_index != Vec2(0, 0) {
             continue;
         }
-        let band = band_chunks.get_mut(tile.tile_index.y()).ok_or_else(|| {
-            ExrFlatError::Incomplete(format!(
+        let band = bands.get_mut(tile.tile_index.y()).ok_or_else(|| {
+            incomplete(format!(
                 "block row {} is outside the image",
                 tile.tile_index.y()
             ))
         })?;
         band.push(chunk);
     }
+    Ok(bands)
+}
 
+/// The image size and its division into bands of `band_height` rows.
+struct BandLayout {
+    width: usize,
+    height: usize,
+    band_height: usize,
+}
+
+/// Decompresses every band in parallel straight into one output buffer per selected channel,
+/// checking that each band's rows are fully covered.
+fn decode_bands(
+    meta: &exr::meta::MetaData,
+    header: &Header,
+    info: &ExrPart,
+    channels: &[usize],
+    band_chunks: Vec<Vec<Chunk>>,
+    layout: &BandLayout,
+) -> Result<Vec<Vec<f32>>, ImageError> {
+    let BandLayout {
+        width,
+        height,
+        band_height,
+    } = *layout;
     // Which output buffer each channel of the part goes to.
     let mut target: Vec<Option<usize>> = vec![None; info.channels.len()];
     for (k, &c) in channels.iter().enumerate() {
@@ -256,7 +278,8 @@ pub fn read_exr_channels(
         .iter()
         .map(|_| vec![0f32; width * height])
         .collect();
-    let mut band_slices: Vec<Vec<&mut [f32]>> = (0..band_count)
+    let mut band_slices: Vec<Vec<&mut [f32]>> = band_chunks
+        .iter()
         .map(|_| Vec::with_capacity(channels.len()))
         .collect();
     for buffer in outputs.iter_mut() {
@@ -272,20 +295,16 @@ pub fn read_exr_channels(
         .into_par_iter()
         .zip(band_chunks.into_par_iter())
         .enumerate()
-        .try_for_each(|(band, (mut slices, chunks))| -> Result<(), ExrFlatError> {
+        .try_for_each(|(band, (mut slices, chunks))| -> Result<(), ImageError> {
             let y0 = band * band_height;
             let rows = band_height.min(height - y0);
             let mut written = 0usize;
             for chunk in chunks {
-                let block = catch_decoder_panic(|| {
-                    UncompressedBlock::decompress_chunk(chunk, &meta, false)
-                })
-                .map_err(ExrFlatError::DecoderPanic)?
-                .map_err(decode_err)?;
-                let scattered = catch_decoder_panic(|| {
+                let block = guarded(|| UncompressedBlock::decompress_chunk(chunk, meta, false))?;
+                written += catch_codec_panic(Codec::Exr, || {
                     scatter_block(
                         &block,
-                        &header,
+                        header,
                         &target,
                         &sample_types,
                         &mut slices,
@@ -293,13 +312,11 @@ pub fn read_exr_channels(
                         rows,
                         width,
                     )
-                })
-                .map_err(ExrFlatError::DecoderPanic)??;
-                written += scattered;
+                })??;
             }
             let expected = rows * width * channels.len();
             if written != expected {
-                return Err(ExrFlatError::Incomplete(format!(
+                return Err(incomplete(format!(
                     "rows {}..{}: {written} of {expected} samples present",
                     y0,
                     y0 + rows
@@ -307,7 +324,7 @@ pub fn read_exr_channels(
             }
             Ok(())
         })?;
-    Ok((info, outputs))
+    Ok(outputs)
 }
 
 /// Copies the selected channels' lines of one decompressed block into the band's buffers;
@@ -322,7 +339,7 @@ fn scatter_block(
     y0: usize,
     rows: usize,
     width: usize,
-) -> Result<usize, ExrFlatError> {
+) -> Result<usize, ImageError> {
     let mut written = 0;
     for line in block.lines(&header.channels) {
         let loc = line.location;
@@ -331,7 +348,7 @@ fn scatter_block(
         };
         let (x, y, n) = (loc.position.x(), loc.position.y(), loc.sample_count);
         if y < y0 || y >= y0 + rows || x + n > width {
-            return Err(ExrFlatError::Incomplete(format!(
+            return Err(incomplete(format!(
                 "a block line at ({x}, {y}) lies outside its block"
             )));
         }
@@ -339,7 +356,7 @@ fn scatter_block(
         let dst = slices
             .get_mut(k)
             .and_then(|s| s.get_mut(start..start + n))
-            .ok_or_else(|| ExrFlatError::Incomplete("block line out of range".into()))?;
+            .ok_or_else(|| incomplete("block line out of range".into()))?;
         let ty = sample_types
             .get(loc.channel)
             .copied()
@@ -351,15 +368,13 @@ fn scatter_block(
 }
 
 /// Native-endian sample bytes to `f32`.
-fn convert_samples(bytes: &[u8], ty: ExrSampleType, dst: &mut [f32]) -> Result<(), ExrFlatError> {
+fn convert_samples(bytes: &[u8], ty: ExrSampleType, dst: &mut [f32]) -> Result<(), ImageError> {
     let size = match ty {
         ExrSampleType::Half => 2,
         ExrSampleType::Float | ExrSampleType::Uint => 4,
     };
     if bytes.len() != dst.len() * size {
-        return Err(ExrFlatError::Incomplete(
-            "a block line has the wrong byte length".into(),
-        ));
+        return Err(incomplete("a block line has the wrong byte length".into()));
     }
     match ty {
         ExrSampleType::Float => {

@@ -1,0 +1,70 @@
+//! The one error type of glassdb-mask: every variant names the file.
+
+use std::path::PathBuf;
+
+use glassdb_image::{ImageError, ImageErrorKind};
+
+/// Everything that can go wrong reading or writing a mask.
+#[derive(Debug, thiserror::Error)]
+pub enum MaskError {
+    #[error("cannot read mask {path}")]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not a PNG or EXR this reader can decode (its class says whether it is
+    /// corrupt, unsupported or too large).
+    #[error("mask {path}")]
+    Decode {
+        path: PathBuf,
+        #[source]
+        source: ImageError,
+    },
+    /// The file decodes but is not laid out as any mask format (e.g. grey PNG without a glass id).
+    #[error("mask {path}: {detail}")]
+    Layout { path: PathBuf, detail: String },
+    #[error("mask {path} has no channel {channel:?} (it has: {})", available.join(", "))]
+    MissingChannel {
+        path: PathBuf,
+        channel: String,
+        available: Vec<String>,
+    },
+    /// A pixel value that the format does not allow.
+    #[error("mask {path}, pixel (x {x}, y {y}): {detail}")]
+    BadPixel {
+        path: PathBuf,
+        x: u32,
+        y: u32,
+        detail: String,
+    },
+    /// A mask that cannot be stored in the requested format without loss.
+    #[error("cannot write mask {path} as {format}: {detail}")]
+    NotRepresentable {
+        path: PathBuf,
+        format: &'static str,
+        detail: String,
+    },
+    #[error("mask image is inconsistent: {0}")]
+    Inconsistent(String),
+    #[error("cannot encode mask {path}")]
+    Encode {
+        path: PathBuf,
+        #[source]
+        source: ImageError,
+    },
+    #[error(transparent)]
+    Write(#[from] glassdb_io::OutputError),
+}
+
+impl MaskError {
+    /// The image-level class of a decoding or encoding failure (`None` for mask-level errors).
+    pub fn image_error_kind(&self) -> Option<ImageErrorKind> {
+        match self {
+            MaskError::Decode { source, .. } | MaskError::Encode { source, .. } => {
+                Some(source.kind())
+            }
+            _ => None,
+        }
+    }
+}

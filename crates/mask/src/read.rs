@@ -1,0 +1,330 @@
+//! Reading masks: the one image reader of glassdb-image decodes the file, and each mask
+//! format's layout (packed PNG, binary PNG, EXR channels) becomes a [`MaskImage`].
+
+use std::path::Path;
+
+use glassdb_image::{ExrFile, ExrPart, ImageFile, PngPixels, PngSamples};
+
+use crate::{CosTheta, MaskError, MaskImage, MaskReadOptions};
+
+/// Reads a mask file (PNG or EXR, detected from its bytes); see the crate docs for the formats.
+pub fn read_mask(path: &Path, opts: &MaskReadOptions) -> Result<MaskImage, MaskError> {
+    let bytes = std::fs::read(path).map_err(|source| MaskError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    read_mask_bytes(&bytes, path, opts)
+}
+
+/// Reads a mask from bytes in memory; `path` is only used in error messages.
+pub fn read_mask_bytes(
+    bytes: &[u8],
+    path: &Path,
+    opts: &MaskReadOptions,
+) -> Result<MaskImage, MaskError> {
+    let decode_err = |source| MaskError::Decode {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mask = match glassdb_image::open_image(bytes, opts.max_pixels).map_err(decode_err)? {
+        ImageFile::Png(png) => match opts.binary_glass_id {
+            Some(id) => binary_from_png(&png, id, path)?,
+            None => packed_from_png(&png, path)?,
+        },
+        ImageFile::Exr(exr) => {
+            if opts.binary_glass_id.is_some() {
+                return Err(MaskError::Layout {
+                    path: path.to_path_buf(),
+                    detail: "a binary mask (--glass) must be a PNG; an EXR mask carries its ids in a channel".into(),
+                });
+            }
+            mask_from_exr(&exr, path, opts)?
+        }
+    };
+    mask.check_consistent().map_err(MaskError::Inconsistent)?;
+    Ok(mask)
+}
+
+/// The packed formats: R = plane, G = id, B = cos θ code (8- or 16-bit). Alpha is ignored.
+fn packed_from_png(png: &PngPixels, path: &Path) -> Result<MaskImage, MaskError> {
+    if png.channels < 3 {
+        return Err(MaskError::Layout {
+            path: path.to_path_buf(),
+            detail: "a grey PNG is not a packed id + cos θ mask (it needs RGB: R = plane, G = id, B = cos θ); \
+                     for the paper's binary white/black mask give the glass id (--glass ID)"
+                .into(),
+        });
+    }
+    let n = png.width as usize * png.height as usize;
+    let ch = png.channels;
+    let (id, plane, cos_theta) = match &png.samples {
+        PngSamples::U8(s) => {
+            let mut id = Vec::with_capacity(n);
+            let mut plane = Vec::with_capacity(n);
+            let mut cos = Vec::with_capacity(n);
+            for px in s.chunks_exact(ch) {
+                plane.push(u16::from(px[0]));
+                id.push(u16::from(px[1]));
+                cos.push(px[2]);
+            }
+            (id, plane, CosTheta::Quantized8(cos))
+        }
+        PngSamples::U16(s) => {
+            let mut id = Vec::with_capacity(n);
+            let mut plane = Vec::with_capacity(n);
+            let mut cos = Vec::with_capacity(n);
+            for px in s.chunks_exact(ch) {
+                plane.push(px[0]);
+                id.push(px[1]);
+                cos.push(px[2]);
+            }
+            (id, plane, CosTheta::Quantized16(cos))
+        }
+    };
+    Ok(MaskImage {
+        width: png.width,
+        height: png.height,
+        id,
+        cos_theta,
+        plane,
+        coverage: None,
+    })
+}
+
+/// The paper's binary mask: black = no glass; any other value = glass `glass_id`, with coverage
+/// = the largest colour sample / maximum (1 for white). Alpha is ignored.
+fn binary_from_png(png: &PngPixels, glass_id: u16, path: &Path) -> Result<MaskImage, MaskError> {
+    if glass_id == 0 {
+        return Err(MaskError::Layout {
+            path: path.to_path_buf(),
+            detail: "glass id 0 means \"no glass\"; a binary mask needs an id from 1".into(),
+        });
+    }
+    let n = png.width as usize * png.height as usize;
+    let colour_channels = if png.channels >= 3 { 3 } else { 1 };
+    let max = png.max_value();
+    let mut id = Vec::with_capacity(n);
+    let mut coverage = Vec::with_capacity(n);
+    let mut partial = false;
+    for i in 0..n {
+        let v = (0..colour_channels)
+            .map(|c| u32::from(png.sample(i, c)))
+            .max()
+            .unwrap_or(0);
+        id.push(if v == 0 { 0 } else { glass_id });
+        partial |= v != 0 && v != max;
+        coverage.push(v as f32 / max as f32);
+    }
+    Ok(MaskImage {
+        width: png.width,
+        height: png.height,
+        id,
+        cos_theta: CosTheta::Normal,
+        plane: vec![0; n],
+        coverage: partial.then_some(coverage),
+    })
+}
+
+/// EXR masks: float (or uint) channels for id, cos θ and optionally plane and coverage.
+fn mask_from_exr(
+    exr: &ExrFile<'_>,
+    path: &Path,
+    opts: &MaskReadOptions,
+) -> Result<MaskImage, MaskError> {
+    let names = &opts.exr_channels;
+    let wanted = [
+        locate_channel(exr.parts(), &names.id, true, path)?,
+        locate_channel(exr.parts(), &names.cos_theta, true, path)?,
+        locate_channel(exr.parts(), &names.plane, false, path)?,
+        locate_channel(exr.parts(), &names.coverage, false, path)?,
+    ];
+    let (w, h, [id_f, cos_f, plane_f, cov_f]) = decode_wanted_channels(exr, &wanted, path)?;
+    let layout_err = |detail: &str| MaskError::Layout {
+        path: path.to_path_buf(),
+        detail: detail.into(),
+    };
+    let width = u32::try_from(w).map_err(|_| layout_err("too wide"))?;
+    let height = u32::try_from(h).map_err(|_| layout_err("too tall"))?;
+    let pixel_err = PixelError { path, width: w };
+    let id = indices_from_floats(&id_f.unwrap_or_default(), "glass id", &names.id, &pixel_err)?;
+    let mut cos_f = cos_f.unwrap_or_default();
+    clamp_cos_theta(&mut cos_f, &id, &names.cos_theta, &pixel_err)?;
+    let plane = match plane_f {
+        Some(p) => indices_from_floats(&p, "plane", &names.plane, &pixel_err)?,
+        None => vec![0; w * h],
+    };
+    let coverage = match cov_f {
+        Some(mut c) => {
+            clamp_coverage(&mut c, &names.coverage, &pixel_err)?;
+            Some(c)
+        }
+        None => None,
+    };
+    Ok(MaskImage {
+        width,
+        height,
+        id,
+        cos_theta: CosTheta::Float(cos_f),
+        plane,
+        coverage,
+    })
+}
+
+/// Finds the (part, channel) named `name`; a required channel that is missing is an error
+/// listing the channels the file has.
+fn locate_channel(
+    parts: &[ExrPart],
+    name: &str,
+    required: bool,
+    path: &Path,
+) -> Result<Option<(usize, usize)>, MaskError> {
+    match glassdb_image::find_channel(parts, name) {
+        Some(found) => Ok(Some(found)),
+        None if required => Err(MaskError::MissingChannel {
+            path: path.to_path_buf(),
+            channel: name.to_string(),
+            available: glassdb_image::all_channel_names(parts),
+        }),
+        None => Ok(None),
+    }
+}
+
+/// The decoded planes of the wanted channels, in the order asked, with the image size.
+type WantedPlanes = (usize, usize, [Option<Vec<f32>>; 4]);
+
+/// Decodes each part once, with all its wanted channels; every part must have the same size.
+fn decode_wanted_channels(
+    exr: &ExrFile<'_>,
+    wanted: &[Option<(usize, usize)>; 4],
+    path: &Path,
+) -> Result<WantedPlanes, MaskError> {
+    let mut decoded: [Option<Vec<f32>>; 4] = [None, None, None, None];
+    let mut size: Option<(usize, usize)> = None;
+    let mut part_indices: Vec<usize> = wanted.iter().flatten().map(|(p, _)| *p).collect();
+    part_indices.sort_unstable();
+    part_indices.dedup();
+    for p in part_indices {
+        let slots: Vec<usize> = (0..4)
+            .filter(|&k| matches!(wanted[k], Some((q, _)) if q == p))
+            .collect();
+        let channels: Vec<usize> = slots
+            .iter()
+            .filter_map(|&k| wanted[k].map(|(_, c)| c))
+            .collect();
+        let (info, buffers) =
+            exr.read_channels(p, &channels)
+                .map_err(|source| MaskError::Decode {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
+        match size {
+            None => size = Some((info.width, info.height)),
+            Some(s) if s != (info.width, info.height) => {
+                return Err(MaskError::Layout {
+                    path: path.to_path_buf(),
+                    detail: format!(
+                        "the mask channels lie in parts of different sizes ({}×{} and {}×{})",
+                        s.0, s.1, info.width, info.height
+                    ),
+                });
+            }
+            Some(_) => {}
+        }
+        for (k, buf) in slots.into_iter().zip(buffers) {
+            decoded[k] = Some(buf);
+        }
+    }
+    let (w, h) = size.ok_or_else(|| MaskError::Layout {
+        path: path.to_path_buf(),
+        detail: "no mask channels".into(),
+    })?;
+    Ok((w, h, decoded))
+}
+
+/// Builds [`MaskError::BadPixel`] for a pixel index of a mask file.
+struct PixelError<'a> {
+    path: &'a Path,
+    width: usize,
+}
+
+impl PixelError<'_> {
+    fn at(&self, i: usize, detail: String) -> MaskError {
+        MaskError::BadPixel {
+            path: self.path.to_path_buf(),
+            x: (i % self.width) as u32,
+            y: (i / self.width) as u32,
+            detail,
+        }
+    }
+}
+
+/// Float samples that must be integers in 0–65535 (ids, planes).
+fn indices_from_floats(
+    values: &[f32],
+    what: &str,
+    channel: &str,
+    bad: &PixelError<'_>,
+) -> Result<Vec<u16>, MaskError> {
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            if (0.0..=65535.0).contains(&v) && v.fract() == 0.0 {
+                Ok(v as u16)
+            } else {
+                Err(bad.at(
+                    i,
+                    format!("{what} {v} in channel {channel:?} is not an integer in 0–65535"),
+                ))
+            }
+        })
+        .collect()
+}
+
+/// How far outside [0, 1] a cos θ or coverage sample may stray (rounding) before it is an error.
+const UNIT_TOLERANCE: f32 = 1e-3;
+
+/// cos θ: checked on glass pixels; tiny excursions from rounding are clamped. Off glass any
+/// value is clamped (NaN becomes 0).
+fn clamp_cos_theta(
+    cos: &mut [f32],
+    id: &[u16],
+    channel: &str,
+    bad: &PixelError<'_>,
+) -> Result<(), MaskError> {
+    for (i, c) in cos.iter_mut().enumerate() {
+        if id.get(i).copied().unwrap_or(0) == 0 {
+            *c = c.clamp(0.0, 1.0);
+            if c.is_nan() {
+                *c = 0.0;
+            }
+            continue;
+        }
+        if !(c.is_finite() && *c >= -UNIT_TOLERANCE && *c <= 1.0 + UNIT_TOLERANCE) {
+            return Err(bad.at(
+                i,
+                format!("cos θ {c} in channel {channel:?} is not in [0, 1]"),
+            ));
+        }
+        *c = c.clamp(0.0, 1.0);
+    }
+    Ok(())
+}
+
+/// Coverage: every pixel in [0, 1] up to rounding, then clamped.
+fn clamp_coverage(
+    coverage: &mut [f32],
+    channel: &str,
+    bad: &PixelError<'_>,
+) -> Result<(), MaskError> {
+    for (i, v) in coverage.iter_mut().enumerate() {
+        if !(v.is_finite() && *v >= -UNIT_TOLERANCE && *v <= 1.0 + UNIT_TOLERANCE) {
+            return Err(bad.at(
+                i,
+                format!("coverage {v} in channel {channel:?} is not in [0, 1]"),
+            ));
+        }
+        *v = v.clamp(0.0, 1.0);
+    }
+    Ok(())
+}
