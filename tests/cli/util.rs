@@ -64,6 +64,37 @@ pub fn fails(cmd: &mut Command) -> String {
     stderr
 }
 
+/// Runs a command that must fail (see [`fails`]), asserts that its stderr names every one of
+/// `parts` and returns the stderr.
+pub fn fails_naming(cmd: &mut Command, parts: &[&str]) -> String {
+    let stderr = fails(cmd);
+    for part in parts {
+        assert!(stderr.contains(part), "stderr lacks {part:?}:\n{stderr}");
+    }
+    stderr
+}
+
+/// `glassdb registry build <catalog> -o <out> [extra…]`.
+pub fn registry_build(catalog: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut cmd = glassdb();
+    cmd.args(["registry", "build"])
+        .arg(catalog)
+        .arg("-o")
+        .arg(out)
+        .args(extra);
+    cmd
+}
+
+/// The statistics every fitted curve of a fit file or a registry carries besides its powers and
+/// coefficients.
+pub const CURVE_FIT_STATS: [&str; 5] = [
+    "degree",
+    "rms_error",
+    "max_abs_error",
+    "max_error_angle_deg",
+    "condition_number",
+];
+
 /// Writes `contents` to `dir/name` and returns the path.
 pub fn write_file(dir: &Path, name: &str, contents: &[u8]) -> PathBuf {
     let p = dir.join(name);
