@@ -68,10 +68,15 @@ pub fn fails(cmd: &mut Command) -> String {
 /// `parts` and returns the stderr.
 pub fn fails_naming(cmd: &mut Command, parts: &[&str]) -> String {
     let stderr = fails(cmd);
-    for part in parts {
-        assert!(stderr.contains(part), "stderr lacks {part:?}:\n{stderr}");
-    }
+    assert_names(&stderr, parts);
     stderr
+}
+
+/// Asserts that `text` (a command's output or an error message) contains every one of `parts`.
+pub fn assert_names(text: &str, parts: &[&str]) {
+    for part in parts {
+        assert!(text.contains(part), "lacks {part:?}:\n{text}");
+    }
 }
 
 /// `glassdb registry build <catalog> -o <out> [extra…]`.
