@@ -223,14 +223,7 @@ pub fn assert_images_match(name: &str, got: &Planes, want: &Planes, tolerance: f
 /// Every channel of an EXR's first layer as f64 planes, read with the `exr` crate (not with
 /// glassdb's own codecs), sorted by channel name.
 pub fn read_exr_planes(path: &Path) -> Planes {
-    use exr::prelude::*;
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
+    let image = exr::prelude::read_first_flat_layer_from_file(path)
         .unwrap_or_else(|e| panic!("reading {} with the exr crate: {e}", path.display()));
     let layer = &image.layer_data;
     let size = layer.size;
