@@ -415,7 +415,6 @@ fn mask_gouraud_is_close_to_exact_and_uses_the_mirror_planes() {
 fn bad_input_gives_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    // OBJ syntax error: file and line.
     let bad = write_file(
         d,
         "bad.obj",
