@@ -160,28 +160,33 @@ def write_catalog():
 # ----------------------------------------------------------------------------- scene
 
 
+def split_lines(path):
+    """The whitespace-separated words of each non-blank line of a text file (OBJ, MTL)."""
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            words = line.split()
+            if words:
+                yield words
+
+
 def parse_obj(path):
     """Minimal OBJ reader: `v`, `f` (v, v/vt, v/vt/vn, v//vn; negative indices), `usemtl`.
     Returns {material: (vertices (N,3) float64, triangles (M,3) int)} (fan triangulation)."""
     verts = []
     faces = {}
     mat = "default"
-    with open(path, encoding="utf-8") as f:
-        for line in f:
-            parts = line.split()
-            if not parts:
-                continue
-            if parts[0] == "v":
-                verts.append([float(x) for x in parts[1:4]])
-            elif parts[0] == "usemtl":
-                mat = parts[1]
-            elif parts[0] == "f":
-                idx = []
-                for p in parts[1:]:
-                    i = int(p.split("/")[0])
-                    idx.append(i - 1 if i > 0 else len(verts) + i)
-                for k in range(1, len(idx) - 1):
-                    faces.setdefault(mat, []).append((idx[0], idx[k], idx[k + 1]))
+    for parts in split_lines(path):
+        if parts[0] == "v":
+            verts.append([float(x) for x in parts[1:4]])
+        elif parts[0] == "usemtl":
+            mat = parts[1]
+        elif parts[0] == "f":
+            idx = []
+            for p in parts[1:]:
+                i = int(p.split("/")[0])
+                idx.append(i - 1 if i > 0 else len(verts) + i)
+            for k in range(1, len(idx) - 1):
+                faces.setdefault(mat, []).append((idx[0], idx[k], idx[k + 1]))
     verts = np.array(verts, dtype=np.float64)
     out = {}
     for m, tris in faces.items():
@@ -194,15 +199,11 @@ def parse_obj(path):
 def read_mtl(path):
     kd = {}
     cur = None
-    with open(path, encoding="utf-8") as f:
-        for line in f:
-            p = line.split()
-            if not p:
-                continue
-            if p[0] == "newmtl":
-                cur = p[1]
-            elif p[0] == "Kd" and cur:
-                kd[cur] = tuple(float(x) for x in p[1:4])
+    for p in split_lines(path):
+        if p[0] == "newmtl":
+            cur = p[1]
+        elif p[0] == "Kd" and cur:
+            kd[cur] = tuple(float(x) for x in p[1:4])
     return kd
 
 

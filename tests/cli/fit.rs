@@ -3,10 +3,18 @@
 
 use std::ffi::OsStr;
 use std::path::Path;
+use std::process::Command;
 
 use serde_json::Value;
 
-use crate::util::{fails, glassdb, ok, repo_path, run, run_oracle, write_file};
+use crate::util::{
+    CURVE_FIT_STATS, assert_names, fails, fails_naming, glassdb, ok, repo_path, run, run_oracle,
+    write_file,
+};
+
+#[path = "../../crates/fit/tests/common/inputs.rs"]
+mod inputs;
+use inputs::{gaussian, r_plus_t_above_one_csv};
 
 const CLEAR: &str = "data/angles/clear_6mm_fresnel.csv";
 const BRONZE: &str = "data/angles/bronze_coated_window4.csv";
@@ -90,51 +98,61 @@ fn eval_curve(curve: &Value, angles: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// `glassdb fit <table> [args…]`.
+fn fit(table: &Path, args: &[&str]) -> Command {
+    let mut cmd = glassdb();
+    cmd.arg("fit").arg(table).args(args);
+    cmd
+}
+
+/// `glassdb eval <fits> [args…]`.
+fn eval(fits: &Path, args: &[&str]) -> Command {
+    let mut cmd = glassdb();
+    cmd.arg("eval").arg(fits).args(args);
+    cmd
+}
+
+const DEGREE_10_FULL_JSON: &[&str] = &["--degree", "10", "--basis", "full", "--json"];
+
+/// The 50-digit oracle's `mode` (`fit` or `normal-equations`) for one column of `table`, full
+/// basis at `degree`.
+fn fit_oracle(mode: &str, table: &Path, column: &str, degree: &str) -> Value {
+    let args = [
+        mode, "--column", column, "--basis", "full", "--degree", degree,
+    ]
+    .map(OsStr::new);
+    let mut args = args.to_vec();
+    args.insert(1, table.as_os_str());
+    json(&run_oracle("fit_oracle.py", &args))
+}
+
 #[test]
 fn main_job_fits_the_bundled_clear_glass() {
     let out = ok(glassdb().args(["fit", CLEAR]).current_dir(repo_path("")));
-    assert!(out.contains("glass clear_6mm_fresnel"), "{out}");
-    assert!(
-        out.contains("reflectance") && out.contains("transmittance"),
-        "{out}"
+    assert_names(
+        &out,
+        &["glass clear_6mm_fresnel", "reflectance", "transmittance"],
     );
     assert!(
         out.contains("0.078819"),
         "normal reflectance of the table's 0° row:\n{out}"
     );
-    assert!(
-        out.contains("C_r(θ) =") && out.contains("C_t(θ) ="),
-        "{out}"
-    );
+    assert_names(&out, &["C_r(θ) =", "C_t(θ) ="]);
 }
 
 #[test]
 fn json_output_file_and_eval_agree_with_the_table() {
     let dir = tempfile::tempdir().unwrap();
     let fits = dir.path().join("fits.json");
-    let stdout = ok(glassdb()
-        .arg("fit")
-        .arg(repo_path(CLEAR))
-        .arg("--json")
-        .arg("-o")
-        .arg(&fits));
+    let stdout = ok(fit(&repo_path(CLEAR), &["--json", "-o"]).arg(&fits));
     let printed = json(&stdout);
     let written = json(&std::fs::read_to_string(&fits).unwrap());
     assert_eq!(printed, written);
     let g = &written["glasses"][0];
     assert_eq!(g["name"], "clear_6mm_fresnel");
     for q in ["reflectance", "transmittance"] {
-        for key in [
-            "normal",
-            "basis",
-            "powers",
-            "coefficients",
-            "degree",
-            "rms_error",
-            "max_abs_error",
-            "max_error_angle_deg",
-            "condition_number",
-        ] {
+        let keys = ["normal", "basis", "powers", "coefficients"];
+        for key in keys.iter().chain(&CURVE_FIT_STATS) {
             assert!(g[q].get(key).is_some(), "{q}.{key} missing");
         }
         assert_eq!(
@@ -144,10 +162,7 @@ fn json_output_file_and_eval_agree_with_the_table() {
     }
     // eval: r(0°) is the table's 0° value exactly (the constraint), and the curve stays close to
     // the physics table away from grazing incidence
-    let ev = json(&ok(glassdb()
-        .arg("eval")
-        .arg(&fits)
-        .args(["--angles", "0:85:5", "--json"])));
+    let ev = json(&ok(&mut eval(&fits, &["--angles", "0:85:5", "--json"])));
     let e = &ev["glasses"][0];
     let angles = floats(&e["angle_deg"]);
     assert_eq!(angles.len(), 18);
@@ -172,40 +187,17 @@ fn json_output_file_and_eval_agree_with_the_table() {
             tt[k].1
         );
     }
-    let text = ok(glassdb()
-        .arg("eval")
-        .arg(&fits)
-        .args(["--angles", "0,45,90"]));
-    assert!(
-        text.contains("angle_deg") && text.contains("0.078819"),
-        "{text}"
-    );
+    let text = ok(&mut eval(&fits, &["--angles", "0,45,90"]));
+    assert_names(&text, &["angle_deg", "0.078819"]);
 }
 
 #[test]
 fn degree_10_on_91_points_matches_the_50_digit_fit() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = json(&ok(glassdb()
-        .arg("fit")
-        .arg(repo_path(CLEAR))
-        .args(["--degree", "10", "--basis", "full", "--json"])));
+    let out = json(&ok(&mut fit(&repo_path(CLEAR), DEGREE_10_FULL_JSON)));
     let g = &out["glasses"][0];
     let angles: Vec<f64> = (0..=90).map(f64::from).collect();
-    let _ = dir;
     for (q, col) in [("reflectance", "R"), ("transmittance", "T")] {
-        let reference = json(&run_oracle(
-            "fit_oracle.py",
-            &[
-                OsStr::new("fit"),
-                repo_path(CLEAR).as_os_str(),
-                OsStr::new("--column"),
-                OsStr::new(col),
-                OsStr::new("--basis"),
-                OsStr::new("full"),
-                OsStr::new("--degree"),
-                OsStr::new("10"),
-            ],
-        ));
+        let reference = fit_oracle("fit", &repo_path(CLEAR), col, "10");
         let ours = eval_curve(&g[q], &angles);
         let theirs = floats(&reference["fitted"]);
         let d = rel_diff(&ours, &theirs);
@@ -228,36 +220,9 @@ fn degree_10_on_91_points_matches_the_50_digit_fit() {
 
 #[test]
 fn normal_equations_lose_digits_that_the_qr_fit_keeps() {
-    let out = json(&ok(glassdb()
-        .arg("fit")
-        .arg(repo_path(CLEAR))
-        .args(["--degree", "10", "--basis", "full", "--json"])));
-    let reference = json(&run_oracle(
-        "fit_oracle.py",
-        &[
-            OsStr::new("fit"),
-            repo_path(CLEAR).as_os_str(),
-            OsStr::new("--column"),
-            OsStr::new("R"),
-            OsStr::new("--basis"),
-            OsStr::new("full"),
-            OsStr::new("--degree"),
-            OsStr::new("10"),
-        ],
-    ));
-    let ne = json(&run_oracle(
-        "fit_oracle.py",
-        &[
-            OsStr::new("normal-equations"),
-            repo_path(CLEAR).as_os_str(),
-            OsStr::new("--column"),
-            OsStr::new("R"),
-            OsStr::new("--basis"),
-            OsStr::new("full"),
-            OsStr::new("--degree"),
-            OsStr::new("10"),
-        ],
-    ));
+    let out = json(&ok(&mut fit(&repo_path(CLEAR), DEGREE_10_FULL_JSON)));
+    let reference = fit_oracle("fit", &repo_path(CLEAR), "R", "10");
+    let ne = fit_oracle("normal-equations", &repo_path(CLEAR), "R", "10");
     let angles: Vec<f64> = (0..=90).map(f64::from).collect();
     let ours = eval_curve(&out["glasses"][0]["reflectance"], &angles);
     let our_digits = -rel_diff(&ours, &floats(&reference["fitted"]))
@@ -297,24 +262,9 @@ fn narrow_range_matches_the_50_digit_fit_and_eval_warns_beyond_it() {
         "fit should warn that 30–90° is extrapolated:\n{stderr}"
     );
     for degree in ["2", "4", "6"] {
-        let out = json(&ok(glassdb()
-            .arg("fit")
-            .arg(&csv)
-            .args(["--degree", degree, "--json"])));
+        let out = json(&ok(&mut fit(&csv, &["--degree", degree, "--json"])));
         let curve = &out["glasses"][0]["reflectance"];
-        let reference = json(&run_oracle(
-            "fit_oracle.py",
-            &[
-                OsStr::new("fit"),
-                csv.as_os_str(),
-                OsStr::new("--column"),
-                OsStr::new("R"),
-                OsStr::new("--basis"),
-                OsStr::new("full"),
-                OsStr::new("--degree"),
-                OsStr::new(degree),
-            ],
-        ));
+        let reference = fit_oracle("fit", &csv, "R", degree);
         let angles: Vec<f64> = (0..=30).map(f64::from).collect();
         let d = rel_diff(&eval_curve(curve, &angles), &floats(&reference["fitted"]));
         eprintln!(
@@ -325,19 +275,13 @@ fn narrow_range_matches_the_50_digit_fit_and_eval_warns_beyond_it() {
         assert!(d <= 1e-10, "degree {degree}: {d:e}");
         assert!(f(&curve["condition_number"]) < 100.0);
     }
-    let (res, _out, stderr) = run(glassdb()
-        .arg("eval")
-        .arg(&fits)
-        .args(["--angles", "0:60:10"]));
+    let (res, _out, stderr) = run(&mut eval(&fits, &["--angles", "0:60:10"]));
     assert!(res.status.success());
     assert!(
         stderr.contains("40, 50, 60° outside the measured 0–30°"),
         "{stderr}"
     );
-    let (_, _, stderr) = run(glassdb()
-        .arg("eval")
-        .arg(&fits)
-        .args(["--angles", "0:30:10"]));
+    let (_, _, stderr) = run(&mut eval(&fits, &["--angles", "0:30:10"]));
     assert!(!stderr.contains("extrapolated"), "{stderr}");
 }
 
@@ -345,26 +289,15 @@ fn narrow_range_matches_the_50_digit_fit_and_eval_warns_beyond_it() {
 fn coated_glass_with_ct_above_one_passes_strict() {
     let dir = tempfile::tempdir().unwrap();
     let fits = dir.path().join("bronze.json");
-    let (res, _out, stderr) = run(glassdb()
-        .arg("fit")
-        .arg(repo_path(BRONZE))
-        .arg("--strict")
-        .arg("-o")
-        .arg(&fits));
+    let (res, _out, stderr) = run(fit(&repo_path(BRONZE), &["--strict", "-o"]).arg(&fits));
     assert!(res.status.success(), "{stderr}");
     // at degree 8 the fitted curve follows the data above 1 near normal incidence, and strict
     // mode still accepts it (WINDOW-4 bronze: C_t(10°) = 1.0066)
-    let (res, _out, stderr) = run(glassdb()
-        .arg("fit")
-        .arg(repo_path(BRONZE))
-        .args(["--strict", "--degree", "8", "-o"])
-        .arg(&fits));
+    let strict_8 = ["--strict", "--degree", "8", "-o"];
+    let (res, _out, stderr) = run(fit(&repo_path(BRONZE), &strict_8).arg(&fits));
     assert!(res.status.success(), "{stderr}");
     assert!(!stderr.contains("physical check"), "{stderr}");
-    let ev = json(&ok(glassdb()
-        .arg("eval")
-        .arg(&fits)
-        .args(["--angles", "0,10", "--json"])));
+    let ev = json(&ok(&mut eval(&fits, &["--angles", "0,10", "--json"])));
     let t = floats(&ev["glasses"][0]["transmittance"]);
     assert!((t[0] - 0.169).abs() < 1e-15, "{}", t[0]);
     assert!(
@@ -372,20 +305,6 @@ fn coated_glass_with_ct_above_one_passes_strict() {
         "C_t(10°) = {}",
         t[1] / t[0]
     );
-}
-
-/// Deterministic N(0, 1) draws (64-bit LCG + Box–Muller).
-fn gaussian(seed: u64, n: usize) -> Vec<f64> {
-    let mut state = seed;
-    let mut uniform = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    };
-    (0..n)
-        .map(|_| (-2.0 * uniform().ln()).sqrt() * (2.0 * std::f64::consts::PI * uniform()).cos())
-        .collect()
 }
 
 #[test]
@@ -429,68 +348,61 @@ fn fit_error(name: &str, contents: &str, extra: &[&str]) -> String {
 
 #[test]
 fn bad_tables_fail_with_a_clear_message() {
-    assert!(fit_error("empty.csv", "", &[]).contains("empty"));
-    assert!(fit_error("nocol.csv", "angle_deg,glass\n0,a\n", &[]).contains("missing column R"));
-    let e = fit_error(
-        "text.csv",
-        "angle_deg,R,T\n0,0.08,0.88\n10,0.08,eighty\n",
-        &[],
-    );
-    assert!(
-        e.contains("line 3, column 3 (T): `eighty` is not a number"),
-        "{e}"
-    );
-    let e = fit_error("nan.csv", "angle_deg,R\n0,0.08\n10,nan\n", &[]);
-    assert!(
-        e.contains("line 3, column 2") && e.contains("not a finite number"),
-        "{e}"
-    );
-    let e = fit_error("angle.csv", "angle_deg,R\n0,0.08\n95,0.5\n", &[]);
-    assert!(
-        e.contains("line 3, column 1") && e.contains("outside 0–90°"),
-        "{e}"
-    );
-    let e = fit_error(
-        "few.csv",
-        "angle_deg,R\n0,0.08\n40,0.09\n80,0.5\n",
-        &["--degree", "5"],
-    );
-    assert!(
-        e.contains("3 distinct angle(s)") && e.contains("6 coefficients"),
-        "{e}"
-    );
-    let e = fit_error("pct.csv", "angle_deg,T\n0,88\n45,86\n", &[]);
-    assert!(
-        e.contains("line 2, column 2") && e.contains("--percent"),
-        "{e}"
-    );
-    let e = fit_error("ragged.csv", "angle_deg,R\n0,0.08,0.9\n", &[]);
-    assert!(e.contains("line 2"), "{e}");
+    // (file, contents, extra arguments, what the message names besides the file)
+    let cases: [(&str, &str, &[&str], &[&str]); 8] = [
+        ("empty.csv", "", &[], &["empty"]),
+        (
+            "nocol.csv",
+            "angle_deg,glass\n0,a\n",
+            &[],
+            &["missing column R"],
+        ),
+        (
+            "text.csv",
+            "angle_deg,R,T\n0,0.08,0.88\n10,0.08,eighty\n",
+            &[],
+            &["line 3, column 3 (T): `eighty` is not a number"],
+        ),
+        (
+            "nan.csv",
+            "angle_deg,R\n0,0.08\n10,nan\n",
+            &[],
+            &["line 3, column 2", "not a finite number"],
+        ),
+        (
+            "angle.csv",
+            "angle_deg,R\n0,0.08\n95,0.5\n",
+            &[],
+            &["line 3, column 1", "outside 0–90°"],
+        ),
+        (
+            "few.csv",
+            "angle_deg,R\n0,0.08\n40,0.09\n80,0.5\n",
+            &["--degree", "5"],
+            &["3 distinct angle(s)", "6 coefficients"],
+        ),
+        (
+            "pct.csv",
+            "angle_deg,T\n0,88\n45,86\n",
+            &[],
+            &["line 2, column 2", "--percent"],
+        ),
+        ("ragged.csv", "angle_deg,R\n0,0.08,0.9\n", &[], &["line 2"]),
+    ];
+    for (name, contents, extra, parts) in cases {
+        assert_names(&fit_error(name, contents, extra), parts);
+    }
     // with --percent the same table works
     let dir = tempfile::tempdir().unwrap();
     let p = write_file(dir.path(), "pct.csv", b"angle_deg,T\n0,88\n45,86\n60,80\n");
-    let out = ok(glassdb().arg("fit").arg(&p).arg("--percent"));
+    let out = ok(&mut fit(&p, &["--percent"]));
     assert!(out.contains("0.880000"), "{out}");
 }
 
 #[test]
 fn strict_mode_fails_on_a_physical_violation() {
     let dir = tempfile::tempdir().unwrap();
-    let rows: String = (0..=9)
-        .map(|i| {
-            format!(
-                "{},{},{}\n",
-                i * 10,
-                0.1 + 0.001 * i as f64,
-                0.92 - 0.001 * i as f64
-            )
-        })
-        .collect();
-    let p = write_file(
-        dir.path(),
-        "sum.csv",
-        format!("angle_deg,R,T\n{rows}").as_bytes(),
-    );
+    let p = write_file(dir.path(), "sum.csv", r_plus_t_above_one_csv().as_bytes());
     let (res, _, stderr) = run(glassdb().arg("fit").arg(&p));
     assert!(res.status.success());
     assert!(stderr.contains("r + t > 1"), "{stderr}");
@@ -500,26 +412,17 @@ fn strict_mode_fails_on_a_physical_violation() {
 
 #[test]
 fn output_problems_fail_without_touching_anything() {
+    const TABLE: &[u8] = b"angle_deg,T\n0,0.88\n45,0.86\n60,0.8\n";
     let dir = tempfile::tempdir().unwrap();
-    let table = write_file(
-        dir.path(),
-        "t.csv",
-        b"angle_deg,T\n0,0.88\n45,0.86\n60,0.8\n",
+    let table = write_file(dir.path(), "t.csv", TABLE);
+    let missing_dir = dir.path().join("missing/dir/out.json");
+    fails_naming(
+        fit(&table, &["-o"]).arg(missing_dir),
+        &["missing/dir/out.json"],
     );
-    let e = fails(
-        glassdb()
-            .arg("fit")
-            .arg(&table)
-            .arg("-o")
-            .arg(dir.path().join("missing/dir/out.json")),
-    );
-    assert!(e.contains("missing/dir/out.json"), "{e}");
-    let e = fails(glassdb().arg("fit").arg(&table).arg("-o").arg(&table));
+    let e = fails(fit(&table, &["-o"]).arg(&table));
     assert!(e.contains("refusing to overwrite"), "{e}");
-    assert_eq!(
-        std::fs::read(&table).unwrap(),
-        b"angle_deg,T\n0,0.88\n45,0.86\n60,0.8\n"
-    );
+    assert_eq!(std::fs::read(&table).unwrap(), TABLE);
     let e = fails(glassdb().arg("fit").arg(dir.path().join("nope.csv")));
     assert!(e.contains("nope.csv"), "{e}");
 }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use glassdb_mask::{CosTheta, MaskReadOptions, read_mask};
 
-use crate::util::{fails, glassdb, ok, repo_path, write_file};
+use crate::util::{fails, fails_naming, glassdb, ok, repo_path, write_file};
 
 fn room() -> PathBuf {
     repo_path("fixtures/scene/room.obj")
@@ -51,19 +51,15 @@ fn has_point(v: &[[f64; 3]], p: [f64; 3]) -> bool {
 fn mirror_finds_both_planes_and_writes_clipped_virtual_scenes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("virtual");
-    let stdout = ok(glassdb()
-        .arg("mirror")
-        .arg(room())
-        .args([
-            "--glass-material",
-            "Clear*",
-            "--glass-material",
-            "Tinted*",
-            "--eye",
-            "0.3,1.2,4",
-            "--out-dir",
-        ])
-        .arg(&out));
+    let glass_and_eye = [
+        "--glass-material",
+        "Clear*",
+        "--glass-material",
+        "Tinted*",
+        "--eye",
+        "0.3,1.2,4",
+    ];
+    let stdout = ok(&mut mirror(&room(), &glass_and_eye, &out));
     assert!(stdout.contains("2 glass planes"), "{stdout}");
     let planes = json(&out.join("planes.json"));
     let p = planes["planes"].as_array().unwrap();
@@ -129,11 +125,8 @@ fn mirror_finds_both_planes_and_writes_clipped_virtual_scenes() {
 fn mirror_with_an_explicit_plane_and_the_eye_behind_it() {
     let dir = tempfile::tempdir().unwrap();
     // The plane y = 1 (normal +y), eye below it: the kept half-space is y ≤ 1.
-    ok(glassdb()
-        .arg("mirror")
-        .arg(room())
-        .args(["--plane", "0,2,0,-2", "--eye", "0,0.5,3", "--out-dir"])
-        .arg(dir.path()));
+    let plane_and_eye = ["--plane", "0,2,0,-2", "--eye", "0,0.5,3"];
+    ok(&mut mirror(&room(), &plane_and_eye, dir.path()));
     let planes = json(&dir.path().join("planes.json"));
     assert_eq!(
         planes["planes"][0]["equation"],
@@ -147,27 +140,42 @@ fn mirror_with_an_explicit_plane_and_the_eye_behind_it() {
     assert!(has_point(&v, [-1.0, 2.0, 0.0]) && has_point(&v, [-1.0, 1.0, 0.0]));
 }
 
-/// The ray from the fixture camera's origin towards world point `p` and the pixel it falls
-/// in, by the conventions of docs/scene.md (computed here from the camera JSON).
-fn pixel_of(p: [f64; 3]) -> (u32, u32, [f64; 3]) {
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(a, a).sqrt();
+    [a[0] / n, a[1] / n, a[2] / n]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The fixture camera (fixtures/scene/camera.json): its origin and its forward, right and up
+/// unit vectors.
+fn camera_frame() -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3]) {
     let o = [0.3, 1.2, 4.0];
     let t = [0.5, 0.8, 0.0];
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let unit = |a: [f64; 3]| {
-        let n = dot(a, a).sqrt();
-        [a[0] / n, a[1] / n, a[2] / n]
-    };
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
     let f = unit(sub(t, o));
     let r = unit(cross(f, [0.0, 1.0, 0.0]));
     let u = cross(r, f);
+    (o, f, r, u)
+}
+
+/// The ray from the fixture camera's origin towards world point `p` and the pixel it falls
+/// in, by the conventions of docs/scene.md (computed here from the camera JSON).
+fn pixel_of(p: [f64; 3]) -> (u32, u32, [f64; 3]) {
+    let (o, f, r, u) = camera_frame();
     let d = sub(p, o);
     let (x, y, z) = (dot(d, r), dot(d, u), dot(d, f));
     let tx = 35f64.to_radians().tan();
@@ -179,24 +187,7 @@ fn pixel_of(p: [f64; 3]) -> (u32, u32, [f64; 3]) {
 
 /// The exact cos θ at the centre of pixel (i, j) on a plane with normal `n`.
 fn cos_at_pixel(i: u32, j: u32, n: [f64; 3]) -> f64 {
-    let o = [0.3, 1.2, 4.0];
-    let t = [0.5, 0.8, 0.0];
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let unit = |a: [f64; 3]| {
-        let n = dot(a, a).sqrt();
-        [a[0] / n, a[1] / n, a[2] / n]
-    };
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let f = unit(sub(t, o));
-    let r = unit(cross(f, [0.0, 1.0, 0.0]));
-    let u = cross(r, f);
+    let (_, f, r, u) = camera_frame();
     let tx = 35f64.to_radians().tan();
     let sx = ((i as f64 + 0.5) / 80.0 - 1.0) * tx;
     let sy = (1.0 - (j as f64 + 0.5) / 60.0) * tx * 0.75;
@@ -216,6 +207,17 @@ fn mask_cmd(camera: &Path, glass: &[&str], out: &Path) -> std::process::Command 
         c.args(["--glass", g]);
     }
     c.arg("-o").arg(out);
+    c
+}
+
+/// `glassdb mirror <obj> [args…] --out-dir <out_dir>`.
+fn mirror(obj: &Path, args: &[&str], out_dir: &Path) -> std::process::Command {
+    let mut c = glassdb();
+    c.arg("mirror")
+        .arg(obj)
+        .args(args)
+        .arg("--out-dir")
+        .arg(out_dir);
     c
 }
 
@@ -413,96 +415,59 @@ fn mask_gouraud_is_close_to_exact_and_uses_the_mirror_planes() {
 fn bad_input_gives_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    // OBJ syntax error: file and line.
     let bad = write_file(
         d,
         "bad.obj",
         b"v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl Glass\nf 1 2 oops\n",
     );
-    let e = fails(
-        glassdb()
-            .arg("mirror")
-            .arg(&bad)
-            .args(["--glass-material", "Glass", "--out-dir"])
-            .arg(d.join("o")),
-    );
-    assert!(e.contains("bad.obj:5:"), "{e}");
-    // No glass faces matched: the materials that exist are listed.
-    let e = fails(
-        glassdb()
-            .arg("mirror")
-            .arg(room())
-            .args(["--glass-material", "Window*", "--out-dir"])
-            .arg(d.join("o")),
-    );
-    assert!(
-        e.contains("Clear_6mm") && e.contains("Wood") && e.contains("Window*"),
-        "{e}"
-    );
-    let e = fails(&mut {
-        let mut c = glassdb();
-        c.arg("mask")
-            .arg(room())
-            .arg("--camera")
-            .arg(camera())
-            .args(["--glass", "Nope=1", "-o"])
-            .arg(d.join("m.png"));
-        c
-    });
-    assert!(e.contains("Concrete"), "{e}");
-    // Degenerate plane.
-    let e = fails(
-        glassdb()
-            .arg("mirror")
-            .arg(room())
-            .args(["--plane", "0,0,0,1", "--out-dir"])
-            .arg(d.join("o")),
-    );
-    assert!(e.contains("degenerate plane"), "{e}");
-    // Eye on a glass plane.
-    let e = fails(
-        glassdb()
-            .arg("mirror")
-            .arg(room())
-            .args(["--glass-material", "Clear*", "--eye", "0,1,0", "--out-dir"])
-            .arg(d.join("o")),
-    );
-    assert!(e.contains("lies on glass plane 0"), "{e}");
-    // Camera with up parallel to the view direction, and zero size.
-    let cam = write_file(
-        d,
-        "up.json",
-        br#"{"origin":[0,5,0],"target":[0,0,0],"up":[0,1,0],"fov_x_deg":60,"width":8,"height":8}"#,
-    );
-    let e = fails(&mut mask_cmd(&cam, &["Clear*=1"], &d.join("m.png")));
-    assert!(e.contains("parallel"), "{e}");
-    let cam = write_file(
-        d,
-        "zero.json",
-        br#"{"origin":[0,1,4],"target":[0,1,0],"up":[0,1,0],"fov_x_deg":60,"width":0,"height":8}"#,
-    );
-    let e = fails(&mut mask_cmd(&cam, &["Clear*=1"], &d.join("m.png")));
-    assert!(e.contains("0x8"), "{e}");
-    let cam = write_file(
-        d,
-        "typo.json",
-        br#"{"origin":[0,1,4],"target":[0,1,0],"up":[0,1,0],"fov_deg":60,"width":8,"height":8}"#,
-    );
-    let e = fails(&mut mask_cmd(&cam, &["Clear*=1"], &d.join("m.png")));
-    assert!(e.contains("typo.json") && e.contains("fov_deg"), "{e}");
+    // A syntax error names file and line; no glass faces matched lists the materials that exist;
+    // a degenerate plane and an eye on a glass plane are named.
+    let mirror_cases: [(&Path, &[&str], &[&str]); 4] = [
+        (&bad, &["--glass-material", "Glass"], &["bad.obj:5:"]),
+        (
+            &room(),
+            &["--glass-material", "Window*"],
+            &["Clear_6mm", "Wood", "Window*"],
+        ),
+        (&room(), &["--plane", "0,0,0,1"], &["degenerate plane"]),
+        (
+            &room(),
+            &["--glass-material", "Clear*", "--eye", "0,1,0"],
+            &["lies on glass plane 0"],
+        ),
+    ];
+    for (obj, args, parts) in mirror_cases {
+        fails_naming(&mut mirror(obj, args, &d.join("o")), parts);
+    }
+    let no_such_material = &mut mask_cmd(&camera(), &["Nope=1"], &d.join("m.png"));
+    fails_naming(no_such_material, &["Concrete"]);
+    // Camera with up parallel to the view direction, zero size, a misspelt key.
+    let cameras: [(&str, &[u8], &[&str]); 3] = [
+        (
+            "up.json",
+            br#"{"origin":[0,5,0],"target":[0,0,0],"up":[0,1,0],"fov_x_deg":60,"width":8,"height":8}"#,
+            &["parallel"],
+        ),
+        (
+            "zero.json",
+            br#"{"origin":[0,1,4],"target":[0,1,0],"up":[0,1,0],"fov_x_deg":60,"width":0,"height":8}"#,
+            &["0x8"],
+        ),
+        (
+            "typo.json",
+            br#"{"origin":[0,1,4],"target":[0,1,0],"up":[0,1,0],"fov_deg":60,"width":8,"height":8}"#,
+            &["typo.json", "fov_deg"],
+        ),
+    ];
+    for (name, json, parts) in cameras {
+        let cam = write_file(d, name, json);
+        fails_naming(&mut mask_cmd(&cam, &["Clear*=1"], &d.join("m.png")), parts);
+    }
     // A coverage channel cannot go into a PNG; a bad --glass mapping is named.
     let e = fails(mask_args(&d.join("m.png")).args(["--samples", "2"]));
     assert!(e.contains("EXR") || e.contains(".exr"), "{e}");
-    let e = fails(
-        glassdb()
-            .arg("mask")
-            .arg(room())
-            .arg("--camera")
-            .arg(camera())
-            .args(["--glass", "Clear*", "-o"])
-            .arg(d.join("m.png")),
-    );
-    assert!(e.contains("PATTERN=ID"), "{e}");
+    let no_id = &mut mask_cmd(&camera(), &["Clear*"], &d.join("m.png"));
+    fails_naming(no_id, &["PATTERN=ID"]);
     // Nothing was written by the failed runs.
     assert!(!d.join("m.png").exists() && !d.join("o").join("planes.json").exists());
 }

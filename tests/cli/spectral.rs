@@ -2,7 +2,9 @@
 //! hard cases, and CLI errors.
 
 use std::ffi::OsStr;
+use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 use glassdb_spectral::{
     Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, Observer, ReadOptions,
@@ -10,7 +12,7 @@ use glassdb_spectral::{
 };
 use serde_json::Value;
 
-use crate::util::{fails, glassdb, ok, repo_path, run_oracle, write_file};
+use crate::util::{fails, fails_naming, glassdb, ok, repo_path, run_oracle, write_file};
 
 const FIXTURES: &[&str] = &[
     "CLEAR_3.DAT",
@@ -27,6 +29,10 @@ const FIXTURES: &[&str] = &[
 
 fn fixture(name: &str) -> PathBuf {
     repo_path("fixtures/glazing").join(name)
+}
+
+fn read_fixture(name: &str) -> SpectralData {
+    read_spectral_file(&fixture(name), &ReadOptions::default()).unwrap()
 }
 
 /// Relative agreement with an absolute floor for channels that cancel to near zero.
@@ -159,21 +165,12 @@ fn every_fixture_matches_colour_science_to_1e9() {
 #[test]
 fn cli_json_matches_the_library_and_has_the_documented_keys() {
     for name in ["CLEAR_3.DAT", "913.json", "nfrc_20748.oag"] {
-        let out = ok(glassdb()
-            .args([
-                "spectral",
-                "--json",
-                "--method",
-                "paper",
-                "--cmf",
-                "stiles-burch-1959",
-            ])
-            .arg(fixture(name)));
-        let v: Value = serde_json::from_str(&out).unwrap();
+        let paper_1959 = ["--method", "paper", "--cmf", "stiles-burch-1959"];
+        let v = spectral_json(&paper_1959, &fixture(name));
         assert_eq!(v["method"], "paper");
         assert_eq!(v["cmf"], "stiles-burch-1959");
         assert!(v["illuminant"].is_null() && v["space"].is_null());
-        let data = read_spectral_file(&fixture(name), &ReadOptions::default()).unwrap();
+        let data = read_fixture(name);
         let it = Integrator::new(&IntegrationSettings {
             method: Method::Paper(RgbCmf::StilesBurch1959),
             extrapolate: false,
@@ -186,19 +183,15 @@ fn cli_json_matches_the_library_and_has_the_documented_keys() {
             assert_eq!(v[q]["luminous"].as_f64().unwrap(), lum);
         }
     }
-    let out = ok(glassdb()
-        .args([
-            "spectral",
-            "--json",
-            "--illuminant",
-            "A",
-            "--space",
-            "display-p3",
-            "--observer",
-            "cie1964",
-        ])
-        .arg(fixture("CSR42_3.afg")));
-    let v: Value = serde_json::from_str(&out).unwrap();
+    let colorimetric = [
+        "--illuminant",
+        "A",
+        "--space",
+        "display-p3",
+        "--observer",
+        "cie1964",
+    ];
+    let v = spectral_json(&colorimetric, &fixture("CSR42_3.afg"));
     assert_eq!(
         (
             v["method"].as_str(),
@@ -228,7 +221,7 @@ fn luminous_values_agree_with_the_igsdb_nfrc_summaries() {
         let path = fixture(name);
         let json: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
         let summary = &json["integrated_results_summary"][0];
-        let data = read_spectral_file(&path, &ReadOptions::default()).unwrap();
+        let data = read_fixture(name);
         for (key, values) in [
             ("tfvis", &data.transmittance),
             ("rfvis", &data.reflectance_front),
@@ -252,7 +245,7 @@ fn luminous_values_agree_with_the_igsdb_nfrc_summaries() {
 
 #[test]
 fn readers_take_the_product_metadata_as_written() {
-    let d = read_spectral_file(&fixture("CLEAR5.LOF"), &ReadOptions::default()).unwrap();
+    let d = read_fixture("CLEAR5.LOF");
     assert_eq!(d.product.name.as_deref(), Some("Optifloat™ Clear"));
     assert_eq!(
         d.product.manufacturer.as_deref(),
@@ -268,18 +261,18 @@ fn readers_take_the_product_metadata_as_written() {
         ),
         (369, 300.0, 2500.0)
     );
-    let d = read_spectral_file(&fixture("nfrc_20748.oag"), &ReadOptions::default()).unwrap();
+    let d = read_fixture("nfrc_20748.oag");
     assert_eq!(d.product.name.as_deref(), Some("8 mm Stopray Titanium-34T"));
     assert_eq!(d.product.coated_side.as_deref(), Some("Front"));
     assert_eq!(d.wavelength_nm.len(), 963);
-    let d = read_spectral_file(&fixture("913.json"), &ReadOptions::default()).unwrap();
+    let d = read_fixture("913.json");
     assert_eq!(
         d.product.manufacturer.as_deref(),
         Some("AGC Glass Co. N.A.")
     );
     assert_eq!(d.product.product_type.as_deref(), Some("monolithic"));
     assert_eq!(d.wavelength_nm[0], 305.0);
-    let d = read_spectral_file(&fixture("nfrc_9223.json"), &ReadOptions::default()).unwrap();
+    let d = read_fixture("nfrc_9223.json");
     assert_eq!(d.product.product_type.as_deref(), Some("applied-film"));
     assert_eq!(d.product.coated_side.as_deref(), Some("Back"));
     assert_eq!(d.wavelength_nm.len(), 441);
@@ -297,28 +290,51 @@ fn csv_file(dir: &Path, name: &str, rows: &[(f64, f64)]) -> PathBuf {
     write_file(dir, name, s.as_bytes())
 }
 
+/// `(wavelength, value)` rows at `start + step·i` for `i` in `0..=last`.
+fn rows(start: f64, step: f64, last: u32, value: impl Fn(f64) -> f64) -> Vec<(f64, f64)> {
+    (0..=last)
+        .map(|i| start + step * f64::from(i))
+        .map(|w| (w, value(w)))
+        .collect()
+}
+
+/// `inside` at the wavelengths in `range`, `outside` elsewhere.
+fn band(range: RangeInclusive<f64>, inside: f64, outside: f64) -> impl Fn(f64) -> f64 {
+    move |w| if range.contains(&w) { inside } else { outside }
+}
+
+/// Compares one file with the oracle to 1e-9 (see `compare_with_oracle`).
+fn matches_oracle(path: &Path, opts: &ReadOptions, extrapolate: bool) {
+    compare_with_oracle(&[path.to_path_buf()], opts, extrapolate, 1e-9);
+}
+
+/// `glassdb spectral [args…] <file>`.
+fn spectral(args: &[&str], file: &Path) -> Command {
+    let mut cmd = glassdb();
+    cmd.arg("spectral").args(args).arg(file);
+    cmd
+}
+
+/// `glassdb spectral --json [args…] <file>`, parsed.
+fn spectral_json(args: &[&str], file: &Path) -> Value {
+    let out = ok(glassdb().args(["spectral", "--json"]).args(args).arg(file));
+    serde_json::from_str(&out).unwrap()
+}
+
+/// The transmittance RGB of `glassdb spectral --json [args…] <file>`.
+fn transmittance_rgb(args: &[&str], file: &Path) -> [f64; 3] {
+    rgb_of(&spectral_json(args, file)["transmittance"]["rgb"])
+}
+
 #[test]
 fn notch_narrower_than_the_grid_is_missed_by_the_iso_grid_but_not_at_1nm() {
     // 1 nm data with a 5 nm wide notch (553–557 nm) between the ISO 9050 grid points 550 and
     // 560: the standard's 10 nm grid never sees it, the 1 nm value does. Both as colour-science.
     let dir = tempfile::tempdir().unwrap();
-    let rows: Vec<(f64, f64)> = (300..=900)
-        .map(|w| {
-            (
-                f64::from(w),
-                if (553..=557).contains(&w) { 0.0 } else { 0.8 },
-            )
-        })
-        .collect();
-    let path = csv_file(dir.path(), "notch.csv", &rows);
-    compare_with_oracle(
-        std::slice::from_ref(&path),
-        &ReadOptions::default(),
-        false,
-        1e-9,
-    );
-    let out = ok(glassdb().args(["spectral", "--json"]).arg(&path));
-    let v: Value = serde_json::from_str(&out).unwrap();
+    let notch = rows(300.0, 1.0, 600, band(553.0..=557.0, 0.0, 0.8));
+    let path = csv_file(dir.path(), "notch.csv", &notch);
+    matches_oracle(&path, &ReadOptions::default(), false);
+    let v = spectral_json(&[], &path);
     let iso = v["transmittance"]["luminous"].as_f64().unwrap();
     let one = v["transmittance"]["luminous_1nm"].as_f64().unwrap();
     assert!((iso - 0.8).abs() < 1e-12, "ISO grid sees no notch: {iso}");
@@ -332,10 +348,8 @@ fn uneven_sampling_rings_exactly_as_colour_science_does() {
     // for irregular spacing rings far outside the data (green ≈ -5.4 for a 0–0.8 spectrum).
     // We reproduce colour's number (documented in docs/spectral.md as a hazard of uneven data).
     let dir = tempfile::tempdir().unwrap();
-    let mut rows: Vec<(f64, f64)> = (0..=14)
-        .map(|i| (300.0 + 50.0 * f64::from(i), 0.8))
-        .filter(|(w, _)| *w != 550.0)
-        .collect();
+    let mut rows: Vec<(f64, f64)> = rows(300.0, 50.0, 14, |_| 0.8);
+    rows.retain(|(w, _)| *w != 550.0);
     rows.extend([
         (549.0, 0.8),
         (550.1, 0.8),
@@ -345,66 +359,32 @@ fn uneven_sampling_rings_exactly_as_colour_science_does() {
     ]);
     rows.sort_by(|a, b| a.0.total_cmp(&b.0));
     let path = csv_file(dir.path(), "ringing.csv", &rows);
-    compare_with_oracle(
-        std::slice::from_ref(&path),
-        &ReadOptions::default(),
-        false,
-        1e-9,
-    );
-    let out = ok(glassdb().args(["spectral", "--json"]).arg(&path));
-    let v: Value = serde_json::from_str(&out).unwrap();
-    let g = rgb_of(&v["transmittance"]["rgb"])[1];
+    matches_oracle(&path, &ReadOptions::default(), false);
+    let g = transmittance_rgb(&[], &path)[1];
     assert!(g < 0.0, "green {g}");
 }
 
 #[test]
 fn coarse_50nm_sampling_uses_sprague_and_matches_colour() {
     let dir = tempfile::tempdir().unwrap();
-    let rows: Vec<(f64, f64)> = (0..=12)
-        .map(|i| {
-            let w = 250.0 + 50.0 * f64::from(i);
-            (w, 0.5 + 0.3 * ((w - 550.0) / 120.0).tanh())
-        })
-        .collect();
-    let path = csv_file(dir.path(), "coarse.csv", &rows);
-    compare_with_oracle(
-        std::slice::from_ref(&path),
-        &ReadOptions::default(),
-        false,
-        1e-9,
-    );
+    let coarse = rows(250.0, 50.0, 12, |w| {
+        0.5 + 0.3 * ((w - 550.0) / 120.0).tanh()
+    });
+    let path = csv_file(dir.path(), "coarse.csv", &coarse);
+    matches_oracle(&path, &ReadOptions::default(), false);
 }
 
 #[test]
 fn partial_coverage_is_an_error_unless_extrapolate() {
     let dir = tempfile::tempdir().unwrap();
-    let rows: Vec<(f64, f64)> = (0..=20)
-        .map(|i| (500.0 + 5.0 * f64::from(i), 0.2 + 0.01 * f64::from(i)))
-        .collect();
-    let path = csv_file(dir.path(), "partial.csv", &rows);
-    let err = fails(glassdb().arg("spectral").arg(&path));
-    assert!(
-        err.contains("partial.csv") && err.contains("500–600 nm") && err.contains("--extrapolate"),
-        "{err}"
-    );
+    let partial = rows(500.0, 5.0, 20, |w| 0.2 + 0.01 * (w - 500.0) / 5.0);
+    let path = csv_file(dir.path(), "partial.csv", &partial);
+    let names = ["partial.csv", "500–600 nm", "--extrapolate"];
+    fails_naming(&mut spectral(&[], &path), &names);
     // With --extrapolate the end values are held, exactly as colour-science does here (the
     // data start and end on the 1 nm grid).
-    compare_with_oracle(
-        std::slice::from_ref(&path),
-        &ReadOptions::default(),
-        true,
-        1e-9,
-    );
-    let out = ok(glassdb()
-        .args([
-            "spectral",
-            "--json",
-            "--extrapolate",
-            "--method",
-            "luminous",
-        ])
-        .arg(&path));
-    let v: Value = serde_json::from_str(&out).unwrap();
+    matches_oracle(&path, &ReadOptions::default(), true);
+    let v = spectral_json(&["--extrapolate", "--method", "luminous"], &path);
     let lum = v["transmittance"]["luminous"].as_f64().unwrap();
     assert!(lum > 0.2 && lum < 0.4, "{lum}");
 }
@@ -412,15 +392,9 @@ fn partial_coverage_is_an_error_unless_extrapolate() {
 #[test]
 fn no_overlap_is_an_error_even_with_extrapolate() {
     let dir = tempfile::tempdir().unwrap();
-    let rows: Vec<(f64, f64)> = (0..=10)
-        .map(|i| (1000.0 + 10.0 * f64::from(i), 0.5))
-        .collect();
-    let path = csv_file(dir.path(), "ir.csv", &rows);
-    let err = fails(glassdb().args(["spectral", "--extrapolate"]).arg(&path));
-    assert!(
-        err.contains("ir.csv") && err.contains("does not overlap"),
-        "{err}"
-    );
+    let path = csv_file(dir.path(), "ir.csv", &rows(1000.0, 10.0, 10, |_| 0.5));
+    let extrapolated = &mut spectral(&["--extrapolate"], &path);
+    fails_naming(extrapolated, &["ir.csv", "does not overlap"]);
 }
 
 #[test]
@@ -450,108 +424,68 @@ fn unsorted_duplicate_and_nan_wavelengths_name_file_and_line() {
     ];
     for (name, text, want) in cases {
         let path = write_file(dir.path(), name, text.as_bytes());
-        let err = fails(glassdb().arg("spectral").arg(&path));
+        let err = fails(&mut spectral(&[], &path));
         assert!(err.contains(want), "{name}: {err}");
     }
-    let err = fails(glassdb().arg("spectral").arg(write_file(
-        dir.path(),
-        "u.csv",
-        b"wavelength_nm,T\n380,0.5\n390,0.5\n385,0.5\n",
-    )));
-    assert!(err.contains("not sorted"), "{err}");
-    let err = fails(glassdb().arg("spectral").arg(write_file(
-        dir.path(),
-        "d.csv",
-        b"wavelength_nm,T\n380,0.5\n390,0.5\n390,0.6\n",
-    )));
-    assert!(
-        err.contains("duplicate wavelength 390 nm (also on line 3)"),
-        "{err}"
-    );
+    let unsorted = write_file(dir.path(), "u.csv", cases[0].1.as_bytes());
+    fails_naming(&mut spectral(&[], &unsorted), &["not sorted"]);
+    let duplicate = write_file(dir.path(), "d.csv", cases[1].1.as_bytes());
+    let names = ["duplicate wavelength 390 nm (also on line 3)"];
+    fails_naming(&mut spectral(&[], &duplicate), &names);
+}
+
+/// Writes each `(file, contents)` and asserts that `glassdb spectral` of it fails naming every
+/// one of the strings given with it.
+fn assert_spectral_errors(cases: &[(&str, &[u8], &[&str])]) {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, contents, parts) in cases {
+        let path = write_file(dir.path(), name, contents);
+        fails_naming(&mut spectral(&[], &path), parts);
+    }
 }
 
 #[test]
 fn nan_and_negative_values_name_file_line_and_column() {
-    let dir = tempfile::tempdir().unwrap();
-    let nan = write_file(
-        dir.path(),
-        "nan.csv",
-        b"wavelength_nm,T,R\n380,0.5,0.1\n390,0.5,nan\n",
-    );
-    let err = fails(glassdb().arg("spectral").arg(&nan));
-    assert!(
-        err.contains("nan.csv:3:3") && err.contains("not a finite number"),
-        "{err}"
-    );
-    let neg = write_file(
-        dir.path(),
-        "neg.csv",
-        b"wavelength_nm,T,R\n380,0.5,0.1\n390,-0.01,0.1\n",
-    );
-    let err = fails(glassdb().arg("spectral").arg(&neg));
-    assert!(
-        err.contains("neg.csv:3:2") && err.contains("negative"),
-        "{err}"
-    );
-    let neg_optics = write_file(
-        dir.path(),
-        "neg.afg",
-        b"{ Units, Wavelength Units } SI Microns\n0.30 0.1 0.1 0.1\n0.31 0.1 -0.2 0.1\n",
-    );
-    let err = fails(glassdb().arg("spectral").arg(&neg_optics));
-    assert!(err.contains("neg.afg:3:3"), "{err}");
-    let json = write_file(
-        dir.path(),
-        "neg.json",
-        b"{\"spectral_data\": {\"spectral_data\": [\n {\"wavelength\": 0.3, \"T\": 0.1},\n {\"wavelength\": 0.31, \"T\": -0.1}\n]}}\n",
-    );
-    let err = fails(glassdb().arg("spectral").arg(&json));
-    assert!(
-        err.contains("neg.json:3") && err.contains("negative"),
-        "{err}"
-    );
+    assert_spectral_errors(&[
+        (
+            "nan.csv",
+            b"wavelength_nm,T,R\n380,0.5,0.1\n390,0.5,nan\n",
+            &["nan.csv:3:3", "not a finite number"],
+        ),
+        (
+            "neg.csv",
+            b"wavelength_nm,T,R\n380,0.5,0.1\n390,-0.01,0.1\n",
+            &["neg.csv:3:2", "negative"],
+        ),
+        (
+            "neg.afg",
+            b"{ Units, Wavelength Units } SI Microns\n0.30 0.1 0.1 0.1\n0.31 0.1 -0.2 0.1\n",
+            &["neg.afg:3:3"],
+        ),
+        (
+            "neg.json",
+            b"{\"spectral_data\": {\"spectral_data\": [\n {\"wavelength\": 0.3, \"T\": 0.1},\n {\"wavelength\": 0.31, \"T\": -0.1}\n]}}\n",
+            &["neg.json:3", "negative"],
+        ),
+    ]);
 }
 
 #[test]
 fn fewer_points_than_the_interpolator_needs() {
     let dir = tempfile::tempdir().unwrap();
     // Five uniformly spaced points: Sprague needs six.
-    let five = csv_file(
-        dir.path(),
-        "five.csv",
-        &[
-            (300.0, 0.5),
-            (450.0, 0.5),
-            (600.0, 0.5),
-            (750.0, 0.5),
-            (900.0, 0.5),
-        ],
-    );
-    let err = fails(glassdb().arg("spectral").arg(&five));
-    assert!(
-        err.contains("five.csv") && err.contains("Sprague") && err.contains("at least 6"),
-        "{err}"
-    );
+    let five = csv_file(dir.path(), "five.csv", &rows(300.0, 150.0, 4, |_| 0.5));
+    let names = ["five.csv", "Sprague", "at least 6"];
+    fails_naming(&mut spectral(&[], &five), &names);
     // Three irregular points: the spline needs four.
-    let three = csv_file(
-        dir.path(),
-        "three.csv",
-        &[(300.0, 0.5), (500.0, 0.5), (900.0, 0.5)],
-    );
-    let err = fails(glassdb().arg("spectral").arg(&three));
-    assert!(
-        err.contains("three.csv") && err.contains("cubic spline") && err.contains("at least 4"),
-        "{err}"
-    );
+    let three = [(300.0, 0.5), (500.0, 0.5), (900.0, 0.5)];
+    let three = csv_file(dir.path(), "three.csv", &three);
+    let names = ["three.csv", "cubic spline", "at least 4"];
+    fails_naming(&mut spectral(&[], &three), &names);
     // Four irregular points are enough.
-    let four = csv_file(
-        dir.path(),
-        "four.csv",
-        &[(300.0, 0.5), (500.0, 0.5), (650.0, 0.5), (900.0, 0.5)],
-    );
-    let out = ok(glassdb().args(["spectral", "--json"]).arg(&four));
-    let v: Value = serde_json::from_str(&out).unwrap();
-    for c in rgb_of(&v["transmittance"]["rgb"]) {
+    let four = [(300.0, 0.5), (500.0, 0.5), (650.0, 0.5), (900.0, 0.5)];
+    let four = csv_file(dir.path(), "four.csv", &four);
+    for c in transmittance_rgb(&[], &four) {
         assert!((c - 0.5).abs() < 1e-12);
     }
 }
@@ -559,34 +493,18 @@ fn fewer_points_than_the_interpolator_needs() {
 #[test]
 fn percent_given_as_fraction_and_fraction_given_as_percent() {
     let dir = tempfile::tempdir().unwrap();
-    let rows: Vec<(f64, f64)> = (0..=40)
+    let percent: Vec<(f64, f64)> = (0..=40)
         .map(|i| (300.0 + 15.0 * f64::from(i), 85.0 + 0.1 * f64::from(i)))
         .collect();
-    let pct = csv_file(dir.path(), "pct.csv", &rows);
-    let err = fails(glassdb().arg("spectral").arg(&pct));
-    assert!(
-        err.contains("pct.csv:2:2") && err.contains("--percent"),
-        "{err}"
-    );
-    let with = ok(glassdb()
-        .args(["spectral", "--json", "--percent"])
-        .arg(&pct));
-    let v: Value = serde_json::from_str(&with).unwrap();
-    let g = rgb_of(&v["transmittance"]["rgb"])[1];
+    let pct = csv_file(dir.path(), "pct.csv", &percent);
+    fails_naming(&mut spectral(&[], &pct), &["pct.csv:2:2", "--percent"]);
+    let g = transmittance_rgb(&["--percent"], &pct)[1];
     assert!(g > 0.85 && g < 0.89, "{g}");
-    compare_with_oracle(
-        std::slice::from_ref(&pct),
-        &ReadOptions { percent: true },
-        false,
-        1e-9,
-    );
-    let frac: Vec<(f64, f64)> = rows.iter().map(|(w, v)| (*w, v / 100.0)).collect();
+    matches_oracle(&pct, &ReadOptions { percent: true }, false);
+    let frac: Vec<(f64, f64)> = percent.iter().map(|(w, v)| (*w, v / 100.0)).collect();
     let frac = csv_file(dir.path(), "frac.csv", &frac);
-    let err = fails(glassdb().args(["spectral", "--percent"]).arg(&frac));
-    assert!(
-        err.contains("frac.csv") && err.contains("looks like fractions"),
-        "{err}"
-    );
+    let names = ["frac.csv", "looks like fractions"];
+    fails_naming(&mut spectral(&["--percent"], &frac), &names);
 }
 
 /// colour-science re-spaces a uniform spectrum that starts at 382.5 nm onto 382.5, 383.5, …
@@ -596,13 +514,10 @@ fn percent_given_as_fraction_and_fraction_given_as_percent() {
 #[test]
 fn off_grid_start_is_evaluated_at_the_right_wavelengths() {
     let dir = tempfile::tempdir().unwrap();
-    let rows: Vec<(f64, f64)> = (0..=80)
-        .map(|i| {
-            let w = 382.5 + 5.0 * f64::from(i);
-            (w, 0.4 + 0.4 * ((w - 520.0) / 40.0).sin().powi(2))
-        })
-        .collect();
-    let path = csv_file(dir.path(), "offgrid.csv", &rows);
+    let offgrid = rows(382.5, 5.0, 80, |w| {
+        0.4 + 0.4 * ((w - 520.0) / 40.0).sin().powi(2)
+    });
+    let path = csv_file(dir.path(), "offgrid.csv", &offgrid);
     let out = run_oracle(
         "spectral_oracle.py",
         &[OsStr::new("--off-grid"), path.as_os_str()],
@@ -634,37 +549,29 @@ fn off_grid_start_is_evaluated_at_the_right_wavelengths() {
 #[test]
 fn cli_rejects_options_that_do_not_apply_and_missing_files() {
     let f = fixture("CLEAR_3.DAT");
-    let err = fails(
-        glassdb()
-            .args(["spectral", "--method", "paper", "--space", "acescg"])
-            .arg(&f),
-    );
-    assert!(err.contains("--space"), "{err}");
-    let err = fails(
-        glassdb()
-            .args(["spectral", "--cmf", "stiles-burch-1955"])
-            .arg(&f),
-    );
-    assert!(err.contains("--cmf"), "{err}");
+    let paper_acescg = ["--method", "paper", "--space", "acescg"];
+    fails_naming(&mut spectral(&paper_acescg, &f), &["--space"]);
+    let cmf_1955 = ["--cmf", "stiles-burch-1955"];
+    fails_naming(&mut spectral(&cmf_1955, &f), &["--cmf"]);
     let err = fails(glassdb().args(["spectral", "/nonexistent/glass.csv"]));
     assert!(err.contains("/nonexistent/glass.csv"), "{err}");
-    let dir = tempfile::tempdir().unwrap();
-    let bad = write_file(dir.path(), "bad.json", b"{\"spectral_data\": [1, 2,,]}");
-    let err = fails(glassdb().arg("spectral").arg(&bad));
-    assert!(err.contains("bad.json:1:"), "{err}");
-    let cols = write_file(dir.path(), "cols.csv", b"wavelength_nm,T,Tr\n380,0.5,0.5\n");
-    let err = fails(glassdb().arg("spectral").arg(&cols));
-    assert!(
-        err.contains("cols.csv:1:3") && err.contains("unknown column `Tr`"),
-        "{err}"
-    );
-    let ragged = write_file(
-        dir.path(),
-        "ragged.csv",
-        b"wavelength_nm,T\n380,0.5\n390,0.5,0.1\n",
-    );
-    let err = fails(glassdb().arg("spectral").arg(&ragged));
-    assert!(err.contains("ragged.csv:3"), "{err}");
+    assert_spectral_errors(&[
+        (
+            "bad.json",
+            b"{\"spectral_data\": [1, 2,,]}",
+            &["bad.json:1:"],
+        ),
+        (
+            "cols.csv",
+            b"wavelength_nm,T,Tr\n380,0.5,0.5\n",
+            &["cols.csv:1:3", "unknown column `Tr`"],
+        ),
+        (
+            "ragged.csv",
+            b"wavelength_nm,T\n380,0.5\n390,0.5,0.1\n",
+            &["ragged.csv:3"],
+        ),
+    ]);
 }
 
 #[test]
@@ -672,24 +579,8 @@ fn paper_method_can_leave_the_input_range_as_documented() {
     // A spectrum that is 1 in the blue and 0 elsewhere: Wright & Guild's r̄ is negative in the
     // blue-green, so the red channel of eq. 15 goes below 0, the smallest input value.
     let dir = tempfile::tempdir().unwrap();
-    let rows: Vec<(f64, f64)> = (0..=100)
-        .map(|i| {
-            let w = 300.0 + 5.0 * f64::from(i);
-            (
-                w,
-                if (440.0..=540.0).contains(&w) {
-                    1.0
-                } else {
-                    0.0
-                },
-            )
-        })
-        .collect();
-    let path = csv_file(dir.path(), "blue.csv", &rows);
-    let out = ok(glassdb()
-        .args(["spectral", "--json", "--method", "paper"])
-        .arg(&path));
-    let v: Value = serde_json::from_str(&out).unwrap();
-    let rgb = rgb_of(&v["transmittance"]["rgb"]);
+    let blue = rows(300.0, 5.0, 100, band(440.0..=540.0, 1.0, 0.0));
+    let path = csv_file(dir.path(), "blue.csv", &blue);
+    let rgb = transmittance_rgb(&["--method", "paper"], &path);
     assert!(rgb[0] < 0.0, "{rgb:?}");
 }

@@ -64,6 +64,42 @@ pub fn fails(cmd: &mut Command) -> String {
     stderr
 }
 
+/// Runs a command that must fail (see [`fails`]), asserts that its stderr names every one of
+/// `parts` and returns the stderr.
+pub fn fails_naming(cmd: &mut Command, parts: &[&str]) -> String {
+    let stderr = fails(cmd);
+    assert_names(&stderr, parts);
+    stderr
+}
+
+/// Asserts that `text` (a command's output or an error message) contains every one of `parts`.
+pub fn assert_names(text: &str, parts: &[&str]) {
+    for part in parts {
+        assert!(text.contains(part), "lacks {part:?}:\n{text}");
+    }
+}
+
+/// `glassdb registry build <catalog> -o <out> [extra…]`.
+pub fn registry_build(catalog: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut cmd = glassdb();
+    cmd.args(["registry", "build"])
+        .arg(catalog)
+        .arg("-o")
+        .arg(out)
+        .args(extra);
+    cmd
+}
+
+/// The statistics every fitted curve of a fit file or a registry carries besides its powers and
+/// coefficients.
+pub const CURVE_FIT_STATS: [&str; 5] = [
+    "degree",
+    "rms_error",
+    "max_abs_error",
+    "max_error_angle_deg",
+    "condition_number",
+];
+
 /// Writes `contents` to `dir/name` and returns the path.
 pub fn write_file(dir: &Path, name: &str, contents: &[u8]) -> PathBuf {
     let p = dir.join(name);
@@ -187,14 +223,7 @@ pub fn assert_images_match(name: &str, got: &Planes, want: &Planes, tolerance: f
 /// Every channel of an EXR's first layer as f64 planes, read with the `exr` crate (not with
 /// glassdb's own codecs), sorted by channel name.
 pub fn read_exr_planes(path: &Path) -> Planes {
-    use exr::prelude::*;
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
+    let image = exr::prelude::read_first_flat_layer_from_file(path)
         .unwrap_or_else(|e| panic!("reading {} with the exr crate: {e}", path.display()));
     let layer = &image.layer_data;
     let size = layer.size;

@@ -16,7 +16,7 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
-use crate::util::{compose, glassdb, make_ref, ok, repo_path};
+use crate::util::{compose, make_ref, ok, registry_build, repo_path};
 
 /// Number of reflection passes (glass planes) of the atrium, in `planes.json` order.
 const PLANES: usize = 3;
@@ -68,6 +68,11 @@ fn read_mask_png(path: &Path) -> (usize, usize, Vec<[u8; 3]>) {
         .map(|c| [c[0], c[1], c[2]])
         .collect();
     (w, h, px)
+}
+
+/// The atrium's mask (`fixtures/atrium/mask.png`).
+fn atrium_mask() -> (usize, usize, Vec<[u8; 3]>) {
+    read_mask_png(&atrium("mask.png"))
 }
 
 /// Pixel sets the errors are reported on.
@@ -182,16 +187,13 @@ fn atrium(rel: &str) -> std::path::PathBuf {
     repo_path("fixtures/atrium").join(rel)
 }
 
-/// Builds the validation registry and composes the atrium into `dir/out.exr`.
-fn compose_atrium(dir: &Path) -> Rgb {
+/// Builds the validation registry and composes the atrium, in a temporary folder.
+fn compose_atrium() -> Rgb {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
     let registry = dir.join("registry.json");
-    ok(glassdb()
-        .args(["registry", "build"])
-        .arg(atrium("catalog.toml"))
-        .arg("-o")
-        .arg(&registry)
-        .arg("--mask")
-        .arg(atrium("mask.png")));
+    let mut build = registry_build(&atrium("catalog.toml"), &registry, &[]);
+    ok(build.arg("--mask").arg(atrium("mask.png")));
     let out = dir.join("out.exr");
     let mut cmd = compose();
     for k in 0..PLANES {
@@ -209,10 +211,9 @@ fn compose_atrium(dir: &Path) -> Rgb {
 
 #[test]
 fn atrium_composite_against_path_traced_reference() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = compose_atrium(dir.path());
+    let out = compose_atrium();
     let reference = read_exr(&atrium("reference.exr"));
-    let (w, h, mask) = read_mask_png(&atrium("mask.png"));
+    let (w, h, mask) = atrium_mask();
     assert_eq!(
         (w, h),
         (out.width, out.height),
@@ -239,10 +240,9 @@ fn atrium_composite_against_path_traced_reference() {
 fn atrium_composite_matches_the_exact_formula_oracle() {
     // Eqs. 8-10 in numpy with the exact thindielectric r, t at the mask's 8-bit cos θ: what the
     // compositor must give up to the registry's polynomial fit and half-float rounding.
-    let dir = tempfile::tempdir().unwrap();
-    let out = compose_atrium(dir.path());
+    let out = compose_atrium();
     let oracle = read_exr(&atrium("analysis/oracle_composite.exr"));
-    let (w, h, mask) = read_mask_png(&atrium("mask.png"));
+    let (w, h, mask) = atrium_mask();
     let reg = regions(w, h, &mask);
     let all = errors(&out, &oracle, |_| true);
     let non_glass = errors(&out, &oracle, |i| !reg.glass[i]);
@@ -310,7 +310,7 @@ fn readme_main_job_composes_the_atrium_with_the_bundled_catalog() {
     let refls: Vec<Rgb> = (0..PLANES)
         .map(|k| read_exr(&atrium(&format!("refl_{k}.exr"))))
         .collect();
-    let (w, _, mask) = read_mask_png(&atrium("mask.png"));
+    let (w, _, mask) = atrium_mask();
     // Sums of R and G over the tinted glass, in the composite and in the pass behind it.
     let (mut out_rg, mut trans_rg) = ([0.0f64; 2], [0.0f64; 2]);
     for (i, m) in mask.iter().enumerate() {

@@ -39,6 +39,16 @@ fn mask(id: Vec<u16>, cos: CosTheta, plane: Vec<u16>, coverage: Option<Vec<f32>>
     }
 }
 
+/// A mask with 8-bit cos θ codes and no coverage.
+fn mask8(id: Vec<u16>, codes: Vec<u8>, plane: Vec<u16>) -> MaskImage {
+    mask(id, CosTheta::Quantized8(codes), plane, None)
+}
+
+/// One pixel of the same value in every channel.
+fn grey(v: f32) -> [Vec<f32>; 3] {
+    [vec![v], vec![v], vec![v]]
+}
+
 fn run(
     trans: [Vec<f32>; 3],
     refl: &[[Vec<f32>; 3]],
@@ -68,12 +78,7 @@ fn run(
 #[test]
 fn golden_constant_glass_8bit_mask() {
     // Pixel 0: no glass → trans. Pixel 1: glass 1 → trans·t + refl·r per channel.
-    let m = mask(
-        vec![0, 1],
-        CosTheta::Quantized8(vec![0, 200]),
-        vec![0, 0],
-        None,
-    );
+    let m = mask8(vec![0, 1], vec![0, 200], vec![0, 0]);
     let trans = [vec![1.0, 1.0], vec![2.0, 2.0], vec![4.0, 4.0]];
     let refl = [[vec![8.0, 10.0], vec![8.0, 10.0], vec![8.0, 10.0]]];
     let (out, counts) = run(trans, &refl, &m, &[Side::Front]);
@@ -95,34 +100,19 @@ fn golden_angle_dependent_glass_each_cos_kind() {
         CosTheta::Float(vec![0.2]),
     ] {
         let m = mask(vec![2], cos.clone(), vec![0], None);
-        let (out, _) = run(
-            [vec![1.0], vec![1.0], vec![1.0]],
-            &[[vec![2.0], vec![2.0], vec![2.0]]],
-            &m,
-            &[Side::Front],
-        );
+        let (out, _) = run(grey(1.0), &[grey(2.0)], &m, &[Side::Front]);
         assert!((out[0][0] - 1.0).abs() < 2e-6, "{cos:?}: {}", out[0][0]);
     }
     // Binary mask: normal-incidence values r0 = 0, t0 = 1 → the transmission pass.
     let m = mask(vec![2], CosTheta::Normal, vec![0], None);
-    let (out, _) = run(
-        [vec![3.0], vec![3.0], vec![3.0]],
-        &[[vec![9.0], vec![9.0], vec![9.0]]],
-        &m,
-        &[Side::Front],
-    );
+    let (out, _) = run(grey(3.0), &[grey(9.0)], &m, &[Side::Front]);
     assert_eq!(out[0][0], 3.0);
 }
 
 #[test]
 fn golden_two_planes_and_back_side() {
     // Pixel 0 on plane 0 (front, r_R = 0.1), pixel 1 on plane 1 (back, r = 0.4).
-    let m = mask(
-        vec![1, 1],
-        CosTheta::Quantized8(vec![255, 255]),
-        vec![0, 1],
-        None,
-    );
+    let m = mask8(vec![1, 1], vec![255, 255], vec![0, 1]);
     let trans = [vec![0.0, 0.0], vec![0.0, 0.0], vec![0.0, 0.0]];
     let refl = [
         [vec![10.0, 99.0], vec![10.0, 99.0], vec![10.0, 99.0]],
@@ -142,23 +132,13 @@ fn golden_coverage() {
         vec![0],
         Some(vec![0.25]),
     );
-    let (out, _) = run(
-        [vec![2.0], vec![2.0], vec![2.0]],
-        &[[vec![4.0], vec![4.0], vec![4.0]]],
-        &m,
-        &[Side::Front],
-    );
+    let (out, _) = run(grey(2.0), &[grey(4.0)], &m, &[Side::Front]);
     assert!((out[0][0] - 1.85).abs() < 1e-6, "{}", out[0][0]);
 }
 
 #[test]
 fn nan_propagates_and_is_counted() {
-    let m = mask(
-        vec![1, 0, 1],
-        CosTheta::Quantized8(vec![9; 3]),
-        vec![0; 3],
-        None,
-    );
+    let m = mask8(vec![1, 0, 1], vec![9; 3], vec![0; 3]);
     let trans = [
         vec![f32::NAN, f32::INFINITY, 1.0],
         vec![1.0; 3],
@@ -174,13 +154,8 @@ fn nan_propagates_and_is_counted() {
 
 #[test]
 fn unknown_ids_pass_through_when_allowed() {
-    let m = mask(vec![9], CosTheta::Quantized8(vec![9]), vec![0], None);
-    let (out, counts) = run(
-        [vec![1.5], vec![1.5], vec![1.5]],
-        &[[vec![7.0], vec![7.0], vec![7.0]]],
-        &m,
-        &[Side::Front],
-    );
+    let m = mask8(vec![9], vec![9], vec![0]);
+    let (out, counts) = run(grey(1.5), &[grey(7.0)], &m, &[Side::Front]);
     assert_eq!(out[0][0], 1.5);
     assert_eq!(counts.passthrough_pixels, 1);
 }

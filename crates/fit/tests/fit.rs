@@ -11,6 +11,10 @@ use glassdb_fit::{
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 
+#[path = "common/inputs.rs"]
+mod inputs;
+use inputs::{gaussian, r_plus_t_above_one_csv};
+
 fn data(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../..")
@@ -253,34 +257,25 @@ fn coated_bronze_curve_with_ct_above_one_is_accepted() {
             .max_abs_error
             <= 0.002
     );
-    // degree 8 follows the rise above 1 and is accepted, even in strict mode
-    let t8 = FitOptions {
-        degree: Some(8),
+    // the full basis at a given degree, and the fitted C_t(10°)
+    let full = |degree| FitOptions {
+        degree: Some(degree),
         basis: Some(Basis::Full),
         ..t_opts.clone()
     };
-    let glass = fit_glass(table, &r_opts, &t8, true).expect("strict mode accepts C_t > 1");
-    let ct10 = glass
-        .transmittance
-        .as_ref()
-        .unwrap()
-        .polynomial
-        .eval_angle_deg(10.0);
+    let ct_at_10 = |glass: &GlassFit| {
+        let t = glass.transmittance.as_ref().unwrap();
+        t.polynomial.eval_angle_deg(10.0)
+    };
+    // degree 8 follows the rise above 1 and is accepted, even in strict mode
+    let glass = fit_glass(table, &r_opts, &full(8), true).expect("strict mode accepts C_t > 1");
+    let ct10 = ct_at_10(&glass);
     assert!(ct10 > 1.003 && ct10 < tau10, "degree 8: C_t(10°) = {ct10}");
     // degree 9 interpolates the 10 points (C_t(10°) = the WINDOW-4 value) but swings below 0
     // between 80° and 90°: that, not C_t > 1, is what the physical check reports
-    let t9 = FitOptions {
-        degree: Some(9),
-        basis: Some(Basis::Full),
-        ..t_opts.clone()
-    };
+    let t9 = full(9);
     let glass = fit_glass(table, &r_opts, &t9, false).unwrap();
-    let ct10 = glass
-        .transmittance
-        .as_ref()
-        .unwrap()
-        .polynomial
-        .eval_angle_deg(10.0);
+    let ct10 = ct_at_10(&glass);
     assert!((ct10 - tau10).abs() < 1e-9, "degree 9: C_t(10°) = {ct10}");
     assert_eq!(glass.warnings.len(), 1, "{:?}", glass.warnings);
     assert!(glass.warnings[0].contains("t < 0"), "{:?}", glass.warnings);
@@ -288,23 +283,6 @@ fn coated_bronze_curve_with_ct_above_one_is_accepted() {
 }
 
 // ---- hard case 6: noise and one outlier ----
-
-/// Deterministic N(0, 1) draws (64-bit LCG + Box–Muller), so the test never changes.
-fn gaussian(seed: u64, n: usize) -> Vec<f64> {
-    let mut state = seed;
-    let mut uniform = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    };
-    (0..n)
-        .map(|_| {
-            let (u1, u2) = (uniform(), uniform());
-            (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-        })
-        .collect()
-}
 
 #[test]
 fn noisy_data_with_one_outlier_is_pointed_at() {
@@ -540,18 +518,7 @@ fn physical_checks_name_the_worst_angle() {
 #[test]
 fn strict_mode_turns_a_violation_into_an_error() {
     // R + T = 1.02 at every angle: the fitted r + t exceeds 1
-    let text = "angle_deg,R,T\n".to_string()
-        + &(0..=9)
-            .map(|i| {
-                format!(
-                    "{},{},{}\n",
-                    i * 10,
-                    0.1 + 0.001 * i as f64,
-                    0.92 - 0.001 * i as f64
-                )
-            })
-            .collect::<String>();
-    let tables = parse(&text, false).unwrap();
+    let tables = parse(&r_plus_t_above_one_csv(), false).unwrap();
     let r = FitOptions::new(Quantity::Reflectance);
     let t = FitOptions::new(Quantity::Transmittance);
     let lax = fit_glass(&tables[0], &r, &t, false).unwrap();
@@ -582,17 +549,9 @@ fn fit_file_has_the_documented_keys_and_round_trips() {
     let glass = &v["glasses"][0];
     assert_eq!(glass["name"], "clear_6mm_fresnel");
     for q in ["reflectance", "transmittance"] {
-        for key in [
-            "normal",
-            "basis",
-            "powers",
-            "coefficients",
-            "degree",
-            "rms_error",
-            "max_abs_error",
-            "max_error_angle_deg",
-            "condition_number",
-        ] {
+        let documented = "normal basis powers coefficients degree rms_error max_abs_error \
+                          max_error_angle_deg condition_number";
+        for key in documented.split_whitespace() {
             assert!(glass[q].get(key).is_some(), "{q} lacks {key}: {}", glass[q]);
         }
     }
@@ -662,52 +621,50 @@ fn err(text: &str) -> String {
 
 #[test]
 fn reader_errors_name_file_line_and_column() {
-    assert!(err("").contains("table.csv: the file is empty"));
-    assert!(err("angle_deg,R\n").contains("no data rows"));
-    assert!(err("R,T\n0,0.1,0.8\n").contains("missing column angle_deg"));
-    assert!(err("angle_deg,glass\n0,a\n").contains("missing column R"));
-    let e = err("angle_deg,R,T\n0,0.08,0.88\n10,abc,0.87\n");
-    assert!(
-        e.contains("table.csv, line 3, column 2 (R): `abc` is not a number"),
-        "{e}"
-    );
-    let e = err("angle_deg,R\n0,NaN\n");
-    assert!(
-        e.contains("line 2, column 2") && e.contains("not a finite number"),
-        "{e}"
-    );
-    let e = err("angle_deg,R\n0,0.1\n91,0.2\n");
-    assert!(
-        e.contains("line 3, column 1") && e.contains("outside 0–90°"),
-        "{e}"
-    );
-    let e = err("angle_deg,R\n-1,0.1\n");
-    assert!(e.contains("outside 0–90°"), "{e}");
-    let e = err("angle_deg,R\n0,8.1\n");
-    assert!(
-        e.contains("line 2, column 2") && e.contains("--percent"),
-        "{e}"
-    );
-    let e = err("angle_deg,R\n0,-0.1\n");
-    assert!(e.contains("outside 0–1"), "{e}");
+    // (table text, what the error must name)
+    let cases: [(&str, &[&str]); 15] = [
+        ("", &["table.csv: the file is empty"]),
+        ("angle_deg,R\n", &["no data rows"]),
+        ("R,T\n0,0.1,0.8\n", &["missing column angle_deg"]),
+        ("angle_deg,glass\n0,a\n", &["missing column R"]),
+        (
+            "angle_deg,R,T\n0,0.08,0.88\n10,abc,0.87\n",
+            &["table.csv, line 3, column 2 (R): `abc` is not a number"],
+        ),
+        (
+            "angle_deg,R\n0,NaN\n",
+            &["line 2, column 2", "not a finite number"],
+        ),
+        (
+            "angle_deg,R\n0,0.1\n91,0.2\n",
+            &["line 3, column 1", "outside 0–90°"],
+        ),
+        ("angle_deg,R\n-1,0.1\n", &["outside 0–90°"]),
+        ("angle_deg,R\n0,8.1\n", &["line 2, column 2", "--percent"]),
+        ("angle_deg,R\n0,-0.1\n", &["outside 0–1"]),
+        (
+            "angle_deg,R,T\n0,0.1\n",
+            &["line 2", "2 field(s) but the header has 3"],
+        ),
+        (
+            "angle_deg,Rf\n0,0.1\n",
+            &["line 1, column 2: unknown column `Rf`"],
+        ),
+        (
+            "angle_deg,R,reflectance\n0,0.1,0.1\n",
+            &["repeats a quantity"],
+        ),
+        ("angle_deg,R\n,0.1\n", &["line 2, column 1", "empty cell"]),
+        ("angle_deg,R\n0,\n", &["no R or T values"]),
+    ];
+    for (text, parts) in cases {
+        let e = err(text);
+        for part in parts {
+            assert!(e.contains(part), "{text:?}: {e}");
+        }
+    }
     let e = parse("angle_deg,R\n0,180\n", true).unwrap_err().to_string();
     assert!(e.contains("0–100 (percent)"), "{e}");
-    let e = err("angle_deg,R,T\n0,0.1\n");
-    assert!(
-        e.contains("line 2") && e.contains("2 field(s) but the header has 3"),
-        "{e}"
-    );
-    let e = err("angle_deg,Rf\n0,0.1\n");
-    assert!(e.contains("line 1, column 2: unknown column `Rf`"), "{e}");
-    let e = err("angle_deg,R,reflectance\n0,0.1,0.1\n");
-    assert!(e.contains("repeats a quantity"), "{e}");
-    let e = err("angle_deg,R\n,0.1\n");
-    assert!(
-        e.contains("line 2, column 1") && e.contains("empty cell"),
-        "{e}"
-    );
-    let e = err("angle_deg,R\n0,\n");
-    assert!(e.contains("no R or T values"), "{e}");
     let e = parse_angle_table(
         b"angle_deg,R\n0,0.\xff1\n",
         Path::new("table.csv"),

@@ -117,13 +117,19 @@ fn write_scene(dir: &Path, quads: &[Quad], split: usize) -> std::path::PathBuf {
 }
 
 fn spec(width: u32, height: u32, fov: f64) -> CameraSpec {
+    camera([0.2, 0.1, 4.0], [0.0, 0.0, 0.0], fov, (width, height))
+}
+
+/// A camera at `origin` looking at `target`, +y up, `fov_x_deg` wide, `size` (width, height)
+/// pixels.
+fn camera(origin: V, target: V, fov_x_deg: f64, size: (u32, u32)) -> CameraSpec {
     CameraSpec {
-        origin: [0.2, 0.1, 4.0],
-        target: [0.0, 0.0, 0.0],
+        origin,
+        target,
         up: [0.0, 1.0, 0.0],
-        fov_x_deg: fov,
-        width,
-        height,
+        fov_x_deg,
+        width: size.0,
+        height: size.1,
     }
 }
 
@@ -407,14 +413,7 @@ fn coverage_counts_the_sub_pixel_rays() {
 
 /// Largest |Gouraud − exact| over the glass pixels.
 fn gouraud_error(mesh: u32) -> f64 {
-    let s = CameraSpec {
-        origin: [0.0, 0.0, 1.5],
-        target: [0.8, 0.0, 0.0],
-        up: [0.0, 1.0, 0.0],
-        fov_x_deg: 100.0,
-        width: 160,
-        height: 120,
-    };
+    let s = camera([0.0, 0.0, 1.5], [0.8, 0.0, 0.0], 100.0, (160, 120));
     // A wide pane seen obliquely: cos θ varies strongly and non-linearly across it.
     let quads = [Quad {
         corner: [-3.0, -1.5, -0.5],

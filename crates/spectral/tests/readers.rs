@@ -2,8 +2,8 @@
 //! satisfy the documented invariants; format detection; integration input checks.
 
 use glassdb_spectral::{
-    IntegrationSettings, Integrator, ReadOptions, SpectralError, SpectralFormat, detect_format,
-    luminous_iso9050, read_spectral_bytes,
+    IntegrationSettings, Integrator, ReadOptions, SpectralData, SpectralError, SpectralFormat,
+    detect_format, luminous_iso9050, read_spectral_bytes,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
@@ -109,64 +109,63 @@ fn format_detection_by_extension_then_content() {
     );
 }
 
+/// Reads `bytes` named `name` with the default options.
+fn read_default(bytes: &[u8], name: &str) -> Result<SpectralData, SpectralError> {
+    read_spectral_bytes(bytes, name, &ReadOptions::default())
+}
+
 #[test]
 fn csv_in_microns_and_optics_in_nanometres_become_nm() {
-    let d = read_spectral_bytes(
+    let d = read_default(
         b"wavelength_um,T,Rb\n0.305,0.5,0.1\n0.310,0.6,0.2\n",
         "a.csv",
-        &ReadOptions::default(),
     )
     .unwrap();
     assert_eq!(d.wavelength_nm, vec![305.0, 310.0]);
     assert!(d.reflectance_front.is_none());
     assert_eq!(d.reflectance_back, Some(vec![0.1, 0.2]));
-    let d = read_spectral_bytes(
-        b"{ Units, Wavelength Units } SI Nanometers\r\n{ Thickness } 4\r\n300\t0.1\t0.2\t0.3\r\n305 0.1 0.2 0.3\r\n",
-        "n.txt",
-        &ReadOptions::default(),
-    )
-    .unwrap();
+    let optics_nm: &[u8] = b"{ Units, Wavelength Units } SI Nanometers\r\n{ Thickness } 4\r\n300\t0.1\t0.2\t0.3\r\n305 0.1 0.2 0.3\r\n";
+    let d = read_default(optics_nm, "n.txt").unwrap();
     assert_eq!(d.wavelength_nm, vec![300.0, 305.0]);
     assert_eq!(d.product.thickness_mm, Some(4.0));
 }
 
 #[test]
 fn errors_name_source_line_and_column() {
-    let e = read_spectral_bytes(
-        b"wavelength_nm,T\n380,0.5\n390,x\n",
-        "g.csv",
-        &ReadOptions::default(),
-    )
-    .unwrap_err();
-    assert_eq!(e.to_string(), "g.csv:3:2: T `x` is not a number");
-    let e = read_spectral_bytes(
-        b"{ Units, Wavelength Units } SI Furlongs\n",
-        "g.DAT",
-        &ReadOptions::default(),
-    )
-    .unwrap_err();
-    assert!(
-        e.to_string()
-            .starts_with("g.DAT:1: unknown wavelength units"),
-        "{e}"
-    );
-    let e = read_spectral_bytes(b"0.3 0.1 0.2\n", "g.DAT", &ReadOptions::default()).unwrap_err();
-    assert_eq!(
-        e.to_string(),
-        "g.DAT:1: expected 4 numbers `wavelength T Rf Rb`, found 3 fields"
-    );
-    let e = read_spectral_bytes(
-        b"wavelength_um,T\n1e300,0.5\n",
-        "h.csv",
-        &ReadOptions::default(),
-    )
-    .unwrap_err();
-    assert!(
-        e.to_string()
-            .starts_with("h.csv:2:1: wavelength is out of range"),
-        "{e}"
-    );
-    let e = read_spectral_bytes(b"{\"name\": 1}", "g.json", &ReadOptions::default()).unwrap_err();
+    // (bytes, file name, the whole message)
+    let exact: [(&[u8], &str, &str); 2] = [
+        (
+            b"wavelength_nm,T\n380,0.5\n390,x\n",
+            "g.csv",
+            "g.csv:3:2: T `x` is not a number",
+        ),
+        (
+            b"0.3 0.1 0.2\n",
+            "g.DAT",
+            "g.DAT:1: expected 4 numbers `wavelength T Rf Rb`, found 3 fields",
+        ),
+    ];
+    for (bytes, name, message) in exact {
+        assert_eq!(read_default(bytes, name).unwrap_err().to_string(), message);
+    }
+    // (bytes, file name, how the message starts)
+    let starts: [(&[u8], &str, &str); 2] = [
+        (
+            b"{ Units, Wavelength Units } SI Furlongs\n",
+            "g.DAT",
+            "g.DAT:1: unknown wavelength units",
+        ),
+        (
+            b"wavelength_um,T\n1e300,0.5\n",
+            "h.csv",
+            "h.csv:2:1: wavelength is out of range",
+        ),
+    ];
+    for (bytes, name, start) in starts {
+        let e = read_default(bytes, name).unwrap_err();
+        assert!(e.to_string().starts_with(start), "{e}");
+    }
+    let e = read_default(b"{\"name\": 1}", "g.json").unwrap_err();
     assert!(matches!(e, SpectralError::Format { .. }), "{e}");
 }
 
