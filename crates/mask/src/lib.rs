@@ -11,6 +11,7 @@
 //!
 //! Id 0 means "no glass" everywhere.
 
+mod cos_code;
 pub mod exr_flat;
 pub mod guard;
 pub mod png_flat;
@@ -19,6 +20,7 @@ mod write;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+pub use cos_code::CosCode;
 pub use write::{MaskFormat, write_mask, write_mask_bytes};
 
 /// A decoded mask, row-major, row 0 at the top. All per-pixel vectors have `width * height`
@@ -37,8 +39,8 @@ pub struct MaskImage {
     pub coverage: Option<Vec<f32>>,
 }
 
-/// cos θ as the mask stores it: quantised codes are kept as codes so that lookups into
-/// 256-entry tables stay exact.
+/// cos θ as the mask stores it: quantised codes ([`CosCode`]) are kept as codes so that
+/// lookups into 256-entry tables stay exact.
 #[derive(Debug, Clone, PartialEq)]
 pub enum CosTheta {
     /// 8-bit: cos θ = code / 255 (the paper's packed mask).
@@ -77,8 +79,8 @@ impl MaskImage {
     /// or 1 for a binary mask. Returns NaN for an index outside the image.
     pub fn cos_theta_at(&self, index: usize) -> f64 {
         let v = match &self.cos_theta {
-            CosTheta::Quantized8(c) => c.get(index).map(|&c| f64::from(c) / 255.0),
-            CosTheta::Quantized16(c) => c.get(index).map(|&c| f64::from(c) / 65535.0),
+            CosTheta::Quantized8(c) => c.get(index).map(|&c| CosCode::decode8(c)),
+            CosTheta::Quantized16(c) => c.get(index).map(|&c| CosCode::Bits16.decode(c)),
             CosTheta::Float(c) => c.get(index).map(|&c| f64::from(c)),
             CosTheta::Normal => (index < self.pixel_count()).then_some(1.0),
         };
