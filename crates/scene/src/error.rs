@@ -76,6 +76,12 @@ pub enum SceneError {
     /// Neither glass materials nor an explicit plane say where the mirrors are.
     #[error("give the glass materials or one plane to mirror across")]
     NoGlassSelected,
+    /// `planes.json` could not be encoded (a non-finite number in a plane).
+    #[error("cannot encode {path}")]
+    EncodePlanes {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
     /// The output directory could not be created.
     #[error("cannot create the output directory {path}")]
     CreateDir {

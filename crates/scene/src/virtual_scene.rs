@@ -266,8 +266,9 @@ fn write_planes_file(
 ) -> Result<PathBuf, SceneError> {
     let planes_path = out_dir.join("planes.json");
     glassdb_io::refuse_input_as_output(&planes_path, [scene.source.as_path()])?;
-    let json = serde_json::to_string_pretty(file).map_err(|e| SceneError::BadOption {
-        message: e.to_string(),
+    let json = serde_json::to_string_pretty(file).map_err(|source| SceneError::EncodePlanes {
+        path: planes_path.clone(),
+        source,
     })?;
     glassdb_io::write_bytes_atomic(&planes_path, format!("{json}\n").as_bytes())?;
     Ok(planes_path)
