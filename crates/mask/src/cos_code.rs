@@ -22,12 +22,6 @@ impl CosCode {
         }
     }
 
-    /// Number of codes (256 or 65536).
-    #[inline]
-    pub const fn code_count(self) -> usize {
-        self.max_code() as usize + 1
-    }
-
     /// The distance in cos θ between neighbouring codes (1/255 or 1/65535); rounding to the
     /// nearest code is off by at most half of it.
     #[inline]

@@ -106,3 +106,44 @@ fn storage_row(st: CosStorage, refs: &[Reference], grid: &[f64]) -> String {
     );
     row
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use glassdb_mask::{
+        CosTheta, MaskFormat, MaskImage, MaskReadOptions, read_mask_bytes, write_mask_bytes,
+    };
+
+    use super::*;
+
+    #[test]
+    fn stored_cos_is_what_a_written_png_mask_reads_back() {
+        // The table measures the masks' own round trip: float cos θ → PNG mask → cos θ.
+        let cos: Vec<f32> = (0..=1000).map(|k| k as f32 / 1000.0).collect();
+        let n = cos.len();
+        let mask = MaskImage {
+            width: n as u32,
+            height: 1,
+            id: vec![1; n],
+            cos_theta: CosTheta::Float(cos.clone()),
+            plane: vec![0; n],
+            coverage: None,
+        };
+        let path = Path::new("round_trip.png");
+        for (format, code) in [
+            (MaskFormat::Png8, CosCode::Bits8),
+            (MaskFormat::Png16, CosCode::Bits16),
+        ] {
+            let bytes = write_mask_bytes(path, &mask, format).unwrap();
+            let back = read_mask_bytes(&bytes, path, &MaskReadOptions::default()).unwrap();
+            for (i, &c) in cos.iter().enumerate() {
+                assert_eq!(
+                    back.cos_theta_at(i),
+                    CosStorage::Code(code).store(f64::from(c)),
+                    "{code:?} at cos θ {c}"
+                );
+            }
+        }
+    }
+}
