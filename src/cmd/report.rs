@@ -1,11 +1,11 @@
 //! `glassdb report`: regenerates `docs/accuracy.md` (speed against error of every approximation)
-//! and its figures. All the work is in `glassdb_plot::report`.
+//! and its figures. All the work is in `glassdb_report`; this names the repository's files.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use glassdb_plot::report::{ReportOptions, generate};
+use glassdb_report::{GouraudScene, ReportOptions, SpectrumFigure, generate};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -24,6 +24,31 @@ pub struct Args {
     /// Values per timing pass (more: steadier timings, slower run).
     #[arg(long, default_value_t = 1 << 20)]
     pub timing_values: usize,
+}
+
+/// The report's inputs in the repository at `root`.
+fn repository_inputs(root: &Path) -> ReportOptions {
+    ReportOptions {
+        root: root.to_path_buf(),
+        catalog: root.join("data/catalog.toml"),
+        angle_tables: vec![
+            root.join("data/angles/clear_6mm_fresnel.csv"),
+            root.join("data/angles/bronze_coated_window4.csv"),
+        ],
+        spectrum_figure: Some(SpectrumFigure {
+            spectrum: root.join("data/glazing/LOW-E_5.LOF"),
+            name: "lowe".into(),
+        }),
+        gouraud_scene: Some(GouraudScene {
+            obj: root.join("fixtures/atrium/atrium.obj"),
+            camera: root.join("fixtures/atrium/camera.json"),
+            glass: vec!["GlassClear=1".into(), "GlassTinted=5".into()],
+            catalog: root.join("fixtures/atrium/catalog.toml"),
+        }),
+        figures_dir: Some(root.join("docs/figures")),
+        figures_link: "figures".into(),
+        timing_values: 1 << 20,
+    }
 }
 
 /// `figures` as the page at `page` should link it: relative when it lies under the page's folder.
@@ -53,7 +78,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.timing_values == 0 {
         bail!("--timing-values must be at least 1");
     }
-    let mut opts = ReportOptions::repository_defaults(&args.root);
+    let mut opts = repository_inputs(&args.root);
     opts.timing_values = args.timing_values;
     opts.figures_dir = (!args.no_figures).then(|| args.figures.clone());
     opts.figures_link = link_to(&args.output, &args.figures);

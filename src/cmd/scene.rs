@@ -10,7 +10,7 @@ use anyhow::{Context, bail};
 use glassdb_mask::{MaskFormat, write_mask};
 use glassdb_scene::{
     Camera, CosEncoding, CosMode, GlassMapping, MirrorRequest, PlaneSource, PlaneTolerance,
-    PlanesFile, RasterOptions, build_mask_scene, load_obj, rasterize, to_mask_image,
+    PlanesFile, RasterOptions, SceneError, build_mask_scene, load_obj, rasterize, to_mask_image,
     write_virtual_scenes,
 };
 
@@ -154,7 +154,8 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
         eye,
         tolerance,
         out_dir: &args.out_dir,
-    })?;
+    })
+    .map_err(with_flag_hint)?;
     println!(
         "{} glass plane{} in {} ({} triangles; tolerance {}°, {:e} units)",
         report.planes.planes.len(),
@@ -188,6 +189,17 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
     }
     println!("wrote {}", report.planes_path.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// A scene error with the command-line flag that sets the rejected value, where there is one.
+fn with_flag_hint(e: SceneError) -> anyhow::Error {
+    let flag = match &e {
+        SceneError::SamplesOutOfRange { .. } => "--samples",
+        SceneError::MeshOutOfRange { .. } => "--mesh",
+        SceneError::NoGlassSelected => "--glass-material PATTERN or --plane a,b,c,d",
+        _ => return e.into(),
+    };
+    anyhow::Error::new(e).context(flag)
 }
 
 /// The mask format from `--format` or the output's extension.
@@ -245,7 +257,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         cos,
         samples: args.samples,
     };
-    glassdb_scene::raster::check_options(&options)?;
+    glassdb_scene::raster::check_options(&options).map_err(with_flag_hint)?;
     let mappings = args
         .glass
         .iter()

@@ -62,13 +62,8 @@ fn bench(c: &mut Criterion) {
     g.bench_function("composite (in place)", |b| {
         b.iter(|| {
             let [r, gg, bb] = &mut trans;
-            let input = KernelInput {
-                refl: &refl_planes,
-                plane_sides: &sides,
-                mask: &m,
-                lut: &lut,
-            };
-            compose_in_place([r, gg, bb], &input).unwrap()
+            let input = KernelInput::new([r, gg, bb], &refl_planes, &sides, &m, &lut).unwrap();
+            compose_in_place(input)
         })
     });
     // The same bytes the composite reads (trans, refl, mask id + cos) copied to a destination.

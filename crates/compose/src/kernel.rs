@@ -13,7 +13,9 @@
 //! The kernel works in place on the transmission pass (no output allocation), one sweep over
 //! the pixels for all planes, rayon over bands of rows.
 
-use glassdb_mask::{CosTheta, MaskImage};
+use std::ops::Range;
+
+use glassdb_mask::{CosCode, CosTheta, MaskImage};
 use glassdb_registry::Side;
 use rayon::prelude::*;
 
@@ -22,14 +24,110 @@ use crate::lut::{GlassLut, GlassSideLut, RtTriple};
 /// Rows per parallel task.
 const BAND_ROWS: usize = 16;
 
-/// What the kernel needs besides the transmission pass it overwrites.
+/// One reflection pass (R, G, B planes) and which face of the glass its plane shows (0: front,
+/// 1: back, the index into [`GlassLut`]'s sides).
+#[derive(Clone, Copy)]
+struct PlanePass<'a> {
+    refl: [&'a [f32]; 3],
+    side: usize,
+}
+
+/// Everything the kernel reads and the transmission pass it overwrites, checked once by
+/// [`KernelInput::new`]: every plane of every pass has one sample per mask pixel and every
+/// reflection pass has its side, so the kernel indexes plainly and cannot fail. Glass ids
+/// without a table and planes without a reflection pass are not errors: those pixels are
+/// left as the transmission pass and counted ([`KernelCounts::passthrough_pixels`]).
 pub struct KernelInput<'a> {
-    /// One reflection pass per plane (R, G, B planes), each `width * height` samples.
-    pub refl: &'a [[&'a [f32]; 3]],
-    /// Which face each plane shows (same length as `refl`).
-    pub plane_sides: &'a [Side],
-    pub mask: &'a MaskImage,
-    pub lut: &'a GlassLut,
+    trans: [&'a mut [f32]; 3],
+    planes: Vec<PlanePass<'a>>,
+    mask: &'a MaskImage,
+    lut: &'a GlassLut,
+}
+
+/// The kernel's inputs do not fit together (the caller checks files first; this guards the
+/// library API).
+#[derive(Debug, thiserror::Error)]
+pub enum KernelShapeError {
+    /// The mask's per-pixel vectors disagree with its size.
+    #[error("kernel input sizes disagree: the mask is inconsistent: {0}")]
+    Mask(String),
+    /// A plane of the transmission pass has the wrong number of samples.
+    #[error(
+        "kernel input sizes disagree: transmission pass channel {channel} has {samples} samples for {pixels} mask pixels"
+    )]
+    Transmission {
+        channel: usize,
+        samples: usize,
+        pixels: usize,
+    },
+    /// A plane of a reflection pass has the wrong number of samples.
+    #[error(
+        "kernel input sizes disagree: reflection pass {pass} channel {channel} has {samples} samples for {pixels} mask pixels"
+    )]
+    Reflection {
+        pass: usize,
+        channel: usize,
+        samples: usize,
+        pixels: usize,
+    },
+    /// The reflection passes and the sides of their planes are not one to one.
+    #[error("kernel input sizes disagree: {passes} reflection passes but {sides} plane sides")]
+    SidesPerPass { passes: usize, sides: usize },
+}
+
+impl<'a> KernelInput<'a> {
+    /// Checks the inputs against the mask: `trans` and every plane of `refl` hold one sample per
+    /// pixel, `plane_sides` one side per reflection pass (plane k shows `plane_sides[k]`).
+    pub fn new(
+        trans: [&'a mut [f32]; 3],
+        refl: &[[&'a [f32]; 3]],
+        plane_sides: &[Side],
+        mask: &'a MaskImage,
+        lut: &'a GlassLut,
+    ) -> Result<KernelInput<'a>, KernelShapeError> {
+        mask.check_consistent().map_err(KernelShapeError::Mask)?;
+        let pixels = mask.pixel_count();
+        if let Some((channel, p)) = trans.iter().enumerate().find(|(_, p)| p.len() != pixels) {
+            return Err(KernelShapeError::Transmission {
+                channel,
+                samples: p.len(),
+                pixels,
+            });
+        }
+        for (pass, planes) in refl.iter().enumerate() {
+            if let Some((channel, p)) = planes.iter().enumerate().find(|(_, p)| p.len() != pixels) {
+                return Err(KernelShapeError::Reflection {
+                    pass,
+                    channel,
+                    samples: p.len(),
+                    pixels,
+                });
+            }
+        }
+        if refl.len() != plane_sides.len() {
+            return Err(KernelShapeError::SidesPerPass {
+                passes: refl.len(),
+                sides: plane_sides.len(),
+            });
+        }
+        let planes = refl
+            .iter()
+            .zip(plane_sides)
+            .map(|(&refl, &side)| PlanePass {
+                refl,
+                side: match side {
+                    Side::Front => 0,
+                    Side::Back => 1,
+                },
+            })
+            .collect();
+        Ok(KernelInput {
+            trans,
+            planes,
+            mask,
+            lut,
+        })
+    }
 }
 
 /// Counts the kernel gathers in its sweep.
@@ -57,15 +155,11 @@ impl KernelCounts {
     }
 }
 
-/// The sizes do not agree (the caller checks files first; this guards the library API).
-#[derive(Debug, thiserror::Error)]
-#[error("kernel input sizes disagree: {0}")]
-pub struct KernelShapeError(pub String);
-
 /// cos θ source over one band of pixels, monomorphised per mask kind.
 trait CosLookup: Sync {
-    /// The same source restricted to pixels `start..start + len`.
-    fn band(&self, start: usize, len: usize) -> Self;
+    /// The same source restricted to the pixels `range`.
+    fn band(&self, range: Range<usize>) -> Self;
+    /// r and t at pixel `j` of the band.
     fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple;
 }
 
@@ -79,34 +173,34 @@ struct FloatCos<'a>(&'a [f32]);
 struct Normal;
 
 impl CosLookup for Code8<'_> {
-    fn band(&self, start: usize, len: usize) -> Self {
-        Code8(self.0.get(start..start + len).unwrap_or(&[]))
+    fn band(&self, range: Range<usize>) -> Self {
+        Code8(&self.0[range])
     }
     #[inline(always)]
     fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
-        lut.at_code8(self.0.get(j).copied().unwrap_or(255))
+        lut.at_code8(self.0[j])
     }
 }
 impl CosLookup for Code16<'_> {
-    fn band(&self, start: usize, len: usize) -> Self {
-        Code16(self.0.get(start..start + len).unwrap_or(&[]))
+    fn band(&self, range: Range<usize>) -> Self {
+        Code16(&self.0[range])
     }
     #[inline(always)]
     fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
-        lut.at_cos(f32::from(self.0.get(j).copied().unwrap_or(65535)) * (1.0 / 65535.0))
+        lut.at_cos(CosCode::Bits16.decode_f32(self.0[j]))
     }
 }
 impl CosLookup for FloatCos<'_> {
-    fn band(&self, start: usize, len: usize) -> Self {
-        FloatCos(self.0.get(start..start + len).unwrap_or(&[]))
+    fn band(&self, range: Range<usize>) -> Self {
+        FloatCos(&self.0[range])
     }
     #[inline(always)]
     fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
-        lut.at_cos(self.0.get(j).copied().unwrap_or(1.0))
+        lut.at_cos(self.0[j])
     }
 }
 impl CosLookup for Normal {
-    fn band(&self, _start: usize, _len: usize) -> Self {
+    fn band(&self, _range: Range<usize>) -> Self {
         Normal
     }
     #[inline(always)]
@@ -115,64 +209,167 @@ impl CosLookup for Normal {
     }
 }
 
-/// Composites in place: `trans` (R, G, B planes of the transmission pass) becomes the output.
-pub fn compose_in_place(
-    trans: [&mut [f32]; 3],
-    input: &KernelInput,
-) -> Result<KernelCounts, KernelShapeError> {
-    let mask = input.mask;
-    let n = mask.pixel_count();
-    let w = mask.width as usize;
-    mask.check_consistent().map_err(KernelShapeError)?;
-    if trans.iter().any(|p| p.len() != n) {
-        return Err(KernelShapeError(format!(
-            "transmission pass planes are not {n} samples"
-        )));
+/// Composites in place: the transmission pass of `input` becomes the output.
+pub fn compose_in_place(input: KernelInput) -> KernelCounts {
+    let KernelInput {
+        trans,
+        planes,
+        mask,
+        lut,
+    } = input;
+    if mask.pixel_count() == 0 {
+        return KernelCounts::default();
     }
-    if input.refl.iter().flatten().any(|p| p.len() != n) {
-        return Err(KernelShapeError(format!(
-            "reflection pass planes are not {n} samples"
-        )));
-    }
-    if input.refl.len() != input.plane_sides.len() {
-        return Err(KernelShapeError(
-            "one side per reflection pass is needed".into(),
-        ));
-    }
-    if n == 0 {
-        return Ok(KernelCounts::default());
-    }
+    let sweep = Sweep {
+        planes: &planes,
+        mask,
+        lut,
+    };
     match &mask.cos_theta {
-        CosTheta::Quantized8(c) => Ok(run(trans, input, &Code8(c), w)),
-        CosTheta::Quantized16(c) => Ok(run(trans, input, &Code16(c), w)),
-        CosTheta::Float(c) => Ok(run(trans, input, &FloatCos(c), w)),
-        CosTheta::Normal => Ok(run(trans, input, &Normal, w)),
+        CosTheta::Quantized8(c) => sweep.run(trans, &Code8(c)),
+        CosTheta::Quantized16(c) => sweep.run(trans, &Code16(c)),
+        CosTheta::Float(c) => sweep.run(trans, &FloatCos(c)),
+        CosTheta::Normal => sweep.run(trans, &Normal),
     }
 }
 
-fn run<C: CosLookup>(
-    trans: [&mut [f32]; 3],
-    input: &KernelInput,
-    cos: &C,
-    w: usize,
-) -> KernelCounts {
-    let band = w * BAND_ROWS;
-    let [tr, tg, tb] = trans;
-    let simple = input.refl.len() == 1 && input.mask.coverage.is_none();
-    tr.par_chunks_mut(band)
-        .zip(tg.par_chunks_mut(band))
-        .zip(tb.par_chunks_mut(band))
-        .enumerate()
-        .map(|(k, ((r, g), b))| {
-            let base = k * band;
-            let cos = cos.band(base, r.len());
-            if simple {
-                sweep_band_one_plane(base, [r, g, b], input, &cos)
-            } else {
-                sweep_band(base, [r, g, b], input, &cos)
+/// The read-only part of a checked [`KernelInput`], shared by the bands.
+struct Sweep<'a> {
+    planes: &'a [PlanePass<'a>],
+    mask: &'a MaskImage,
+    lut: &'a GlassLut,
+}
+
+impl Sweep<'_> {
+    /// One parallel sweep over bands of rows.
+    fn run<C: CosLookup>(&self, trans: [&mut [f32]; 3], cos: &C) -> KernelCounts {
+        let band = self.mask.width as usize * BAND_ROWS;
+        let [tr, tg, tb] = trans;
+        let simple = self.planes.len() == 1 && self.mask.coverage.is_none();
+        tr.par_chunks_mut(band)
+            .zip(tg.par_chunks_mut(band))
+            .zip(tb.par_chunks_mut(band))
+            .enumerate()
+            .map(|(k, ((r, g), b))| {
+                let pixels = k * band..k * band + r.len();
+                let cos = cos.band(pixels.clone());
+                if simple {
+                    self.band_one_plane(pixels, [r, g, b], &cos)
+                } else {
+                    self.band_any_planes(pixels, [r, g, b], &cos)
+                }
+            })
+            .reduce(KernelCounts::default, KernelCounts::add)
+    }
+
+    /// The common case: one plane, no coverage. Ids are spatially coherent, so the table of
+    /// the previous glass pixel is reused while the id stays the same.
+    fn band_one_plane<C: CosLookup>(
+        &self,
+        pixels: Range<usize>,
+        out: [&mut [f32]; 3],
+        cos: &C,
+    ) -> KernelCounts {
+        let mut counts = KernelCounts::default();
+        let pass = &self.planes[0];
+        let ids = &self.mask.id[pixels.clone()];
+        let rr = &pass.refl[0][pixels.clone()];
+        let rg = &pass.refl[1][pixels.clone()];
+        let rb = &pass.refl[2][pixels];
+        let [or, og, ob] = out;
+        let mut last_id = 0u16;
+        let mut last: Option<&GlassSideLut> = None;
+        for (j, ((((&id, r_out), g_out), b_out), ((&fr, &fg), &fb))) in ids
+            .iter()
+            .zip(or.iter_mut())
+            .zip(og.iter_mut())
+            .zip(ob.iter_mut())
+            .zip(rr.iter().zip(rg).zip(rb))
+            .enumerate()
+        {
+            let tr = [*r_out, *g_out, *b_out];
+            if id == 0 {
+                count_untouched(&mut counts, tr);
+                continue;
             }
-        })
-        .reduce(KernelCounts::default, KernelCounts::add)
+            if id != last_id {
+                last_id = id;
+                last = self.lut.sides(id).map(|s| &s[pass.side]);
+            }
+            let Some(lut) = last else {
+                counts.passthrough_pixels += 1;
+                continue;
+            };
+            let rt = cos.rt(lut, j);
+            let rf = [fr, fg, fb];
+            let o = [
+                weighted(tr[0], rt.t[0], rf[0], rt.r[0]),
+                weighted(tr[1], rt.t[1], rf[1], rt.r[1]),
+                weighted(tr[2], rt.t[2], rf[2], rt.r[2]),
+            ];
+            *r_out = o[0];
+            *g_out = o[1];
+            *b_out = o[2];
+            count_composited(&mut counts, o, tr, rf);
+        }
+        counts
+    }
+
+    /// Any number of planes, with or without coverage.
+    fn band_any_planes<C: CosLookup>(
+        &self,
+        pixels: Range<usize>,
+        out: [&mut [f32]; 3],
+        cos: &C,
+    ) -> KernelCounts {
+        let mask = self.mask;
+        let base = pixels.start;
+        let ids = &mask.id[pixels.clone()];
+        let planes = &mask.plane[pixels.clone()];
+        let coverage = mask.coverage.as_deref().map(|c| &c[pixels]);
+        let mut counts = KernelCounts::default();
+        let [or, og, ob] = out;
+        for (j, (((&id, &plane), r_out), (g_out, b_out))) in ids
+            .iter()
+            .zip(planes)
+            .zip(or.iter_mut())
+            .zip(og.iter_mut().zip(ob.iter_mut()))
+            .enumerate()
+        {
+            if id == 0 {
+                count_untouched(&mut counts, [*r_out, *g_out, *b_out]);
+                continue;
+            }
+            // An id without a table, or a plane without a reflection pass: left as is.
+            let (Some(sides), Some(pass)) =
+                (self.lut.sides(id), self.planes.get(usize::from(plane)))
+            else {
+                counts.passthrough_pixels += 1;
+                continue;
+            };
+            let mut rt = cos.rt(&sides[pass.side], j);
+            if let Some(coverage) = coverage {
+                let k = coverage[j];
+                for c in 0..3 {
+                    rt.t[c] = 1.0 - k + k * rt.t[c];
+                    rt.r[c] *= k;
+                }
+            }
+            let i = base + j;
+            let rf = [pass.refl[0][i], pass.refl[1][i], pass.refl[2][i]];
+            let tr_in = [*r_out, *g_out, *b_out];
+            let o = [
+                weighted(tr_in[0], rt.t[0], rf[0], rt.r[0]),
+                weighted(tr_in[1], rt.t[1], rf[1], rt.r[1]),
+                weighted(tr_in[2], rt.t[2], rf[2], rt.r[2]),
+            ];
+            *r_out = o[0];
+            *g_out = o[1];
+            *b_out = o[2];
+            count_composited(&mut counts, o, tr_in, rf);
+        }
+        counts
+    }
 }
 
 /// Counts the non-finite samples of a pixel the kernel leaves as the transmission pass.
@@ -199,73 +396,6 @@ fn count_composited(counts: &mut KernelCounts, o: [f32; 3], tr: [f32; 3], rf: [f
     }
 }
 
-/// The common case: one plane, no coverage. Ids are spatially coherent, so the table of the
-/// previous glass pixel is reused while the id stays the same.
-fn sweep_band_one_plane<C: CosLookup>(
-    base: usize,
-    out: [&mut [f32]; 3],
-    input: &KernelInput,
-    cos: &C,
-) -> KernelCounts {
-    let mut counts = KernelCounts::default();
-    let len = out[0].len();
-    let (Some(ids), Some(refl), Some(&side)) = (
-        input.mask.id.get(base..base + len),
-        input.refl.first(),
-        input.plane_sides.first(),
-    ) else {
-        return counts;
-    };
-    let (Some(rr), Some(rg), Some(rb)) = (
-        refl[0].get(base..base + len),
-        refl[1].get(base..base + len),
-        refl[2].get(base..base + len),
-    ) else {
-        return counts;
-    };
-    let side = match side {
-        Side::Front => 0,
-        Side::Back => 1,
-    };
-    let [or, og, ob] = out;
-    let mut last_id = 0u16;
-    let mut last: Option<&GlassSideLut> = None;
-    for (j, ((((&id, r_out), g_out), b_out), ((&fr, &fg), &fb))) in ids
-        .iter()
-        .zip(or.iter_mut())
-        .zip(og.iter_mut())
-        .zip(ob.iter_mut())
-        .zip(rr.iter().zip(rg).zip(rb))
-        .enumerate()
-    {
-        let tr = [*r_out, *g_out, *b_out];
-        if id == 0 {
-            count_untouched(&mut counts, tr);
-            continue;
-        }
-        if id != last_id {
-            last_id = id;
-            last = input.lut.sides(id).map(|s| &s[side]);
-        }
-        let Some(lut) = last else {
-            counts.passthrough_pixels += 1;
-            continue;
-        };
-        let rt = cos.rt(lut, j);
-        let rf = [fr, fg, fb];
-        let o = [
-            weighted(tr[0], rt.t[0], rf[0], rt.r[0]),
-            weighted(tr[1], rt.t[1], rf[1], rt.r[1]),
-            weighted(tr[2], rt.t[2], rf[2], rt.r[2]),
-        ];
-        *r_out = o[0];
-        *g_out = o[1];
-        *b_out = o[2];
-        count_composited(&mut counts, o, tr, rf);
-    }
-    counts
-}
-
 #[inline(always)]
 fn weighted(tr: f32, t: f32, rf: f32, r: f32) -> f32 {
     // A term whose weight is exactly 0 is dropped (branches predict well: r and t are per glass).
@@ -277,68 +407,4 @@ fn weighted(tr: f32, t: f32, rf: f32, r: f32) -> f32 {
     } else {
         a + rf * r
     }
-}
-
-fn sweep_band<C: CosLookup>(
-    base: usize,
-    out: [&mut [f32]; 3],
-    input: &KernelInput,
-    cos: &C,
-) -> KernelCounts {
-    let mask = input.mask;
-    let len = out[0].len();
-    let ids = mask.id.get(base..base + len).unwrap_or(&[]);
-    let planes = mask.plane.get(base..base + len).unwrap_or(&[]);
-    let coverage = mask.coverage.as_ref().and_then(|c| c.get(base..base + len));
-    let mut counts = KernelCounts::default();
-    let [or, og, ob] = out;
-    for (j, (((&id, &plane), r_out), (g_out, b_out))) in ids
-        .iter()
-        .zip(planes)
-        .zip(or.iter_mut())
-        .zip(og.iter_mut().zip(ob.iter_mut()))
-        .enumerate()
-    {
-        if id == 0 {
-            count_untouched(&mut counts, [*r_out, *g_out, *b_out]);
-            continue;
-        }
-        let i = base + j;
-        let p = plane as usize;
-        let (Some(sides), Some(refl), Some(&side)) = (
-            input.lut.sides(id),
-            input.refl.get(p),
-            input.plane_sides.get(p),
-        ) else {
-            counts.passthrough_pixels += 1;
-            continue;
-        };
-        let lut = match side {
-            Side::Front => &sides[0],
-            Side::Back => &sides[1],
-        };
-        let mut rt = cos.rt(lut, j);
-        if let Some(k) = coverage.and_then(|c| c.get(j)).copied() {
-            for c in 0..3 {
-                rt.t[c] = 1.0 - k + k * rt.t[c];
-                rt.r[c] *= k;
-            }
-        }
-        let rf = [
-            refl[0].get(i).copied().unwrap_or(0.0),
-            refl[1].get(i).copied().unwrap_or(0.0),
-            refl[2].get(i).copied().unwrap_or(0.0),
-        ];
-        let tr_in = [*r_out, *g_out, *b_out];
-        let o = [
-            weighted(tr_in[0], rt.t[0], rf[0], rt.r[0]),
-            weighted(tr_in[1], rt.t[1], rf[1], rt.r[1]),
-            weighted(tr_in[2], rt.t[2], rf[2], rt.r[2]),
-        ];
-        *r_out = o[0];
-        *g_out = o[1];
-        *b_out = o[2];
-        count_composited(&mut counts, o, tr_in, rf);
-    }
-    counts
 }

@@ -306,14 +306,9 @@ pub fn compose_frame(
             [r.as_slice(), g.as_slice(), b.as_slice()]
         })
         .collect();
-    let input = KernelInput {
-        refl: &refl_planes,
-        plane_sides: &plane_sides,
-        mask: &mask,
-        lut,
-    };
     let [r, g, b] = &mut trans.image.rgb;
-    let counts = kernel::compose_in_place([r, g, b], &input)?;
+    let input = KernelInput::new([r, g, b], &refl_planes, &plane_sides, &mask, lut)?;
+    let counts = kernel::compose_in_place(input);
     let cos_range = mask.cos_theta_range();
     let (width, height) = (trans.image.width, trans.image.height);
     drop(refl_planes);

@@ -2,12 +2,14 @@
 //! per side, r and t for the three channels (method.md eqs. 11–14, `r = r0·C_r(θ)`,
 //! `t = t0·C_t(θ)`, clamped to the physical range as the registry does) at
 //!
-//! - the 256 cos θ codes of an 8-bit mask (cos θ = i/255): exact, the registry's own values;
+//! - the 256 cos θ codes of an 8-bit mask ([`CosCode::Bits8`], cos θ = i/255): exact, the
+//!   registry's own values;
 //! - a fine table of [`FINE_STEPS`] + 1 points for 16-bit and float masks, linearly
 //!   interpolated; its largest error (measured when it is built, at every interval midpoint)
 //!   is [`GlassLut::fine_table_error`];
 //! - normal incidence from `r0`, `t0` (`r0_back` for the back side) for binary masks.
 
+use glassdb_mask::CosCode;
 use glassdb_registry::{Registry, Side};
 
 /// Intervals of the fine table over cos θ ∈ [0, 1].
@@ -35,10 +37,10 @@ impl RtTriple {
 /// One glass seen from one side.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GlassSideLut {
-    /// At cos θ = i/255.
-    pub q8: Vec<RtTriple>,
+    /// At the cos θ of each 8-bit code, `CosCode::decode8(i)`.
+    pub q8: Box<[RtTriple; 256]>,
     /// At cos θ = i/FINE_STEPS, i = 0…FINE_STEPS.
-    pub fine: Vec<RtTriple>,
+    pub fine: Box<[RtTriple; FINE_STEPS + 1]>,
     /// At normal incidence (r0, t0).
     pub normal: RtTriple,
 }
@@ -55,16 +57,13 @@ impl GlassSideLut {
         } * FINE_STEPS as f32;
         let i = (x as usize).min(FINE_STEPS - 1);
         let f = x - i as f32;
-        match (self.fine.get(i), self.fine.get(i + 1)) {
-            (Some(a), Some(b)) => RtTriple::lerp(a, b, f),
-            _ => self.normal,
-        }
+        RtTriple::lerp(&self.fine[i], &self.fine[i + 1], f)
     }
 
     /// At an 8-bit cos θ code: an exact table entry.
     #[inline]
     pub fn at_code8(&self, code: u8) -> RtTriple {
-        self.q8.get(code as usize).copied().unwrap_or(self.normal)
+        self.q8[usize::from(code)]
     }
 }
 
@@ -109,12 +108,12 @@ impl GlassLut {
                 continue;
             }
             let make = |side: Side| -> (GlassSideLut, f64) {
-                let q8 = (0..256)
-                    .map(|i| to_triple(eval(id, side, i as f64 / 255.0)))
-                    .collect();
-                let fine: Vec<RtTriple> = (0..=FINE_STEPS)
-                    .map(|i| to_triple(eval(id, side, i as f64 / FINE_STEPS as f64)))
-                    .collect();
+                let q8 = Box::new(std::array::from_fn(|code| {
+                    to_triple(eval(id, side, CosCode::decode8(code as u8)))
+                }));
+                let fine = Box::new(std::array::from_fn(|i| {
+                    to_triple(eval(id, side, i as f64 / FINE_STEPS as f64))
+                }));
                 let lut = GlassSideLut {
                     q8,
                     fine,
@@ -146,11 +145,10 @@ impl GlassLut {
         }
     }
 
-    /// Builds the tables for every glass of the registry (its `tables_256`, `eval` and normal
-    /// values).
+    /// Builds the tables for every glass of the registry (its `eval` and normal values).
     pub fn from_registry(registry: &Registry) -> GlassLut {
         let ids: Vec<u16> = registry.glasses.iter().map(|g| g.id).collect();
-        let mut lut = GlassLut::from_fn(
+        GlassLut::from_fn(
             &ids,
             |id, side, cos| {
                 registry
@@ -166,27 +164,7 @@ impl GlassLut {
                     (r, g.t0)
                 })
             },
-        );
-        // The 8-bit entries are the registry's own 256-entry tables, bit for bit.
-        for g in &registry.glasses {
-            let Some(&slot) = lut.index.get(g.id as usize) else {
-                continue;
-            };
-            let Some(sides) = lut.slots.get_mut(slot as usize) else {
-                continue;
-            };
-            for side in [Side::Front, Side::Back] {
-                let tables = g.tables_256(side);
-                let q8 = &mut sides[side_index(side)].q8;
-                for (i, e) in q8.iter_mut().enumerate() {
-                    for (c, table) in tables.iter().enumerate() {
-                        e.r[c] = table.r[i];
-                        e.t[c] = table.t[i];
-                    }
-                }
-            }
-        }
-        lut
+        )
     }
 
     /// Whether `id` has an entry.
@@ -233,5 +211,24 @@ mod tests {
         assert_eq!(s.at_code8(0).r[0], 1.0);
         assert!((s.at_cos(0.5).t[1] - 0.45).abs() < 1e-6);
         assert!(lut.contains(3) && !lut.contains(4) && !lut.contains(0));
+    }
+
+    #[test]
+    fn code8_entries_are_the_registry_at_the_codes_cos_theta() {
+        // The 8-bit entries equal the registry's eval at the code's cos θ, in f32, bit for bit.
+        let reg = glassdb_registry::default_registry().unwrap();
+        let lut = GlassLut::from_registry(&reg);
+        let g = &reg.glasses[0];
+        for side in [Side::Front, Side::Back] {
+            let s = lut.side(g.id, side).unwrap();
+            for code in [0u8, 1, 77, 128, 254, 255] {
+                let (r, t) = g.eval(side, CosCode::decode8(code));
+                let e = s.at_code8(code);
+                for c in 0..3 {
+                    assert_eq!(e.r[c], r[c] as f32);
+                    assert_eq!(e.t[c], t[c] as f32);
+                }
+            }
+        }
     }
 }

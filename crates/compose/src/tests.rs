@@ -6,7 +6,7 @@ use glassdb_mask::{CosTheta, MaskImage};
 use proptest::prelude::*;
 
 use super::*;
-use crate::kernel::compose_in_place;
+use crate::kernel::{KernelShapeError, compose_in_place};
 use crate::lut::GlassLut;
 
 /// Glass 1: r = (0.1, 0.2, 0.3), t = (0.5, 0.6, 0.7) at every angle, back r = (0.4, 0.4, 0.4).
@@ -62,16 +62,8 @@ fn run(
         .collect();
     let mut out = trans;
     let [a, b, c] = &mut out;
-    let counts = compose_in_place(
-        [a, b, c],
-        &KernelInput {
-            refl: &refl_planes,
-            plane_sides: sides,
-            mask: m,
-            lut: &lut,
-        },
-    )
-    .unwrap();
+    let counts =
+        compose_in_place(KernelInput::new([a, b, c], &refl_planes, sides, m, &lut).unwrap());
     (out, counts)
 }
 
@@ -158,6 +150,55 @@ fn unknown_ids_pass_through_when_allowed() {
     let (out, counts) = run(grey(1.5), &[grey(7.0)], &m, &[Side::Front]);
     assert_eq!(out[0][0], 1.5);
     assert_eq!(counts.passthrough_pixels, 1);
+}
+
+#[test]
+fn kernel_input_of_the_wrong_shape_is_refused_once() {
+    let lut = test_lut();
+    let m = mask(vec![1, 0], CosTheta::Normal, vec![0, 0], None);
+    let two = [1.0f32; 2];
+    let three = [1.0f32; 3];
+    let good = [[two.as_slice(), two.as_slice(), two.as_slice()]];
+    let (mut a, mut b, mut c) = (vec![1.0f32; 2], vec![1.0f32; 2], vec![1.0f32; 3]);
+    let e = KernelInput::new([&mut a, &mut b, &mut c], &good, &[Side::Front], &m, &lut);
+    assert!(matches!(
+        e,
+        Err(KernelShapeError::Transmission {
+            channel: 2,
+            samples: 3,
+            pixels: 2
+        })
+    ));
+    let bad = [[two.as_slice(), three.as_slice(), two.as_slice()]];
+    let mut c = vec![1.0f32; 2];
+    let e = KernelInput::new([&mut a, &mut b, &mut c], &bad, &[Side::Front], &m, &lut);
+    assert!(matches!(
+        e,
+        Err(KernelShapeError::Reflection {
+            pass: 0,
+            channel: 1,
+            ..
+        })
+    ));
+    let e = KernelInput::new([&mut a, &mut b, &mut c], &good, &[], &m, &lut);
+    assert!(matches!(
+        e,
+        Err(KernelShapeError::SidesPerPass {
+            passes: 1,
+            sides: 0
+        })
+    ));
+    let inconsistent = mask(vec![1, 0], CosTheta::Quantized8(vec![3]), vec![0, 0], None);
+    let e = KernelInput::new(
+        [&mut a, &mut b, &mut c],
+        &good,
+        &[Side::Front],
+        &inconsistent,
+        &lut,
+    );
+    assert!(matches!(e, Err(KernelShapeError::Mask(_))));
+    let ok = KernelInput::new([&mut a, &mut b, &mut c], &good, &[Side::Front], &m, &lut);
+    assert_eq!(compose_in_place(ok.unwrap()).passthrough_pixels, 0);
 }
 
 #[test]

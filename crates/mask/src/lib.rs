@@ -12,12 +12,14 @@
 //! Id 0 means "no glass" everywhere. Decoding and encoding the files is glassdb-image's job;
 //! this crate maps the formats' layouts to and from [`MaskImage`].
 
+mod cos_code;
 mod error;
 mod read;
 mod write;
 
 use std::collections::BTreeMap;
 
+pub use cos_code::CosCode;
 pub use error::MaskError;
 pub use glassdb_image::DEFAULT_MAX_PIXELS;
 pub use read::{read_mask, read_mask_bytes};
@@ -39,8 +41,8 @@ pub struct MaskImage {
     pub coverage: Option<Vec<f32>>,
 }
 
-/// cos θ as the mask stores it: quantised codes are kept as codes so that lookups into
-/// 256-entry tables stay exact.
+/// cos θ as the mask stores it: quantised codes ([`CosCode`]) are kept as codes so that
+/// lookups into 256-entry tables stay exact.
 #[derive(Debug, Clone, PartialEq)]
 pub enum CosTheta {
     /// 8-bit: cos θ = code / 255 (the paper's packed mask).
@@ -79,8 +81,8 @@ impl MaskImage {
     /// or 1 for a binary mask. Returns NaN for an index outside the image.
     pub fn cos_theta_at(&self, index: usize) -> f64 {
         let v = match &self.cos_theta {
-            CosTheta::Quantized8(c) => c.get(index).map(|&c| f64::from(c) / 255.0),
-            CosTheta::Quantized16(c) => c.get(index).map(|&c| f64::from(c) / 65535.0),
+            CosTheta::Quantized8(c) => c.get(index).map(|&c| CosCode::decode8(c)),
+            CosTheta::Quantized16(c) => c.get(index).map(|&c| CosCode::Bits16.decode(c)),
             CosTheta::Float(c) => c.get(index).map(|&c| f64::from(c)),
             CosTheta::Normal => (index < self.pixel_count()).then_some(1.0),
         };

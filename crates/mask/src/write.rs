@@ -4,7 +4,7 @@ use std::path::Path;
 
 use glassdb_image::{ImageError, PngColor, PngCompression, PngEncodeOptions, PngSampleSlice};
 
-use crate::{CosTheta, MaskError, MaskImage};
+use crate::{CosCode, CosTheta, MaskError, MaskImage};
 
 /// The file formats a mask can be written in (see the crate docs and `docs/mask.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -66,11 +66,12 @@ pub fn write_mask_bytes(
                             .into(),
                 });
             }
-            let (limit, scale) = if format == MaskFormat::Png8 {
-                (255u16, 255.0)
+            let code_width = if format == MaskFormat::Png8 {
+                CosCode::Bits8
             } else {
-                (65535u16, 65535.0)
+                CosCode::Bits16
             };
+            let limit = code_width.max_code();
             let mut samples: Vec<u16> = Vec::with_capacity(mask.pixel_count() * 3);
             for i in 0..mask.pixel_count() {
                 let id = mask.id[i];
@@ -89,7 +90,7 @@ pub fn write_mask_bytes(
                 }
                 let code = match (&mask.cos_theta, format) {
                     (CosTheta::Quantized8(c), MaskFormat::Png8) => u16::from(c[i]),
-                    (CosTheta::Quantized8(c), _) => u16::from(c[i]) * 257,
+                    (CosTheta::Quantized8(c), _) => CosCode::Bits8.to_bits16(u16::from(c[i])),
                     (CosTheta::Quantized16(c), MaskFormat::Png16) => c[i],
                     (CosTheta::Normal, _) => limit,
                     _ => {
@@ -97,7 +98,7 @@ pub fn write_mask_bytes(
                         if !c.is_finite() {
                             return Err(not_representable(i, format!("cos θ {c} is not a number")));
                         }
-                        (c.clamp(0.0, 1.0) * scale).round() as u16
+                        code_width.encode(c)
                     }
                 };
                 samples.extend_from_slice(&[plane, id, code]);

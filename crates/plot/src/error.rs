@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-/// Failures of plotting and of the accuracy report.
+/// Failures of plotting.
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
     /// The output name has no extension we can write (`.png` or `.svg`).
@@ -57,9 +57,6 @@ pub enum PlotError {
     /// An error from the registry crate.
     #[error(transparent)]
     Registry(#[from] glassdb_registry::RegistryError),
-    /// An error from the scene crate (OBJ loading, rasterising a mask).
-    #[error(transparent)]
-    Scene(#[from] glassdb_scene::SceneError),
     /// An error from the mask crate.
     #[error(transparent)]
     Mask(#[from] glassdb_mask::MaskError),

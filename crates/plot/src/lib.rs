@@ -1,7 +1,7 @@
 //! Figures for glassdb users, who review fit quality by looking rather than by reading
 //! coefficients: fitted angle curves with residuals, spectra with the colour-matching functions
-//! beneath, a registry's curves per channel, a mask's reflectance as a heat map; and the
-//! speed-against-error report (`docs/accuracy.md`).
+//! beneath, a registry's curves per channel, a mask's reflectance as a heat map. The
+//! speed-against-error report (`docs/accuracy.md`) draws its figures with them (glassdb-report).
 //!
 //! Everything renders with plotters and the embedded DejaVu Sans font (no system font
 //! library); PNG or SVG by the output extension; files are written atomically.
@@ -18,7 +18,6 @@ pub mod render;
 pub use error::PlotError;
 pub use render::{Figure, ImageFormat, save};
 pub mod plots;
-pub mod report;
 
 #[cfg(test)]
 mod tests;

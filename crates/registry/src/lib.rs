@@ -5,7 +5,7 @@
 //! JSON file (`docs/registry.md`).
 //!
 //! - [`Registry`]: the JSON schema, loading with validation, and atomic writing.
-//! - [`GlassRecord::tables_256`] / [`GlassRecord::eval`]: what the compositor looks up.
+//! - [`GlassRecord::eval`]: what the compositor tabulates.
 //! - [`build_registry`] / [`default_registry`]: catalog → registry.
 
 mod build;
@@ -18,6 +18,6 @@ mod record;
 pub use build::{Application, BuildOptions, build_registry, curve_record, default_registry};
 pub use error::RegistryError;
 pub use record::{
-    AngleModelRecord, CHANNELS, ChannelTables, CurveRecord, FileRef, GlassRecord, LuminousRecord,
-    ProductRecord, Provenance, Registry, SCHEMA_VERSION, Side, SpectralMethodRecord,
+    AngleModelRecord, CHANNELS, CurveRecord, FileRef, GlassRecord, LuminousRecord, ProductRecord,
+    Provenance, Registry, SCHEMA_VERSION, Side, SpectralMethodRecord,
 };

@@ -198,13 +198,6 @@ impl Side {
     }
 }
 
-/// r and t of one channel at cos θ = i/255, i = 0…255, clamped to the physical range.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ChannelTables {
-    pub r: [f32; 256],
-    pub t: [f32; 256],
-}
-
 impl CurveRecord {
     /// `C(cos θ)`, unclamped.
     #[inline]
@@ -285,22 +278,6 @@ impl GlassRecord {
             (out_r[c], out_t[c]) = clamp_physical(r[c], t[c]);
         }
         (out_r, out_t)
-    }
-
-    /// Per channel, r and t at cos θ = i/255 for i = 0…255: exact lookups for 8-bit masks.
-    pub fn tables_256(&self, side: Side) -> [ChannelTables; 3] {
-        let mut tables: [ChannelTables; 3] = std::array::from_fn(|_| ChannelTables {
-            r: [0.0; 256],
-            t: [0.0; 256],
-        });
-        for i in 0..256usize {
-            let (r, t) = self.eval(side, i as f64 / 255.0);
-            for c in 0..3 {
-                tables[c].r[i] = r[c] as f32;
-                tables[c].t[i] = t[c] as f32;
-            }
-        }
-        tables
     }
 }
 
@@ -592,17 +569,6 @@ mod tests {
         // Back: r0_back = 0.05 → 0.1625.
         let (rb, _) = g.eval(Side::Back, 0.5);
         assert!((rb[0] - 0.1625).abs() < 1e-15);
-        // Tables at i/255 equal eval at the same cos θ, in f32.
-        for side in [Side::Front, Side::Back] {
-            let tables = g.tables_256(side);
-            for i in [0usize, 1, 77, 128, 254, 255] {
-                let (r, t) = g.eval(side, i as f64 / 255.0);
-                for c in 0..3 {
-                    assert_eq!(tables[c].r[i], r[c] as f32);
-                    assert_eq!(tables[c].t[i], t[c] as f32);
-                }
-            }
-        }
         // Grazing: r = 1, t = 0 exactly; out-of-range cos θ is clamped.
         assert_eq!(g.eval(Side::Front, 0.0), ([1.0; 3], [0.0; 3]));
         assert_eq!(g.eval(Side::Front, -0.3), g.eval(Side::Front, 0.0));

@@ -64,9 +64,24 @@ pub enum SceneError {
     /// A `planes.json` is malformed, or a glass face lies on none of its planes.
     #[error("planes file {path}: {message}")]
     BadPlanes { path: PathBuf, message: String },
-    /// An option value is out of range (tolerances, mesh size, sample count).
+    /// An option value is out of range (tolerances, plane count).
     #[error("{message}")]
     BadOption { message: String },
+    /// The K of K×K coverage samples per pixel is 0 or above the limit.
+    #[error("{samples} samples per pixel side must be between 1 and {max}")]
+    SamplesOutOfRange { samples: u32, max: u32 },
+    /// The N of the Gouraud N×N mesh is 0 or above the limit.
+    #[error("a Gouraud mesh of {mesh}×{mesh} cells must have between 1 and {max} per side")]
+    MeshOutOfRange { mesh: u32, max: u32 },
+    /// Neither glass materials nor an explicit plane say where the mirrors are.
+    #[error("give the glass materials or one plane to mirror across")]
+    NoGlassSelected,
+    /// `planes.json` could not be encoded (a non-finite number in a plane).
+    #[error("cannot encode {path}")]
+    EncodePlanes {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
     /// The output directory could not be created.
     #[error("cannot create the output directory {path}")]
     CreateDir {

@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use glassdb_mask::{CosTheta, MaskImage};
+use glassdb_mask::{CosCode, CosTheta, MaskImage};
 
 use crate::error::SceneError;
 use crate::math;
@@ -267,9 +267,9 @@ pub fn build_mask_scene(
 /// How cos θ is stored in the mask.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CosEncoding {
-    /// code = round(cos θ · 255).
+    /// 8-bit codes of [`CosCode::Bits8`]: code = round(cos θ · 255).
     Quantized8,
-    /// code = round(cos θ · 65535).
+    /// 16-bit codes of [`CosCode::Bits16`]: code = round(cos θ · 65535).
     Quantized16,
     /// cos θ as f32.
     Float,
@@ -281,13 +281,13 @@ pub fn to_mask_image(out: RasterOutput, enc: CosEncoding) -> MaskImage {
         CosEncoding::Quantized8 => CosTheta::Quantized8(
             out.cos_theta
                 .iter()
-                .map(|&c| (c as f64 * 255.0).round().clamp(0.0, 255.0) as u8)
+                .map(|&c| CosCode::encode8(f64::from(c)))
                 .collect(),
         ),
         CosEncoding::Quantized16 => CosTheta::Quantized16(
             out.cos_theta
                 .iter()
-                .map(|&c| (c as f64 * 65535.0).round().clamp(0.0, 65535.0) as u16)
+                .map(|&c| CosCode::Bits16.encode(f64::from(c)))
                 .collect(),
         ),
         CosEncoding::Float => CosTheta::Float(out.cos_theta),

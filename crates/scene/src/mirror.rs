@@ -164,21 +164,21 @@ fn crossing(plane: &Plane, a: &Corner, b: &Corner) -> Corner {
     }
 }
 
-/// Mirrors `scene` across `plane`, keeping the half-space where `plane.signed_distance ≥ 0`
-/// (orient the plane so that the eye is on its positive side). Vertices within `eps` of the
-/// plane count as on it. `drop(mesh, triangle)` removes triangles (the glass itself).
-pub fn mirror_scene(
-    scene: &Scene,
-    plane: &Plane,
-    eps: f64,
-    drop: impl Fn(usize, usize) -> bool,
-) -> (Vec<Mesh>, MirrorStats) {
-    let mut stats = MirrorStats::default();
-    let mut meshes = Vec::with_capacity(scene.meshes.len());
-    for (mi, src) in scene.meshes.iter().enumerate() {
+/// Where a triangle lies against the plane, and so what was emitted for it.
+enum TriangleFate {
+    /// Entirely in the kept half-space (or in the plane): emitted whole.
+    Kept,
+    /// Crossing the plane: its part in the kept half-space emitted (one or two triangles).
+    Clipped,
+    /// Entirely behind the plane: nothing emitted.
+    Behind,
+}
+
+impl<'a> Builder<'a> {
+    fn new(src: &'a Mesh) -> Builder<'a> {
         let has_t = !src.tex_triangles.is_empty();
         let has_n = !src.normal_triangles.is_empty();
-        let mut b = Builder {
+        Builder {
             src,
             out: Mesh {
                 group: src.group.clone(),
@@ -191,71 +191,114 @@ pub fn mirror_scene(
             has_t,
             has_n,
             crossings: HashMap::new(),
-        };
-        for (t, tri) in src.triangles.iter().enumerate() {
+        }
+    }
+
+    /// The corners of triangle `t` with their signed distances to `plane` (0 within `eps`).
+    fn corners(&self, t: usize, plane: &Plane, eps: f64) -> [Corner; 3] {
+        let src = self.src;
+        let tri = src.triangles[t];
+        std::array::from_fn(|k| {
+            let p = src.positions[tri[k] as usize];
+            let s = plane.signed_distance(p);
+            let ti = if self.has_t {
+                src.tex_triangles[t][k]
+            } else {
+                0
+            };
+            let ni = if self.has_n {
+                src.normal_triangles[t][k]
+            } else {
+                0
+            };
+            Corner {
+                s: if s.abs() <= eps { 0.0 } else { s },
+                pos: p,
+                tex: self.has_t.then(|| src.texcoords[ti as usize]),
+                nrm: self.has_n.then(|| src.normals[ni as usize]),
+                orig: Some((tri[k], ti, ni)),
+                edge: None,
+            }
+        })
+    }
+
+    /// Emits the part of the triangle in the kept half-space (`s ≥ 0`).
+    fn keep_front(&mut self, plane: &Plane, corners: &[Corner; 3]) -> TriangleFate {
+        let any_front = corners.iter().any(|c| c.s > 0.0);
+        let any_back = corners.iter().any(|c| c.s < 0.0);
+        if !any_back {
+            self.emit(&corners[0], &corners[1], &corners[2]);
+            return TriangleFate::Kept;
+        }
+        if !any_front {
+            return TriangleFate::Behind;
+        }
+        // Sutherland–Hodgman against one plane: a triangle gives a triangle or a quad.
+        let mut poly: Vec<Corner> = Vec::with_capacity(4);
+        for k in 0..3 {
+            let cur = &corners[k];
+            let next = &corners[(k + 1) % 3];
+            if cur.s >= 0.0 {
+                poly.push(*cur);
+            }
+            if (cur.s > 0.0 && next.s < 0.0) || (cur.s < 0.0 && next.s > 0.0) {
+                poly.push(crossing(plane, cur, next));
+            }
+        }
+        for k in 1..poly.len().saturating_sub(1) {
+            self.emit(&poly[0], &poly[k], &poly[k + 1]);
+        }
+        TriangleFate::Clipped
+    }
+}
+
+/// Reflects a mesh across `plane`, then reverses the winding: a reflection flips handedness,
+/// so reversing the corner order keeps each face's winding normal equal to its mirrored
+/// outward normal.
+fn reflect_mesh(out: &mut Mesh, plane: &Plane) {
+    for p in &mut out.positions {
+        *p = plane.reflect_point(*p);
+    }
+    for n in &mut out.normals {
+        *n = plane.reflect_direction(*n);
+    }
+    for tri in out
+        .triangles
+        .iter_mut()
+        .chain(out.tex_triangles.iter_mut())
+        .chain(out.normal_triangles.iter_mut())
+    {
+        tri.swap(1, 2);
+    }
+}
+
+/// Mirrors `scene` across `plane`, keeping the half-space where `plane.signed_distance ≥ 0`
+/// (orient the plane so that the eye is on its positive side). Vertices within `eps` of the
+/// plane count as on it. `drop(mesh, triangle)` removes triangles (the glass itself).
+pub fn mirror_scene(
+    scene: &Scene,
+    plane: &Plane,
+    eps: f64,
+    drop: impl Fn(usize, usize) -> bool,
+) -> (Vec<Mesh>, MirrorStats) {
+    let mut stats = MirrorStats::default();
+    let mut meshes = Vec::with_capacity(scene.meshes.len());
+    for (mi, src) in scene.meshes.iter().enumerate() {
+        let mut b = Builder::new(src);
+        for t in 0..src.triangles.len() {
             if drop(mi, t) {
                 stats.dropped += 1;
                 continue;
             }
-            let corners: [Corner; 3] = std::array::from_fn(|k| {
-                let p = src.positions[tri[k] as usize];
-                let s = plane.signed_distance(p);
-                let ti = if has_t { src.tex_triangles[t][k] } else { 0 };
-                let ni = if has_n { src.normal_triangles[t][k] } else { 0 };
-                Corner {
-                    s: if s.abs() <= eps { 0.0 } else { s },
-                    pos: p,
-                    tex: has_t.then(|| src.texcoords[ti as usize]),
-                    nrm: has_n.then(|| src.normals[ni as usize]),
-                    orig: Some((tri[k], ti, ni)),
-                    edge: None,
-                }
-            });
-            let any_front = corners.iter().any(|c| c.s > 0.0);
-            let any_back = corners.iter().any(|c| c.s < 0.0);
-            if !any_back {
-                stats.kept += 1;
-                b.emit(&corners[0], &corners[1], &corners[2]);
-                continue;
-            }
-            if !any_front {
-                stats.behind += 1;
-                continue;
-            }
-            // Sutherland–Hodgman against one plane: a triangle gives a triangle or a quad.
-            stats.clipped += 1;
-            let mut poly: Vec<Corner> = Vec::with_capacity(4);
-            for k in 0..3 {
-                let cur = &corners[k];
-                let next = &corners[(k + 1) % 3];
-                if cur.s >= 0.0 {
-                    poly.push(*cur);
-                }
-                if (cur.s > 0.0 && next.s < 0.0) || (cur.s < 0.0 && next.s > 0.0) {
-                    poly.push(crossing(plane, cur, next));
-                }
-            }
-            for k in 1..poly.len().saturating_sub(1) {
-                b.emit(&poly[0], &poly[k], &poly[k + 1]);
+            let corners = b.corners(t, plane, eps);
+            match b.keep_front(plane, &corners) {
+                TriangleFate::Kept => stats.kept += 1,
+                TriangleFate::Clipped => stats.clipped += 1,
+                TriangleFate::Behind => stats.behind += 1,
             }
         }
         let mut out = b.out;
-        // Reflect, then reverse the winding: a reflection flips handedness, so reversing the
-        // corner order keeps each face's winding normal equal to its mirrored outward normal.
-        for p in &mut out.positions {
-            *p = plane.reflect_point(*p);
-        }
-        for n in &mut out.normals {
-            *n = plane.reflect_direction(*n);
-        }
-        for tri in out
-            .triangles
-            .iter_mut()
-            .chain(out.tex_triangles.iter_mut())
-            .chain(out.normal_triangles.iter_mut())
-        {
-            tri.swap(1, 2);
-        }
+        reflect_mesh(&mut out, plane);
         stats.written += out.triangles.len();
         if !out.triangles.is_empty() {
             meshes.push(out);

@@ -6,7 +6,7 @@ use std::path::{Component, Path, PathBuf};
 use crate::error::SceneError;
 use crate::math::Vec3;
 use crate::mirror::{MirrorStats, mirror_scene};
-use crate::obj::{Scene, write_obj};
+use crate::obj::{Mesh, Scene, write_obj};
 use crate::planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_planes};
 use crate::planes_file::{PLANES_FORMAT, PlaneEntry, PlanesFile, ToleranceJson};
 
@@ -73,124 +73,29 @@ pub fn write_virtual_scenes(req: &MirrorRequest) -> Result<MirrorReport, SceneEr
         m.and_then(|i| glass_table.get(i).copied().flatten())
             .is_some()
     };
-    let patterns = MaterialMatcher::new(&req.glass_patterns)?.describe();
-
-    let planes: Vec<GlassPlane> = match req.explicit_plane {
-        Some(eq) => {
-            let plane = Plane::from_equation(eq)?;
-            let (mut area, mut triangles, mut materials) = (0.0, 0usize, Vec::<String>::new());
-            for mesh in &scene.meshes {
-                if !is_glass(mesh.material) {
-                    continue;
-                }
-                for t in 0..mesh.triangles.len() {
-                    let c = mesh.corners(t);
-                    if c.iter()
-                        .all(|&p| plane.signed_distance(p).abs() <= req.tolerance.distance)
-                    {
-                        let a2 = crate::math::triangle_normal_area2(c[0], c[1], c[2]);
-                        area += 0.5 * crate::math::norm(a2);
-                        triangles += 1;
-                        let name = scene.material_name(mesh).to_string();
-                        if !materials.contains(&name) {
-                            materials.push(name);
-                        }
-                    }
-                }
-            }
-            vec![GlassPlane {
-                index: 0,
-                plane,
-                area,
-                materials,
-                triangles,
-            }]
-        }
-        None => {
-            if req.glass_patterns.is_empty() {
-                return Err(SceneError::BadOption {
-                    message: "give the glass materials (--glass-material PATTERN) or one plane (--plane a,b,c,d)".into(),
-                });
-            }
-            detect_planes(scene, is_glass, req.tolerance, &patterns)?.0
-        }
-    };
-    if planes.len() > u16::MAX as usize {
-        return Err(SceneError::BadOption {
-            message: format!("{} glass planes: at most 65535 fit a mask", planes.len()),
-        });
-    }
-
+    let planes = glass_planes(req, is_glass)?;
     std::fs::create_dir_all(req.out_dir).map_err(|source| SceneError::CreateDir {
         path: req.out_dir.to_path_buf(),
         source,
     })?;
-    let src_dir = scene
-        .source
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
-    let src_dir = if src_dir.as_os_str().is_empty() {
-        PathBuf::from(".")
-    } else {
-        src_dir
-    };
-    let mtllibs: Vec<String> = scene
-        .mtllibs
-        .iter()
-        .map(|lib| relative_to(&src_dir.join(lib), req.out_dir))
-        .collect();
-
+    let mtllibs = mtllibs_from(scene, req.out_dir);
     let mut entries = Vec::with_capacity(planes.len());
     let mut all_stats = Vec::with_capacity(planes.len());
     for gp in &planes {
-        let (kept, eye_side) = match req.eye {
-            Some(eye) => {
-                let s = gp.plane.signed_distance(eye);
-                if s.abs() <= req.tolerance.distance {
-                    return Err(SceneError::EyeOnPlane {
-                        eye,
-                        plane: gp.index,
-                        distance: s,
-                    });
-                }
-                if s > 0.0 {
-                    (gp.plane, "front")
-                } else {
-                    (gp.plane.flipped(), "back")
-                }
-            }
-            None => (gp.plane, "front"),
-        };
+        let (kept, eye_side) = kept_side(gp, req.eye, req.tolerance.distance)?;
         let (meshes, stats) = mirror_scene(scene, &kept, req.tolerance.distance, |m, _| {
             is_glass(scene.meshes[m].material)
         });
-        let name = virtual_scene_name(gp.index);
-        let path = req.out_dir.join(&name);
-        glassdb_io::refuse_input_as_output(&path, [scene.source.as_path()])?;
-        let eq = gp.plane.equation();
-        let header = vec![
-            format!(
-                "virtual scene of {} (glassdb mirror)",
-                scene.source.display()
-            ),
-            format!(
-                "mirrored across glass plane {}: {:?}·(x, y, z, 1) = 0, eye side: {eye_side}",
-                gp.index, eq
-            ),
-            "geometry behind the plane removed, faces crossing it clipped, glass faces dropped"
-                .to_string(),
-        ];
-        write_obj(&path, &header, &mtllibs, &scene.materials, &meshes)?;
+        let file = write_plane_scene(scene, gp, eye_side, &mtllibs, &meshes, req.out_dir)?;
         entries.push(PlaneEntry {
             index: gp.index,
-            equation: eq,
+            equation: gp.plane.equation(),
             area: gp.area,
             materials: gp.materials.clone(),
             triangles: gp.triangles,
             eye_side: eye_side.to_string(),
             reflection_matrix: gp.plane.reflection_matrix(),
-            file: name,
+            file,
             triangles_written: stats.written,
             triangles_clipped: stats.clipped,
         });
@@ -206,15 +111,165 @@ pub fn write_virtual_scenes(req: &MirrorRequest) -> Result<MirrorReport, SceneEr
         },
         planes: entries,
     };
-    let planes_path = req.out_dir.join("planes.json");
-    glassdb_io::refuse_input_as_output(&planes_path, [scene.source.as_path()])?;
-    let json = serde_json::to_string_pretty(&file).map_err(|e| SceneError::BadOption {
-        message: e.to_string(),
-    })?;
-    glassdb_io::write_bytes_atomic(&planes_path, format!("{json}\n").as_bytes())?;
+    let planes_path = write_planes_file(&file, scene, req.out_dir)?;
     Ok(MirrorReport {
         planes_path,
         planes: file,
         stats: all_stats,
     })
+}
+
+/// The glass planes to mirror across: the explicit one, or those detected among the glass
+/// faces; at most as many as a mask's plane index can tell apart.
+fn glass_planes(
+    req: &MirrorRequest,
+    is_glass: impl Fn(Option<usize>) -> bool,
+) -> Result<Vec<GlassPlane>, SceneError> {
+    let planes = match req.explicit_plane {
+        Some(eq) => vec![explicit_glass_plane(
+            req.scene,
+            Plane::from_equation(eq)?,
+            is_glass,
+            req.tolerance.distance,
+        )],
+        None => {
+            if req.glass_patterns.is_empty() {
+                return Err(SceneError::NoGlassSelected);
+            }
+            let patterns = MaterialMatcher::new(&req.glass_patterns)?.describe();
+            detect_planes(req.scene, is_glass, req.tolerance, &patterns)?.0
+        }
+    };
+    if planes.len() > u16::MAX as usize {
+        return Err(SceneError::BadOption {
+            message: format!("{} glass planes: at most 65535 fit a mask", planes.len()),
+        });
+    }
+    Ok(planes)
+}
+
+/// The given plane as plane 0, with the area, triangles and materials of the glass faces
+/// lying on it (within `distance`).
+fn explicit_glass_plane(
+    scene: &Scene,
+    plane: Plane,
+    is_glass: impl Fn(Option<usize>) -> bool,
+    distance: f64,
+) -> GlassPlane {
+    let (mut area, mut triangles, mut materials) = (0.0, 0usize, Vec::<String>::new());
+    for mesh in &scene.meshes {
+        if !is_glass(mesh.material) {
+            continue;
+        }
+        for t in 0..mesh.triangles.len() {
+            let c = mesh.corners(t);
+            if c.iter()
+                .all(|&p| plane.signed_distance(p).abs() <= distance)
+            {
+                let a2 = crate::math::triangle_normal_area2(c[0], c[1], c[2]);
+                area += 0.5 * crate::math::norm(a2);
+                triangles += 1;
+                let name = scene.material_name(mesh).to_string();
+                if !materials.contains(&name) {
+                    materials.push(name);
+                }
+            }
+        }
+    }
+    GlassPlane {
+        index: 0,
+        plane,
+        area,
+        materials,
+        triangles,
+    }
+}
+
+/// The scene's material libraries as the virtual scenes in `out_dir` refer to them.
+fn mtllibs_from(scene: &Scene, out_dir: &Path) -> Vec<String> {
+    let src_dir = scene
+        .source
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    let src_dir = if src_dir.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        src_dir
+    };
+    scene
+        .mtllibs
+        .iter()
+        .map(|lib| relative_to(&src_dir.join(lib), out_dir))
+        .collect()
+}
+
+/// The plane oriented so that the kept half-space holds the eye (front without an eye), and
+/// the side the eye sees. An eye on the plane is an error.
+fn kept_side(
+    gp: &GlassPlane,
+    eye: Option<Vec3>,
+    distance: f64,
+) -> Result<(Plane, &'static str), SceneError> {
+    let Some(eye) = eye else {
+        return Ok((gp.plane, "front"));
+    };
+    let s = gp.plane.signed_distance(eye);
+    if s.abs() <= distance {
+        return Err(SceneError::EyeOnPlane {
+            eye,
+            plane: gp.index,
+            distance: s,
+        });
+    }
+    Ok(if s > 0.0 {
+        (gp.plane, "front")
+    } else {
+        (gp.plane.flipped(), "back")
+    })
+}
+
+/// Writes plane `gp`'s virtual scene into `out_dir`; returns its file name.
+fn write_plane_scene(
+    scene: &Scene,
+    gp: &GlassPlane,
+    eye_side: &str,
+    mtllibs: &[String],
+    meshes: &[Mesh],
+    out_dir: &Path,
+) -> Result<String, SceneError> {
+    let name = virtual_scene_name(gp.index);
+    let path = out_dir.join(&name);
+    glassdb_io::refuse_input_as_output(&path, [scene.source.as_path()])?;
+    let header = vec![
+        format!(
+            "virtual scene of {} (glassdb mirror)",
+            scene.source.display()
+        ),
+        format!(
+            "mirrored across glass plane {}: {:?}·(x, y, z, 1) = 0, eye side: {eye_side}",
+            gp.index,
+            gp.plane.equation()
+        ),
+        "geometry behind the plane removed, faces crossing it clipped, glass faces dropped"
+            .to_string(),
+    ];
+    write_obj(&path, &header, mtllibs, &scene.materials, meshes)?;
+    Ok(name)
+}
+
+/// Writes `planes.json` into `out_dir`; returns its path.
+fn write_planes_file(
+    file: &PlanesFile,
+    scene: &Scene,
+    out_dir: &Path,
+) -> Result<PathBuf, SceneError> {
+    let planes_path = out_dir.join("planes.json");
+    glassdb_io::refuse_input_as_output(&planes_path, [scene.source.as_path()])?;
+    let json = serde_json::to_string_pretty(file).map_err(|source| SceneError::EncodePlanes {
+        path: planes_path.clone(),
+        source,
+    })?;
+    glassdb_io::write_bytes_atomic(&planes_path, format!("{json}\n").as_bytes())?;
+    Ok(planes_path)
 }

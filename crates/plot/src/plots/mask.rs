@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use glassdb_mask::{CosTheta, MaskImage, MaskReadOptions, read_mask};
+use glassdb_mask::{MaskImage, MaskReadOptions, read_mask};
 use glassdb_registry::{GlassRecord, Registry, Side};
 
 use crate::PlotError;
@@ -49,14 +49,10 @@ impl Default for MaskPlotOptions {
     }
 }
 
-/// cos θ of pixel `i` as the mask stores it.
+/// cos θ of pixel `i` as the mask stores it (decoded by the mask's codec); `None` outside
+/// the image.
 pub fn pixel_cos(mask: &MaskImage, i: usize) -> Option<f64> {
-    match &mask.cos_theta {
-        CosTheta::Quantized8(v) => v.get(i).map(|&c| c as f64 / 255.0),
-        CosTheta::Quantized16(v) => v.get(i).map(|&c| c as f64 / 65535.0),
-        CosTheta::Float(v) => v.get(i).map(|&c| c as f64),
-        CosTheta::Normal => Some(1.0),
-    }
+    (i < mask.pixel_count()).then(|| mask.cos_theta_at(i))
 }
 
 fn pick(values: [f64; 3], channel: MaskChannel) -> f64 {

@@ -1,0 +1,35 @@
+//! The one error type of glassdb-report: a section that cannot be computed names what failed.
+
+use std::path::PathBuf;
+
+/// Failures of generating the report.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// An input file (the catalog) could not be read.
+    #[error("cannot read {path}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The figures directory could not be created.
+    #[error("cannot create the figures directory {path}")]
+    CreateDir {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// Drawing or saving a figure failed.
+    #[error(transparent)]
+    Plot(#[from] glassdb_plot::PlotError),
+    /// An error from the fit crate (angle tables, fitting).
+    #[error(transparent)]
+    Fit(#[from] glassdb_fit::FitError),
+    /// An error from the spectral crate (reading spectra, integrating them).
+    #[error(transparent)]
+    Spectral(#[from] glassdb_spectral::SpectralError),
+    /// An error from the registry crate (catalog parsing, building a registry).
+    #[error(transparent)]
+    Registry(#[from] glassdb_registry::RegistryError),
+    /// An error from the scene crate (OBJ loading, rasterising a mask).
+    #[error(transparent)]
+    Scene(#[from] glassdb_scene::SceneError),
+}
