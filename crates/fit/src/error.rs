@@ -98,16 +98,16 @@ pub enum FitError {
     },
     /// A value above 1 in a table read as fractions.
     #[error(
-        "{path}, line {line}, column {column} ({header}): {value} is above 1; values are fractions 0–1 (if the table is in percent, pass --percent)"
+        "{path}, line {line}, column {column} ({header}): {value} is above 1; values are fractions 0–1 (the table may be in percent)"
     )]
-    PercentWithoutFlag {
+    AboveOneInFractions {
         path: PathBuf,
         line: u64,
         column: usize,
         header: String,
         value: f64,
     },
-    /// A value outside 0–1 (or 0–100 with `--percent`).
+    /// A value outside 0–1 (or 0–100 when read as percent).
     #[error("{path}, line {line}, column {column} ({header}): {value} is outside {range}")]
     ValueOutOfRange {
         path: PathBuf,

@@ -236,7 +236,7 @@ pub fn parse_angle_table(
                 }
                 Ok(Some(v / 100.0))
             } else if v > 1.0 {
-                Err(FitError::PercentWithoutFlag {
+                Err(FitError::AboveOneInFractions {
                     path: p(),
                     line,
                     column: col + 1,

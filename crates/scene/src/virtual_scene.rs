@@ -8,6 +8,8 @@ use crate::math::Vec3;
 use crate::mirror::{MirrorStats, mirror_scene};
 use crate::obj::{Scene, write_obj};
 use crate::planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_planes};
+use glassdb_registry::Side;
+
 use crate::planes_file::{PLANES_FORMAT, PlaneEntry, PlanesFile, ToleranceJson};
 
 /// What to mirror and where to put it.
@@ -155,12 +157,12 @@ pub fn write_virtual_scenes(req: &MirrorRequest) -> Result<MirrorReport, SceneEr
                     });
                 }
                 if s > 0.0 {
-                    (gp.plane, "front")
+                    (gp.plane, Side::Front)
                 } else {
-                    (gp.plane.flipped(), "back")
+                    (gp.plane.flipped(), Side::Back)
                 }
             }
-            None => (gp.plane, "front"),
+            None => (gp.plane, Side::Front),
         };
         let (meshes, stats) = mirror_scene(scene, &kept, req.tolerance.distance, |m, _| {
             is_glass(scene.meshes[m].material)
@@ -188,7 +190,7 @@ pub fn write_virtual_scenes(req: &MirrorRequest) -> Result<MirrorReport, SceneEr
             area: gp.area,
             materials: gp.materials.clone(),
             triangles: gp.triangles,
-            eye_side: eye_side.to_string(),
+            eye_side,
             reflection_matrix: gp.plane.reflection_matrix(),
             file: name,
             triangles_written: stats.written,

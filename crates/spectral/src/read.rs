@@ -267,17 +267,20 @@ impl Collected<'_> {
                 }
                 let s = v * scale;
                 if s > 1.0 {
-                    let hint = if percent {
-                        " (above 100 %)".to_owned()
-                    } else {
-                        "; if the file is in percent, pass --percent (ReadOptions::percent)"
-                            .to_owned()
-                    };
+                    if !percent {
+                        return Err(SpectralError::AboveOneInFractions {
+                            source_name: source.to_owned(),
+                            line: place.line,
+                            column: place.column,
+                            name: name.to_string(),
+                            value: v,
+                        });
+                    }
                     return Err(SpectralError::parse(
                         source,
                         place.line,
                         place.column,
-                        format!("{name} = {v} is above 1{hint}"),
+                        format!("{name} = {v} is above 1 (above 100 %)"),
                     ));
                 }
                 scaled.push(s);
@@ -285,10 +288,9 @@ impl Collected<'_> {
             out[k] = Some(scaled);
         }
         if percent && !any_above_one {
-            return Err(SpectralError::format(
-                source,
-                "--percent was given but no value exceeds 1: the file looks like fractions (drop --percent)",
-            ));
+            return Err(SpectralError::FractionsReadAsPercent {
+                source_name: source.to_owned(),
+            });
         }
         let [transmittance, reflectance_front, reflectance_back] = out;
         Ok(SpectralData {

@@ -1,0 +1,117 @@
+//! The angle curves of a glass: C_r, C_t, C_r_back per channel fitted to the model tables, or
+//! one measured curve (continued to grazing) shared by the three channels.
+
+use glassdb_fit::{AngleSamples, FitOptions, Quantity};
+
+use crate::angle_model::{MeasuredTable, ModelTables, continue_measured};
+use crate::normal::NormalValues;
+use crate::{AngleCurve, BuildOptions, CHANNELS, RegistryError};
+
+/// Normal values at or below this are zero: the curve never matters and is the nominal one.
+const ZERO_NORMAL: f64 = 1e-9;
+
+/// The three curves of each kind, per channel.
+pub(crate) struct GlassCurves {
+    pub c_r: [AngleCurve; 3],
+    pub c_t: [AngleCurve; 3],
+    pub c_r_back: [AngleCurve; 3],
+}
+
+/// Fits one curve; the validation tolerance recorded with it is the larger of the fit
+/// tolerance and the fit's own largest residual.
+fn fit_curve(
+    samples: &AngleSamples,
+    quantity: Quantity,
+    opts: &BuildOptions,
+    glass: &str,
+    curve: String,
+) -> Result<AngleCurve, RegistryError> {
+    let mut fo = FitOptions::new(quantity);
+    fo.tol = opts.fit_tol;
+    fo.max_degree = opts.max_degree;
+    let fit = glassdb_fit::fit_curve(samples, &fo).map_err(|source| RegistryError::Fit {
+        glass: glass.to_string(),
+        curve,
+        source: Box::new(source),
+    })?;
+    let summary = fit.diagnostics.summary;
+    Ok(AngleCurve {
+        polynomial: fit.polynomial,
+        fit: summary,
+        tolerance: opts.fit_tol.max(summary.max_abs_error),
+    })
+}
+
+/// Fits every curve of a glass. A measured table's R and T curves (the ratio C(θ) of the table,
+/// continued by the model's channel G beyond its last angle) are shared by the three channels;
+/// otherwise each channel fits its model table. Zero normal values get the nominal curve.
+pub(crate) fn fit_glass_curves(
+    normal: &NormalValues,
+    tables: &ModelTables,
+    measured: Option<&MeasuredTable>,
+    opts: &BuildOptions,
+    glass: &str,
+) -> Result<GlassCurves, RegistryError> {
+    let fit = |samples: &AngleSamples, quantity: Quantity, curve: String| {
+        fit_curve(samples, quantity, opts, glass, curve)
+    };
+    let shared_r = match measured.and_then(|m| m.reflectance.as_ref()) {
+        Some(m) => Some(fit(
+            &continue_measured(m, &tables.angles, &tables.rf, true),
+            Quantity::Reflectance,
+            "measured R".into(),
+        )?),
+        None => None,
+    };
+    let shared_t = match measured.and_then(|m| m.transmittance.as_ref()) {
+        Some(m) => Some(fit(
+            &continue_measured(m, &tables.angles, &tables.t, false),
+            Quantity::Transmittance,
+            "measured T".into(),
+        )?),
+        None => None,
+    };
+    let mut c_r = Vec::with_capacity(3);
+    let mut c_t = Vec::with_capacity(3);
+    let mut c_r_back = Vec::with_capacity(3);
+    for (ch, name) in CHANNELS.iter().enumerate() {
+        c_r.push(match &shared_r {
+            Some(c) => c.clone(),
+            None if normal.r0[ch] <= ZERO_NORMAL => AngleCurve::nominal_transmittance(),
+            None => fit(
+                &tables.samples(&tables.rf, ch),
+                Quantity::Reflectance,
+                format!("C_r channel {name}"),
+            )?,
+        });
+        c_t.push(match &shared_t {
+            Some(c) => c.clone(),
+            None if normal.t0[ch] <= ZERO_NORMAL => AngleCurve::nominal_transmittance(),
+            None => fit(
+                &tables.samples(&tables.t, ch),
+                Quantity::Transmittance,
+                format!("C_t channel {name}"),
+            )?,
+        });
+        c_r_back.push(if normal.r0_back[ch] <= ZERO_NORMAL {
+            AngleCurve::nominal_transmittance()
+        } else {
+            fit(
+                &tables.samples(&tables.rb, ch),
+                Quantity::Reflectance,
+                format!("C_r_back channel {name}"),
+            )?
+        });
+    }
+    Ok(GlassCurves {
+        c_r: three(c_r),
+        c_t: three(c_t),
+        c_r_back: three(c_r_back),
+    })
+}
+
+/// The three per-channel curves of a vector filled for channels R, G, B.
+fn three(curves: Vec<AngleCurve>) -> [AngleCurve; 3] {
+    let mut it = curves.into_iter();
+    std::array::from_fn(|_| it.next().unwrap_or_else(AngleCurve::nominal_transmittance))
+}
