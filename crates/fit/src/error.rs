@@ -25,12 +25,21 @@ pub enum FitError {
     /// The file has a header but no data rows.
     #[error("{path}: no data rows after the header")]
     NoRows { path: PathBuf },
-    /// The CSV structure is broken (e.g. a row with a different number of fields than the header).
-    #[error("{path}, line {line}: {message}")]
+    /// A row with a different number of fields than the header.
+    #[error("{path}, line {line}: row has {fields} field(s) but the header has {header_fields}")]
+    RaggedRow {
+        path: PathBuf,
+        line: u64,
+        fields: u64,
+        header_fields: u64,
+    },
+    /// The CSV reader failed otherwise (text not UTF-8, an I/O error); the reader's error is
+    /// the source.
+    #[error("{path}, line {line}: not readable as CSV")]
     Csv {
         path: PathBuf,
         line: u64,
-        message: String,
+        source: csv::Error,
     },
     /// A required column is missing from the header.
     #[error("{path}, line {line}: missing column {wanted} (header has: {found})")]

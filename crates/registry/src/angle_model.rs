@@ -333,3 +333,36 @@ pub(crate) fn continue_measured(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::catalog::NormalSource;
+
+    #[test]
+    fn auto_model_from_product_type_and_from_rf_rb() {
+        let spec = GlassSpec {
+            id: 1,
+            name: "x".into(),
+            normal: NormalSource::Explicit {
+                r0: [0.1; 3],
+                t0: [0.8; 3],
+                r0_back: [0.1; 3],
+            },
+            angles: None,
+            model: ModelChoice::Auto,
+            ior: None,
+        };
+        let t = [0.8, 0.8];
+        let (m, _) = choose_model(&spec, Some("Monolithic"), &t, &[0.1, 0.1], &[0.3, 0.3]);
+        assert_eq!(m, Physical::Uncoated);
+        let (m, _) = choose_model(&spec, Some("applied-film"), &t, &[0.1, 0.1], &[0.1, 0.1]);
+        assert_eq!(m, Physical::Coated);
+        let (m, why) = choose_model(&spec, None, &t, &[0.1, 0.1], &[0.104, 0.1]);
+        assert_eq!(m, Physical::Uncoated, "{why}");
+        let (m, _) = choose_model(&spec, None, &t, &[0.1, 0.1], &[0.106, 0.1]);
+        assert_eq!(m, Physical::Coated);
+        let (m, _) = choose_model(&spec, None, &[0.0, 0.0], &[0.9, 0.9], &[0.9, 0.9]);
+        assert_eq!(m, Physical::Opaque);
+    }
+}

@@ -71,11 +71,10 @@ pub(crate) fn fit_glass_curves(
         )?),
         None => None,
     };
-    let mut c_r = Vec::with_capacity(3);
-    let mut c_t = Vec::with_capacity(3);
-    let mut c_r_back = Vec::with_capacity(3);
-    for (ch, name) in CHANNELS.iter().enumerate() {
-        c_r.push(match &shared_r {
+    // Per channel in the order R, G, B: front reflectance, transmittance, back reflectance.
+    let channel = |ch: usize| -> Result<[AngleCurve; 3], RegistryError> {
+        let name = CHANNELS[ch];
+        let c_r = match &shared_r {
             Some(c) => c.clone(),
             None if normal.r0[ch] <= ZERO_NORMAL => AngleCurve::nominal_transmittance(),
             None => fit(
@@ -83,8 +82,8 @@ pub(crate) fn fit_glass_curves(
                 Quantity::Reflectance,
                 format!("C_r channel {name}"),
             )?,
-        });
-        c_t.push(match &shared_t {
+        };
+        let c_t = match &shared_t {
             Some(c) => c.clone(),
             None if normal.t0[ch] <= ZERO_NORMAL => AngleCurve::nominal_transmittance(),
             None => fit(
@@ -92,8 +91,8 @@ pub(crate) fn fit_glass_curves(
                 Quantity::Transmittance,
                 format!("C_t channel {name}"),
             )?,
-        });
-        c_r_back.push(if normal.r0_back[ch] <= ZERO_NORMAL {
+        };
+        let c_r_back = if normal.r0_back[ch] <= ZERO_NORMAL {
             AngleCurve::nominal_transmittance()
         } else {
             fit(
@@ -101,17 +100,14 @@ pub(crate) fn fit_glass_curves(
                 Quantity::Reflectance,
                 format!("C_r_back channel {name}"),
             )?
-        });
-    }
+        };
+        Ok([c_r, c_t, c_r_back])
+    };
+    let [[r_r, t_r, rb_r], [r_g, t_g, rb_g], [r_b, t_b, rb_b]] =
+        [channel(0)?, channel(1)?, channel(2)?];
     Ok(GlassCurves {
-        c_r: three(c_r),
-        c_t: three(c_t),
-        c_r_back: three(c_r_back),
+        c_r: [r_r, r_g, r_b],
+        c_t: [t_r, t_g, t_b],
+        c_r_back: [rb_r, rb_g, rb_b],
     })
-}
-
-/// The three per-channel curves of a vector filled for channels R, G, B.
-fn three(curves: Vec<AngleCurve>) -> [AngleCurve; 3] {
-    let mut it = curves.into_iter();
-    std::array::from_fn(|_| it.next().unwrap_or_else(AngleCurve::nominal_transmittance))
 }

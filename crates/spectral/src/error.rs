@@ -27,6 +27,14 @@ pub enum SpectralError {
         message: String,
     },
 
+    /// The CSV reader failed (an I/O error, broken quoting); its error is the source.
+    #[error("{source_name}:{line}: not readable as CSV")]
+    Csv {
+        source_name: String,
+        line: usize,
+        source: csv::Error,
+    },
+
     /// A value above 1 in a file read as fractions: the file is probably in percent
     /// ([`crate::ReadOptions::percent`]).
     #[error(
@@ -115,6 +123,14 @@ pub enum SpectralError {
     EmbeddedTable {
         table: &'static str,
         message: String,
+    },
+
+    /// Reference data built once per process (tables, luminous weights) failed to build; the
+    /// first failure, shared by every later call, is the source (a build defect).
+    #[error("embedded {what} could not be built")]
+    EmbeddedData {
+        what: &'static str,
+        source: std::sync::Arc<SpectralError>,
     },
 }
 

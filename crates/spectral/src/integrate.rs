@@ -10,8 +10,8 @@
 use std::cell::RefCell;
 use std::fmt;
 use std::str::FromStr;
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -550,18 +550,18 @@ pub fn luminous(
     grid: LuminousGrid,
     extrapolate: bool,
 ) -> Result<f64, SpectralError> {
-    static ISO: OnceLock<Result<Integrator, String>> = OnceLock::new();
-    static ONE: OnceLock<Result<Integrator, String>> = OnceLock::new();
+    static ISO: OnceLock<Result<Integrator, Arc<SpectralError>>> = OnceLock::new();
+    static ONE: OnceLock<Result<Integrator, Arc<SpectralError>>> = OnceLock::new();
     let cell = match grid {
         LuminousGrid::Iso9050 => &ISO,
         LuminousGrid::OneNm => &ONE,
     };
     let integrator = cell
-        .get_or_init(|| Integrator::luminous_on(grid).map_err(|e| e.to_string()))
+        .get_or_init(|| Integrator::luminous_on(grid).map_err(Arc::new))
         .as_ref()
-        .map_err(|message| SpectralError::EmbeddedTable {
-            table: "luminous weights",
-            message: message.clone(),
+        .map_err(|source| SpectralError::EmbeddedData {
+            what: "luminous weights",
+            source: Arc::clone(source),
         })?;
     Ok(integrator.apply(wavelength_nm, values, extrapolate)?[1])
 }

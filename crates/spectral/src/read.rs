@@ -317,7 +317,7 @@ fn read_csv(bytes: &[u8], source: &str, opts: &ReadOptions) -> Result<SpectralDa
         .from_reader(bytes);
     let headers = reader
         .byte_headers()
-        .map_err(|e| csv_error(source, &e))?
+        .map_err(|e| csv_error(source, e))?
         .clone();
     let header_line = 1usize;
     let mut wl_col: Option<(usize, f64)> = None; // (index, scale to nm)
@@ -393,7 +393,7 @@ fn read_csv(bytes: &[u8], source: &str, opts: &ReadOptions) -> Result<SpectralDa
         match reader.read_byte_record(&mut record) {
             Ok(false) => break,
             Ok(true) => {}
-            Err(e) => return Err(csv_error(source, &e)),
+            Err(e) => return Err(csv_error(source, e)),
         }
         let line = record.position().map(|p| p.line() as usize).unwrap_or(0);
         let field = |i: usize| -> Result<&str, SpectralError> {
@@ -430,17 +430,23 @@ fn read_csv(bytes: &[u8], source: &str, opts: &ReadOptions) -> Result<SpectralDa
     collected.finish(opts.percent, ProductInfo::empty(SpectralFormat::Csv))
 }
 
-fn csv_error(source: &str, e: &csv::Error) -> SpectralError {
+fn csv_error(source: &str, e: csv::Error) -> SpectralError {
     let line = e.position().map(|p| p.line() as usize).unwrap_or(0);
-    let message = match e.kind() {
+    match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..
-        } => {
-            format!("{len} fields where the header has {expected_len}")
-        }
-        _ => e.to_string(),
-    };
-    SpectralError::parse(source, line, None, message)
+        } => SpectralError::parse(
+            source,
+            line,
+            None,
+            format!("{len} fields where the header has {expected_len}"),
+        ),
+        _ => SpectralError::Csv {
+            source_name: source.to_owned(),
+            line,
+            source: e,
+        },
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
