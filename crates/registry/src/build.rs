@@ -339,6 +339,41 @@ mod tests {
     }
 
     #[test]
+    fn mask_ids_restrict_the_build_and_are_checked_against_the_catalog() {
+        let dir = tempfile::tempdir().unwrap();
+        let glass = |id: u16| {
+            format!(
+                "[[glass]]\nid = {id}\nname = \"g{id}\"\nr0 = [0.08, 0.08, 0.08]\nt0 = [0.9, 0.9, 0.9]\n"
+            )
+        };
+        let catalog = write(
+            dir.path(),
+            "catalog.toml",
+            &[glass(1), glass(2), glass(300)].concat(),
+        );
+        let only = |counts: &[(u16, u64)], eight_bit: bool| BuildOptions {
+            mask_ids: Some(MaskIds {
+                pixel_counts: counts.iter().copied().collect(),
+                eight_bit_mask: eight_bit.then(|| PathBuf::from("m8.png")),
+            }),
+            ..BuildOptions::default()
+        };
+        let reg = build_registry(&catalog, &only(&[(2, 10)], false)).unwrap();
+        assert_eq!(reg.glasses.iter().map(|g| g.id).collect::<Vec<_>>(), [2]);
+        let err = build_registry(&catalog, &only(&[(2, 10), (7, 3)], false)).unwrap_err();
+        assert!(
+            matches!(&err, RegistryError::IdsNotInCatalog { ids, .. } if ids == &[(7, 3)]),
+            "{err}"
+        );
+        let err = build_registry(&catalog, &only(&[(1, 4)], true)).unwrap_err();
+        assert!(
+            matches!(&err, RegistryError::IdTooLargeForMask { id: 300, .. }),
+            "{err}"
+        );
+        assert!(err.to_string().contains("m8.png"), "{err}");
+    }
+
+    #[test]
     fn opaque_metal_from_complex_ior() {
         let dir = tempfile::tempdir().unwrap();
         // Per-channel complex index; r0 is the Fresnel value |(N−1)/(N+1)|².
