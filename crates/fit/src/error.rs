@@ -163,6 +163,14 @@ pub enum FitError {
     /// A fit file (JSON) is malformed or inconsistent.
     #[error("{path}: {message}")]
     FitFile { path: PathBuf, message: String },
+    /// A curve of a fit file cannot be evaluated as written.
+    #[error("{path}: glass `{glass}`, {quantity}")]
+    CurveShape {
+        path: PathBuf,
+        glass: String,
+        quantity: &'static str,
+        source: crate::PolynomialShape,
+    },
     /// A fit of one curve of one glass failed (the inner error says why).
     #[error("glass `{glass}`, {quantity}: {error}")]
     Curve {

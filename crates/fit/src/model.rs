@@ -96,6 +96,51 @@ impl CosPolynomial {
     }
 }
 
+/// The highest power of cos θ a curve may have (the power basis is hopeless far below it).
+pub const MAX_POWER: u32 = 64;
+
+/// Why a [`CosPolynomial`] as written (in a fit file or a registry) cannot be evaluated.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PolynomialShape {
+    #[error("no terms")]
+    NoTerms,
+    #[error("{powers} powers but {coefficients} coefficients")]
+    LengthMismatch { powers: usize, coefficients: usize },
+    #[error("power {0} is beyond the supported {MAX_POWER}")]
+    PowerTooHigh(u32),
+    #[error("powers must ascend strictly, but {0} is followed by {1}")]
+    NotAscending(u32, u32),
+    #[error("the paper basis has no constant term (power 0)")]
+    ConstantInPaperBasis,
+}
+
+impl CosPolynomial {
+    /// Checks what [`CosPolynomial::eval`] relies on: at least one term, one coefficient per
+    /// power, powers ≤ [`MAX_POWER`] and strictly ascending, no power 0 in the paper basis.
+    /// (Finiteness of the coefficients is the caller's check, to name the coefficient.)
+    pub fn check_shape(&self) -> Result<(), PolynomialShape> {
+        if self.powers.is_empty() && self.coefficients.is_empty() {
+            return Err(PolynomialShape::NoTerms);
+        }
+        if self.powers.len() != self.coefficients.len() {
+            return Err(PolynomialShape::LengthMismatch {
+                powers: self.powers.len(),
+                coefficients: self.coefficients.len(),
+            });
+        }
+        if let Some(&p) = self.powers.iter().find(|&&p| p > MAX_POWER) {
+            return Err(PolynomialShape::PowerTooHigh(p));
+        }
+        if let Some(w) = self.powers.windows(2).find(|w| w[1] <= w[0]) {
+            return Err(PolynomialShape::NotAscending(w[0], w[1]));
+        }
+        if self.basis == Basis::Paper && self.powers[0] == 0 {
+            return Err(PolynomialShape::ConstantInPaperBasis);
+        }
+        Ok(())
+    }
+}
+
 /// `x^p` with the common small powers 0 and 1 exact and free.
 #[inline]
 fn pow_small(x: f64, p: u32) -> f64 {

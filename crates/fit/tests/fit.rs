@@ -633,6 +633,61 @@ fn malformed_fit_files_are_errors() {
     }
 }
 
+#[test]
+fn polynomial_shape_is_checked_once_for_fit_files_and_registries() {
+    use glassdb_fit::{CosPolynomial, PolynomialShape};
+    let poly = |basis, powers: Vec<u32>, coefficients: Vec<f64>| CosPolynomial {
+        basis,
+        powers,
+        coefficients,
+    };
+    assert_eq!(
+        poly(Basis::Full, vec![0, 1], vec![1.0, 0.0]).check_shape(),
+        Ok(())
+    );
+    for (bad, want) in [
+        (poly(Basis::Full, vec![], vec![]), PolynomialShape::NoTerms),
+        (
+            poly(Basis::Full, vec![0, 1], vec![1.0]),
+            PolynomialShape::LengthMismatch {
+                powers: 2,
+                coefficients: 1,
+            },
+        ),
+        (
+            poly(Basis::Full, vec![0, 65], vec![1.0, 0.0]),
+            PolynomialShape::PowerTooHigh(65),
+        ),
+        (
+            poly(Basis::Full, vec![1, 1], vec![1.0, 0.0]),
+            PolynomialShape::NotAscending(1, 1),
+        ),
+        (
+            poly(Basis::Paper, vec![0, 1], vec![0.0, 1.0]),
+            PolynomialShape::ConstantInPaperBasis,
+        ),
+    ] {
+        assert_eq!(bad.check_shape(), Err(want));
+    }
+    let e = parse_fit_json(
+        br#"{"glasses":[{"name":"g","reflectance":{"normal":0.1,"basis":"full","powers":[1,0],"coefficients":[1,0],
+            "degree":1,"rms_error":0,"max_abs_error":0,"max_error_angle_deg":0,"condition_number":1}}]}"#,
+        Path::new("bad.json"),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            FitError::CurveShape {
+                quantity: "reflectance",
+                source: PolynomialShape::NotAscending(1, 0),
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
 // ---- hard case 7: the reader ----
 
 #[test]

@@ -62,12 +62,22 @@ pub enum RegistryError {
     },
 
     /// A curve object is malformed (no terms, powers and coefficients of different lengths, …).
-    #[error("{source_name}: glass {glass}: curve {field}: {reason}")]
+    #[error("{source_name}: glass {glass}: curve {field}")]
     CurveShape {
         source_name: String,
         glass: String,
         field: String,
-        reason: String,
+        #[source]
+        shape: glassdb_fit::PolynomialShape,
+    },
+
+    /// A curve's recorded validation tolerance is negative.
+    #[error("{source_name}: glass {glass}: curve {field}: negative tolerance {tolerance}")]
+    NegativeTolerance {
+        source_name: String,
+        glass: String,
+        field: String,
+        tolerance: f64,
     },
 
     /// The curves give an unphysical value at some angle (outside [0, 1] or r + t > 1) by more

@@ -481,7 +481,7 @@ mod tests {
     fn powers_must_ascend_and_the_paper_basis_has_no_constant() {
         let mut reg = sample();
         reg.glasses[0].c_r[0] = curve(vec![0, 2, 1], vec![10.0, 9.0, -18.0]);
-        let e = reg.validate().unwrap_err().to_string();
+        let e = glassdb_io::ErrorChain(&reg.validate().unwrap_err()).to_string();
         assert!(
             e.contains("c_r[0] (R)") && e.contains("ascend strictly"),
             "{e}"
@@ -489,7 +489,7 @@ mod tests {
         let mut reg = sample();
         reg.glasses[0].c_t[0].polynomial.powers = vec![0];
         reg.glasses[0].c_t[0].polynomial.basis = glassdb_fit::Basis::Paper;
-        let e = reg.validate().unwrap_err().to_string();
+        let e = glassdb_io::ErrorChain(&reg.validate().unwrap_err()).to_string();
         assert!(e.contains("no constant term"), "{e}");
     }
 

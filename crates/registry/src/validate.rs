@@ -3,8 +3,6 @@
 
 use std::collections::BTreeMap;
 
-use glassdb_fit::Basis;
-
 use crate::RegistryError;
 use crate::record::{CHANNELS, GlassRecord, Registry, SCHEMA_VERSION, Side};
 
@@ -89,36 +87,15 @@ fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryErro
     for (field, curves) in [("c_r", &g.c_r), ("c_t", &g.c_t), ("c_r_back", &g.c_r_back)] {
         for (c, curve) in curves.iter().enumerate() {
             let name = format!("{field}[{c}] ({})", CHANNELS[c]);
-            let shape = |reason: String| RegistryError::CurveShape {
-                source_name: source_name.to_string(),
-                glass: glass.clone(),
-                field: name.clone(),
-                reason,
-            };
-            if curve.polynomial.powers.is_empty() {
-                return Err(shape("no terms".into()));
-            }
-            if curve.polynomial.powers.len() != curve.polynomial.coefficients.len() {
-                return Err(shape(format!(
-                    "{} powers but {} coefficients",
-                    curve.polynomial.powers.len(),
-                    curve.polynomial.coefficients.len()
-                )));
-            }
-            if let Some(p) = curve.polynomial.powers.iter().find(|&&p| p > 64) {
-                return Err(shape(format!("power {p} is beyond the supported 64")));
-            }
-            if let Some(w) = curve.polynomial.powers.windows(2).find(|w| w[1] <= w[0]) {
-                return Err(shape(format!(
-                    "powers must ascend strictly, but {} is followed by {}",
-                    w[0], w[1]
-                )));
-            }
-            if curve.polynomial.basis == Basis::Paper && curve.polynomial.powers[0] == 0 {
-                return Err(shape(
-                    "the paper basis has no constant term (power 0)".into(),
-                ));
-            }
+            curve
+                .polynomial
+                .check_shape()
+                .map_err(|shape| RegistryError::CurveShape {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    field: name.clone(),
+                    shape,
+                })?;
             for (k, v) in curve.polynomial.coefficients.iter().enumerate() {
                 if !v.is_finite() {
                     return Err(non_finite(format!("{name}.coefficients[{k}]")));
@@ -135,7 +112,12 @@ fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryErro
                 }
             }
             if curve.tolerance < 0.0 {
-                return Err(shape(format!("negative tolerance {}", curve.tolerance)));
+                return Err(RegistryError::NegativeTolerance {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    field: name.clone(),
+                    tolerance: curve.tolerance,
+                });
             }
         }
     }
