@@ -28,7 +28,8 @@ pub struct Args {
     /// `id` and `cos_theta` channels, or a binary PNG with --glass (docs/mask.md).
     #[arg(long, value_name = "FILE")]
     pub mask: PathBuf,
-    /// Registry JSON (`glassdb registry build`); default: the bundled catalog.
+    /// Registry JSON (`glassdb registry build`); default: the bundled data/registry.json (built
+    /// from data/catalog.toml).
     #[arg(long, value_name = "JSON")]
     pub registry: Option<PathBuf>,
     /// Output, .exr or .png (default: beside the transmission pass, `<name>.composite.<ext>`).
@@ -153,7 +154,10 @@ fn default_output(trans: &Path) -> PathBuf {
 
 fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
     let (registry, label) = match &args.registry {
-        Some(p) => (Registry::from_json_file(p)?, p.display().to_string()),
+        Some(p) => (
+            Registry::from_json_file(p).map_err(super::registry_error)?,
+            p.display().to_string(),
+        ),
         None => (
             glassdb_registry::default_registry()?,
             "the bundled catalog".to_string(),

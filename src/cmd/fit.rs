@@ -75,7 +75,8 @@ pub struct EvalArgs {
 }
 
 pub fn run_fit(args: FitArgs) -> anyhow::Result<ExitCode> {
-    let tables = glassdb_fit::read_angle_table(&args.table, args.percent)?;
+    let tables =
+        glassdb_fit::read_angle_table(&args.table, args.percent).map_err(super::fit_error)?;
     let base = FitOptions {
         degree: args.degree,
         tol: args.tol,
@@ -176,13 +177,13 @@ fn fit_report(file: &FitFile, args: &FitArgs) -> String {
                 q,
                 c.normal,
                 c.polynomial.basis.name(),
-                d.degree,
+                d.summary.degree,
                 d.points,
-                d.rms_error,
-                d.max_abs_error,
-                trim_num(d.max_error_angle_deg),
+                d.summary.rms_error,
+                d.summary.max_abs_error,
+                trim_num(d.summary.max_error_angle_deg),
                 loo,
-                d.condition_number
+                d.summary.condition_number
             );
         }
         for (sym, c) in [("C_r", &g.reflectance), ("C_t", &g.transmittance)] {

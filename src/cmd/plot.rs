@@ -231,10 +231,9 @@ fn parse_side(s: &str) -> anyhow::Result<(u16, bool)> {
         .trim()
         .parse()
         .with_context(|| format!("--side {s}: plane index `{k}` is not a number 0–65535"))?;
-    match side.trim() {
-        "back" => Ok((k, true)),
-        "front" => Ok((k, false)),
-        other => bail!("--side {s}: side `{other}` must be front or back"),
+    match side.parse::<glassdb_registry::Side>() {
+        Ok(side) => Ok((k, side == glassdb_registry::Side::Back)),
+        Err(_) => bail!("--side {s}: side `{}` must be front or back", side.trim()),
     }
 }
 

@@ -6,8 +6,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use glassdb_registry::{Application, BuildOptions, GlassRecord, Registry, Side};
-use glassdb_spectral::{Illuminant, IntegrationSettings, Method, Observer, RgbCmf, RgbSpace};
+use glassdb_registry::{
+    AngleCurve, Application, BuildOptions, GlassRecord, MaskIds, Registry, Side,
+};
+use glassdb_spectral::{
+    Illuminant, IntegrationSettings, Method, MethodKind, Observer, RgbCmf, RgbSpace,
+};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -96,17 +100,14 @@ fn parse<T: std::str::FromStr<Err = String>>(value: &str, flag: &str) -> anyhow:
 }
 
 fn settings(a: &BuildArgs) -> anyhow::Result<IntegrationSettings> {
-    let method = match a.method.to_ascii_lowercase().as_str() {
-        "colorimetric" => Method::Colorimetric {
+    let method = match parse::<MethodKind>(&a.method, "method")? {
+        MethodKind::Colorimetric => Method::Colorimetric {
             observer: parse::<Observer>(&a.observer, "observer")?,
             illuminant: parse::<Illuminant>(&a.illuminant, "illuminant")?,
             space: parse::<RgbSpace>(&a.space, "space")?,
         },
-        "paper" => Method::Paper(parse::<RgbCmf>(&a.cmf, "cmf")?),
-        "luminous" => Method::Luminous,
-        other => anyhow::bail!(
-            "--method: unknown value `{other}`; expected one of: colorimetric, paper, luminous"
-        ),
+        MethodKind::Paper => Method::Paper(parse::<RgbCmf>(&a.cmf, "cmf")?),
+        MethodKind::Luminous => Method::Luminous,
     };
     Ok(IntegrationSettings {
         method,
@@ -126,7 +127,7 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     glassdb_io::refuse_input_as_output(&a.output, inputs)?;
     let opts = BuildOptions {
         spectral: settings(&a)?,
-        masks: a.masks.clone(),
+        mask_ids: mask_ids(&a.masks)?,
         fit_tol: a.tol,
         max_degree: a.max_degree,
         application: if a.per_channel {
@@ -134,9 +135,9 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
         } else {
             Application::PerWavelength
         },
-        ..BuildOptions::default()
     };
-    let registry = glassdb_registry::build_registry(&a.catalog, &opts)?;
+    let registry =
+        glassdb_registry::build_registry(&a.catalog, &opts).map_err(super::registry_error)?;
     registry.write_json(&a.output)?;
     let ids: Vec<String> = registry.glasses.iter().map(|g| g.id.to_string()).collect();
     eprintln!(
@@ -157,21 +158,36 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The ids the given masks use (None without masks), read here so that the registry library
+/// knows nothing of masks.
+fn mask_ids(masks: &[PathBuf]) -> anyhow::Result<Option<MaskIds>> {
+    if masks.is_empty() {
+        return Ok(None);
+    }
+    let mut ids = MaskIds::default();
+    for path in masks {
+        let mask = glassdb_mask::read_mask(path, &glassdb_mask::MaskReadOptions::default())
+            .with_context(|| format!("mask {}", path.display()))?;
+        if matches!(mask.cos_theta, glassdb_mask::CosTheta::Quantized8(_))
+            && ids.eight_bit_mask.is_none()
+        {
+            ids.eight_bit_mask = Some(path.clone());
+        }
+        for (id, n) in mask.id_pixel_counts() {
+            *ids.pixel_counts.entry(id).or_insert(0) += n;
+        }
+    }
+    Ok(Some(ids))
+}
+
 fn rgb(v: &[f64; 3]) -> String {
     format!("{:.4} {:.4} {:.4}", v[0], v[1], v[2])
 }
 
 fn show(a: ShowArgs) -> anyhow::Result<ExitCode> {
-    let registry = Registry::from_json_file(&a.registry)?;
+    let registry = Registry::from_json_file(&a.registry).map_err(super::registry_error)?;
     let side = if a.back { Side::Back } else { Side::Front };
-    let s = &registry.spectral;
-    let mut method = s.method.clone();
-    for part in [&s.cmf, &s.observer, &s.illuminant, &s.space]
-        .into_iter()
-        .flatten()
-    {
-        method.push_str(&format!(" {part}"));
-    }
+    let method = method_text(&registry.spectral);
     println!(
         "{}: schema {}, spectral method {method}, {} glasses",
         a.registry.display(),
@@ -187,6 +203,20 @@ fn show(a: ShowArgs) -> anyhow::Result<ExitCode> {
         println!();
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The method and its options, e.g. `colorimetric cie1931 D65 srgb`.
+fn method_text(s: &IntegrationSettings) -> String {
+    let kind = s.method.kind();
+    match s.method {
+        Method::Paper(cmf) => format!("{kind} {cmf}"),
+        Method::Colorimetric {
+            observer,
+            illuminant,
+            space,
+        } => format!("{kind} {observer} {illuminant} {space}"),
+        Method::Luminous => kind.to_string(),
+    }
 }
 
 fn print_glass(g: &GlassRecord, side: Side) {
@@ -215,13 +245,13 @@ fn print_glass(g: &GlassRecord, side: Side) {
         model.push_str(&format!("; chosen by {}", m.chosen_by));
     }
     println!("  angle model: {model}");
-    let fit_line = |label: &str, curves: &[glassdb_registry::CurveRecord; 3]| {
+    let fit_line = |label: &str, curves: &[AngleCurve; 3]| {
         let parts: Vec<String> = curves
             .iter()
             .map(|c| {
                 format!(
                     "deg {} max err {:.1e} at {:.0}°",
-                    c.degree, c.max_abs_error, c.max_error_angle_deg
+                    c.fit.degree, c.fit.max_abs_error, c.fit.max_error_angle_deg
                 )
             })
             .collect();
@@ -254,7 +284,7 @@ fn check(a: CheckArgs) -> anyhow::Result<ExitCode> {
                 r.glasses.len()
             ),
             Err(e) => {
-                eprintln!("FAILED: {}", glassdb_io::ErrorChain(&e));
+                eprintln!("FAILED: {:#}", super::registry_error(e));
                 failed += 1;
             }
         }

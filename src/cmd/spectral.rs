@@ -174,7 +174,8 @@ struct QuantityResult {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let settings = args.settings.settings()?;
     let method = settings.method;
-    let data = read_spectral_file(&args.file, &args.settings.read_options())?;
+    let data = read_spectral_file(&args.file, &args.settings.read_options())
+        .map_err(super::spectral_error)?;
     let integrator = Integrator::new(&settings)?;
     let results = integrate_all(&data, &integrator, settings.extrapolate)?;
     let out = if args.json {
@@ -211,11 +212,16 @@ fn integrate_all(
     for (key, label, values) in quantities {
         let Some(values) = values else { continue };
         let context = || format!("{}: {label}", data.source);
-        let rgb = integrator.channels(wl, values).with_context(context)?;
-        let luminous_iso =
-            luminous(wl, values, LuminousGrid::Iso9050, extrapolate).with_context(context)?;
-        let luminous_1nm =
-            luminous(wl, values, LuminousGrid::OneNm, extrapolate).with_context(context)?;
+        let rgb = integrator
+            .channels(wl, values)
+            .map_err(super::spectral_error)
+            .with_context(context)?;
+        let luminous_iso = luminous(wl, values, LuminousGrid::Iso9050, extrapolate)
+            .map_err(super::spectral_error)
+            .with_context(context)?;
+        let luminous_1nm = luminous(wl, values, LuminousGrid::OneNm, extrapolate)
+            .map_err(super::spectral_error)
+            .with_context(context)?;
         results.push(QuantityResult {
             key,
             label,
@@ -228,21 +234,21 @@ fn integrate_all(
 }
 
 fn to_json(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> Value {
-    let (name, cmf, observer, illuminant, space) = match method {
-        Method::Paper(c) => ("paper", Some(c.name()), None, None, None),
+    let (cmf, observer, illuminant, space) = match method {
+        Method::Paper(c) => (Some(c.name()), None, None, None),
         Method::Colorimetric {
             observer,
             illuminant,
             space,
         } => (
-            "colorimetric",
             None,
             Some(observer.name()),
             Some(illuminant.name()),
             Some(space.name()),
         ),
-        Method::Luminous => ("luminous", None, None, None, None),
+        Method::Luminous => (None, None, None, None),
     };
+    let name = method.kind().name();
     let mut obj = json!({
         "method": name,
         "cmf": cmf,

@@ -42,7 +42,7 @@ fn write_registry(dir: &Path) -> PathBuf {
         })
     };
     let reg = serde_json::json!({
-        "schema": 1,
+        "schema": 2,
         "spectral": {"method": "luminous"},
         "glasses": [
             glass(1, [0.25, 0.125, 0.0625], [0.5, 0.25, 0.125], [0.5; 3], &c),
@@ -340,7 +340,20 @@ fn golden_two_planes_with_back_side() {
     assert_close(px[2], [1.5, 1.5, 1.5], "plane 1, back");
     // Same through planes.json.
     let planes = g.path("planes.json");
-    std::fs::write(&planes, r#"{"format":"glassdb-planes/1","planes":[{"index":0,"eye_side":"front"},{"index":1,"eye_side":"back"}]}"#).unwrap();
+    let plane = |index: usize, side: &str| {
+        format!(
+            r#"{{"index":{index},"equation":[0.0,0.0,1.0,{index}.0],"area":1.0,"materials":["glass"],"triangles":2,"eye_side":"{side}","reflection_matrix":[[1.0,0.0,0.0,0.0],[0.0,1.0,0.0,0.0],[0.0,0.0,-1.0,0.0],[0.0,0.0,0.0,1.0]],"file":"virtual_plane_{index}.obj","triangles_written":0,"triangles_clipped":0}}"#
+        )
+    };
+    std::fs::write(
+        &planes,
+        format!(
+            r#"{{"format":"glassdb-planes/1","source":"scene.obj","eye":null,"tolerance":{{"angle_deg":0.5,"distance":0.001}},"planes":[{},{}]}}"#,
+            plane(0, "front"),
+            plane(1, "back")
+        ),
+    )
+    .unwrap();
     let out2 = g.path("o2.exr");
     ok(g.cmd(&m, &out2)
         .arg("--refl")

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage};
 
 use crate::util::{
-    CURVE_FIT_STATS, fails, glassdb, ok, registry_build as build, repo_path, run_oracle, write_file,
+    CURVE_FIT_STATS, fails, glassdb, ok, registry_build as build, repo_path, repo_root, run_oracle,
+    write_file,
 };
 
 const EXPLICIT_GLASS: &str = "r0 = [0.08, 0.08, 0.08]\nt0 = [0.85, 0.86, 0.84]\n";
@@ -150,7 +151,7 @@ fn violating_registry() -> String {
     let ct = curve("[0]", "[1.0]");
     let crb = curve("[0, 1, 2]", "[0.0, 0.0, 1.0]");
     format!(
-        r#"{{"schema": 1, "spectral": {{"method": "colorimetric"}}, "glasses": [{{
+        r#"{{"schema": 2, "spectral": {{"method": "colorimetric"}}, "glasses": [{{
             "id": 7, "name": "leaky", "r0": [0.1, 0.1, 0.1], "t0": [0.85, 0.85, 0.85], "r0_back": [0.1, 0.1, 0.1],
             "c_r": [{cr}, {cr}, {cr}], "c_t": [{ct}, {ct}, {ct}], "c_r_back": [{crb}, {crb}, {crb}],
             "angle_model": {{"kind": "uncoated", "applied": "per-channel"}}, "provenance": {{}}}}]}}"#
@@ -175,9 +176,14 @@ fn check_rejects_malformed_registries() {
     let cases = [
         ("not JSON", "{\"schema\": 1,\n \"glasses\": [", "line 2"),
         (
-            "schema 2",
-            "{\"schema\": 2, \"glasses\": []}",
-            "schema 2 is not supported",
+            "schema 1",
+            "{\"schema\": 1, \"glasses\": []}",
+            "schema 1 is not supported",
+        ),
+        (
+            "schema 1, the command that rebuilds it",
+            "{\"schema\": 1, \"glasses\": []}",
+            "rebuild it: glassdb registry build CATALOG.toml -o ",
         ),
         ("id 0", &good.replace("\"id\": 7", "\"id\": 0"), "id 0"),
         (
@@ -231,7 +237,7 @@ fn build_show_check_and_json_round_trip() {
     let out = dir.path().join("reg.json");
     ok(&mut build(&catalog, &out, &["--method", "luminous"]));
     let reg = read_json(&out);
-    assert_eq!(reg["schema"], 1);
+    assert_eq!(reg["schema"], 2);
     assert_eq!(reg["spectral"]["method"], "luminous");
     assert_eq!(glass_ids(&reg), [1, 3, 200], "glasses are sorted by id");
     let clear = glass_by_name(&reg, "Clear 3");
@@ -399,6 +405,36 @@ fn mask_filtered_build_keeps_only_the_ids_in_use() {
         &["--mask", junk.to_str().unwrap()],
     ));
     assert!(err.contains("junk.png"), "{err}");
+}
+
+/// `data/registry.json` (the bundled default) is exactly what the documented command builds
+/// from `data/catalog.toml`; `GLASSDB_REGEN=1` rewrites it instead.
+#[test]
+fn bundled_registry_json_rebuilds_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("registry.json");
+    ok(glassdb()
+        .current_dir(repo_root())
+        .args(["registry", "build", "data/catalog.toml", "-o"])
+        .arg(&out));
+    let fresh = std::fs::read(&out).unwrap();
+    let committed = repo_path("data/registry.json");
+    if std::env::var_os("GLASSDB_REGEN").is_some_and(|v| v == "1") {
+        std::fs::write(&committed, &fresh).unwrap();
+    }
+    assert!(
+        fresh == std::fs::read(&committed).unwrap(),
+        "data/registry.json differs from `glassdb registry build data/catalog.toml -o data/registry.json` \
+         (run from the repository root); regenerate it with GLASSDB_REGEN=1 cargo test --test cli bundled_registry_json"
+    );
+    // Nothing machine-specific: paths are relative to the repository or to the catalog.
+    let text = String::from_utf8(fresh).unwrap();
+    let root = repo_root().display().to_string();
+    assert!(!text.contains(&root), "absolute path in data/registry.json");
+    assert_eq!(
+        glassdb_registry::default_registry().unwrap(),
+        glassdb_registry::Registry::from_json_str(&text, "fresh").unwrap()
+    );
 }
 
 #[test]

@@ -74,8 +74,9 @@ pub enum ComposeError {
     },
     #[error("{0}")]
     BadOption(String),
-    #[error("{path}: {detail}")]
-    PlanesFile { path: PathBuf, detail: String },
+    /// A `planes.json` could not be read or is not a valid planes file.
+    #[error(transparent)]
+    PlanesFile(#[from] glassdb_scene::SceneError),
     #[error("cannot tell the output format of {path}: use a .exr or .png extension")]
     OutputExtension { path: PathBuf },
     #[error("cannot encode {path}")]

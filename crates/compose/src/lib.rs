@@ -143,48 +143,15 @@ pub fn parse_side_spec(spec: &str) -> Result<(usize, Side), ComposeError> {
     };
     let (k, side) = spec.split_once('=').ok_or_else(bad)?;
     let k: usize = k.trim().parse().map_err(|_| bad())?;
-    let side = match side.trim().to_ascii_lowercase().as_str() {
-        "front" => Side::Front,
-        "back" => Side::Back,
-        _ => return Err(bad()),
-    };
+    let side: Side = side.parse().map_err(|_| bad())?;
     Ok((k, side))
 }
 
-/// Plane sides from a `planes.json` written by `glassdb mirror` (`planes[k].eye_side`).
+/// Plane sides from a `planes.json` written by `glassdb mirror` (`planes[k].eye_side`), read
+/// by the scene crate's own reader (format and plane order checked).
 pub fn sides_from_planes_json(path: &Path) -> Result<BTreeMap<usize, Side>, ComposeError> {
-    let bad = |detail: String| ComposeError::PlanesFile {
-        path: path.to_path_buf(),
-        detail,
-    };
-    let text = std::fs::read_to_string(path).map_err(|cause| ComposeError::Read {
-        path: path.to_path_buf(),
-        cause,
-    })?;
-    let json: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| bad(format!("line {}, column {}: {e}", e.line(), e.column())))?;
-    let planes = json
-        .get("planes")
-        .and_then(|p| p.as_array())
-        .ok_or_else(|| bad("no \"planes\" array".into()))?;
-    let mut sides = BTreeMap::new();
-    for (k, p) in planes.iter().enumerate() {
-        let index = p
-            .get("index")
-            .and_then(|i| i.as_u64())
-            .map_or(k, |i| i as usize);
-        let side = match p.get("eye_side").and_then(|s| s.as_str()) {
-            Some("front") => Side::Front,
-            Some("back") => Side::Back,
-            other => {
-                return Err(bad(format!(
-                    "plane {k}: eye_side {other:?} is not \"front\" or \"back\""
-                )));
-            }
-        };
-        sides.insert(index, side);
-    }
-    Ok(sides)
+    let file = glassdb_scene::PlanesFile::load(path)?;
+    Ok(file.planes.iter().map(|p| (p.index, p.eye_side)).collect())
 }
 
 /// Reads the inputs of one image in parallel.

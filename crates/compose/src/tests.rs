@@ -213,7 +213,7 @@ fn side_specs_parse() {
 fn planes_json_sides() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("planes.json");
-    std::fs::write(&p, r#"{"format":"glassdb-planes/1","planes":[{"index":0,"eye_side":"front"},{"index":1,"eye_side":"back"}]}"#).unwrap();
+    std::fs::write(&p, planes_json(&["front", "back"], &[0, 1])).unwrap();
     let sides = sides_from_planes_json(&p).unwrap();
     assert_eq!(sides, BTreeMap::from([(0, Side::Front), (1, Side::Back)]));
     std::fs::write(&p, r#"{"planes":[{"eye_side":"up"}]}"#).unwrap();
@@ -223,6 +223,36 @@ fn planes_json_sides() {
             .to_string()
             .contains("planes.json")
     );
+    // The scene crate's reader checks the side names, the format and the plane order.
+    for bad in [
+        planes_json(&["front", "up"], &[0, 1]),
+        planes_json(&["front", "back"], &[1, 0]),
+        planes_json(&["front"], &[0]).replace("glassdb-planes/1", "glassdb-planes/9"),
+    ] {
+        std::fs::write(&p, &bad).unwrap();
+        let err = sides_from_planes_json(&p).unwrap_err();
+        assert!(
+            matches!(err, ComposeError::PlanesFile(_)) && err.to_string().contains("planes.json"),
+            "{err}"
+        );
+    }
+}
+
+/// A planes file as `glassdb mirror` writes it, with the given eye sides and plane indices.
+fn planes_json(sides: &[&str], indices: &[usize]) -> String {
+    let planes: Vec<String> = sides
+        .iter()
+        .zip(indices)
+        .map(|(side, index)| {
+            format!(
+                r#"{{"index":{index},"equation":[0.0,0.0,1.0,{index}.0],"area":1.0,"materials":["glass"],"triangles":2,"eye_side":"{side}","reflection_matrix":[[1.0,0.0,0.0,0.0],[0.0,1.0,0.0,0.0],[0.0,0.0,-1.0,0.0],[0.0,0.0,0.0,1.0]],"file":"virtual_plane_{index}.obj","triangles_written":0,"triangles_clipped":0}}"#
+            )
+        })
+        .collect();
+    format!(
+        r#"{{"format":"glassdb-planes/1","source":"scene.obj","eye":null,"tolerance":{{"angle_deg":0.5,"distance":0.001}},"planes":[{}]}}"#,
+        planes.join(",")
+    )
 }
 
 proptest! {

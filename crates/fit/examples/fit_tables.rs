@@ -51,13 +51,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                                 println!(
                                     "| {d} | {} | {:.2e} | {:.2e} | {:+.2e} | {} | {:.3} | {:.3e} |",
                                     b.name(),
-                                    c.diagnostics.max_abs_error,
+                                    c.diagnostics.summary.max_abs_error,
                                     e85,
                                     elast,
                                     c.diagnostics
                                         .loo_rms_error
                                         .map_or("-".into(), |v| format!("{v:.2e}")),
-                                    c.diagnostics.condition_number,
+                                    c.diagnostics.summary.condition_number,
                                     c.diagnostics
                                         .power_basis_condition_number
                                         .unwrap_or(f64::NAN)
@@ -101,10 +101,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 println!(
                     "\ndefault: {} basis, degree {} ({}), max err {:.2e} at {}°, max err 0–85° {:.2e}",
                     c.polynomial.basis.name(),
-                    c.diagnostics.degree,
+                    c.diagnostics.summary.degree,
                     c.diagnostics.degree_selection,
-                    c.diagnostics.max_abs_error,
-                    c.diagnostics.max_error_angle_deg,
+                    c.diagnostics.summary.max_abs_error,
+                    c.diagnostics.summary.max_error_angle_deg,
                     max_err(s, |a| c.eval_angle_deg(a), 85.0)
                 );
             }

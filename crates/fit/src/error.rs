@@ -25,12 +25,21 @@ pub enum FitError {
     /// The file has a header but no data rows.
     #[error("{path}: no data rows after the header")]
     NoRows { path: PathBuf },
-    /// The CSV structure is broken (e.g. a row with a different number of fields than the header).
-    #[error("{path}, line {line}: {message}")]
+    /// A row with a different number of fields than the header.
+    #[error("{path}, line {line}: row has {fields} field(s) but the header has {header_fields}")]
+    RaggedRow {
+        path: PathBuf,
+        line: u64,
+        fields: u64,
+        header_fields: u64,
+    },
+    /// The CSV reader failed otherwise (text not UTF-8, an I/O error); the reader's error is
+    /// the source.
+    #[error("{path}, line {line}: not readable as CSV")]
     Csv {
         path: PathBuf,
         line: u64,
-        message: String,
+        source: csv::Error,
     },
     /// A required column is missing from the header.
     #[error("{path}, line {line}: missing column {wanted} (header has: {found})")]
@@ -98,16 +107,16 @@ pub enum FitError {
     },
     /// A value above 1 in a table read as fractions.
     #[error(
-        "{path}, line {line}, column {column} ({header}): {value} is above 1; values are fractions 0–1 (if the table is in percent, pass --percent)"
+        "{path}, line {line}, column {column} ({header}): {value} is above 1; values are fractions 0–1 (the table may be in percent)"
     )]
-    PercentWithoutFlag {
+    AboveOneInFractions {
         path: PathBuf,
         line: u64,
         column: usize,
         header: String,
         value: f64,
     },
-    /// A value outside 0–1 (or 0–100 with `--percent`).
+    /// A value outside 0–1 (or 0–100 when read as percent).
     #[error("{path}, line {line}, column {column} ({header}): {value} is outside {range}")]
     ValueOutOfRange {
         path: PathBuf,
@@ -154,6 +163,14 @@ pub enum FitError {
     /// A fit file (JSON) is malformed or inconsistent.
     #[error("{path}: {message}")]
     FitFile { path: PathBuf, message: String },
+    /// A curve of a fit file cannot be evaluated as written.
+    #[error("{path}: glass `{glass}`, {quantity}")]
+    CurveShape {
+        path: PathBuf,
+        glass: String,
+        quantity: &'static str,
+        source: crate::PolynomialShape,
+    },
     /// A fit of one curve of one glass failed (the inner error says why).
     #[error("glass `{glass}`, {quantity}: {error}")]
     Curve {

@@ -96,25 +96,12 @@ pub fn parse_fit_json(bytes: &[u8], path: &Path) -> Result<FitFile, FitError> {
             let Some(c) = c else { continue };
             let where_ = format!("glass `{}`, {q}", g.name);
             let p = &c.polynomial;
-            if p.coefficients.is_empty() || p.coefficients.len() != p.powers.len() {
-                return Err(err(format!(
-                    "{where_}: {} powers but {} coefficients",
-                    p.powers.len(),
-                    p.coefficients.len()
-                )));
-            }
-            if p.powers.windows(2).any(|w| w[1] <= w[0]) {
-                return Err(err(format!(
-                    "{where_}: powers must ascend strictly, got {:?}",
-                    p.powers
-                )));
-            }
-            if p.powers.last().is_some_and(|&m| m > 64) {
-                return Err(err(format!(
-                    "{where_}: power {:?} above 64",
-                    p.powers.last()
-                )));
-            }
+            p.check_shape().map_err(|source| FitError::CurveShape {
+                path: path.to_path_buf(),
+                glass: g.name.clone(),
+                quantity: q,
+                source,
+            })?;
             if !c.normal.is_finite() || p.coefficients.iter().any(|v| !v.is_finite()) {
                 return Err(err(format!(
                     "{where_}: non-finite normal value or coefficient"

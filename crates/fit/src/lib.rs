@@ -23,7 +23,7 @@ pub use glass::{
 };
 pub use model::{
     AngleSamples, Basis, CosPolynomial, CurveFit, DEFAULT_MAX_DEGREE, DEFAULT_TOL, FitDiagnostics,
-    FitOptions, Quantity, SuspectPoint, cos_deg,
+    FitOptions, FitSummary, MAX_POWER, PolynomialShape, Quantity, SuspectPoint, cos_deg,
 };
 pub use solve::{
     EXTRAPOLATION_MARGIN_DEG, LOO_GUARD_FACTOR, MAX_DEGREE, SUSPECT_STUDENTIZED, fit_curve,

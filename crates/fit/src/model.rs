@@ -40,6 +40,23 @@ impl Basis {
     }
 }
 
+impl std::fmt::Display for Basis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Basis {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Basis, String> {
+        [Basis::Paper, Basis::Full]
+            .into_iter()
+            .find(|b| s.eq_ignore_ascii_case(b.name()))
+            .ok_or_else(|| format!("unknown basis `{s}`; expected paper or full"))
+    }
+}
+
 /// `C(θ) = Σ_k coefficients[k] · cos(θ)^powers[k]` (method eqs. 12–13): the ratio of a
 /// quantity at incidence angle θ to its normal-incidence value. `powers` ascend strictly.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
@@ -50,42 +67,22 @@ pub struct CosPolynomial {
 }
 
 impl CosPolynomial {
-    /// C at `cos_theta` by Horner's rule over the (ascending) powers: one multiply-add per
-    /// coefficient when the powers are contiguous, as every fit this crate produces is.
+    /// C at `cos_theta` by Horner's rule over the (strictly ascending) powers: one multiply-add
+    /// per coefficient, times `cos^gap` where consecutive powers skip (never, for the fits this
+    /// crate writes), times `cos^powers[0]` at the end.
     #[inline]
     pub fn eval(&self, cos_theta: f64) -> f64 {
         let n = self.coefficients.len().min(self.powers.len());
-        if n == 0 {
+        let Some(last) = n.checked_sub(1) else {
             return 0.0;
-        }
+        };
         let x = cos_theta;
-        let (first, last) = (self.powers[0], self.powers[n - 1]);
-        if last.checked_sub(first) == Some(n as u32 - 1) {
-            // contiguous powers first..=last (every fit this crate writes): plain Horner
-            let acc = self.coefficients[..n]
-                .iter()
-                .rev()
-                .fold(0.0, |acc, &c| acc * x + c);
-            return match first {
-                0 => acc,
-                1 => acc * x,
-                p => acc * x.powi(p as i32),
-            };
+        let mut acc = self.coefficients[last];
+        for k in (0..last).rev() {
+            let gap = self.powers[k + 1].saturating_sub(self.powers[k]);
+            acc = acc * pow_small(x, gap) + self.coefficients[k];
         }
-        let mut acc = self.coefficients[n - 1];
-        for k in (0..n - 1).rev() {
-            let gap = i64::from(self.powers[k + 1]) - i64::from(self.powers[k]);
-            acc = if gap == 1 {
-                acc * x
-            } else {
-                acc * x.powi(gap as i32)
-            } + self.coefficients[k];
-        }
-        match self.powers[0] {
-            0 => acc,
-            1 => acc * x,
-            p => acc * x.powi(p as i32),
-        }
+        acc * pow_small(x, self.powers[0])
     }
 
     /// C at an incidence angle in degrees (cos 90° is taken as exactly 0).
@@ -96,6 +93,61 @@ impl CosPolynomial {
     /// The highest power (the degree n of eqs. 12–13).
     pub fn degree(&self) -> u32 {
         self.powers.last().copied().unwrap_or(0)
+    }
+}
+
+/// The highest power of cos θ a curve may have (the power basis is hopeless far below it).
+pub const MAX_POWER: u32 = 64;
+
+/// Why a [`CosPolynomial`] as written (in a fit file or a registry) cannot be evaluated.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PolynomialShape {
+    #[error("no terms")]
+    NoTerms,
+    #[error("{powers} powers but {coefficients} coefficients")]
+    LengthMismatch { powers: usize, coefficients: usize },
+    #[error("power {0} is beyond the supported {MAX_POWER}")]
+    PowerTooHigh(u32),
+    #[error("powers must ascend strictly, but {0} is followed by {1}")]
+    NotAscending(u32, u32),
+    #[error("the paper basis has no constant term (power 0)")]
+    ConstantInPaperBasis,
+}
+
+impl CosPolynomial {
+    /// Checks what [`CosPolynomial::eval`] relies on: at least one term, one coefficient per
+    /// power, powers ≤ [`MAX_POWER`] and strictly ascending, no power 0 in the paper basis.
+    /// (Finiteness of the coefficients is the caller's check, to name the coefficient.)
+    pub fn check_shape(&self) -> Result<(), PolynomialShape> {
+        if self.powers.is_empty() && self.coefficients.is_empty() {
+            return Err(PolynomialShape::NoTerms);
+        }
+        if self.powers.len() != self.coefficients.len() {
+            return Err(PolynomialShape::LengthMismatch {
+                powers: self.powers.len(),
+                coefficients: self.coefficients.len(),
+            });
+        }
+        if let Some(&p) = self.powers.iter().find(|&&p| p > MAX_POWER) {
+            return Err(PolynomialShape::PowerTooHigh(p));
+        }
+        if let Some(w) = self.powers.windows(2).find(|w| w[1] <= w[0]) {
+            return Err(PolynomialShape::NotAscending(w[0], w[1]));
+        }
+        if self.basis == Basis::Paper && self.powers[0] == 0 {
+            return Err(PolynomialShape::ConstantInPaperBasis);
+        }
+        Ok(())
+    }
+}
+
+/// `x^p` with the common small powers 0 and 1 exact and free.
+#[inline]
+fn pow_small(x: f64, p: u32) -> f64 {
+    match p {
+        0 => 1.0,
+        1 => x,
+        p => x.powi(p.min(i32::MAX as u32) as i32),
     }
 }
 
@@ -121,10 +173,10 @@ pub struct SuspectPoint {
     pub studentized: f64,
 }
 
-/// How well a curve fits its data, and what was solved. The first five fields are the issue's
-/// JSON keys; the rest are extra keys (all optional when reading).
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
-pub struct FitDiagnostics {
+/// How well a curve fits its data: the five numbers every consumer of a fit keeps (the fit
+/// JSON and the registry store them beside the polynomial, under these keys).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq)]
+pub struct FitSummary {
     /// Highest power of cos θ.
     pub degree: u32,
     /// RMS of fitted − measured over the data (fraction, absolute: r(θ), not C(θ)).
@@ -136,6 +188,27 @@ pub struct FitDiagnostics {
     /// 2-norm condition number of the least-squares matrix actually solved (orthogonal
     /// Chebyshev basis on the data's cos θ range, restricted to the constraint's null space).
     pub condition_number: f64,
+}
+
+impl FitSummary {
+    /// The summary of an exact curve that was not fitted (no residual, condition number 1).
+    pub fn exact(degree: u32) -> FitSummary {
+        FitSummary {
+            degree,
+            rms_error: 0.0,
+            max_abs_error: 0.0,
+            max_error_angle_deg: 0.0,
+            condition_number: 1.0,
+        }
+    }
+}
+
+/// How well a curve fits its data, and what was solved: the [`FitSummary`] keys (the issue's
+/// JSON keys) and extra keys (all optional when reading).
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct FitDiagnostics {
+    #[serde(flatten)]
+    pub summary: FitSummary,
     /// Condition number of the same fit written in the power basis (cos^p θ columns): what a
     /// naive solver would face; the normal equations square it.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -20,7 +20,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::dd::Dd;
 use crate::error::FitError;
 use crate::model::{
-    AngleSamples, Basis, CosPolynomial, CurveFit, FitDiagnostics, FitOptions, Quantity,
+    AngleSamples, Basis, CosPolynomial, CurveFit, FitDiagnostics, FitOptions, FitSummary, Quantity,
     SuspectPoint, cos_deg,
 };
 
@@ -258,124 +258,163 @@ fn qr_least_squares(b: DMatrix<f64>, rhs: &DVector<f64>) -> Option<(DVector<f64>
     Some((w, hat))
 }
 
-/// Fits one basis at one degree.
-pub(crate) fn solve_fixed(
-    p: &Prepared,
-    basis: Basis,
-    degree: u32,
-    tol: f64,
-) -> Result<Solved, FitError> {
-    let m = coefficient_count(basis, degree);
-    let n = p.angle_deg.len();
-    if m == 0 {
-        return Err(FitError::InvalidOptions(
-            "the paper basis needs degree ≥ 1".into(),
-        ));
-    }
-    if n < m {
-        return Err(FitError::TooFewPoints {
-            points: n,
-            coefficients: m,
-            degree,
-            basis: basis.name(),
-        });
-    }
-    let powers = basis.powers(degree);
-    // Constrained fit when the 0° value is measured and non-zero.
-    let constrained = match p.measured_normal {
-        Some(v0) if v0 > 0.0 => Some(v0),
-        Some(v0) if v0 == 0.0 && p.value.iter().all(|&v| v == 0.0) => {
-            return Ok(zero_curve(basis, degree, powers));
-        }
-        Some(v0) if v0 == 0.0 => {
-            return Err(FitError::BadNormal {
+/// How the 0° value enters a fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum NormalConstraint {
+    /// The measured, positive 0° value: C(1) = 1 is imposed and `C = value / normal`.
+    Measured(f64),
+    /// No 0° row: the absolute curve is fitted and its value at cos θ = 1 becomes the normal.
+    Extrapolated,
+    /// Zero everywhere (e.g. an opaque pane's transmittance): nothing to fit.
+    AllZero,
+}
+
+impl NormalConstraint {
+    fn of(p: &Prepared) -> Result<NormalConstraint, FitError> {
+        match p.measured_normal {
+            Some(v0) if v0 > 0.0 => Ok(NormalConstraint::Measured(v0)),
+            Some(v0) if v0 == 0.0 && p.value.iter().all(|&v| v == 0.0) => {
+                Ok(NormalConstraint::AllZero)
+            }
+            Some(v0) if v0 == 0.0 => Err(FitError::BadNormal {
                 normal: v0,
                 detail: "but the curve is not zero at other angles",
-            });
-        }
-        Some(v0) => {
-            return Err(FitError::BadNormal {
+            }),
+            Some(v0) => Err(FitError::BadNormal {
                 normal: v0,
                 detail: "negative",
-            });
+            }),
+            None => Ok(NormalConstraint::Extrapolated),
         }
-        None => None,
-    };
-    // Rows of the least-squares system: all points except the 0° row in the constrained case.
-    let rows: Vec<usize> = (0..n)
-        .filter(|&i| constrained.is_none() || p.angle_deg[i] != 0.0)
-        .collect();
-    let lo = rows
-        .iter()
-        .map(|&i| p.cos[i])
-        .fold(f64::INFINITY, f64::min)
-        .min(if constrained.is_some() {
-            1.0
-        } else {
-            f64::INFINITY
-        });
-    let hi = rows
-        .iter()
-        .map(|&i| p.cos[i])
-        .fold(f64::NEG_INFINITY, f64::max)
-        .max(if constrained.is_some() {
-            1.0
-        } else {
-            f64::NEG_INFINITY
-        });
-    let map = Affine::new(lo, hi);
-    let mut tj = vec![0.0; m];
-    let mut phi = |x: f64, out: &mut [f64]| {
-        chebyshev(map.u(x), m, &mut tj);
-        for j in 0..m {
-            out[j] = if basis == Basis::Paper {
+    }
+
+    fn measured(self) -> Option<f64> {
+        match self {
+            NormalConstraint::Measured(v0) => Some(v0),
+            _ => None,
+        }
+    }
+}
+
+/// The Chebyshev-type basis of one fit: `T_j(u(x))` (full) or `x·T_j(u(x))` (paper), j < m.
+struct ChebyshevBasis {
+    basis: Basis,
+    map: Affine,
+    m: usize,
+}
+
+impl ChebyshevBasis {
+    /// The basis on the cos θ range of the fitted rows (and cos 0° = 1 when constrained).
+    fn on_rows(p: &Prepared, rows: &[usize], basis: Basis, m: usize, constrained: bool) -> Self {
+        let with_one = |bound: f64| if constrained { 1.0 } else { bound };
+        let lo = rows
+            .iter()
+            .map(|&i| p.cos[i])
+            .fold(f64::INFINITY, f64::min)
+            .min(with_one(f64::INFINITY));
+        let hi = rows
+            .iter()
+            .map(|&i| p.cos[i])
+            .fold(f64::NEG_INFINITY, f64::max)
+            .max(with_one(f64::NEG_INFINITY));
+        ChebyshevBasis {
+            basis,
+            map: Affine::new(lo, hi),
+            m,
+        }
+    }
+
+    /// The m basis functions at x, into `out` (`tj` is scratch of length m).
+    fn at(&self, x: f64, tj: &mut [f64], out: &mut [f64]) {
+        chebyshev(self.map.u(x), self.m, tj);
+        for j in 0..self.m {
+            out[j] = if self.basis == Basis::Paper {
                 x * tj[j]
             } else {
                 tj[j]
             };
         }
-    };
-    let nr = rows.len();
-    let mut a = DMatrix::<f64>::zeros(nr, m);
-    let mut rowbuf = vec![0.0; m];
-    for (r, &i) in rows.iter().enumerate() {
-        phi(p.cos[i], &mut rowbuf);
-        for j in 0..m {
-            a[(r, j)] = rowbuf[j];
-        }
     }
-    let scale = constrained.unwrap_or(1.0);
-    let target = DVector::from_iterator(nr, rows.iter().map(|&i| p.value[i] / scale));
 
-    let singular = || FitError::Singular { degree, points: n };
-    // coefficients in the Chebyshev-type basis (double-double for the conversion), residuals
-    // and hat diagonal in the solved system
-    let (cheb, hat, solved_matrix_cond, free) = if constrained.is_some() {
-        let mut g = DVector::<f64>::zeros(m);
-        phi(1.0, g.as_mut_slice());
-        let (h, gh0) = householder_nullspace(&g);
-        let w0 = 1.0 / gh0;
-        let ah = &a * &h;
-        let rhs = &target - ah.column(0) * w0;
-        let bfree = ah.columns(1, m - 1).into_owned();
-        let cond = condition_number(&bfree);
-        let (wfree, hat) = qr_least_squares(bfree, &rhs).ok_or_else(singular)?;
-        // a = H w in double-double
-        let mut w = vec![Dd::from_f64(w0)];
-        w.extend(wfree.iter().map(|&v| Dd::from_f64(v)));
-        let cheb: Vec<Dd> = (0..m)
-            .map(|r| (0..m).fold(Dd::ZERO, |acc, c| acc + Dd::from_f64(h[(r, c)]) * w[c]))
-            .collect();
-        (cheb, hat, cond, m - 1)
-    } else {
+    /// The design matrix over the given rows.
+    fn design(&self, p: &Prepared, rows: &[usize]) -> DMatrix<f64> {
+        let mut a = DMatrix::<f64>::zeros(rows.len(), self.m);
+        let (mut tj, mut rowbuf) = (vec![0.0; self.m], vec![0.0; self.m]);
+        for (r, &i) in rows.iter().enumerate() {
+            self.at(p.cos[i], &mut tj, &mut rowbuf);
+            for j in 0..self.m {
+                a[(r, j)] = rowbuf[j];
+            }
+        }
+        a
+    }
+}
+
+/// The least-squares solution in the Chebyshev-type basis.
+struct ChebyshevSolution {
+    /// Coefficients (double-double for the conversion to powers).
+    coefficients: Vec<Dd>,
+    /// Hat-matrix diagonal over the fitted rows.
+    hat: Vec<f64>,
+    /// Condition number of the matrix actually solved.
+    cond: f64,
+    /// Number of free coefficients.
+    free: usize,
+}
+
+/// Solves `a·c ≈ target`, with `g·c = 1` (g = the basis at cos θ = 1) when `constrained`.
+fn solve_chebyshev(
+    cheb: &ChebyshevBasis,
+    a: DMatrix<f64>,
+    target: &DVector<f64>,
+    constrained: bool,
+    singular: impl Fn() -> FitError,
+) -> Result<ChebyshevSolution, FitError> {
+    let m = cheb.m;
+    if !constrained {
         let cond = condition_number(&a);
-        let (w, hat) = qr_least_squares(a.clone(), &target).ok_or_else(singular)?;
-        (w.iter().map(|&v| Dd::from_f64(v)).collect(), hat, cond, m)
-    };
+        let (w, hat) = qr_least_squares(a, target).ok_or_else(singular)?;
+        return Ok(ChebyshevSolution {
+            coefficients: w.iter().map(|&v| Dd::from_f64(v)).collect(),
+            hat,
+            cond,
+            free: m,
+        });
+    }
+    let mut g = DVector::<f64>::zeros(m);
+    cheb.at(1.0, &mut vec![0.0; m], g.as_mut_slice());
+    let (h, gh0) = householder_nullspace(&g);
+    let w0 = 1.0 / gh0;
+    let ah = &a * &h;
+    let rhs = target - ah.column(0) * w0;
+    let bfree = ah.columns(1, m - 1).into_owned();
+    let cond = condition_number(&bfree);
+    let (wfree, hat) = qr_least_squares(bfree, &rhs).ok_or_else(singular)?;
+    // a = H w in double-double
+    let mut w = vec![Dd::from_f64(w0)];
+    w.extend(wfree.iter().map(|&v| Dd::from_f64(v)));
+    let coefficients = (0..m)
+        .map(|r| (0..m).fold(Dd::ZERO, |acc, c| acc + Dd::from_f64(h[(r, c)]) * w[c]))
+        .collect();
+    Ok(ChebyshevSolution {
+        coefficients,
+        hat,
+        cond,
+        free: m - 1,
+    })
+}
 
-    let mut power = to_power_basis(&cheb, map, basis);
+/// The power-basis polynomial and normal value of a Chebyshev solution, with `C(1) = 1` as
+/// exactly as the f64 Horner evaluation allows.
+fn power_polynomial(
+    cheb: &ChebyshevBasis,
+    solution: &[Dd],
+    constraint: NormalConstraint,
+    powers: Vec<u32>,
+) -> Result<(f64, CosPolynomial), FitError> {
+    let mut power = to_power_basis(solution, cheb.map, cheb.basis);
     let normal;
-    if let Some(v0) = constrained {
+    if let Some(v0) = constraint.measured() {
         normal = v0;
         // move the conversion's rounding out of C(1) into the lowest power
         let sum = power.iter().fold(Dd::ZERO, |acc, &c| acc + c);
@@ -400,13 +439,12 @@ pub(crate) fn solve_fixed(
         let sum = power.iter().fold(Dd::ZERO, |acc, &c| acc + c);
         power[0] = power[0] - (sum - Dd::from_f64(1.0));
     }
-    let mut coefficients: Vec<f64> = power.iter().map(|c| c.to_f64()).collect();
     // make the f64 evaluation at cos θ = 1 (Horner, as `CosPolynomial::eval` does it) give 1
     // as exactly as rounding allows: nudge the lowest coefficient by the leftover
     let mut poly = CosPolynomial {
-        basis,
-        powers: powers.clone(),
-        coefficients: coefficients.clone(),
+        basis: cheb.basis,
+        powers,
+        coefficients: power.iter().map(|c| c.to_f64()).collect(),
     };
     for _ in 0..4 {
         let e = poly.eval(1.0) - 1.0;
@@ -415,7 +453,125 @@ pub(crate) fn solve_fixed(
         }
         poly.coefficients[0] -= e;
     }
-    coefficients.clone_from(&poly.coefficients);
+    Ok((normal, poly))
+}
+
+/// Leave-one-out (PRESS) RMS error over the fitted rows; `None` when a point determines a
+/// coefficient by itself (hat value 1).
+fn leave_one_out_rms(rows: &[usize], hat: &[f64], residual: &[f64]) -> Option<f64> {
+    let nr = rows.len();
+    let mut press = 0.0;
+    let mut loo_defined = nr > 0;
+    for (r, &i) in rows.iter().enumerate() {
+        let one_minus_h = 1.0 - hat[r];
+        if one_minus_h < 1e-10 {
+            loo_defined = false;
+            break;
+        }
+        let e = residual[i] / one_minus_h;
+        press += e * e;
+    }
+    loo_defined.then(|| (press / nr as f64).sqrt())
+}
+
+/// Isolated points whose externally studentized residual exceeds [`SUSPECT_STUDENTIZED`] (and
+/// tol/2), worst first; none with fewer than 3 degrees of freedom.
+fn suspect_points(
+    p: &Prepared,
+    rows: &[usize],
+    hat: &[f64],
+    residual: &[f64],
+    free: usize,
+    tol: f64,
+) -> Vec<SuspectPoint> {
+    let n = p.angle_deg.len();
+    let dof = rows.len() as i64 - free as i64;
+    let mut suspects = Vec::new();
+    if dof < 3 {
+        return suspects;
+    }
+    let ssr: f64 = rows.iter().map(|&i| residual[i] * residual[i]).sum();
+    for (r, &i) in rows.iter().enumerate() {
+        let one_minus_h = 1.0 - hat[r];
+        if one_minus_h < 1e-10 {
+            continue;
+        }
+        let e = residual[i];
+        let s2 = (ssr - e * e / one_minus_h) / (dof - 1) as f64;
+        if s2 <= 0.0 {
+            continue;
+        }
+        let t = e / (s2.sqrt() * one_minus_h.sqrt());
+        // an outlier is isolated: its neighbours fit much better (a systematic misfit,
+        // e.g. at grazing incidence, spreads over consecutive points instead)
+        let isolated = [i.checked_sub(1), (i + 1 < n).then_some(i + 1)]
+            .into_iter()
+            .flatten()
+            .all(|k| residual[k].abs() < e.abs() / 3.0);
+        if t.abs() > SUSPECT_STUDENTIZED && e.abs() > 0.5 * tol && isolated {
+            suspects.push(SuspectPoint {
+                angle_deg: p.angle_deg[i],
+                residual: e,
+                studentized: t,
+            });
+        }
+    }
+    suspects.sort_by(|a, b| b.studentized.abs().total_cmp(&a.studentized.abs()));
+    suspects
+}
+
+/// Condition number of the power-basis design matrix over the same points (for comparison).
+fn power_basis_condition(p: &Prepared, powers: &[u32]) -> f64 {
+    let mut vand = DMatrix::<f64>::zeros(p.cos.len(), powers.len());
+    for (i, &c) in p.cos.iter().enumerate() {
+        for (j, &pw) in powers.iter().enumerate() {
+            vand[(i, j)] = c.powi(pw as i32);
+        }
+    }
+    condition_number(&vand)
+}
+
+/// Fits one basis at one degree: the constraint, the Chebyshev least squares, the power form,
+/// then residual statistics (max, RMS, leave-one-out, suspects).
+pub(crate) fn solve_fixed(
+    p: &Prepared,
+    basis: Basis,
+    degree: u32,
+    tol: f64,
+) -> Result<Solved, FitError> {
+    let m = coefficient_count(basis, degree);
+    let n = p.angle_deg.len();
+    if m == 0 {
+        return Err(FitError::InvalidOptions(
+            "the paper basis needs degree ≥ 1".into(),
+        ));
+    }
+    if n < m {
+        return Err(FitError::TooFewPoints {
+            points: n,
+            coefficients: m,
+            degree,
+            basis: basis.name(),
+        });
+    }
+    let powers = basis.powers(degree);
+    let constraint = NormalConstraint::of(p)?;
+    if constraint == NormalConstraint::AllZero {
+        return Ok(zero_curve(basis, degree, powers));
+    }
+    let constrained = constraint.measured();
+    // Rows of the least-squares system: all points except the 0° row in the constrained case.
+    let rows: Vec<usize> = (0..n)
+        .filter(|&i| constrained.is_none() || p.angle_deg[i] != 0.0)
+        .collect();
+    let cheb = ChebyshevBasis::on_rows(p, &rows, basis, m, constrained.is_some());
+    let a = cheb.design(p, &rows);
+    let scale = constrained.unwrap_or(1.0);
+    let target = DVector::from_iterator(rows.len(), rows.iter().map(|&i| p.value[i] / scale));
+    let singular = || FitError::Singular { degree, points: n };
+    let solution = solve_chebyshev(&cheb, a, &target, constrained.is_some(), singular)?;
+    let (normal, poly) =
+        power_polynomial(&cheb, &solution.coefficients, constraint, powers.clone())?;
 
     // residuals of the exported power-basis curve (what users evaluate)
     let residual: Vec<f64> = (0..n)
@@ -432,72 +588,18 @@ pub(crate) fn solve_fixed(
             );
     let rms = (residual.iter().map(|r| r * r).sum::<f64>() / n as f64).sqrt();
 
-    // leave-one-out (PRESS) and externally studentized residuals on the least-squares rows
-    let dof = nr as i64 - free as i64;
-    let mut press = 0.0;
-    let mut loo_defined = nr > 0;
-    for (r, &i) in rows.iter().enumerate() {
-        let one_minus_h = 1.0 - hat[r];
-        if one_minus_h < 1e-10 {
-            loo_defined = false;
-            break;
-        }
-        let e = residual[i] / one_minus_h;
-        press += e * e;
-    }
-    let loo_rms = loo_defined.then(|| (press / nr as f64).sqrt());
-    let mut suspects = Vec::new();
-    if dof >= 3 {
-        let ssr: f64 = rows.iter().map(|&i| residual[i] * residual[i]).sum();
-        for (r, &i) in rows.iter().enumerate() {
-            let one_minus_h = 1.0 - hat[r];
-            if one_minus_h < 1e-10 {
-                continue;
-            }
-            let e = residual[i];
-            let s2 = (ssr - e * e / one_minus_h) / (dof - 1) as f64;
-            if s2 <= 0.0 {
-                continue;
-            }
-            let t = e / (s2.sqrt() * one_minus_h.sqrt());
-            // an outlier is isolated: its neighbours fit much better (a systematic misfit,
-            // e.g. at grazing incidence, spreads over consecutive points instead)
-            let isolated = [i.checked_sub(1), (i + 1 < n).then_some(i + 1)]
-                .into_iter()
-                .flatten()
-                .all(|k| residual[k].abs() < e.abs() / 3.0);
-            if t.abs() > SUSPECT_STUDENTIZED && e.abs() > 0.5 * tol && isolated {
-                suspects.push(SuspectPoint {
-                    angle_deg: p.angle_deg[i],
-                    residual: e,
-                    studentized: t,
-                });
-            }
-        }
-        suspects.sort_by(|a, b| b.studentized.abs().total_cmp(&a.studentized.abs()));
-    }
-
-    // the power-basis design matrix over the same points, for comparison
-    let mut vand = DMatrix::<f64>::zeros(n, m);
-    for i in 0..n {
-        for (j, &pw) in powers.iter().enumerate() {
-            vand[(i, j)] = p.cos[i].powi(pw as i32);
-        }
-    }
-    let power_cond = condition_number(&vand);
-
     Ok(Solved {
         basis,
         degree,
         normal,
-        coefficients,
+        coefficients: poly.coefficients,
         max_abs,
         max_idx,
         rms,
-        loo_rms,
-        cond: solved_matrix_cond,
-        power_cond,
-        suspects,
+        loo_rms: leave_one_out_rms(&rows, &solution.hat, &residual),
+        cond: solution.cond,
+        power_cond: power_basis_condition(p, &powers),
+        suspects: suspect_points(p, &rows, &solution.hat, &residual, solution.free, tol),
     })
 }
 
@@ -706,11 +808,13 @@ fn package(p: &Prepared, s: Solved, how: &'static str, opts: &FitOptions) -> Cur
         ));
     }
     let diagnostics = FitDiagnostics {
-        degree: s.degree,
-        rms_error: s.rms,
-        max_abs_error: s.max_abs,
-        max_error_angle_deg: p.angle_deg.get(s.max_idx).copied().unwrap_or(0.0),
-        condition_number: finite_or(s.cond, f64::MAX),
+        summary: FitSummary {
+            degree: s.degree,
+            rms_error: s.rms,
+            max_abs_error: s.max_abs,
+            max_error_angle_deg: p.angle_deg.get(s.max_idx).copied().unwrap_or(0.0),
+            condition_number: finite_or(s.cond, f64::MAX),
+        },
         power_basis_condition_number: Some(finite_or(s.power_cond, f64::MAX)),
         points: p.angle_deg.len(),
         angle_min_deg: Some(amin),

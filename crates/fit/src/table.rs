@@ -101,7 +101,7 @@ pub fn parse_angle_table(
         .flexible(false)
         .from_reader(bytes);
 
-    let headers = rdr.byte_headers().map_err(|e| csv_error(p(), &e))?.clone();
+    let headers = rdr.byte_headers().map_err(|e| csv_error(p(), e))?.clone();
     if headers.is_empty() || (headers.len() == 1 && headers[0].iter().all(u8::is_ascii_whitespace))
     {
         return Err(FitError::EmptyFile { path: p() });
@@ -161,7 +161,7 @@ pub fn parse_angle_table(
         match rdr.read_byte_record(&mut record) {
             Ok(true) => {}
             Ok(false) => break,
-            Err(e) => return Err(csv_error(p(), &e)),
+            Err(e) => return Err(csv_error(p(), e)),
         }
         let line = record.position().map(|pos| pos.line()).unwrap_or(0);
         let cell = |col: usize| -> Result<&str, FitError> {
@@ -236,7 +236,7 @@ pub fn parse_angle_table(
                 }
                 Ok(Some(v / 100.0))
             } else if v > 1.0 {
-                Err(FitError::PercentWithoutFlag {
+                Err(FitError::AboveOneInFractions {
                     path: p(),
                     line,
                     column: col + 1,
@@ -285,22 +285,22 @@ pub fn parse_angle_table(
     group(rows, path)
 }
 
-fn csv_error(path: PathBuf, e: &csv::Error) -> FitError {
+fn csv_error(path: PathBuf, e: csv::Error) -> FitError {
     let line = e.position().map(|pos| pos.line()).unwrap_or(0);
-    let message = match e.kind() {
+    match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..
-        } => {
-            format!("row has {len} field(s) but the header has {expected_len}")
-        }
-        csv::ErrorKind::Utf8 { .. } => "text is not valid UTF-8".to_string(),
-        csv::ErrorKind::Io(io) => format!("read error: {io}"),
-        _ => e.to_string(),
-    };
-    FitError::Csv {
-        path,
-        line,
-        message,
+        } => FitError::RaggedRow {
+            path,
+            line,
+            fields: *len,
+            header_fields: *expected_len,
+        },
+        _ => FitError::Csv {
+            path,
+            line,
+            source: e,
+        },
     }
 }
 

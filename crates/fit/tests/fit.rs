@@ -93,9 +93,9 @@ fn exact_polynomials_are_reproduced_and_coefficients_recovered() {
             let fit = fit_curve(&s, &opts(q, Some(basis), Some(degree))).unwrap();
             assert_eq!(fit.normal, normal);
             assert!(
-                fit.diagnostics.max_abs_error <= 1e-12,
+                fit.diagnostics.summary.max_abs_error <= 1e-12,
                 "{basis:?} {coef:?}: {}",
-                fit.diagnostics.max_abs_error
+                fit.diagnostics.summary.max_abs_error
             );
             for (got, want) in fit.polynomial.coefficients.iter().zip(&coef) {
                 assert!(
@@ -106,8 +106,8 @@ fn exact_polynomials_are_reproduced_and_coefficients_recovered() {
             }
             // automatic selection finds a degree no higher than the truth's, exact to 1e-12
             let auto = fit_curve(&s, &opts(q, Some(basis), None)).unwrap();
-            assert!(auto.diagnostics.degree <= degree);
-            assert!(auto.diagnostics.max_abs_error <= DEFAULT_TOL_TEST);
+            assert!(auto.diagnostics.summary.degree <= degree);
+            assert!(auto.diagnostics.summary.max_abs_error <= DEFAULT_TOL_TEST);
         }
     }
 }
@@ -161,9 +161,9 @@ fn nonabsorbing_slab_fits_within_tolerance_to_85_degrees() {
         assert!(
             worst <= 0.002,
             "{q:?}: max error 0–85° = {worst} at degree {}",
-            fit.diagnostics.degree
+            fit.diagnostics.summary.degree
         );
-        assert!(fit.diagnostics.degree <= 8);
+        assert!(fit.diagnostics.summary.degree <= 8);
     }
 }
 
@@ -177,7 +177,9 @@ fn paper_basis_cannot_reach_reflectance_one_at_grazing() {
     .unwrap();
     let full = fit_curve(&s, &opts(Quantity::Reflectance, Some(Basis::Full), Some(8))).unwrap();
     assert_eq!(paper.eval_angle_deg(90.0), 0.0); // forced by the form
-    assert!(paper.diagnostics.max_abs_error > 10.0 * full.diagnostics.max_abs_error);
+    assert!(
+        paper.diagnostics.summary.max_abs_error > 10.0 * full.diagnostics.summary.max_abs_error
+    );
     // the default for reflectance is the full basis
     assert_eq!(
         fit_curve(&s, &FitOptions::new(Quantity::Reflectance))
@@ -196,15 +198,15 @@ fn narrow_range_is_stable_and_warns_about_extrapolation() {
     let mut previous = f64::INFINITY;
     for d in 1..=8 {
         let fit = fit_curve(&s, &opts(Quantity::Reflectance, Some(Basis::Full), Some(d))).unwrap();
-        let e = fit.diagnostics.max_abs_error;
+        let e = fit.diagnostics.summary.max_abs_error;
         eprintln!(
             "0–30°, degree {d}: max error {e:.2e}, cond {:.1}",
-            fit.diagnostics.condition_number
+            fit.diagnostics.summary.condition_number
         );
         assert!(
-            fit.diagnostics.condition_number < 100.0,
+            fit.diagnostics.summary.condition_number < 100.0,
             "degree {d}: cond {}",
-            fit.diagnostics.condition_number
+            fit.diagnostics.summary.condition_number
         );
         assert!(
             e <= previous * 1.01 + 1e-15,
@@ -254,6 +256,7 @@ fn coated_bronze_curve_with_ct_above_one_is_accepted() {
             .as_ref()
             .unwrap()
             .diagnostics
+            .summary
             .max_abs_error
             <= 0.002
     );
@@ -297,7 +300,7 @@ fn noisy_data_with_one_outlier_is_pointed_at() {
         s.value[40] -= 0.03; // the outlier, at 40°
         let fit = fit_curve(&s, &FitOptions::new(Quantity::Transmittance)).unwrap();
         let d = &fit.diagnostics;
-        assert_eq!(d.max_error_angle_deg, 40.0, "seed {seed}");
+        assert_eq!(d.summary.max_error_angle_deg, 40.0, "seed {seed}");
         assert_eq!(
             d.suspect_points.len(),
             1,
@@ -312,7 +315,11 @@ fn noisy_data_with_one_outlier_is_pointed_at() {
                 .any(|w| w.contains("suspect point at 40°"))
         );
         // the noise does not drive the degree to the maximum: leave-one-out guard
-        assert!(d.degree < 8, "seed {seed}: degree {}", d.degree);
+        assert!(
+            d.summary.degree < 8,
+            "seed {seed}: degree {}",
+            d.summary.degree
+        );
     }
 }
 
@@ -585,6 +592,61 @@ fn malformed_fit_files_are_errors() {
     }
 }
 
+#[test]
+fn polynomial_shape_is_checked_once_for_fit_files_and_registries() {
+    use glassdb_fit::{CosPolynomial, PolynomialShape};
+    let poly = |basis, powers: Vec<u32>, coefficients: Vec<f64>| CosPolynomial {
+        basis,
+        powers,
+        coefficients,
+    };
+    assert_eq!(
+        poly(Basis::Full, vec![0, 1], vec![1.0, 0.0]).check_shape(),
+        Ok(())
+    );
+    for (bad, want) in [
+        (poly(Basis::Full, vec![], vec![]), PolynomialShape::NoTerms),
+        (
+            poly(Basis::Full, vec![0, 1], vec![1.0]),
+            PolynomialShape::LengthMismatch {
+                powers: 2,
+                coefficients: 1,
+            },
+        ),
+        (
+            poly(Basis::Full, vec![0, 65], vec![1.0, 0.0]),
+            PolynomialShape::PowerTooHigh(65),
+        ),
+        (
+            poly(Basis::Full, vec![1, 1], vec![1.0, 0.0]),
+            PolynomialShape::NotAscending(1, 1),
+        ),
+        (
+            poly(Basis::Paper, vec![0, 1], vec![0.0, 1.0]),
+            PolynomialShape::ConstantInPaperBasis,
+        ),
+    ] {
+        assert_eq!(bad.check_shape(), Err(want));
+    }
+    let e = parse_fit_json(
+        br#"{"glasses":[{"name":"g","reflectance":{"normal":0.1,"basis":"full","powers":[1,0],"coefficients":[1,0],
+            "degree":1,"rms_error":0,"max_abs_error":0,"max_error_angle_deg":0,"condition_number":1}}]}"#,
+        Path::new("bad.json"),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            FitError::CurveShape {
+                quantity: "reflectance",
+                source: PolynomialShape::NotAscending(1, 0),
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
 // ---- hard case 7: the reader ----
 
 #[test]
@@ -640,7 +702,10 @@ fn reader_errors_name_file_line_and_column() {
             &["line 3, column 1", "outside 0–90°"],
         ),
         ("angle_deg,R\n-1,0.1\n", &["outside 0–90°"]),
-        ("angle_deg,R\n0,8.1\n", &["line 2, column 2", "--percent"]),
+        (
+            "angle_deg,R\n0,8.1\n",
+            &["line 2, column 2", "may be in percent"],
+        ),
         ("angle_deg,R\n0,-0.1\n", &["outside 0–1"]),
         (
             "angle_deg,R,T\n0,0.1\n",
@@ -663,6 +728,16 @@ fn reader_errors_name_file_line_and_column() {
             assert!(e.contains(part), "{text:?}: {e}");
         }
     }
+    // The library says what is wrong; the command line adds which flag fixes it.
+    assert!(!err("angle_deg,R\n0,8.1\n").contains("--"));
+    assert!(matches!(
+        parse("angle_deg,R\n0,8.1\n", false),
+        Err(glassdb_fit::FitError::AboveOneInFractions {
+            line: 2,
+            column: 2,
+            ..
+        })
+    ));
     let e = parse("angle_deg,R\n0,180\n", true).unwrap_err().to_string();
     assert!(e.contains("0–100 (percent)"), "{e}");
     let e = parse_angle_table(

@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
+use glassdb_fit::{Basis, CosPolynomial, FitSummary};
 use glassdb_mask::{CosTheta, MaskImage};
-use glassdb_registry::{
-    AngleModelRecord, CurveRecord, GlassRecord, Provenance, Registry, SpectralMethodRecord,
-};
+use glassdb_registry::{AngleCurve, AngleModelRecord, GlassRecord, Provenance, Registry};
+use glassdb_spectral::{IntegrationSettings, Method};
 
 use crate::chart::{Line, Panel, clipped_runs, format_axis_tick, format_tick};
 use crate::figure::{Cell, GridFigure};
@@ -150,20 +150,18 @@ fn heat_map_range_and_rendering() {
     assert!(render_png(&wrong).is_err());
 }
 
-fn curve(powers: Vec<u32>, coefficients: Vec<f64>) -> CurveRecord {
-    CurveRecord {
-        basis: if powers.first() == Some(&0) {
-            "full".into()
-        } else {
-            "paper".into()
+fn curve(powers: Vec<u32>, coefficients: Vec<f64>) -> AngleCurve {
+    AngleCurve {
+        fit: FitSummary::exact(powers.last().copied().unwrap_or(0)),
+        polynomial: CosPolynomial {
+            basis: if powers.first() == Some(&0) {
+                Basis::Full
+            } else {
+                Basis::Paper
+            },
+            powers,
+            coefficients,
         },
-        degree: powers.last().copied().unwrap_or(0),
-        powers,
-        coefficients,
-        rms_error: 0.0,
-        max_abs_error: 0.0,
-        max_error_angle_deg: 0.0,
-        condition_number: 1.0,
         tolerance: 0.002,
     }
 }
@@ -174,12 +172,8 @@ fn linear_registry() -> Registry {
     let one = curve(vec![0], vec![1.0]);
     Registry {
         schema: glassdb_registry::SCHEMA_VERSION,
-        spectral: SpectralMethodRecord {
-            method: "explicit".into(),
-            cmf: None,
-            observer: None,
-            illuminant: None,
-            space: None,
+        spectral: IntegrationSettings {
+            method: Method::Luminous,
             extrapolate: false,
         },
         glasses: vec![GlassRecord {

@@ -133,9 +133,9 @@ pub enum NormalSource {
 
 /// Parses catalog text; `path` names it in errors.
 pub fn parse_catalog(text: &str, path: &Path) -> Result<Vec<GlassSpec>, RegistryError> {
-    let catalog: Catalog = toml::from_str(text).map_err(|e| RegistryError::CatalogSyntax {
+    let catalog: Catalog = toml::from_str(text).map_err(|source| RegistryError::CatalogToml {
         path: path.to_path_buf(),
-        message: e.to_string().trim_end().to_string(),
+        source: Box::new(source),
     })?;
     if catalog.glass.is_empty() {
         return Err(RegistryError::CatalogSyntax {
@@ -393,7 +393,7 @@ mod tests {
             ),
         ];
         for (text, want) in cases {
-            let msg = parse(text).unwrap_err().to_string();
+            let msg = glassdb_io::ErrorChain(&parse(text).unwrap_err()).to_string();
             assert!(
                 msg.contains(want),
                 "catalog {text:?}: message {msg:?} lacks {want:?}"

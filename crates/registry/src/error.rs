@@ -22,7 +22,7 @@ pub enum RegistryError {
 
     /// The registry was written by a different, incompatible schema version.
     #[error(
-        "{source_name}: registry schema {found} is not supported (this build reads schema {expected})"
+        "{source_name}: registry schema {found} is not supported (this build reads schema {expected}); rebuild it from its catalog"
     )]
     SchemaVersion {
         source_name: String,
@@ -62,12 +62,22 @@ pub enum RegistryError {
     },
 
     /// A curve object is malformed (no terms, powers and coefficients of different lengths, …).
-    #[error("{source_name}: glass {glass}: curve {field}: {reason}")]
+    #[error("{source_name}: glass {glass}: curve {field}")]
     CurveShape {
         source_name: String,
         glass: String,
         field: String,
-        reason: String,
+        #[source]
+        shape: glassdb_fit::PolynomialShape,
+    },
+
+    /// A curve's recorded validation tolerance is negative.
+    #[error("{source_name}: glass {glass}: curve {field}: negative tolerance {tolerance}")]
+    NegativeTolerance {
+        source_name: String,
+        glass: String,
+        field: String,
+        tolerance: f64,
     },
 
     /// The curves give an unphysical value at some angle (outside [0, 1] or r + t > 1) by more
@@ -78,7 +88,7 @@ pub enum RegistryError {
     Unphysical {
         source_name: String,
         glass: String,
-        side: &'static str,
+        side: crate::Side,
         channel: &'static str,
         angle_deg: f64,
         what: String,
@@ -94,7 +104,14 @@ pub enum RegistryError {
     Serialize(serde_json::Error),
 
     /// The catalog TOML is malformed, has an unknown key or a value of the wrong type
-    /// (the message names the key, line and column).
+    /// (the source names the key, line and column).
+    #[error("{path}: not a valid catalog")]
+    CatalogToml {
+        path: PathBuf,
+        source: Box<toml::de::Error>,
+    },
+
+    /// The catalog is not UTF-8 text, or lists no glass.
     #[error("{path}: {message}")]
     CatalogSyntax { path: PathBuf, message: String },
 
@@ -106,37 +123,67 @@ pub enum RegistryError {
         message: String,
     },
 
-    /// A spectral file named by the catalog could not be read or integrated.
-    #[error("glass {glass}: spectral file {path}: {message}")]
+    /// A file named by the catalog (spectral data or angle table) could not be read.
+    #[error("glass {glass}: cannot read {path}")]
+    InputFile {
+        glass: String,
+        path: PathBuf,
+        source: std::io::Error,
+    },
+
+    /// A spectral file named by the catalog could not be parsed.
+    #[error("glass {glass}: spectral file {path}")]
     Spectral {
         glass: String,
         path: PathBuf,
-        message: String,
+        source: Box<glassdb_spectral::SpectralError>,
     },
 
-    /// Integration of the per-wavelength angle model failed (e.g. partial wavelength coverage).
-    #[error("glass {glass}: spectral integration: {message}")]
-    Integration { glass: String, message: String },
+    /// A spectral file parses but its data do not describe this glass (missing column, more
+    /// light out than in, …).
+    #[error("glass {glass}: spectral file {path}: {detail}")]
+    SpectralContent {
+        glass: String,
+        path: PathBuf,
+        detail: String,
+    },
 
-    /// A measured angle table named by the catalog could not be read or does not fit this glass.
-    #[error("glass {glass}: angle table {path}: {message}")]
+    /// The spectral method's settings cannot be used (its tables failed to build).
+    #[error("spectral method")]
+    SpectralMethod(#[source] Box<glassdb_spectral::SpectralError>),
+
+    /// Integration of one spectrum (normal or per-wavelength angle model) failed, e.g. partial
+    /// wavelength coverage.
+    #[error("glass {glass}: spectral integration of the {what}")]
+    Integration {
+        glass: String,
+        what: String,
+        source: Box<glassdb_spectral::SpectralError>,
+    },
+
+    /// A measured angle table named by the catalog could not be parsed.
+    #[error("glass {glass}: angle table {path}")]
     AngleTable {
         glass: String,
         path: PathBuf,
-        message: String,
+        source: Box<glassdb_fit::FitError>,
+    },
+
+    /// A measured angle table holds no glass, or several and none of this glass's name.
+    #[error("glass {glass}: angle table {path}: {detail}")]
+    AngleTableGlass {
+        glass: String,
+        path: PathBuf,
+        detail: String,
     },
 
     /// Fitting the angle curves failed.
-    #[error("glass {glass}: fitting {curve}: {message}")]
+    #[error("glass {glass}: fitting {curve}")]
     Fit {
         glass: String,
         curve: String,
-        message: String,
+        source: Box<glassdb_fit::FitError>,
     },
-
-    /// A mask given with `--mask` could not be read (the mask error names the file).
-    #[error(transparent)]
-    Mask(#[from] glassdb_mask::MaskError),
 
     /// Masks use ids that the catalog does not define.
     #[error("{}", missing_ids_message(catalog, ids))]
@@ -155,10 +202,6 @@ pub enum RegistryError {
         id: u16,
         mask: PathBuf,
     },
-
-    /// The compiled-in default catalog failed to build (a bug in the bundled data).
-    #[error("bundled default catalog: {0}")]
-    Bundled(String),
 }
 
 fn missing_ids_message(catalog: &std::path::Path, ids: &[(u16, u64)]) -> String {

@@ -6,18 +6,24 @@
 //!
 //! - [`Registry`]: the JSON schema, loading with validation, and atomic writing.
 //! - [`GlassRecord::eval`]: what the compositor tabulates.
-//! - [`build_registry`] / [`default_registry`]: catalog → registry.
+//! - [`build_registry`]: catalog → registry; [`default_registry`]: the bundled, prebuilt
+//!   `data/registry.json`.
 
+mod angle_model;
 mod build;
 mod bundled;
 pub mod catalog;
+mod curves;
 mod error;
+mod normal;
 pub mod physics;
 mod record;
+mod validate;
 
-pub use build::{Application, BuildOptions, build_registry, curve_record, default_registry};
+pub use build::{Application, BuildOptions, MaskIds, build_registry};
+pub use bundled::{DEFAULT_REGISTRY_JSON, DEFAULT_REGISTRY_NAME, default_registry};
 pub use error::RegistryError;
 pub use record::{
-    AngleModelRecord, CHANNELS, CurveRecord, FileRef, GlassRecord, LuminousRecord, ProductRecord,
-    Provenance, Registry, SCHEMA_VERSION, Side, SpectralMethodRecord,
+    AngleCurve, AngleModelRecord, CHANNELS, FileRef, GlassRecord, LuminousRecord, ProductRecord,
+    Provenance, Registry, SCHEMA_VERSION, Side, UnknownSide,
 };

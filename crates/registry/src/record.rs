@@ -1,25 +1,23 @@
-//! The registry JSON (schema 1): types, loading, validation, and the evaluation the compositor
-//! uses (method.md eqs. 11–14: `r(θ) = r0·C_r(θ)`, `t(θ) = t0·C_t(θ)`, per channel).
+//! The registry JSON (schema 2): types, loading, and the evaluation the compositor uses
+//! (method.md eqs. 11–14: `r(θ) = r0·C_r(θ)`, `t(θ) = t0·C_t(θ)`, per channel).
 
-use std::collections::BTreeMap;
+use std::fmt;
 use std::path::Path;
+use std::str::FromStr;
 
+use glassdb_fit::{CosPolynomial, FitSummary};
+use glassdb_spectral::IntegrationSettings;
 use serde::{Deserialize, Serialize};
 
 use crate::RegistryError;
 
-/// The registry schema version this crate reads and writes.
-pub const SCHEMA_VERSION: u32 = 1;
+/// The registry schema version this crate reads and writes. Schema 2: curves are the fit
+/// crate's [`CosPolynomial`] (basis `paper` or `full`, strictly ascending powers) and
+/// [`FitSummary`]; the spectral method is [`IntegrationSettings`].
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// Channel names, in the order of every `[_; 3]` array in the registry.
 pub const CHANNELS: [&str; 3] = ["R", "G", "B"];
-
-/// Angle step of the validation grid (degrees): 0, 0.25, …, 90.
-const VALIDATION_STEP_DEG: f64 = 0.25;
-
-/// Slack added to every recorded tolerance so that rounding in the JSON round trip never flips
-/// a check.
-const VALIDATION_EPS: f64 = 1e-9;
 
 /// The id-indexed table of glasses a scene uses.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -27,31 +25,9 @@ pub struct Registry {
     /// Schema version ([`SCHEMA_VERSION`]).
     pub schema: u32,
     /// The spectral method that turned spectra into per-channel values (one for the whole build).
-    pub spectral: SpectralMethodRecord,
+    pub spectral: IntegrationSettings,
     /// The glasses, sorted by id.
     pub glasses: Vec<GlassRecord>,
-}
-
-/// How spectra were reduced to channels (keys as in `glassdb spectral --json`).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct SpectralMethodRecord {
-    /// `colorimetric`, `paper` or `luminous`.
-    pub method: String,
-    /// RGB colour-matching functions (method `paper` only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cmf: Option<String>,
-    /// CIE standard observer (method `colorimetric`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub observer: Option<String>,
-    /// Illuminant (method `colorimetric`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub illuminant: Option<String>,
-    /// RGB working space (method `colorimetric`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub space: Option<String>,
-    /// Whether spectra not covering the method's range were extrapolated (end values held).
-    #[serde(default)]
-    pub extrapolate: bool,
 }
 
 /// One glass product: normal-incidence values per channel and its angle curves.
@@ -68,11 +44,11 @@ pub struct GlassRecord {
     /// Back reflectance at normal incidence, per channel (coated glass differs from the front).
     pub r0_back: [f64; 3],
     /// Front reflectance curves C_r per channel: `r(θ) = r0·C_r(cos θ)`.
-    pub c_r: [CurveRecord; 3],
+    pub c_r: [AngleCurve; 3],
     /// Transmittance curves C_t per channel: `t(θ) = t0·C_t(cos θ)`.
-    pub c_t: [CurveRecord; 3],
+    pub c_t: [AngleCurve; 3],
     /// Back reflectance curves per channel: `r_back(θ) = r0_back·C_r_back(cos θ)`.
-    pub c_r_back: [CurveRecord; 3],
+    pub c_r_back: [AngleCurve; 3],
     /// Luminous (ISO 9050: D65 × V(λ)) values at normal incidence, when a spectrum was given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub luminous: Option<LuminousRecord>,
@@ -82,26 +58,14 @@ pub struct GlassRecord {
     pub provenance: Provenance,
 }
 
-/// One angle curve `C(cos θ) = Σ_k coefficients[k]·cos^powers[k] θ` with its fit diagnostics
-/// (keys as in `glassdb fit`).
+/// One angle curve: the fitted polynomial `C(cos θ)` with the summary of its fit, under the
+/// keys of `glassdb fit` (`basis`, `powers`, `coefficients`, `degree`, `rms_error`, …).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CurveRecord {
-    /// `paper` (powers 1…n) or `full` (powers 0…n).
-    pub basis: String,
-    /// Exponents of cos θ.
-    pub powers: Vec<u32>,
-    /// Coefficients, one per power.
-    pub coefficients: Vec<f64>,
-    /// Polynomial degree (largest power).
-    pub degree: u32,
-    /// RMS of the absolute residual in r (or t) over the fitted samples.
-    pub rms_error: f64,
-    /// Largest absolute residual in r (or t) over the fitted samples.
-    pub max_abs_error: f64,
-    /// Angle (degrees) of the largest residual.
-    pub max_error_angle_deg: f64,
-    /// Condition number of the least-squares system solved.
-    pub condition_number: f64,
+pub struct AngleCurve {
+    #[serde(flatten)]
+    pub polynomial: CosPolynomial,
+    #[serde(flatten)]
+    pub fit: FitSummary,
     /// Absolute tolerance on r (or t) that validation allows beyond the physical range
     /// (at least the fit's own max residual).
     pub tolerance: f64,
@@ -180,8 +144,9 @@ pub struct ProductRecord {
     pub thickness_mm: Option<f64>,
 }
 
-/// Which face of the glass the viewer sees.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which face of the glass the viewer sees (`front` or `back` in JSON and on the command line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Side {
     /// The front face (the catalog's Rf; the viewer's side in the scene).
     Front,
@@ -190,7 +155,8 @@ pub enum Side {
 }
 
 impl Side {
-    fn label(self) -> &'static str {
+    /// The lowercase name: `front` or `back`.
+    pub fn name(self) -> &'static str {
         match self {
             Side::Front => "front",
             Side::Back => "back",
@@ -198,28 +164,45 @@ impl Side {
     }
 }
 
-impl CurveRecord {
+impl fmt::Display for Side {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A side name that is neither `front` nor `back`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown side `{0}`; expected front or back")]
+pub struct UnknownSide(pub String);
+
+impl FromStr for Side {
+    type Err = UnknownSide;
+
+    /// `front` or `back`, any case, surrounding spaces ignored.
+    fn from_str(s: &str) -> Result<Side, UnknownSide> {
+        [Side::Front, Side::Back]
+            .into_iter()
+            .find(|side| s.trim().eq_ignore_ascii_case(side.name()))
+            .ok_or_else(|| UnknownSide(s.to_string()))
+    }
+}
+
+impl AngleCurve {
     /// `C(cos θ)`, unclamped.
     #[inline]
     pub fn eval(&self, cos_theta: f64) -> f64 {
-        self.powers
-            .iter()
-            .zip(&self.coefficients)
-            .map(|(&p, &c)| c * cos_theta.powi(p.min(i32::MAX as u32) as i32))
-            .sum()
+        self.polynomial.eval(cos_theta)
     }
 
     /// A curve equal to `cos θ` (used where t0 = 0, so C_t never matters): C(0°) = 1, C(90°) = 0.
-    pub fn nominal_transmittance() -> CurveRecord {
-        CurveRecord {
-            basis: "paper".into(),
-            powers: vec![1],
-            coefficients: vec![1.0],
-            degree: 1,
-            rms_error: 0.0,
-            max_abs_error: 0.0,
-            max_error_angle_deg: 0.0,
-            condition_number: 1.0,
+    pub fn nominal_transmittance() -> AngleCurve {
+        AngleCurve {
+            polynomial: CosPolynomial {
+                basis: glassdb_fit::Basis::Paper,
+                powers: vec![1],
+                coefficients: vec![1.0],
+            },
+            fit: FitSummary::exact(1),
             tolerance: 0.0,
         }
     }
@@ -248,7 +231,7 @@ impl GlassRecord {
         format!("id {} (\"{}\")", self.id, self.name)
     }
 
-    fn r_parts(&self, side: Side) -> (&[f64; 3], &[CurveRecord; 3]) {
+    pub(crate) fn r_parts(&self, side: Side) -> (&[f64; 3], &[AngleCurve; 3]) {
         match side {
             Side::Front => (&self.r0, &self.c_r),
             Side::Back => (&self.r0_back, &self.c_r_back),
@@ -320,43 +303,6 @@ impl Registry {
         Ok(registry)
     }
 
-    /// Validates: schema version, ids unique and non-zero, every number finite, normal values
-    /// in [0, 1] with r0 + t0 ≤ 1, well-formed curves, and on a dense 0–90° grid per side and
-    /// channel 0 ≤ r, t ≤ 1 and r + t ≤ 1, each within the tolerance recorded for the curve.
-    pub fn validate(&self) -> Result<(), RegistryError> {
-        self.validate_named("registry")
-    }
-
-    /// [`Registry::validate`] with a name for the messages.
-    pub fn validate_named(&self, source_name: &str) -> Result<(), RegistryError> {
-        if self.schema != SCHEMA_VERSION {
-            return Err(RegistryError::SchemaVersion {
-                source_name: source_name.to_string(),
-                found: self.schema,
-                expected: SCHEMA_VERSION,
-            });
-        }
-        let mut seen: BTreeMap<u16, &str> = BTreeMap::new();
-        for g in &self.glasses {
-            if g.id == 0 {
-                return Err(RegistryError::IdZero {
-                    source_name: source_name.to_string(),
-                    name: g.name.clone(),
-                });
-            }
-            if let Some(first) = seen.insert(g.id, &g.name) {
-                return Err(RegistryError::DuplicateId {
-                    source_name: source_name.to_string(),
-                    id: g.id,
-                    first: first.to_string(),
-                    second: g.name.clone(),
-                });
-            }
-            validate_glass(g, source_name)?;
-        }
-        Ok(())
-    }
-
     /// The glass with this registration id.
     pub fn glass(&self, id: u16) -> Option<&GlassRecord> {
         self.glasses.iter().find(|g| g.id == id)
@@ -378,143 +324,22 @@ impl Registry {
     }
 }
 
-fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryError> {
-    let glass = g.label();
-    let non_finite = |field: String| RegistryError::NonFinite {
-        source_name: source_name.to_string(),
-        glass: glass.clone(),
-        field,
-    };
-    for (field, values) in [("r0", &g.r0), ("t0", &g.t0), ("r0_back", &g.r0_back)] {
-        for (c, v) in values.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(non_finite(format!("{field}[{c}] ({})", CHANNELS[c])));
-            }
-            if !(0.0..=1.0).contains(v) {
-                return Err(RegistryError::NormalValue {
-                    source_name: source_name.to_string(),
-                    glass: glass.clone(),
-                    what: format!("{field} channel {} = {v} is outside [0, 1]", CHANNELS[c]),
-                });
-            }
-        }
-    }
-    if let Some(l) = &g.luminous {
-        for (field, v) in [
-            ("luminous.transmittance", l.transmittance),
-            ("luminous.reflectance", l.reflectance),
-            ("luminous.reflectance_back", l.reflectance_back),
-        ] {
-            if !v.is_finite() {
-                return Err(non_finite(field.to_string()));
-            }
-        }
-    }
-    for (field, curves) in [("c_r", &g.c_r), ("c_t", &g.c_t), ("c_r_back", &g.c_r_back)] {
-        for (c, curve) in curves.iter().enumerate() {
-            let name = format!("{field}[{c}] ({})", CHANNELS[c]);
-            let shape = |reason: String| RegistryError::CurveShape {
-                source_name: source_name.to_string(),
-                glass: glass.clone(),
-                field: name.clone(),
-                reason,
-            };
-            if curve.powers.is_empty() {
-                return Err(shape("no terms".into()));
-            }
-            if curve.powers.len() != curve.coefficients.len() {
-                return Err(shape(format!(
-                    "{} powers but {} coefficients",
-                    curve.powers.len(),
-                    curve.coefficients.len()
-                )));
-            }
-            if let Some(p) = curve.powers.iter().find(|&&p| p > 64) {
-                return Err(shape(format!("power {p} is beyond the supported 64")));
-            }
-            for (k, v) in curve.coefficients.iter().enumerate() {
-                if !v.is_finite() {
-                    return Err(non_finite(format!("{name}.coefficients[{k}]")));
-                }
-            }
-            for (key, v) in [
-                ("rms_error", curve.rms_error),
-                ("max_abs_error", curve.max_abs_error),
-                ("max_error_angle_deg", curve.max_error_angle_deg),
-                ("tolerance", curve.tolerance),
-            ] {
-                if !v.is_finite() {
-                    return Err(non_finite(format!("{name}.{key}")));
-                }
-            }
-            if curve.tolerance < 0.0 {
-                return Err(shape(format!("negative tolerance {}", curve.tolerance)));
-            }
-        }
-    }
-    let steps = (90.0 / VALIDATION_STEP_DEG).round() as usize;
-    for side in [Side::Front, Side::Back] {
-        let (_, c_r) = g.r_parts(side);
-        for i in 0..=steps {
-            let angle_deg = i as f64 * VALIDATION_STEP_DEG;
-            let cos = if i == steps {
-                0.0
-            } else {
-                angle_deg.to_radians().cos()
-            };
-            let (r, t) = g.eval_raw(side, cos);
-            for c in 0..3 {
-                let tol_r = c_r[c].tolerance + VALIDATION_EPS;
-                let tol_t = g.c_t[c].tolerance + VALIDATION_EPS;
-                let fail = |what: String, tolerance: f64| RegistryError::Unphysical {
-                    source_name: source_name.to_string(),
-                    glass: glass.clone(),
-                    side: side.label(),
-                    channel: CHANNELS[c],
-                    angle_deg,
-                    what,
-                    tolerance,
-                };
-                if !r[c].is_finite() || !t[c].is_finite() {
-                    return Err(fail("r or t is not finite".into(), 0.0));
-                }
-                if r[c] < -tol_r || r[c] > 1.0 + tol_r {
-                    return Err(fail(format!("r = {:.6} is outside [0, 1]", r[c]), tol_r));
-                }
-                if t[c] < -tol_t || t[c] > 1.0 + tol_t {
-                    return Err(fail(format!("t = {:.6} is outside [0, 1]", t[c]), tol_t));
-                }
-                if r[c] + t[c] > 1.0 + tol_r + tol_t {
-                    return Err(fail(
-                        format!(
-                            "r + t = {:.6} + {:.6} = {:.6} > 1 (energy is not conserved)",
-                            r[c],
-                            t[c],
-                            r[c] + t[c]
-                        ),
-                        tol_r + tol_t,
-                    ));
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn curve(powers: Vec<u32>, coefficients: Vec<f64>) -> CurveRecord {
-        CurveRecord {
-            basis: "full".into(),
-            degree: *powers.iter().max().unwrap_or(&0),
-            powers,
-            coefficients,
-            rms_error: 0.0,
-            max_abs_error: 0.0,
-            max_error_angle_deg: 0.0,
-            condition_number: 1.0,
+    fn curve(powers: Vec<u32>, coefficients: Vec<f64>) -> AngleCurve {
+        AngleCurve {
+            fit: FitSummary::exact(*powers.iter().max().unwrap_or(&0)),
+            polynomial: CosPolynomial {
+                basis: if powers.first() == Some(&0) {
+                    glassdb_fit::Basis::Full
+                } else {
+                    glassdb_fit::Basis::Paper
+                },
+                powers,
+                coefficients,
+            },
             tolerance: 0.002,
         }
     }
@@ -526,14 +351,7 @@ mod tests {
         let ct = curve(vec![1], vec![1.0]);
         Registry {
             schema: SCHEMA_VERSION,
-            spectral: SpectralMethodRecord {
-                method: "colorimetric".into(),
-                cmf: None,
-                observer: Some("cie1931".into()),
-                illuminant: Some("D65".into()),
-                space: Some("srgb".into()),
-                extrapolate: false,
-            },
+            spectral: IntegrationSettings::default(),
             glasses: vec![GlassRecord {
                 id: 4,
                 name: "hand-made".into(),
@@ -599,7 +417,7 @@ mod tests {
         assert!(err.contains("id 4 (\"hand-made\")"), "{err}");
         assert!(err.contains("back side, channel B, at 54.5°"), "{err}");
         let mut reg = sample();
-        reg.glasses[0].c_t[1].coefficients[0] = f64::NAN;
+        reg.glasses[0].c_t[1].polynomial.coefficients[0] = f64::NAN;
         assert!(
             reg.validate()
                 .unwrap_err()
@@ -612,6 +430,33 @@ mod tests {
             reg.validate(),
             Err(RegistryError::DuplicateId { id: 4, .. })
         ));
+    }
+
+    #[test]
+    fn side_names_parse_print_and_serialise() {
+        for side in [Side::Front, Side::Back] {
+            assert_eq!(side.to_string().parse::<Side>().unwrap(), side);
+            assert_eq!(serde_json::to_string(&side).unwrap(), format!("\"{side}\""));
+        }
+        assert_eq!(" Back ".parse::<Side>().unwrap(), Side::Back);
+        assert!("left".parse::<Side>().is_err());
+        assert!(serde_json::from_str::<Side>("\"up\"").is_err());
+    }
+
+    #[test]
+    fn powers_must_ascend_and_the_paper_basis_has_no_constant() {
+        let mut reg = sample();
+        reg.glasses[0].c_r[0] = curve(vec![0, 2, 1], vec![10.0, 9.0, -18.0]);
+        let e = glassdb_io::ErrorChain(&reg.validate().unwrap_err()).to_string();
+        assert!(
+            e.contains("c_r[0] (R)") && e.contains("ascend strictly"),
+            "{e}"
+        );
+        let mut reg = sample();
+        reg.glasses[0].c_t[0].polynomial.powers = vec![0];
+        reg.glasses[0].c_t[0].polynomial.basis = glassdb_fit::Basis::Paper;
+        let e = glassdb_io::ErrorChain(&reg.validate().unwrap_err()).to_string();
+        assert!(e.contains("no constant term"), "{e}");
     }
 
     #[test]
@@ -646,6 +491,27 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("schema 3 is not supported"), "{e}");
+        // A schema-1 file says what to do, without naming command-line flags (the binary adds
+        // the exact command).
+        let err =
+            Registry::from_json_str("{\"schema\": 1, \"glasses\": []}", "old.json").unwrap_err();
+        assert!(
+            matches!(
+                err,
+                RegistryError::SchemaVersion {
+                    found: 1,
+                    expected: 2,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        let e = err.to_string();
+        assert!(
+            e.contains("schema 1 is not supported") && e.contains("rebuild it from its catalog"),
+            "{e}"
+        );
+        assert!(!e.contains("--"), "{e}");
         let e = Registry::from_json_str("[1, 2]", "z.json")
             .unwrap_err()
             .to_string();

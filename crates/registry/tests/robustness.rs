@@ -2,22 +2,22 @@
 
 use std::path::Path;
 
+use glassdb_fit::{Basis, CosPolynomial, FitSummary};
 use glassdb_registry::{
-    AngleModelRecord, CurveRecord, GlassRecord, Provenance, Registry, SCHEMA_VERSION, Side,
-    SpectralMethodRecord, catalog::parse_catalog,
+    AngleCurve, AngleModelRecord, GlassRecord, Provenance, Registry, SCHEMA_VERSION, Side,
+    catalog::parse_catalog,
 };
+use glassdb_spectral::{IntegrationSettings, Method};
 use proptest::prelude::*;
 
-fn curve(coefficients: Vec<f64>) -> CurveRecord {
-    CurveRecord {
-        basis: "full".into(),
-        powers: (0..coefficients.len() as u32).collect(),
-        degree: coefficients.len().saturating_sub(1) as u32,
-        coefficients,
-        rms_error: 0.0,
-        max_abs_error: 0.0,
-        max_error_angle_deg: 0.0,
-        condition_number: 1.0,
+fn curve(coefficients: Vec<f64>) -> AngleCurve {
+    AngleCurve {
+        fit: FitSummary::exact(coefficients.len().saturating_sub(1) as u32),
+        polynomial: CosPolynomial {
+            basis: Basis::Full,
+            powers: (0..coefficients.len() as u32).collect(),
+            coefficients,
+        },
         tolerance: 0.002,
     }
 }
@@ -83,10 +83,7 @@ proptest! {
         // Validation either accepts or gives an error; it never panics.
         let reg = Registry {
             schema: SCHEMA_VERSION,
-            spectral: SpectralMethodRecord {
-                method: "luminous".into(), cmf: None, observer: None, illuminant: None, space: None,
-                extrapolate: false,
-            },
+            spectral: IntegrationSettings { method: Method::Luminous, extrapolate: false },
             glasses: vec![g],
         };
         let _ = reg.validate();

@@ -79,34 +79,25 @@ fn degree_table(md: &mut String, r: &Reference, grid: &[f64]) {
     );
 }
 
-/// Subsection "Evaluation cost": Horner against the registry's curve, and a whole pixel.
+/// Subsection "Evaluation cost": the curve's Horner evaluation, and a whole pixel.
 fn evaluation_cost(md: &mut String, refs: &[Reference], inputs: &[f64]) {
     let _ = writeln!(md, "### Evaluation cost\n");
     let _ = writeln!(
         md,
-        "Time per value of `CosPolynomial::eval` (Horner), of the registry's `CurveRecord::eval` \
-         (a sum of `powi` terms), and per pixel of `GlassRecord::eval` (r and t of three channels, \
-         clamped to the physical range), over pseudo-random cos θ (θ uniform in 0–89°).\n"
+        "Time per value of `CosPolynomial::eval` (Horner; the registry's curves are the same \
+         type), and per pixel of `GlassRecord::eval` (r and t of three channels, clamped to the \
+         physical range), over pseudo-random cos θ (θ uniform in 0–89°).\n"
     );
-    let _ = writeln!(
-        md,
-        "| n (full basis) | CosPolynomial::eval ns/value | CurveRecord::eval ns/value |"
-    );
-    let _ = writeln!(md, "|---|---|---|");
+    let _ = writeln!(md, "| n (full basis) | CosPolynomial::eval ns/value |");
+    let _ = writeln!(md, "|---|---|");
     let sr = samples(&refs[0], Quantity::Reflectance);
-    let st = samples(&refs[0], Quantity::Transmittance);
     for degree in [2u32, 4, 6, 8] {
-        let (Some(fr), Some(_)) = (
-            fit_fixed(&sr, Quantity::Reflectance, degree, Basis::Full),
-            fit_fixed(&st, Quantity::Transmittance, degree, Basis::Full),
-        ) else {
+        let Some(fr) = fit_fixed(&sr, Quantity::Reflectance, degree, Basis::Full) else {
             continue;
         };
         let poly = fr.polynomial.clone();
         let horner = ns_per_value(inputs, |c| poly.eval(c));
-        let rec = glassdb_registry::curve_record(&fr, 0.002);
-        let powi = ns_per_value(inputs, |c| rec.eval(c));
-        let _ = writeln!(md, "| {degree} | {horner:.2} | {powi:.2} |");
+        let _ = writeln!(md, "| {degree} | {horner:.2} |");
     }
     let _ = writeln!(md);
     pixel_cost(md, inputs);
@@ -121,7 +112,7 @@ fn pixel_cost(md: &mut String, inputs: &[f64]) {
                     .c_r
                     .iter()
                     .chain(&g.c_t)
-                    .map(|c| c.degree.to_string())
+                    .map(|c| c.fit.degree.to_string())
                     .collect();
                 let pixel = ns_per_value(inputs, |c| {
                     let (r, t) = g.eval(Side::Front, c);

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use glassdb_registry::Side;
 use serde::{Deserialize, Serialize};
 
 use crate::error::SceneError;
@@ -43,7 +44,7 @@ pub struct PlaneEntry {
     /// Glass triangles on the plane.
     pub triangles: usize,
     /// `"front"` or `"back"`: which face of the glass faces the eye (the kept half-space).
-    pub eye_side: String,
+    pub eye_side: Side,
     /// Row-major 4×4 reflection matrix for column vectors `[x, y, z, 1]`.
     pub reflection_matrix: [[f64; 4]; 4],
     /// The virtual scene's OBJ, relative to the planes file.

@@ -1,6 +1,7 @@
 //! `glassdb mirror` as a library call: find the glass planes, write one virtual scene per
 //! plane and `planes.json`.
 
+use glassdb_registry::Side;
 use std::path::{Component, Path, PathBuf};
 
 use crate::error::SceneError;
@@ -93,7 +94,7 @@ pub fn write_virtual_scenes(req: &MirrorRequest) -> Result<MirrorReport, SceneEr
             area: gp.area,
             materials: gp.materials.clone(),
             triangles: gp.triangles,
-            eye_side: eye_side.to_string(),
+            eye_side,
             reflection_matrix: gp.plane.reflection_matrix(),
             file,
             triangles_written: stats.written,
@@ -210,9 +211,9 @@ fn kept_side(
     gp: &GlassPlane,
     eye: Option<Vec3>,
     distance: f64,
-) -> Result<(Plane, &'static str), SceneError> {
+) -> Result<(Plane, Side), SceneError> {
     let Some(eye) = eye else {
-        return Ok((gp.plane, "front"));
+        return Ok((gp.plane, Side::Front));
     };
     let s = gp.plane.signed_distance(eye);
     if s.abs() <= distance {
@@ -223,9 +224,9 @@ fn kept_side(
         });
     }
     Ok(if s > 0.0 {
-        (gp.plane, "front")
+        (gp.plane, Side::Front)
     } else {
-        (gp.plane.flipped(), "back")
+        (gp.plane.flipped(), Side::Back)
     })
 }
 
@@ -233,7 +234,7 @@ fn kept_side(
 fn write_plane_scene(
     scene: &Scene,
     gp: &GlassPlane,
-    eye_side: &str,
+    eye_side: Side,
     mtllibs: &[String],
     meshes: &[Mesh],
     out_dir: &Path,

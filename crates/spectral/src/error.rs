@@ -27,6 +27,33 @@ pub enum SpectralError {
         message: String,
     },
 
+    /// The CSV reader failed (an I/O error, broken quoting); its error is the source.
+    #[error("{source_name}:{line}: not readable as CSV")]
+    Csv {
+        source_name: String,
+        line: usize,
+        source: csv::Error,
+    },
+
+    /// A value above 1 in a file read as fractions: the file is probably in percent
+    /// ([`crate::ReadOptions::percent`]).
+    #[error(
+        "{source_name}:{line}{}: {name} = {value} is above 1; the file may be in percent", column.map(|c| format!(":{c}")).unwrap_or_default()
+    )]
+    AboveOneInFractions {
+        source_name: String,
+        line: usize,
+        column: Option<usize>,
+        name: String,
+        value: f64,
+    },
+
+    /// Read as percent, but no value exceeds 1: the file looks like fractions.
+    #[error(
+        "{source_name}: read as percent, but no value exceeds 1: the file looks like fractions"
+    )]
+    FractionsReadAsPercent { source_name: String },
+
     /// The file as a whole is unusable (no data rows, unknown format, no quantity columns).
     #[error("{source_name}: {message}")]
     Format {
@@ -64,7 +91,7 @@ pub enum SpectralError {
 
     /// The spectrum does not cover the wavelength range the chosen method integrates over.
     #[error(
-        "the spectrum covers {have_start_nm}–{have_end_nm} nm but {method} integrates over {need_start_nm}–{need_end_nm} nm; pass --extrapolate (IntegrationSettings::extrapolate) to hold the end values constant outside the data"
+        "the spectrum covers {have_start_nm}–{have_end_nm} nm but {method} integrates over {need_start_nm}–{need_end_nm} nm (IntegrationSettings::extrapolate holds the end values constant outside the data)"
     )]
     PartialCoverage {
         method: String,
@@ -96,6 +123,14 @@ pub enum SpectralError {
     EmbeddedTable {
         table: &'static str,
         message: String,
+    },
+
+    /// Reference data built once per process (tables, luminous weights) failed to build; the
+    /// first failure, shared by every later call, is the source (a build defect).
+    #[error("embedded {what} could not be built")]
+    EmbeddedData {
+        what: &'static str,
+        source: std::sync::Arc<SpectralError>,
     },
 }
 

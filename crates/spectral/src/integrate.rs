@@ -10,8 +10,8 @@
 use std::cell::RefCell;
 use std::fmt;
 use std::str::FromStr;
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -88,8 +88,31 @@ pub enum Method {
     Luminous,
 }
 
-/// Everything an [`Integrator`] needs.
+/// Which of the three methods, by name: what `--method` and the JSON `method` key hold.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MethodKind {
+    Colorimetric,
+    Paper,
+    Luminous,
+}
+
+impl Method {
+    /// The method's kind (its name without options).
+    pub fn kind(self) -> MethodKind {
+        match self {
+            Method::Paper(_) => MethodKind::Paper,
+            Method::Colorimetric { .. } => MethodKind::Colorimetric,
+            Method::Luminous => MethodKind::Luminous,
+        }
+    }
+}
+
+/// Everything an [`Integrator`] needs. Its JSON form is one flat object: `method` (a
+/// [`MethodKind`]), that method's options (`cmf`; `observer`, `illuminant`, `space`; absent
+/// ones take their defaults) and `extrapolate` (default false).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(into = "SettingsJson", try_from = "SettingsJson")]
 pub struct IntegrationSettings {
     pub method: Method,
     /// Hold the spectrum's end values constant where it does not cover the method's grid
@@ -107,6 +130,85 @@ impl Default for IntegrationSettings {
             },
             extrapolate: false,
         }
+    }
+}
+
+/// The flat JSON form of [`IntegrationSettings`].
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SettingsJson {
+    method: MethodKind,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cmf: Option<RgbCmf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    observer: Option<Observer>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    illuminant: Option<Illuminant>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    space: Option<RgbSpace>,
+    #[serde(default)]
+    extrapolate: bool,
+}
+
+impl From<IntegrationSettings> for SettingsJson {
+    fn from(s: IntegrationSettings) -> SettingsJson {
+        let mut json = SettingsJson {
+            method: s.method.kind(),
+            cmf: None,
+            observer: None,
+            illuminant: None,
+            space: None,
+            extrapolate: s.extrapolate,
+        };
+        match s.method {
+            Method::Paper(cmf) => json.cmf = Some(cmf),
+            Method::Colorimetric {
+                observer,
+                illuminant,
+                space,
+            } => {
+                json.observer = Some(observer);
+                json.illuminant = Some(illuminant);
+                json.space = Some(space);
+            }
+            Method::Luminous => {}
+        }
+        json
+    }
+}
+
+impl TryFrom<SettingsJson> for IntegrationSettings {
+    type Error = String;
+
+    /// Refuses options of another method (e.g. `cmf` with `colorimetric`).
+    fn try_from(j: SettingsJson) -> Result<IntegrationSettings, String> {
+        let colorimetric = j.observer.is_some() || j.illuminant.is_some() || j.space.is_some();
+        let method = match j.method {
+            MethodKind::Paper if colorimetric => {
+                return Err(
+                    "observer, illuminant and space apply to method colorimetric, not paper".into(),
+                );
+            }
+            MethodKind::Paper => Method::Paper(j.cmf.unwrap_or(RgbCmf::WrightGuild1931)),
+            MethodKind::Colorimetric if j.cmf.is_some() => {
+                return Err("cmf applies to method paper, not colorimetric".into());
+            }
+            MethodKind::Colorimetric => Method::Colorimetric {
+                observer: j.observer.unwrap_or(Observer::Cie1931),
+                illuminant: j.illuminant.unwrap_or(Illuminant::D65),
+                space: j.space.unwrap_or(RgbSpace::Srgb),
+            },
+            MethodKind::Luminous if colorimetric || j.cmf.is_some() => {
+                return Err(
+                    "cmf, observer, illuminant and space do not apply to method luminous".into(),
+                );
+            }
+            MethodKind::Luminous => Method::Luminous,
+        };
+        Ok(IntegrationSettings {
+            method,
+            extrapolate: j.extrapolate,
+        })
     }
 }
 
@@ -448,18 +550,18 @@ pub fn luminous(
     grid: LuminousGrid,
     extrapolate: bool,
 ) -> Result<f64, SpectralError> {
-    static ISO: OnceLock<Result<Integrator, String>> = OnceLock::new();
-    static ONE: OnceLock<Result<Integrator, String>> = OnceLock::new();
+    static ISO: OnceLock<Result<Integrator, Arc<SpectralError>>> = OnceLock::new();
+    static ONE: OnceLock<Result<Integrator, Arc<SpectralError>>> = OnceLock::new();
     let cell = match grid {
         LuminousGrid::Iso9050 => &ISO,
         LuminousGrid::OneNm => &ONE,
     };
     let integrator = cell
-        .get_or_init(|| Integrator::luminous_on(grid).map_err(|e| e.to_string()))
+        .get_or_init(|| Integrator::luminous_on(grid).map_err(Arc::new))
         .as_ref()
-        .map_err(|message| SpectralError::EmbeddedTable {
-            table: "luminous weights",
-            message: message.clone(),
+        .map_err(|source| SpectralError::EmbeddedData {
+            what: "luminous weights",
+            source: Arc::clone(source),
         })?;
     Ok(integrator.apply(wavelength_nm, values, extrapolate)?[1])
 }
@@ -525,6 +627,7 @@ macro_rules! names {
 names!(RgbCmf { WrightGuild1931 => "wright-guild-1931", StilesBurch1955 => "stiles-burch-1955", StilesBurch1959 => "stiles-burch-1959" });
 names!(Observer { Cie1931 => "cie1931", Cie1964 => "cie1964" });
 names!(Illuminant { D65 => "D65", A => "A", E => "E" });
+names!(MethodKind { Colorimetric => "colorimetric", Paper => "paper", Luminous => "luminous" });
 names!(RgbSpace { Srgb => "srgb", AcesCg => "acescg", DisplayP3 => "display-p3" });
 
 #[cfg(test)]
@@ -606,6 +709,62 @@ mod tests {
                 (a[k] - b[k]).abs() < 1e-13 && (b[k] - c[k]).abs() < 1e-15,
                 "{a:?} {b:?} {c:?}"
             );
+        }
+    }
+
+    #[test]
+    fn settings_json_is_flat_and_round_trips() {
+        let default = IntegrationSettings::default();
+        let text = serde_json::to_string(&default).unwrap();
+        assert_eq!(
+            text,
+            r#"{"method":"colorimetric","observer":"cie1931","illuminant":"D65","space":"srgb","extrapolate":false}"#
+        );
+        assert_eq!(
+            serde_json::from_str::<IntegrationSettings>(&text).unwrap(),
+            default
+        );
+        let paper = IntegrationSettings {
+            method: Method::Paper(RgbCmf::StilesBurch1955),
+            extrapolate: true,
+        };
+        let text = serde_json::to_string(&paper).unwrap();
+        assert_eq!(
+            text,
+            r#"{"method":"paper","cmf":"stiles-burch-1955","extrapolate":true}"#
+        );
+        assert_eq!(
+            serde_json::from_str::<IntegrationSettings>(&text).unwrap(),
+            paper
+        );
+        // Absent options take their defaults; options of another method are refused.
+        let lum: IntegrationSettings = serde_json::from_str(r#"{"method":"luminous"}"#).unwrap();
+        assert_eq!(lum.method, Method::Luminous);
+        assert!(!lum.extrapolate);
+        let col: IntegrationSettings =
+            serde_json::from_str(r#"{"method":"colorimetric","space":"acescg"}"#).unwrap();
+        assert_eq!(
+            col.method,
+            Method::Colorimetric {
+                observer: Observer::Cie1931,
+                illuminant: Illuminant::D65,
+                space: RgbSpace::AcesCg
+            }
+        );
+        for bad in [
+            r#"{"method":"paper","space":"srgb"}"#,
+            r#"{"method":"colorimetric","cmf":"stiles-burch-1955"}"#,
+            r#"{"method":"luminous","observer":"cie1931"}"#,
+            r#"{"method":"explicit"}"#,
+        ] {
+            assert!(
+                serde_json::from_str::<IntegrationSettings>(bad).is_err(),
+                "{bad}"
+            );
+        }
+        for &k in MethodKind::ALL {
+            assert_eq!(k.name().parse::<MethodKind>().unwrap(), k);
+            assert_eq!(serde_json::to_string(&k).unwrap(), format!("\"{k}\""));
         }
     }
 

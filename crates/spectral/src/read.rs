@@ -267,17 +267,20 @@ impl Collected<'_> {
                 }
                 let s = v * scale;
                 if s > 1.0 {
-                    let hint = if percent {
-                        " (above 100 %)".to_owned()
-                    } else {
-                        "; if the file is in percent, pass --percent (ReadOptions::percent)"
-                            .to_owned()
-                    };
+                    if !percent {
+                        return Err(SpectralError::AboveOneInFractions {
+                            source_name: source.to_owned(),
+                            line: place.line,
+                            column: place.column,
+                            name: name.to_string(),
+                            value: v,
+                        });
+                    }
                     return Err(SpectralError::parse(
                         source,
                         place.line,
                         place.column,
-                        format!("{name} = {v} is above 1{hint}"),
+                        format!("{name} = {v} is above 1 (above 100 %)"),
                     ));
                 }
                 scaled.push(s);
@@ -285,10 +288,9 @@ impl Collected<'_> {
             out[k] = Some(scaled);
         }
         if percent && !any_above_one {
-            return Err(SpectralError::format(
-                source,
-                "--percent was given but no value exceeds 1: the file looks like fractions (drop --percent)",
-            ));
+            return Err(SpectralError::FractionsReadAsPercent {
+                source_name: source.to_owned(),
+            });
         }
         let [transmittance, reflectance_front, reflectance_back] = out;
         Ok(SpectralData {
@@ -315,7 +317,7 @@ fn read_csv(bytes: &[u8], source: &str, opts: &ReadOptions) -> Result<SpectralDa
         .from_reader(bytes);
     let headers = reader
         .byte_headers()
-        .map_err(|e| csv_error(source, &e))?
+        .map_err(|e| csv_error(source, e))?
         .clone();
     let header_line = 1usize;
     let mut wl_col: Option<(usize, f64)> = None; // (index, scale to nm)
@@ -391,7 +393,7 @@ fn read_csv(bytes: &[u8], source: &str, opts: &ReadOptions) -> Result<SpectralDa
         match reader.read_byte_record(&mut record) {
             Ok(false) => break,
             Ok(true) => {}
-            Err(e) => return Err(csv_error(source, &e)),
+            Err(e) => return Err(csv_error(source, e)),
         }
         let line = record.position().map(|p| p.line() as usize).unwrap_or(0);
         let field = |i: usize| -> Result<&str, SpectralError> {
@@ -428,17 +430,23 @@ fn read_csv(bytes: &[u8], source: &str, opts: &ReadOptions) -> Result<SpectralDa
     collected.finish(opts.percent, ProductInfo::empty(SpectralFormat::Csv))
 }
 
-fn csv_error(source: &str, e: &csv::Error) -> SpectralError {
+fn csv_error(source: &str, e: csv::Error) -> SpectralError {
     let line = e.position().map(|p| p.line() as usize).unwrap_or(0);
-    let message = match e.kind() {
+    match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..
-        } => {
-            format!("{len} fields where the header has {expected_len}")
-        }
-        _ => e.to_string(),
-    };
-    SpectralError::parse(source, line, None, message)
+        } => SpectralError::parse(
+            source,
+            line,
+            None,
+            format!("{len} fields where the header has {expected_len}"),
+        ),
+        _ => SpectralError::Csv {
+            source_name: source.to_owned(),
+            line,
+            source: e,
+        },
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,7 +1,7 @@
 //! The CIE reference tables, embedded in the binary (`data/cie/`, exported bit-exactly from
 //! colour-science 0.4.7; provenance and licences in `data/cie/README.md`).
 
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use crate::error::SpectralError;
 
@@ -91,7 +91,7 @@ pub(crate) struct Tables {
     pub stiles_burch_1959: Table,
 }
 
-static TABLES: OnceLock<Result<Tables, String>> = OnceLock::new();
+static TABLES: OnceLock<Result<Tables, Arc<SpectralError>>> = OnceLock::new();
 
 /// The parsed tables (parsed on first use; an error here is a build defect).
 pub(crate) fn tables() -> Result<&'static Tables, SpectralError> {
@@ -111,13 +111,13 @@ pub(crate) fn tables() -> Result<&'static Tables, SpectralError> {
                 )?,
             })
         };
-        all().map_err(|e| e.to_string())
+        all().map_err(Arc::new)
     });
     parsed
         .as_ref()
-        .map_err(|message| SpectralError::EmbeddedTable {
-            table: "data/cie",
-            message: message.clone(),
+        .map_err(|source| SpectralError::EmbeddedData {
+            what: "data/cie tables",
+            source: Arc::clone(source),
         })
 }
 

@@ -81,7 +81,7 @@ fn quantity_style(q: Quantity) -> (RGBColor, MarkerShape) {
 fn fit_label(q: Quantity, fit: &CurveFit, measured: bool) -> String {
     let d = &fit.diagnostics;
     let err = if measured {
-        format!(", max |err| {}", format_tick(d.max_abs_error))
+        format!(", max |err| {}", format_tick(d.summary.max_abs_error))
     } else {
         String::new()
     };

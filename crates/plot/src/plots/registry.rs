@@ -108,7 +108,7 @@ pub fn registry_figure_of(
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let method = &reg.spectral.method;
+    let method = reg.spectral.method.kind();
     Ok(GridFigure {
         title: format!("Glass registry: {name}"),
         subtitle: Some(format!(

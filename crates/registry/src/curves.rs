@@ -1,0 +1,113 @@
+//! The angle curves of a glass: C_r, C_t, C_r_back per channel fitted to the model tables, or
+//! one measured curve (continued to grazing) shared by the three channels.
+
+use glassdb_fit::{AngleSamples, FitOptions, Quantity};
+
+use crate::angle_model::{MeasuredTable, ModelTables, continue_measured};
+use crate::normal::NormalValues;
+use crate::{AngleCurve, BuildOptions, CHANNELS, RegistryError};
+
+/// Normal values at or below this are zero: the curve never matters and is the nominal one.
+const ZERO_NORMAL: f64 = 1e-9;
+
+/// The three curves of each kind, per channel.
+pub(crate) struct GlassCurves {
+    pub c_r: [AngleCurve; 3],
+    pub c_t: [AngleCurve; 3],
+    pub c_r_back: [AngleCurve; 3],
+}
+
+/// Fits one curve; the validation tolerance recorded with it is the larger of the fit
+/// tolerance and the fit's own largest residual.
+fn fit_curve(
+    samples: &AngleSamples,
+    quantity: Quantity,
+    opts: &BuildOptions,
+    glass: &str,
+    curve: String,
+) -> Result<AngleCurve, RegistryError> {
+    let mut fo = FitOptions::new(quantity);
+    fo.tol = opts.fit_tol;
+    fo.max_degree = opts.max_degree;
+    let fit = glassdb_fit::fit_curve(samples, &fo).map_err(|source| RegistryError::Fit {
+        glass: glass.to_string(),
+        curve,
+        source: Box::new(source),
+    })?;
+    let summary = fit.diagnostics.summary;
+    Ok(AngleCurve {
+        polynomial: fit.polynomial,
+        fit: summary,
+        tolerance: opts.fit_tol.max(summary.max_abs_error),
+    })
+}
+
+/// Fits every curve of a glass. A measured table's R and T curves (the ratio C(θ) of the table,
+/// continued by the model's channel G beyond its last angle) are shared by the three channels;
+/// otherwise each channel fits its model table. Zero normal values get the nominal curve.
+pub(crate) fn fit_glass_curves(
+    normal: &NormalValues,
+    tables: &ModelTables,
+    measured: Option<&MeasuredTable>,
+    opts: &BuildOptions,
+    glass: &str,
+) -> Result<GlassCurves, RegistryError> {
+    let fit = |samples: &AngleSamples, quantity: Quantity, curve: String| {
+        fit_curve(samples, quantity, opts, glass, curve)
+    };
+    let shared_r = match measured.and_then(|m| m.reflectance.as_ref()) {
+        Some(m) => Some(fit(
+            &continue_measured(m, &tables.angles, &tables.rf, true),
+            Quantity::Reflectance,
+            "measured R".into(),
+        )?),
+        None => None,
+    };
+    let shared_t = match measured.and_then(|m| m.transmittance.as_ref()) {
+        Some(m) => Some(fit(
+            &continue_measured(m, &tables.angles, &tables.t, false),
+            Quantity::Transmittance,
+            "measured T".into(),
+        )?),
+        None => None,
+    };
+    // Per channel in the order R, G, B: front reflectance, transmittance, back reflectance.
+    let channel = |ch: usize| -> Result<[AngleCurve; 3], RegistryError> {
+        let name = CHANNELS[ch];
+        let c_r = match &shared_r {
+            Some(c) => c.clone(),
+            None if normal.r0[ch] <= ZERO_NORMAL => AngleCurve::nominal_transmittance(),
+            None => fit(
+                &tables.samples(&tables.rf, ch),
+                Quantity::Reflectance,
+                format!("C_r channel {name}"),
+            )?,
+        };
+        let c_t = match &shared_t {
+            Some(c) => c.clone(),
+            None if normal.t0[ch] <= ZERO_NORMAL => AngleCurve::nominal_transmittance(),
+            None => fit(
+                &tables.samples(&tables.t, ch),
+                Quantity::Transmittance,
+                format!("C_t channel {name}"),
+            )?,
+        };
+        let c_r_back = if normal.r0_back[ch] <= ZERO_NORMAL {
+            AngleCurve::nominal_transmittance()
+        } else {
+            fit(
+                &tables.samples(&tables.rb, ch),
+                Quantity::Reflectance,
+                format!("C_r_back channel {name}"),
+            )?
+        };
+        Ok([c_r, c_t, c_r_back])
+    };
+    let [[r_r, t_r, rb_r], [r_g, t_g, rb_g], [r_b, t_b, rb_b]] =
+        [channel(0)?, channel(1)?, channel(2)?];
+    Ok(GlassCurves {
+        c_r: [r_r, r_g, r_b],
+        c_t: [t_r, t_g, t_b],
+        c_r_back: [rb_r, rb_g, rb_b],
+    })
+}

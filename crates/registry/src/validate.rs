@@ -1,0 +1,171 @@
+//! Registry validation: ids, finite numbers, normal values, curve shapes, and the physical range
+//! of r and t on a dense angle grid per side and channel (`docs/registry.md`, "Validation").
+
+use std::collections::BTreeMap;
+
+use crate::RegistryError;
+use crate::record::{CHANNELS, GlassRecord, Registry, SCHEMA_VERSION, Side};
+
+/// Angle step of the validation grid (degrees): 0, 0.25, …, 90.
+const VALIDATION_STEP_DEG: f64 = 0.25;
+
+/// Slack added to every recorded tolerance so that rounding in the JSON round trip never flips
+/// a check.
+const VALIDATION_EPS: f64 = 1e-9;
+
+impl Registry {
+    /// Validates: schema version, ids unique and non-zero, every number finite, normal values
+    /// in [0, 1] with r0 + t0 ≤ 1, well-formed curves, and on a dense 0–90° grid per side and
+    /// channel 0 ≤ r, t ≤ 1 and r + t ≤ 1, each within the tolerance recorded for the curve.
+    pub fn validate(&self) -> Result<(), RegistryError> {
+        self.validate_named("registry")
+    }
+
+    /// [`Registry::validate`] with a name for the messages.
+    pub fn validate_named(&self, source_name: &str) -> Result<(), RegistryError> {
+        if self.schema != SCHEMA_VERSION {
+            return Err(RegistryError::SchemaVersion {
+                source_name: source_name.to_string(),
+                found: self.schema,
+                expected: SCHEMA_VERSION,
+            });
+        }
+        let mut seen: BTreeMap<u16, &str> = BTreeMap::new();
+        for g in &self.glasses {
+            if g.id == 0 {
+                return Err(RegistryError::IdZero {
+                    source_name: source_name.to_string(),
+                    name: g.name.clone(),
+                });
+            }
+            if let Some(first) = seen.insert(g.id, &g.name) {
+                return Err(RegistryError::DuplicateId {
+                    source_name: source_name.to_string(),
+                    id: g.id,
+                    first: first.to_string(),
+                    second: g.name.clone(),
+                });
+            }
+            validate_glass(g, source_name)?;
+        }
+        Ok(())
+    }
+}
+
+fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryError> {
+    let glass = g.label();
+    let non_finite = |field: String| RegistryError::NonFinite {
+        source_name: source_name.to_string(),
+        glass: glass.clone(),
+        field,
+    };
+    for (field, values) in [("r0", &g.r0), ("t0", &g.t0), ("r0_back", &g.r0_back)] {
+        for (c, v) in values.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(non_finite(format!("{field}[{c}] ({})", CHANNELS[c])));
+            }
+            if !(0.0..=1.0).contains(v) {
+                return Err(RegistryError::NormalValue {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    what: format!("{field} channel {} = {v} is outside [0, 1]", CHANNELS[c]),
+                });
+            }
+        }
+    }
+    if let Some(l) = &g.luminous {
+        for (field, v) in [
+            ("luminous.transmittance", l.transmittance),
+            ("luminous.reflectance", l.reflectance),
+            ("luminous.reflectance_back", l.reflectance_back),
+        ] {
+            if !v.is_finite() {
+                return Err(non_finite(field.to_string()));
+            }
+        }
+    }
+    for (field, curves) in [("c_r", &g.c_r), ("c_t", &g.c_t), ("c_r_back", &g.c_r_back)] {
+        for (c, curve) in curves.iter().enumerate() {
+            let name = format!("{field}[{c}] ({})", CHANNELS[c]);
+            curve
+                .polynomial
+                .check_shape()
+                .map_err(|shape| RegistryError::CurveShape {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    field: name.clone(),
+                    shape,
+                })?;
+            for (k, v) in curve.polynomial.coefficients.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(non_finite(format!("{name}.coefficients[{k}]")));
+                }
+            }
+            for (key, v) in [
+                ("rms_error", curve.fit.rms_error),
+                ("max_abs_error", curve.fit.max_abs_error),
+                ("max_error_angle_deg", curve.fit.max_error_angle_deg),
+                ("tolerance", curve.tolerance),
+            ] {
+                if !v.is_finite() {
+                    return Err(non_finite(format!("{name}.{key}")));
+                }
+            }
+            if curve.tolerance < 0.0 {
+                return Err(RegistryError::NegativeTolerance {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    field: name.clone(),
+                    tolerance: curve.tolerance,
+                });
+            }
+        }
+    }
+    let steps = (90.0 / VALIDATION_STEP_DEG).round() as usize;
+    for side in [Side::Front, Side::Back] {
+        let (_, c_r) = g.r_parts(side);
+        for i in 0..=steps {
+            let angle_deg = i as f64 * VALIDATION_STEP_DEG;
+            let cos = if i == steps {
+                0.0
+            } else {
+                angle_deg.to_radians().cos()
+            };
+            let (r, t) = g.eval_raw(side, cos);
+            for c in 0..3 {
+                let tol_r = c_r[c].tolerance + VALIDATION_EPS;
+                let tol_t = g.c_t[c].tolerance + VALIDATION_EPS;
+                let fail = |what: String, tolerance: f64| RegistryError::Unphysical {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    side,
+                    channel: CHANNELS[c],
+                    angle_deg,
+                    what,
+                    tolerance,
+                };
+                if !r[c].is_finite() || !t[c].is_finite() {
+                    return Err(fail("r or t is not finite".into(), 0.0));
+                }
+                if r[c] < -tol_r || r[c] > 1.0 + tol_r {
+                    return Err(fail(format!("r = {:.6} is outside [0, 1]", r[c]), tol_r));
+                }
+                if t[c] < -tol_t || t[c] > 1.0 + tol_t {
+                    return Err(fail(format!("t = {:.6} is outside [0, 1]", t[c]), tol_t));
+                }
+                if r[c] + t[c] > 1.0 + tol_r + tol_t {
+                    return Err(fail(
+                        format!(
+                            "r + t = {:.6} + {:.6} = {:.6} > 1 (energy is not conserved)",
+                            r[c],
+                            t[c],
+                            r[c] + t[c]
+                        ),
+                        tol_r + tol_t,
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
