@@ -13,7 +13,7 @@ use glassdb_compose::pixels::{InputTransfer, PngBits};
 use glassdb_compose::sequence::{self, FrameOutcome};
 use glassdb_compose::{ComposeJob, ComposeSettings, FrameReport, UnknownIds, compose_frame};
 use glassdb_mask::{ExrMaskChannels, MaskReadOptions};
-use glassdb_registry::Registry;
+use glassdb_registry::{Registry, Side};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -155,7 +155,7 @@ fn default_output(trans: &Path) -> PathBuf {
 fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
     let (registry, label) = match &args.registry {
         Some(p) => (
-            Registry::from_json_file(p).map_err(super::registry_error)?,
+            Registry::from_json_file(p).map_err(anyhow::Error::new)?,
             p.display().to_string(),
         ),
         None => (
@@ -174,7 +174,7 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
         None => Default::default(),
     };
     for spec in &args.side {
-        let (k, side) = glassdb_compose::parse_side_spec(spec)?;
+        let (k, side) = parse_side_spec(spec)?;
         if k >= args.refl.len() {
             bail!(
                 "--side {spec}: plane {k} has no reflection pass ({} given; planes count from 0)",
@@ -396,5 +396,28 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             list.join(", ")
         );
         Ok(ExitCode::from(crate::cmd::EXIT_FAILURE))
+    }
+}
+
+/// Parses a `--side` value, `K=front` / `K=back` (plane index K).
+fn parse_side_spec(spec: &str) -> anyhow::Result<(usize, Side)> {
+    let bad =
+        || anyhow::anyhow!("--side {spec:?}: expected PLANE=front or PLANE=back, e.g. 2=back");
+    let (k, side) = spec.split_once('=').ok_or_else(bad)?;
+    let k: usize = k.trim().parse().map_err(|_| bad())?;
+    let side: Side = side.parse().map_err(|_| bad())?;
+    Ok((k, side))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn side_specs_parse() {
+        assert_eq!(parse_side_spec("2=back").unwrap(), (2, Side::Back));
+        assert_eq!(parse_side_spec("0=Front").unwrap(), (0, Side::Front));
+        assert!(parse_side_spec("x=back").is_err());
+        assert!(parse_side_spec("1=left").is_err());
     }
 }

@@ -76,7 +76,7 @@ pub struct EvalArgs {
 
 pub fn run_fit(args: FitArgs) -> anyhow::Result<ExitCode> {
     let tables =
-        glassdb_fit::read_angle_table(&args.table, args.percent).map_err(super::fit_error)?;
+        glassdb_fit::read_angle_table(&args.table, args.percent).map_err(anyhow::Error::new)?;
     let base = FitOptions {
         degree: args.degree,
         tol: args.tol,

@@ -137,7 +137,7 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
         },
     };
     let registry =
-        glassdb_registry::build_registry(&a.catalog, &opts).map_err(super::registry_error)?;
+        glassdb_registry::build_registry(&a.catalog, &opts).map_err(anyhow::Error::new)?;
     registry.write_json(&a.output)?;
     let ids: Vec<String> = registry.glasses.iter().map(|g| g.id.to_string()).collect();
     eprintln!(
@@ -185,7 +185,7 @@ fn rgb(v: &[f64; 3]) -> String {
 }
 
 fn show(a: ShowArgs) -> anyhow::Result<ExitCode> {
-    let registry = Registry::from_json_file(&a.registry).map_err(super::registry_error)?;
+    let registry = Registry::from_json_file(&a.registry).map_err(anyhow::Error::new)?;
     let side = if a.back { Side::Back } else { Side::Front };
     let method = method_text(&registry.spectral);
     println!(
@@ -284,7 +284,7 @@ fn check(a: CheckArgs) -> anyhow::Result<ExitCode> {
                 r.glasses.len()
             ),
             Err(e) => {
-                eprintln!("FAILED: {:#}", super::registry_error(e));
+                eprintln!("FAILED: {}", super::hints::with_hints(&e.into()));
                 failed += 1;
             }
         }

@@ -10,7 +10,7 @@ use anyhow::{Context, bail};
 use glassdb_mask::{MaskFormat, write_mask};
 use glassdb_scene::{
     Camera, CosEncoding, CosMode, GlassMapping, MirrorRequest, PlaneSource, PlaneTolerance,
-    PlanesFile, RasterOptions, SceneError, build_mask_scene, load_obj, rasterize, to_mask_image,
+    PlanesFile, RasterOptions, build_mask_scene, load_obj, rasterize, to_mask_image,
     write_virtual_scenes,
 };
 
@@ -155,7 +155,7 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
         tolerance,
         out_dir: &args.out_dir,
     })
-    .map_err(with_flag_hint)?;
+    .map_err(anyhow::Error::new)?;
     println!(
         "{} glass plane{} in {} ({} triangles; tolerance {}°, {:e} units)",
         report.planes.planes.len(),
@@ -189,17 +189,6 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
     }
     println!("wrote {}", report.planes_path.display());
     Ok(ExitCode::SUCCESS)
-}
-
-/// A scene error with the command-line flag that sets the rejected value, where there is one.
-fn with_flag_hint(e: SceneError) -> anyhow::Error {
-    let flag = match &e {
-        SceneError::SamplesOutOfRange { .. } => "--samples",
-        SceneError::MeshOutOfRange { .. } => "--mesh",
-        SceneError::NoGlassSelected => "--glass-material PATTERN or --plane a,b,c,d",
-        _ => return e.into(),
-    };
-    anyhow::Error::new(e).context(flag)
 }
 
 /// The mask format from `--format` or the output's extension.
@@ -257,7 +246,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         cos,
         samples: args.samples,
     };
-    glassdb_scene::raster::check_options(&options).map_err(with_flag_hint)?;
+    glassdb_scene::raster::check_options(&options).map_err(anyhow::Error::new)?;
     let mappings = args
         .glass
         .iter()

@@ -175,7 +175,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let settings = args.settings.settings()?;
     let method = settings.method;
     let data = read_spectral_file(&args.file, &args.settings.read_options())
-        .map_err(super::spectral_error)?;
+        .map_err(anyhow::Error::new)?;
     let integrator = Integrator::new(&settings)?;
     let results = integrate_all(&data, &integrator, settings.extrapolate)?;
     let out = if args.json {
@@ -214,13 +214,13 @@ fn integrate_all(
         let context = || format!("{}: {label}", data.source);
         let rgb = integrator
             .channels(wl, values)
-            .map_err(super::spectral_error)
+            .map_err(anyhow::Error::new)
             .with_context(context)?;
         let luminous_iso = luminous(wl, values, LuminousGrid::Iso9050, extrapolate)
-            .map_err(super::spectral_error)
+            .map_err(anyhow::Error::new)
             .with_context(context)?;
         let luminous_1nm = luminous(wl, values, LuminousGrid::OneNm, extrapolate)
-            .map_err(super::spectral_error)
+            .map_err(anyhow::Error::new)
             .with_context(context)?;
         results.push(QuantityResult {
             key,

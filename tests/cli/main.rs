@@ -1,6 +1,7 @@
 //! End-to-end tests: one binary that drives the built `glassdb` and `compose` executables.
 //! One module per area; shared helpers in `util`.
 
+mod architecture;
 mod compose;
 mod fit;
 mod fixtures;

@@ -31,7 +31,7 @@ pub enum ComposeError {
         available: Vec<String>,
     },
     /// Several RGB layers and none chosen.
-    #[error("{path} has several RGB layers ({}); choose one with --layer", candidates.join(", "))]
+    #[error("{path} has several RGB layers ({}); choose one", candidates.join(", "))]
     AmbiguousLayer {
         path: PathBuf,
         candidates: Vec<String>,
@@ -54,7 +54,7 @@ pub enum ComposeError {
     },
     /// Ids in the mask that the registry does not have.
     #[error(
-        "mask {mask} has glass ids with no registry entry in {registry}: {} (add them to the registry, or pass --unknown passthrough to leave those pixels as the transmission pass)",
+        "mask {mask} has glass ids with no registry entry in {registry}: {}",
         list_counts(ids)
     )]
     UnknownIds {
@@ -64,7 +64,7 @@ pub enum ComposeError {
     },
     /// Glass pixels on a plane that has no reflection pass.
     #[error(
-        "mask {mask} has {pixels} glass pixels on plane {plane}, but only {passes} reflection pass(es) were given (--refl repeats: the k-th is plane k)"
+        "mask {mask} has {pixels} glass pixels on plane {plane}, but only {passes} reflection pass(es) were given (the k-th pass is plane k)"
     )]
     PlaneWithoutPass {
         mask: PathBuf,
@@ -72,8 +72,23 @@ pub enum ComposeError {
         pixels: u64,
         passes: usize,
     },
-    #[error("{0}")]
-    BadOption(String),
+    /// A compose job without any reflection pass.
+    #[error("at least one reflection pass is needed")]
+    NoReflectionPass,
+    /// An image whose width or height does not fit the pixel buffers.
+    #[error("{path}: image too large")]
+    TooLarge { path: PathBuf },
+    /// An EXR compression name that is not one of OpenEXR's.
+    #[error("unknown EXR compression {name:?} (choose one of: {})", known.join(", "))]
+    UnknownCompression {
+        name: String,
+        known: Vec<&'static str>,
+    },
+    /// A zip level given for a compression that is not zip or zips.
+    #[error("a zip level applies to zip and zips output, not {compression}")]
+    ZipLevelNotApplicable { compression: &'static str },
+    #[error("zip level {level} is out of range (0–9)")]
+    ZipLevelOutOfRange { level: u32 },
     /// A `planes.json` could not be read or is not a valid planes file.
     #[error(transparent)]
     PlanesFile(#[from] glassdb_scene::SceneError),
@@ -89,8 +104,17 @@ pub enum ComposeError {
     Output(#[from] glassdb_io::OutputError),
     #[error(transparent)]
     Kernel(#[from] crate::kernel::KernelShapeError),
-    #[error("{0}")]
-    Sequence(String),
+    /// A frame list that does not parse or is out of range.
+    #[error("frame list {spec:?}: {why} (e.g. 1-240 or 1,5,10-20)")]
+    FrameList { spec: String, why: String },
+    /// A sequence path without the `####` that the frame number replaces.
+    #[error("{path} has no #### for the frame number")]
+    NoFramePattern { path: PathBuf },
+    /// Several frames into one output file.
+    #[error(
+        "the output {path} has no #### for the frame number, so every frame would overwrite it"
+    )]
+    OutputWithoutFramePattern { path: PathBuf },
 }
 
 impl ComposeError {

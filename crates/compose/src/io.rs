@@ -199,7 +199,9 @@ fn read_exr_pass(
     let b = buffers.pop().unwrap_or_default();
     let g = buffers.pop().unwrap_or_default();
     let r = buffers.pop().unwrap_or_default();
-    let too_big = || ComposeError::BadOption(format!("{}: image too large", path.display()));
+    let too_big = || ComposeError::TooLarge {
+        path: path.to_path_buf(),
+    };
     Ok(Pass {
         image: LinearImage {
             width: u32::try_from(info.width).map_err(|_| too_big())?,
@@ -243,15 +245,9 @@ pub fn parse_exr_compression(name: &str) -> Result<exr::compression::Compression
         .iter()
         .find(|(n, _)| n.eq_ignore_ascii_case(name))
         .map(|(_, c)| *c)
-        .ok_or_else(|| {
-            ComposeError::BadOption(format!(
-                "unknown EXR compression {name:?} (choose one of: {})",
-                EXR_COMPRESSIONS
-                    .iter()
-                    .map(|(n, _)| *n)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ))
+        .ok_or_else(|| ComposeError::UnknownCompression {
+            name: name.to_string(),
+            known: EXR_COMPRESSIONS.iter().map(|(n, _)| *n).collect(),
         })
 }
 
@@ -357,16 +353,13 @@ pub fn write_output(
                 (Some(_), level) => Some(level.unwrap_or(glassdb_image::DEFAULT_ZIP_LEVEL)),
                 (None, None) => None,
                 (None, Some(_)) => {
-                    return Err(ComposeError::BadOption(format!(
-                        "a zip level applies to zip and zips output, not {}",
-                        exr_compression_name(compression)
-                    )));
+                    return Err(ComposeError::ZipLevelNotApplicable {
+                        compression: exr_compression_name(compression),
+                    });
                 }
             };
             if let Some(level) = zip_level.filter(|&l| l > 9) {
-                return Err(ComposeError::BadOption(format!(
-                    "zip level {level} is out of range (0–9)"
-                )));
+                return Err(ComposeError::ZipLevelOutOfRange { level });
             }
             let n = write_exr(path, image, data_type, compression, zip_level)?;
             let ty = if data_type == ExrDataType::Half {

@@ -134,19 +134,6 @@ impl FrameReport {
     }
 }
 
-/// Parses `K=front` / `K=back` (plane index K).
-pub fn parse_side_spec(spec: &str) -> Result<(usize, Side), ComposeError> {
-    let bad = || {
-        ComposeError::BadOption(format!(
-            "--side {spec:?}: expected PLANE=front or PLANE=back, e.g. 2=back"
-        ))
-    };
-    let (k, side) = spec.split_once('=').ok_or_else(bad)?;
-    let k: usize = k.trim().parse().map_err(|_| bad())?;
-    let side: Side = side.parse().map_err(|_| bad())?;
-    Ok((k, side))
-}
-
 /// Plane sides from a `planes.json` written by `glassdb mirror` (`planes[k].eye_side`), read
 /// by the scene crate's own reader (format and plane order checked).
 pub fn sides_from_planes_json(path: &Path) -> Result<BTreeMap<usize, Side>, ComposeError> {
@@ -245,9 +232,7 @@ pub fn compose_frame(
     lut: &GlassLut,
 ) -> Result<FrameReport, ComposeError> {
     if job.refl.is_empty() {
-        return Err(ComposeError::BadOption(
-            "at least one reflection pass (--refl) is needed".into(),
-        ));
+        return Err(ComposeError::NoReflectionPass);
     }
     io::output_format(&job.output)?;
     glassdb_io::refuse_input_as_output(

@@ -18,11 +18,8 @@ pub fn is_pattern(pattern: &Path) -> bool {
 /// Replaces the last run of `#` in `pattern` by `frame`, zero-padded to the run's length.
 pub fn expand(pattern: &Path, frame: u32) -> Result<PathBuf, ComposeError> {
     let s = pattern.to_string_lossy();
-    let end = s.rfind('#').ok_or_else(|| {
-        ComposeError::Sequence(format!(
-            "{} has no #### for the frame number",
-            pattern.display()
-        ))
+    let end = s.rfind('#').ok_or_else(|| ComposeError::NoFramePattern {
+        path: pattern.to_path_buf(),
     })? + 1;
     let start = s[..end].trim_end_matches('#').len();
     let width = end - start;
@@ -37,10 +34,9 @@ pub fn expand(pattern: &Path, frame: u32) -> Result<PathBuf, ComposeError> {
 
 /// Parses a frame list: `N`, `A-B`, comma-separated, e.g. `1-240` or `1,5,10-20`.
 pub fn parse_frames(spec: &str) -> Result<Vec<u32>, ComposeError> {
-    let bad = |why: &str| {
-        ComposeError::Sequence(format!(
-            "--frames {spec:?}: {why} (e.g. 1-240 or 1,5,10-20)"
-        ))
+    let bad = |why: &str| ComposeError::FrameList {
+        spec: spec.to_string(),
+        why: why.to_string(),
     };
     let mut frames = Vec::new();
     for item in spec.split(',') {
@@ -106,10 +102,9 @@ pub fn compose_sequence(
     on_done: &(dyn Fn(&FrameOutcome) + Sync),
 ) -> Result<Vec<FrameOutcome>, ComposeError> {
     if !is_pattern(&pattern.output) && frames.len() > 1 {
-        return Err(ComposeError::Sequence(format!(
-            "the output {} has no #### for the frame number, so every frame would overwrite it",
-            pattern.output.display()
-        )));
+        return Err(ComposeError::OutputWithoutFramePattern {
+            path: pattern.output.clone(),
+        });
     }
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<FrameOutcome>> = Mutex::new(Vec::with_capacity(frames.len()));

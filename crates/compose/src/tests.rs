@@ -202,14 +202,6 @@ fn kernel_input_of_the_wrong_shape_is_refused_once() {
 }
 
 #[test]
-fn side_specs_parse() {
-    assert_eq!(parse_side_spec("2=back").unwrap(), (2, Side::Back));
-    assert_eq!(parse_side_spec("0=Front").unwrap(), (0, Side::Front));
-    assert!(parse_side_spec("x=back").is_err());
-    assert!(parse_side_spec("1=left").is_err());
-}
-
-#[test]
 fn planes_json_sides() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("planes.json");

@@ -24,6 +24,14 @@ pub enum MaskError {
     /// The file decodes but is not laid out as any mask format (e.g. grey PNG without a glass id).
     #[error("mask {path}: {detail}")]
     Layout { path: PathBuf, detail: String },
+    /// A binary (white-on-black) mask given as an EXR.
+    #[error("mask {path}: a binary mask must be a PNG; an EXR mask carries its ids in a channel")]
+    BinaryMaskNotPng { path: PathBuf },
+    /// A grey PNG read as a packed mask, with no glass id given for the binary form.
+    #[error(
+        "mask {path}: a grey PNG is not a packed id + cos θ mask (it needs RGB: R = plane, G = id, B = cos θ); for the paper's binary white/black mask give the glass id"
+    )]
+    GreyPngWithoutGlassId { path: PathBuf },
     #[error("mask {path} has no channel {channel:?} (it has: {})", available.join(", "))]
     MissingChannel {
         path: PathBuf,

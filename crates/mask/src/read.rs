@@ -33,9 +33,8 @@ pub fn read_mask_bytes(
         },
         ImageFile::Exr(exr) => {
             if opts.binary_glass_id.is_some() {
-                return Err(MaskError::Layout {
+                return Err(MaskError::BinaryMaskNotPng {
                     path: path.to_path_buf(),
-                    detail: "a binary mask (--glass) must be a PNG; an EXR mask carries its ids in a channel".into(),
                 });
             }
             mask_from_exr(&exr, path, opts)?
@@ -48,11 +47,8 @@ pub fn read_mask_bytes(
 /// The packed formats: R = plane, G = id, B = cos θ code (8- or 16-bit). Alpha is ignored.
 fn packed_from_png(png: &PngPixels, path: &Path) -> Result<MaskImage, MaskError> {
     if png.channels < 3 {
-        return Err(MaskError::Layout {
+        return Err(MaskError::GreyPngWithoutGlassId {
             path: path.to_path_buf(),
-            detail: "a grey PNG is not a packed id + cos θ mask (it needs RGB: R = plane, G = id, B = cos θ); \
-                     for the paper's binary white/black mask give the glass id (--glass ID)"
-                .into(),
         });
     }
     let n = png.width as usize * png.height as usize;

@@ -1,0 +1,150 @@
+//! The command-line hints: libraries say what is wrong, only the binary knows which flag or
+//! command fixes it. [`hints`] walks an error's whole cause chain and matches the library
+//! error variants that one flag or command answers; [`super::finish`] prints each as `hint:`.
+
+use glassdb_compose::ComposeError;
+use glassdb_fit::FitError;
+use glassdb_mask::MaskError;
+use glassdb_plot::PlotError;
+use glassdb_registry::RegistryError;
+use glassdb_scene::SceneError;
+use glassdb_spectral::SpectralError;
+
+/// The hints for every error in `err`'s cause chain, outermost first, without repeats.
+pub fn hints(err: &anyhow::Error) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for cause in err.chain() {
+        if let Some(h) = hint(cause)
+            && !out.contains(&h)
+        {
+            out.push(h);
+        }
+    }
+    out
+}
+
+/// The error message followed by its hints in parentheses, on one line (for reports that list
+/// several failures).
+pub fn with_hints(err: &anyhow::Error) -> String {
+    let hints = hints(err);
+    if hints.is_empty() {
+        format!("{err:#}")
+    } else {
+        format!("{err:#} ({})", hints.join("; "))
+    }
+}
+
+fn hint(cause: &(dyn std::error::Error + 'static)) -> Option<String> {
+    if let Some(e) = cause.downcast_ref::<FitError>() {
+        return fit_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<SpectralError>() {
+        return spectral_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<RegistryError>() {
+        return registry_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<MaskError>() {
+        return mask_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<SceneError>() {
+        return scene_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<ComposeError>() {
+        return compose_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<PlotError>() {
+        return plot_hint(e);
+    }
+    None
+}
+
+/// Plot errors wrap the readers' errors transparently (their `source` skips the wrapped error
+/// itself), so the wrapped error is matched here.
+fn plot_hint(e: &PlotError) -> Option<String> {
+    match e {
+        PlotError::Fit(e) => fit_hint(e),
+        PlotError::Spectral(e) => spectral_hint(e),
+        PlotError::Registry(e) => registry_hint(e),
+        PlotError::Mask(e) => mask_hint(e),
+        _ => None,
+    }
+}
+
+fn fit_hint(e: &FitError) -> Option<String> {
+    match e {
+        FitError::AboveOneInFractions { .. } => {
+            Some("if the table is in percent, pass --percent".into())
+        }
+        _ => None,
+    }
+}
+
+fn spectral_hint(e: &SpectralError) -> Option<String> {
+    match e {
+        SpectralError::AboveOneInFractions { .. } => {
+            Some("if the file is in percent, pass --percent".into())
+        }
+        SpectralError::FractionsReadAsPercent { .. } => Some("drop --percent".into()),
+        SpectralError::PartialCoverage { .. } => {
+            Some("pass --extrapolate to hold the end values constant outside the data".into())
+        }
+        _ => None,
+    }
+}
+
+fn registry_hint(e: &RegistryError) -> Option<String> {
+    match e {
+        RegistryError::SchemaVersion { source_name, .. } => Some(format!(
+            "rebuild it: glassdb registry build CATALOG.toml -o {source_name}"
+        )),
+        _ => None,
+    }
+}
+
+fn mask_hint(e: &MaskError) -> Option<String> {
+    match e {
+        MaskError::BinaryMaskNotPng { .. } => {
+            Some("--glass ID reads a binary PNG mask; drop it for an EXR mask".into())
+        }
+        MaskError::GreyPngWithoutGlassId { .. } => {
+            Some("give the glass id of a binary mask with --glass ID".into())
+        }
+        _ => None,
+    }
+}
+
+fn scene_hint(e: &SceneError) -> Option<String> {
+    match e {
+        SceneError::SamplesOutOfRange { .. } => Some("set it with --samples".into()),
+        SceneError::MeshOutOfRange { .. } => Some("set it with --mesh".into()),
+        SceneError::NoGlassSelected => {
+            Some("pass --glass-material PATTERN or --plane a,b,c,d".into())
+        }
+        _ => None,
+    }
+}
+
+fn compose_hint(e: &ComposeError) -> Option<String> {
+    match e {
+        // Transparent wrappers: their `source` skips the wrapped error itself.
+        ComposeError::Mask(e) => mask_hint(e),
+        ComposeError::Registry(e) => registry_hint(e),
+        ComposeError::PlanesFile(e) => scene_hint(e),
+        ComposeError::AmbiguousLayer { .. } => Some("choose one with --layer".into()),
+        ComposeError::UnknownIds { .. } => Some(
+            "add them to the registry, or pass --unknown passthrough to leave those pixels as \
+             the transmission pass"
+                .into(),
+        ),
+        ComposeError::PlaneWithoutPass { .. } => {
+            Some("repeat --refl: the k-th is the pass of plane k".into())
+        }
+        ComposeError::NoReflectionPass => Some("give one with --refl".into()),
+        ComposeError::FrameList { .. } => Some("check --frames".into()),
+        ComposeError::ZipLevelNotApplicable { .. } | ComposeError::ZipLevelOutOfRange { .. } => {
+            Some("--zip-level sets it".into())
+        }
+        _ => None,
+    }
+}
