@@ -51,5 +51,5 @@ fn main() -> ExitCode {
         Command::Plot(a) => cmd::plot::run(a),
         Command::Report(a) => cmd::report::run(a),
     };
-    glassdb::cmd::finish(result)
+    cmd::finish(result)
 }

@@ -240,7 +240,7 @@ fn golden_angle_dependence_with_16bit_and_exr_masks() {
     }
     // EXR mask with a renderer's own channel names.
     let mexr = g.path("aov.exr");
-    let mut c = glassdb_mask::MaskImage {
+    let mut c = MaskImage {
         cos_theta: CosTheta::Float(vec![0.2; 3]),
         ..m.clone()
     };

@@ -210,7 +210,7 @@ impl CosLookup for Normal {
 }
 
 /// Composites in place: the transmission pass of `input` becomes the output.
-pub fn compose_in_place(input: KernelInput) -> KernelCounts {
+pub fn compose_in_place(input: KernelInput<'_>) -> KernelCounts {
     let KernelInput {
         trans,
         planes,

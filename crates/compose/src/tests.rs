@@ -267,10 +267,10 @@ proptest! {
         let t_path = dir.path().join("t.exr");
         let r_path = dir.path().join("r.exr");
         let m_path = dir.path().join("m.png");
-        let write = |p: &std::path::Path, v: &[f32]| {
+        let write = |p: &Path, v: &[f32]| {
             let img = pixels::LinearImage { width: 4, height: 3, rgb: planes(v), alpha: None };
             let src = io::PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, compression: exr::compression::Compression::ZIP16, layer: String::new() };
-            io::write_output(p, img, &src, &io::OutputOptions::default()).unwrap();
+            io::write_output(p, img, &src, &OutputOptions::default()).unwrap();
         };
         write(&t_path, &trans);
         write(&r_path, &refl);

@@ -732,7 +732,7 @@ fn reader_errors_name_file_line_and_column() {
     assert!(!err("angle_deg,R\n0,8.1\n").contains("--"));
     assert!(matches!(
         parse("angle_deg,R\n0,8.1\n", false),
-        Err(glassdb_fit::FitError::AboveOneInFractions {
+        Err(FitError::AboveOneInFractions {
             line: 2,
             column: 2,
             ..

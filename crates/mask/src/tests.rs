@@ -234,10 +234,16 @@ fn binary_mask_white_is_the_given_glass_at_normal_incidence() {
 fn grey_png_without_glass_id_is_explained() {
     let bytes = encode_png(1, 1, PngColor::Grey, Depth::Eight, &[255]);
     let err = read_mask_bytes(&bytes, Path::new("g.png"), &opts()).unwrap_err();
-    assert!(matches!(err, MaskError::GreyPngWithoutGlassId { .. }), "{err:?}");
+    assert!(
+        matches!(err, MaskError::GreyPngWithoutGlassId { .. }),
+        "{err:?}"
+    );
     // The library says what is missing; the command line adds the flag that gives it.
     let err = err.to_string();
-    assert!(err.contains("g.png") && err.contains("give the glass id"), "{err}");
+    assert!(
+        err.contains("g.png") && err.contains("give the glass id"),
+        "{err}"
+    );
     assert!(!err.contains("--"), "{err}");
 }
 

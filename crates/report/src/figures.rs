@@ -98,7 +98,7 @@ pub(crate) fn section_figures(
 fn fit_figures(
     md: &mut String,
     opts: &ReportOptions,
-    sink: &mut FigureSink,
+    sink: &mut FigureSink<'_>,
 ) -> Result<(), ReportError> {
     for table in &opts.angle_tables {
         let stem = table
@@ -130,7 +130,7 @@ fn spectral_figures(
     md: &mut String,
     opts: &ReportOptions,
     spectrum: &SpectrumFigure,
-    sink: &mut FigureSink,
+    sink: &mut FigureSink<'_>,
 ) -> Result<(), ReportError> {
     for (method, tag, label) in [
         (
@@ -171,7 +171,7 @@ fn spectral_figures(
 fn registry_figure(
     md: &mut String,
     opts: &ReportOptions,
-    sink: &mut FigureSink,
+    sink: &mut FigureSink<'_>,
 ) -> Result<(), ReportError> {
     let Ok(reg) = build_registry(&opts.catalog, &BuildOptions::default()) else {
         return Ok(());
@@ -199,7 +199,11 @@ fn registry_figure(
 }
 
 /// The reflectance heat map of the Gouraud section's exact mask.
-fn mask_figure(md: &mut String, sm: &SceneMask, sink: &mut FigureSink) -> Result<(), ReportError> {
+fn mask_figure(
+    md: &mut String,
+    sm: &SceneMask,
+    sink: &mut FigureSink<'_>,
+) -> Result<(), ReportError> {
     let fig = mask_figure_of(
         &sm.mask,
         &sm.registry,
@@ -221,7 +225,7 @@ fn mask_figure(md: &mut String, sm: &SceneMask, sink: &mut FigureSink) -> Result
 fn cos_storage_figure(
     md: &mut String,
     refs: &[Reference],
-    sink: &mut FigureSink,
+    sink: &mut FigureSink<'_>,
 ) -> Result<(), ReportError> {
     let fig = GridFigure {
         title: "Reflectance error from storing cos θ".into(),

@@ -109,7 +109,7 @@ pub(crate) fn section_tables(md: &mut String, refs: &[Reference], inputs: &[f64]
     let t4096 = CosTable::new(Grid::Steps(4095), p);
     let t65536 = CosTable::new(Grid::Code(CosCode::Bits16), p);
     type Way<'a> = (&'a str, Box<dyn Fn(f64) -> f64 + 'a>);
-    let ways: Vec<Way> = vec![
+    let ways: Vec<Way<'_>> = vec![
         ("exact physics (Fresnel slab)", Box::new(|c| r.eval(c).0)),
         ("polynomial (Horner)", Box::new(p)),
         ("256-entry table, nearest", Box::new(|c| t256.nearest(c))),

@@ -46,8 +46,8 @@ fn relative_to(target: &Path, base: &Path) -> String {
             .display()
             .to_string();
     };
-    let tc: Vec<Component> = t.components().collect();
-    let bc: Vec<Component> = b.components().collect();
+    let tc: Vec<Component<'_>> = t.components().collect();
+    let bc: Vec<Component<'_>> = b.components().collect();
     let common = tc.iter().zip(&bc).take_while(|(x, y)| x == y).count();
     let mut rel = PathBuf::new();
     for _ in common..bc.len() {
@@ -62,7 +62,7 @@ fn relative_to(target: &Path, base: &Path) -> String {
 /// Finds the planes (or takes the explicit one), writes `plane_<k>.obj` for each and
 /// `planes.json` into `out_dir` (created if missing). All glass faces are dropped from every
 /// virtual scene: reflection passes, like the transmission pass, are rendered without glass.
-pub fn write_virtual_scenes(req: &MirrorRequest) -> Result<MirrorReport, SceneError> {
+pub fn write_virtual_scenes(req: &MirrorRequest<'_>) -> Result<MirrorReport, SceneError> {
     let scene = req.scene;
     req.tolerance.validate()?;
     let glass_table = if req.glass_patterns.is_empty() {
@@ -123,7 +123,7 @@ pub fn write_virtual_scenes(req: &MirrorRequest) -> Result<MirrorReport, SceneEr
 /// The glass planes to mirror across: the explicit one, or those detected among the glass
 /// faces; at most as many as a mask's plane index can tell apart.
 fn glass_planes(
-    req: &MirrorRequest,
+    req: &MirrorRequest<'_>,
     is_glass: impl Fn(Option<usize>) -> bool,
 ) -> Result<Vec<GlassPlane>, SceneError> {
     let planes = match req.explicit_plane {

@@ -23,7 +23,7 @@ fn runner(cases: u32) -> TestRunner {
 }
 
 /// The invariants every successful read promises.
-fn check_invariants(d: &glassdb_spectral::SpectralData) {
+fn check_invariants(d: &SpectralData) {
     assert!(!d.wavelength_nm.is_empty());
     assert!(d.wavelength_nm.windows(2).all(|p| p[1] > p[0]));
     assert!(d.wavelength_nm.iter().all(|w| w.is_finite() && *w > 0.0));

@@ -27,7 +27,7 @@ pub(super) struct Resolver<'a> {
 
 impl Resolver<'_> {
     /// Writes the pixels of rows `row0..row0 + rows` from their samples' labels.
-    pub(super) fn resolve_band(&self, row0: u32, rows: u32, winner: &[u32], out: BandPixels) {
+    pub(super) fn resolve_band(&self, row0: u32, rows: u32, winner: &[u32], out: BandPixels<'_>) {
         let w = self.cam.width;
         let ns = self.samples.len();
         let BandPixels {
