@@ -6,7 +6,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::error::FitError;
-use crate::model::{CurveFit, FitOptions, Quantity};
+use crate::model::{AngleSamples, CurveFit, FitOptions, Quantity};
 use crate::solve::fit_curve;
 use crate::table::GlassAngleTable;
 
@@ -192,25 +192,19 @@ pub fn fit_glass(
         quantity: Quantity::Transmittance,
         ..transmittance.clone()
     };
-    let in_curve = |quantity: &'static str| {
-        move |e: FitError| FitError::Curve {
-            glass: table.name.clone(),
-            quantity,
-            error: Box::new(e),
-        }
+    // Fits one curve of the table when it has one; an error names the glass and the quantity.
+    let fit = |samples: Option<&AngleSamples>, opts: &FitOptions, quantity: &'static str| {
+        samples
+            .map(|s| fit_curve(s, opts))
+            .transpose()
+            .map_err(|e| FitError::Curve {
+                glass: table.name.clone(),
+                quantity,
+                error: Box::new(e),
+            })
     };
-    let r = table
-        .reflectance
-        .as_ref()
-        .map(|s| fit_curve(s, &r_opts))
-        .transpose()
-        .map_err(in_curve("reflectance"))?;
-    let t = table
-        .transmittance
-        .as_ref()
-        .map(|s| fit_curve(s, &t_opts))
-        .transpose()
-        .map_err(in_curve("transmittance"))?;
+    let r = fit(table.reflectance.as_ref(), &r_opts, "reflectance")?;
+    let t = fit(table.transmittance.as_ref(), &t_opts, "transmittance")?;
     let mut warnings = Vec::new();
     for rep in &table.repeated_angles {
         let mut spreads = Vec::new();

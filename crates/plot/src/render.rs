@@ -75,18 +75,29 @@ fn guarded<T>(what: &str, f: impl FnOnce() -> Result<T, PlotError>) -> Result<T,
     }
 }
 
+/// Fills `backend`'s area white and draws `fig` on it in `format`, a panic inside plotters
+/// turned into [`PlotError::DrawPanic`].
+fn draw_on<F: Figure, DB: DrawingBackend>(
+    fig: &F,
+    backend: DB,
+    format: ImageFormat,
+) -> Result<(), PlotError> {
+    guarded(&fig.describe(), || {
+        let root = backend.into_drawing_area();
+        root.fill(&WHITE).map_err(draw_err)?;
+        fig.draw(&root, format)?;
+        root.present().map_err(draw_err)
+    })
+}
+
 /// Draws `fig` into an RGB8 buffer (row-major, `width * height * 3` bytes).
 pub fn render_rgb<F: Figure>(fig: &F) -> Result<(Vec<u8>, u32, u32), PlotError> {
     font::ensure_registered()?;
     let (w, h) = fig.size();
     check_size(w, h)?;
     let mut buf = vec![255u8; w as usize * h as usize * 3];
-    guarded(&fig.describe(), || {
-        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(draw_err)?;
-        fig.draw(&root, ImageFormat::Png)?;
-        root.present().map_err(draw_err)
-    })?;
+    let backend = BitMapBackend::with_buffer(&mut buf, (w, h));
+    draw_on(fig, backend, ImageFormat::Png)?;
     Ok((buf, w, h))
 }
 
@@ -102,12 +113,11 @@ pub fn render_svg<F: Figure>(fig: &F) -> Result<String, PlotError> {
     let (w, h) = fig.size();
     check_size(w, h)?;
     let mut svg = String::new();
-    guarded(&fig.describe(), || {
-        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(draw_err)?;
-        fig.draw(&root, ImageFormat::Svg)?;
-        root.present().map_err(draw_err)
-    })?;
+    draw_on(
+        fig,
+        SVGBackend::with_string(&mut svg, (w, h)),
+        ImageFormat::Svg,
+    )?;
     Ok(svg)
 }
 

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use glassdb_fit::{Basis, CosPolynomial, FitSummary};
 use glassdb_mask::{CosTheta, MaskImage};
-use glassdb_registry::{AngleCurve, AngleModelRecord, GlassRecord, Provenance, Registry};
+use glassdb_registry::{AngleCurve, GlassRecord, Registry};
 use glassdb_spectral::{IntegrationSettings, Method};
 
 use crate::chart::{Line, Panel, clipped_runs, format_axis_tick, format_tick};
@@ -176,26 +176,13 @@ fn linear_registry() -> Registry {
             method: Method::Luminous,
             extrapolate: false,
         },
-        glasses: vec![GlassRecord {
-            id: 3,
-            name: "linear".into(),
-            r0: [0.1, 0.2, 0.3],
-            t0: [0.5, 0.6, 0.7],
-            r0_back: [0.4, 0.4, 0.4],
-            c_r: [lin.clone(), lin.clone(), lin],
-            c_t: [one.clone(), one.clone(), one.clone()],
-            c_r_back: [one.clone(), one.clone(), one],
-            luminous: None,
-            angle_model: AngleModelRecord {
-                kind: "measured".into(),
-                applied: "per-channel".into(),
-                ior: None,
-                measured_max_angle_deg: None,
-                continued_by: None,
-                chosen_by: String::new(),
-            },
-            provenance: Provenance::default(),
-        }],
+        glasses: vec![GlassRecord::with_shared_curves(
+            3,
+            "linear",
+            "measured",
+            [[0.1, 0.2, 0.3], [0.5, 0.6, 0.7], [0.4, 0.4, 0.4]],
+            [&lin, &one, &one],
+        )],
     }
 }
 

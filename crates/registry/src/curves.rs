@@ -55,53 +55,58 @@ pub(crate) fn fit_glass_curves(
     let fit = |samples: &AngleSamples, quantity: Quantity, curve: String| {
         fit_curve(samples, quantity, opts, glass, curve)
     };
-    let shared_r = match measured.and_then(|m| m.reflectance.as_ref()) {
-        Some(m) => Some(fit(
-            &continue_measured(m, &tables.angles, &tables.rf, true),
+    // A measured curve continued by the model `table` beyond its last angle.
+    let shared = |measured: Option<&AngleSamples>, table: &[[f64; 3]], quantity, curve: &str| {
+        let reflect = quantity == Quantity::Reflectance;
+        measured
+            .map(|m| {
+                let continued = continue_measured(m, &tables.angles, table, reflect);
+                fit(&continued, quantity, curve.into())
+            })
+            .transpose()
+    };
+    let measured_r = measured.and_then(|m| m.reflectance.as_ref());
+    let measured_t = measured.and_then(|m| m.transmittance.as_ref());
+    let shared_r = shared(measured_r, &tables.rf, Quantity::Reflectance, "measured R")?;
+    let shared_t = shared(measured_t, &tables.t, Quantity::Transmittance, "measured T")?;
+    // Front reflectance, transmittance, back reflectance: the shared curve if any, else the
+    // nominal one for a zero normal value, else a fit of the channel's model table.
+    let kinds = [
+        (
+            shared_r.as_ref(),
+            normal.r0,
+            &tables.rf,
             Quantity::Reflectance,
-            "measured R".into(),
-        )?),
-        None => None,
-    };
-    let shared_t = match measured.and_then(|m| m.transmittance.as_ref()) {
-        Some(m) => Some(fit(
-            &continue_measured(m, &tables.angles, &tables.t, false),
+            "C_r",
+        ),
+        (
+            shared_t.as_ref(),
+            normal.t0,
+            &tables.t,
             Quantity::Transmittance,
-            "measured T".into(),
-        )?),
-        None => None,
-    };
-    // Per channel in the order R, G, B: front reflectance, transmittance, back reflectance.
+            "C_t",
+        ),
+        (
+            None,
+            normal.r0_back,
+            &tables.rb,
+            Quantity::Reflectance,
+            "C_r_back",
+        ),
+    ];
+    // Per channel in the order R, G, B.
     let channel = |ch: usize| -> Result<[AngleCurve; 3], RegistryError> {
-        let name = CHANNELS[ch];
-        let c_r = match &shared_r {
-            Some(c) => c.clone(),
-            None if normal.r0[ch] <= ZERO_NORMAL => AngleCurve::nominal_transmittance(),
-            None => fit(
-                &tables.samples(&tables.rf, ch),
-                Quantity::Reflectance,
-                format!("C_r channel {name}"),
-            )?,
-        };
-        let c_t = match &shared_t {
-            Some(c) => c.clone(),
-            None if normal.t0[ch] <= ZERO_NORMAL => AngleCurve::nominal_transmittance(),
-            None => fit(
-                &tables.samples(&tables.t, ch),
-                Quantity::Transmittance,
-                format!("C_t channel {name}"),
-            )?,
-        };
-        let c_r_back = if normal.r0_back[ch] <= ZERO_NORMAL {
-            AngleCurve::nominal_transmittance()
-        } else {
-            fit(
-                &tables.samples(&tables.rb, ch),
-                Quantity::Reflectance,
-                format!("C_r_back channel {name}"),
-            )?
-        };
-        Ok([c_r, c_t, c_r_back])
+        let [c_r, c_t, c_r_back] =
+            kinds.map(|(shared, normal, table, quantity, kind)| match shared {
+                Some(c) => Ok(c.clone()),
+                None if normal[ch] <= ZERO_NORMAL => Ok(AngleCurve::nominal_transmittance()),
+                None => fit(
+                    &tables.samples(table, ch),
+                    quantity,
+                    format!("{kind} channel {}", CHANNELS[ch]),
+                ),
+            });
+        Ok([c_r?, c_t?, c_r_back?])
     };
     let [[r_r, t_r, rb_r], [r_g, t_g, rb_g], [r_b, t_b, rb_b]] =
         [channel(0)?, channel(1)?, channel(2)?];

@@ -226,6 +226,38 @@ fn clamp_physical(r: f64, t: f64) -> (f64, f64) {
 }
 
 impl GlassRecord {
+    /// A hand-made glass (tests, examples): normal-incidence values `[r0, t0, r0_back]` and one
+    /// curve each `[c_r, c_t, c_r_back]` shared by all three channels, under the per-channel
+    /// angle model `kind`, with no luminous values and no provenance.
+    pub fn with_shared_curves(
+        id: u16,
+        name: &str,
+        kind: &str,
+        [r0, t0, r0_back]: [[f64; 3]; 3],
+        [c_r, c_t, c_r_back]: [&AngleCurve; 3],
+    ) -> GlassRecord {
+        GlassRecord {
+            id,
+            name: name.to_string(),
+            r0,
+            t0,
+            r0_back,
+            c_r: std::array::from_fn(|_| c_r.clone()),
+            c_t: std::array::from_fn(|_| c_t.clone()),
+            c_r_back: std::array::from_fn(|_| c_r_back.clone()),
+            luminous: None,
+            angle_model: AngleModelRecord {
+                kind: kind.to_string(),
+                applied: "per-channel".into(),
+                ior: None,
+                measured_max_angle_deg: None,
+                continued_by: None,
+                chosen_by: String::new(),
+            },
+            provenance: Provenance::default(),
+        }
+    }
+
     /// "id 3 (\"Clear 6 mm\")", for messages.
     pub fn label(&self) -> String {
         format!("id {} (\"{}\")", self.id, self.name)
@@ -352,26 +384,13 @@ mod tests {
         Registry {
             schema: SCHEMA_VERSION,
             spectral: IntegrationSettings::default(),
-            glasses: vec![GlassRecord {
-                id: 4,
-                name: "hand-made".into(),
-                r0: [0.1; 3],
-                t0: [0.8, 0.7, 0.6],
-                r0_back: [0.05; 3],
-                c_r: [cr.clone(), cr.clone(), cr.clone()],
-                c_t: [ct.clone(), ct.clone(), ct],
-                c_r_back: [cr.clone(), cr.clone(), cr],
-                luminous: None,
-                angle_model: AngleModelRecord {
-                    kind: "uncoated".into(),
-                    applied: "per-channel".into(),
-                    ior: None,
-                    measured_max_angle_deg: None,
-                    continued_by: None,
-                    chosen_by: String::new(),
-                },
-                provenance: Provenance::default(),
-            }],
+            glasses: vec![GlassRecord::with_shared_curves(
+                4,
+                "hand-made",
+                "uncoated",
+                [[0.1; 3], [0.8, 0.7, 0.6], [0.05; 3]],
+                [&cr, &ct, &cr],
+            )],
         }
     }
 

@@ -4,8 +4,7 @@ use std::path::Path;
 
 use glassdb_fit::{Basis, CosPolynomial, FitSummary};
 use glassdb_registry::{
-    AngleCurve, AngleModelRecord, GlassRecord, Provenance, Registry, SCHEMA_VERSION, Side,
-    catalog::parse_catalog,
+    AngleCurve, GlassRecord, Registry, SCHEMA_VERSION, Side, catalog::parse_catalog,
 };
 use glassdb_spectral::{IntegrationSettings, Method};
 use proptest::prelude::*;
@@ -23,28 +22,14 @@ fn curve(coefficients: Vec<f64>) -> AngleCurve {
 }
 
 fn glass(r0: f64, t0: f64, cr: Vec<f64>, ct: Vec<f64>) -> GlassRecord {
-    let cr = curve(cr);
-    let ct = curve(ct);
-    GlassRecord {
-        id: 1,
-        name: "random".into(),
-        r0: [r0; 3],
-        t0: [t0; 3],
-        r0_back: [r0; 3],
-        c_r: [cr.clone(), cr.clone(), cr.clone()],
-        c_t: [ct.clone(), ct.clone(), ct],
-        c_r_back: [cr.clone(), cr.clone(), cr],
-        luminous: None,
-        angle_model: AngleModelRecord {
-            kind: "uncoated".into(),
-            applied: "per-channel".into(),
-            ior: None,
-            measured_max_angle_deg: None,
-            continued_by: None,
-            chosen_by: String::new(),
-        },
-        provenance: Provenance::default(),
-    }
+    let (cr, ct) = (curve(cr), curve(ct));
+    GlassRecord::with_shared_curves(
+        1,
+        "random",
+        "uncoated",
+        [[r0; 3], [t0; 3], [r0; 3]],
+        [&cr, &ct, &cr],
+    )
 }
 
 proptest! {

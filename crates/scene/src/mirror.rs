@@ -46,9 +46,9 @@ struct Corner {
 struct Builder<'a> {
     src: &'a Mesh,
     out: Mesh,
-    pos_map: Vec<u32>,
-    tex_map: Vec<u32>,
-    nrm_map: Vec<u32>,
+    pos_map: IndexMap,
+    tex_map: IndexMap,
+    nrm_map: IndexMap,
     has_t: bool,
     has_n: bool,
     crossings: HashMap<[CornerIndices; 2], CornerIndices>,
@@ -58,29 +58,18 @@ impl Builder<'_> {
     fn index_of(&mut self, c: &Corner) -> (u32, u32, u32) {
         match c.orig {
             Some((p, t, n)) => {
-                let pi = remap(
-                    &mut self.pos_map,
-                    &mut self.out.positions,
-                    p,
-                    self.src.positions[p as usize],
-                );
+                let pi = self
+                    .pos_map
+                    .index(&mut self.out.positions, &self.src.positions, p);
                 let ti = if self.has_t {
-                    remap(
-                        &mut self.tex_map,
-                        &mut self.out.texcoords,
-                        t,
-                        self.src.texcoords[t as usize],
-                    )
+                    self.tex_map
+                        .index(&mut self.out.texcoords, &self.src.texcoords, t)
                 } else {
                     0
                 };
                 let ni = if self.has_n {
-                    remap(
-                        &mut self.nrm_map,
-                        &mut self.out.normals,
-                        n,
-                        self.src.normals[n as usize],
-                    )
+                    self.nrm_map
+                        .index(&mut self.out.normals, &self.src.normals, n)
                 } else {
                     0
                 };
@@ -90,17 +79,14 @@ impl Builder<'_> {
                 if let Some(ix) = c.edge.and_then(|e| self.crossings.get(&e)) {
                     return *ix;
                 }
-                self.out.positions.push(c.pos);
-                let pi = (self.out.positions.len() - 1) as u32;
+                let pi = push_index(&mut self.out.positions, c.pos);
                 let mut ti = 0;
                 if let (true, Some(t)) = (self.has_t, c.tex) {
-                    self.out.texcoords.push(t);
-                    ti = (self.out.texcoords.len() - 1) as u32;
+                    ti = push_index(&mut self.out.texcoords, t);
                 }
                 let mut ni = 0;
                 if let (true, Some(n)) = (self.has_n, c.nrm) {
-                    self.out.normals.push(n);
-                    ni = (self.out.normals.len() - 1) as u32;
+                    ni = push_index(&mut self.out.normals, n);
                 }
                 if let Some(e) = c.edge {
                     self.crossings.insert(e, (pi, ti, ni));
@@ -122,13 +108,30 @@ impl Builder<'_> {
     }
 }
 
-fn remap<T: Copy>(map: &mut [u32], out: &mut Vec<T>, i: u32, value: T) -> u32 {
-    let slot = &mut map[i as usize];
-    if *slot == UNSET {
-        out.push(value);
-        *slot = (out.len() - 1) as u32;
+/// Source index → output index of one vertex attribute (positions, texcoords or normals), so
+/// that each source value used is copied to the output once.
+struct IndexMap(Vec<u32>);
+
+impl IndexMap {
+    /// A map over `len` source values, none copied yet.
+    fn new(len: usize) -> IndexMap {
+        IndexMap(vec![UNSET; len])
     }
-    *slot
+
+    /// The output index of source value `i`, copying `src[i]` to `out` on first use.
+    fn index<T: Copy>(&mut self, out: &mut Vec<T>, src: &[T], i: u32) -> u32 {
+        let slot = &mut self.0[i as usize];
+        if *slot == UNSET {
+            *slot = push_index(out, src[i as usize]);
+        }
+        *slot
+    }
+}
+
+/// Appends `value` to `out` and returns its index there.
+fn push_index<T>(out: &mut Vec<T>, value: T) -> u32 {
+    out.push(value);
+    (out.len() - 1) as u32
 }
 
 /// The point where edge a→b crosses the plane (`a.s`, `b.s` of opposite signs), attributes
@@ -185,9 +188,9 @@ impl<'a> Builder<'a> {
                 material: src.material,
                 ..Default::default()
             },
-            pos_map: vec![UNSET; src.positions.len()],
-            tex_map: vec![UNSET; if has_t { src.texcoords.len() } else { 0 }],
-            nrm_map: vec![UNSET; if has_n { src.normals.len() } else { 0 }],
+            pos_map: IndexMap::new(src.positions.len()),
+            tex_map: IndexMap::new(if has_t { src.texcoords.len() } else { 0 }),
+            nrm_map: IndexMap::new(if has_n { src.normals.len() } else { 0 }),
             has_t,
             has_n,
             crossings: HashMap::new(),

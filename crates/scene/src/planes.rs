@@ -259,6 +259,17 @@ impl Cluster {
 /// Relative area below which a triangle counts as degenerate (no normal).
 const DEGENERATE_AREA: f64 = 1e-14;
 
+/// The unit normal and the area of triangle `abc`, or `None` when it is degenerate: twice its
+/// area at most [`DEGENERATE_AREA`] times `scale2` (the squared scene diagonal), or not finite.
+fn unit_normal_and_area(a: Vec3, b: Vec3, c: Vec3, scale2: f64) -> Option<(Vec3, f64)> {
+    let area2 = math::triangle_normal_area2(a, b, c);
+    let len = math::norm(area2);
+    if len <= DEGENERATE_AREA * scale2 || !len.is_finite() {
+        return None;
+    }
+    Some((math::scale(area2, 1.0 / len), 0.5 * len))
+}
+
 /// Groups the triangles with `is_glass(material)` into distinct planes within `tol`.
 /// Faces with opposite windings on the same plane join the same plane. Errors when no
 /// glass triangle exists, or all glass triangles are degenerate.
@@ -281,13 +292,9 @@ pub fn detect_planes(
             for (t, slot) in row.iter_mut().enumerate() {
                 glass_seen += 1;
                 let [a, b, c] = mesh.corners(t);
-                let area2 = math::triangle_normal_area2(a, b, c);
-                let len = math::norm(area2);
-                if len <= DEGENERATE_AREA * scale2 || !len.is_finite() {
+                let Some((n, area)) = unit_normal_and_area(a, b, c, scale2) else {
                     continue;
-                }
-                let n = math::scale(area2, 1.0 / len);
-                let area = 0.5 * len;
+                };
                 let centroid = math::scale(math::add(math::add(a, b), c), 1.0 / 3.0);
                 let found = clusters.iter().position(|cl| {
                     math::dot(cl.plane.normal, n).abs() >= cos_tol
@@ -370,12 +377,9 @@ pub fn assign_to_planes(
         if is_glass(mesh.material) {
             for (t, slot) in row.iter_mut().enumerate() {
                 let [a, b, c] = mesh.corners(t);
-                let area2 = math::triangle_normal_area2(a, b, c);
-                let len = math::norm(area2);
-                if len <= DEGENERATE_AREA * scale2 || !len.is_finite() {
+                let Some((n, _)) = unit_normal_and_area(a, b, c, scale2) else {
                     continue;
-                }
-                let n = math::scale(area2, 1.0 / len);
+                };
                 let best = planes
                     .iter()
                     .enumerate()

@@ -347,6 +347,14 @@ impl Integrator {
         values: &[f64],
         extrapolate: bool,
     ) -> Result<[f64; 3], SpectralError> {
+        let check_coverage = || {
+            check_coverage(
+                wavelength_nm,
+                &self.grid_nm,
+                extrapolate,
+                &self.description(),
+            )
+        };
         // Fast path: a wavelength array this thread has already validated (equality with the
         // cached copy implies it is valid and irregular). Seen once: build its spline kernel
         // now; kernel already built: one dot product.
@@ -365,22 +373,12 @@ impl Integrator {
                 Some(dot_kernel(kernel, values))
             });
             if let Some(acc) = hit {
-                check_coverage(
-                    wavelength_nm,
-                    &self.grid_nm,
-                    extrapolate,
-                    &self.description(),
-                )?;
+                check_coverage()?;
                 return Ok(acc);
             }
         }
         let uniform = validate(wavelength_nm, values)?;
-        check_coverage(
-            wavelength_nm,
-            &self.grid_nm,
-            extrapolate,
-            &self.description(),
-        )?;
+        check_coverage()?;
         // First sight of this wavelength array: evaluate directly (one spline solve, cheaper
         // than building the kernel) and remember the array for next time.
         let mut acc = [0.0f64; 3];
@@ -768,33 +766,25 @@ mod tests {
         }
     }
 
+    /// Each value serialises to its name as a JSON string.
+    fn assert_json_names<T: Serialize>(values: &[T], name: impl Fn(&T) -> &'static str) {
+        for value in values {
+            assert_eq!(
+                serde_json::to_string(value).unwrap(),
+                format!("\"{}\"", name(value))
+            );
+        }
+    }
+
     #[test]
     fn names_round_trip() {
         for &c in RgbCmf::ALL {
             assert_eq!(c.name().parse::<RgbCmf>().unwrap(), c);
-            assert_eq!(
-                serde_json::to_string(&c).unwrap(),
-                format!("\"{}\"", c.name())
-            );
         }
-        for &s in RgbSpace::ALL {
-            assert_eq!(
-                serde_json::to_string(&s).unwrap(),
-                format!("\"{}\"", s.name())
-            );
-        }
-        for &o in Observer::ALL {
-            assert_eq!(
-                serde_json::to_string(&o).unwrap(),
-                format!("\"{}\"", o.name())
-            );
-        }
-        for &i in Illuminant::ALL {
-            assert_eq!(
-                serde_json::to_string(&i).unwrap(),
-                format!("\"{}\"", i.name())
-            );
-        }
+        assert_json_names(RgbCmf::ALL, |c| c.name());
+        assert_json_names(RgbSpace::ALL, |s| s.name());
+        assert_json_names(Observer::ALL, |o| o.name());
+        assert_json_names(Illuminant::ALL, |i| i.name());
         assert!("bogus".parse::<RgbSpace>().is_err());
     }
 }

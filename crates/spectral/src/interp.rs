@@ -260,6 +260,32 @@ thread_local! {
     static SCRATCH: RefCell<(Vec<f64>, Vec<f64>)> = const { RefCell::new((Vec::new(), Vec::new())) };
 }
 
+/// The end value `y` holds at `t` when `t` lies before the first or after the last sample.
+#[inline]
+fn end_value_beyond(x: &[f64], y: &[f64], t: f64) -> Option<f64> {
+    let last = x.len() - 1;
+    if t < x[0] {
+        Some(y[0])
+    } else if t > x[last] {
+        Some(y[last])
+    } else {
+        None
+    }
+}
+
+/// The sample range `lo..hi` the spline over `grid` needs: the samples covering the grid plus
+/// [`SPLINE_MARGIN`] on each side, or all of them when that leaves fewer than four.
+fn spline_window(x: &[f64], grid: &[f64]) -> (usize, usize) {
+    let n = x.len();
+    let (g0, g1) = (
+        grid.first().copied().unwrap_or(x[0]),
+        grid.last().copied().unwrap_or(x[n - 1]),
+    );
+    let lo = x.partition_point(|&w| w < g0).saturating_sub(SPLINE_MARGIN);
+    let hi = (x.partition_point(|&w| w <= g1) + SPLINE_MARGIN).min(n);
+    if hi - lo < 4 { (0, n) } else { (lo, hi) }
+}
+
 /// Evaluates the interpolant of validated data `(x, y)` at every ascending `grid` point and
 /// hands `(grid index, value)` to `sink`. Grid points outside `[x[0], x[n-1]]` get the data's
 /// end values (the caller decides whether that is allowed).
@@ -270,19 +296,13 @@ pub(crate) fn for_each_on_grid(
     grid: &[f64],
     mut sink: impl FnMut(usize, f64),
 ) {
-    let n = x.len();
-    let (first, last) = (x[0], x[n - 1]);
     if uniform {
         let sp = Sprague::new(x, y);
         // cnt = number of xp strictly below t (numpy searchsorted, side "left").
         let mut cnt = 0usize;
         for (j, &t) in grid.iter().enumerate() {
-            if t < first {
-                sink(j, y[0]);
-                continue;
-            }
-            if t > last {
-                sink(j, y[n - 1]);
+            if let Some(end) = end_value_beyond(x, y, t) {
+                sink(j, end);
                 continue;
             }
             while cnt < sp.len_padded() && sp.xp(cnt) < t {
@@ -294,25 +314,15 @@ pub(crate) fn for_each_on_grid(
         SCRATCH.with(|cell| {
             let mut guard = cell.borrow_mut();
             let (slopes, scratch) = &mut *guard;
-            let (g0, g1) = (
-                grid.first().copied().unwrap_or(first),
-                grid.last().copied().unwrap_or(last),
-            );
-            let lo = x.partition_point(|&w| w < g0).saturating_sub(SPLINE_MARGIN);
-            let hi = (x.partition_point(|&w| w <= g1) + SPLINE_MARGIN).min(n);
-            let (lo, hi) = if hi - lo < 4 { (0, n) } else { (lo, hi) };
+            let (lo, hi) = spline_window(x, grid);
             let (xw, yw) = (&x[lo..hi], &y[lo..hi]);
             spline_slopes(xw, yw, slopes, scratch);
             let nw = xw.len();
             let mut k = 0usize;
             let mut seg = Segment::new(xw, yw, slopes, 0);
             for (j, &t) in grid.iter().enumerate() {
-                if t < first {
-                    sink(j, y[0]);
-                    continue;
-                }
-                if t > last {
-                    sink(j, y[n - 1]);
+                if let Some(end) = end_value_beyond(x, y, t) {
+                    sink(j, end);
                     continue;
                 }
                 if k + 2 < nw && xw[k + 1] < t {
@@ -346,13 +356,7 @@ pub(crate) fn spline_kernel(
     kernel.clear();
     kernel.resize(n, [0.0; 3]);
     let (first, last) = (x[0], x[n - 1]);
-    let (g0, g1) = (
-        grid.first().copied().unwrap_or(first),
-        grid.last().copied().unwrap_or(last),
-    );
-    let lo = x.partition_point(|&w| w < g0).saturating_sub(SPLINE_MARGIN);
-    let hi = (x.partition_point(|&w| w <= g1) + SPLINE_MARGIN).min(n);
-    let (lo, hi) = if hi - lo < 4 { (0, n) } else { (lo, hi) };
+    let (lo, hi) = spline_window(x, grid);
     let xw = &x[lo..hi];
     let nw = xw.len();
     // β: weights of the slopes; α goes straight into the kernel.

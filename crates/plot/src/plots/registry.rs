@@ -34,31 +34,21 @@ fn glass_cell(g: &GlassRecord) -> Cell {
     };
     for (ch, &colour) in CHANNEL_COLOURS.iter().enumerate() {
         let name = CHANNEL_NAMES[ch];
-        let rec = g.clone();
-        p.lines.push(Line::new(
-            Some(format!("r {name} (r0 {:.4})", g.r0[ch])),
-            colour,
-            curve_points(move |c| rec.eval(Side::Front, c).0[ch]),
-        ));
-        let rec = g.clone();
-        p.lines.push(
-            Line::new(
-                Some(format!("t {name} (t0 {:.4})", g.t0[ch])),
-                colour,
-                curve_points(move |c| rec.eval(Side::Front, c).1[ch]),
-            )
-            .dashed(),
-        );
+        // Channel `ch` of r (`reflectance`) or else t, seen from `side`, against angle.
+        let line = |label: String, side: Side, reflectance: bool| {
+            let points = curve_points(|c| {
+                let (r, t) = g.eval(side, c);
+                if reflectance { r[ch] } else { t[ch] }
+            });
+            Line::new(Some(label), colour, points)
+        };
+        let r_label = format!("r {name} (r0 {:.4})", g.r0[ch]);
+        p.lines.push(line(r_label, Side::Front, true));
+        let t_label = format!("t {name} (t0 {:.4})", g.t0[ch]);
+        p.lines.push(line(t_label, Side::Front, false).dashed());
         if back_differs {
-            let rec = g.clone();
-            p.lines.push(
-                Line::new(
-                    Some(format!("r back {name} ({:.4})", g.r0_back[ch])),
-                    colour,
-                    curve_points(move |c| rec.eval(Side::Back, c).0[ch]),
-                )
-                .width(1),
-            );
+            let back_label = format!("r back {name} ({:.4})", g.r0_back[ch]);
+            p.lines.push(line(back_label, Side::Back, true).width(1));
         }
     }
     Cell {
