@@ -290,20 +290,7 @@ fn to_text(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> 
     if let (Some(first), Some(last)) = (wl.first(), wl.last()) {
         let _ = writeln!(s, "  {} samples, {first}–{last} nm", wl.len());
     }
-    let method_line = match method {
-        Method::Paper(c) => format!("paper (eqs. 15–20), {c} RGB colour-matching functions"),
-        Method::Colorimetric {
-            observer,
-            illuminant,
-            space,
-        } => {
-            format!(
-                "colorimetric, observer {observer}, illuminant {illuminant}, space {space} (linear)"
-            )
-        }
-        Method::Luminous => "luminous (ISO 9050, D65 × V(λ), 380–780 nm at 10 nm)".to_owned(),
-    };
-    let _ = writeln!(s, "method: {method_line}");
+    let _ = writeln!(s, "method: {method}");
     let _ = writeln!(
         s,
         "{:<22}{:>10}{:>10}{:>10}{:>14}{:>14}",

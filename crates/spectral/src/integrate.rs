@@ -108,6 +108,25 @@ impl Method {
     }
 }
 
+/// The readable description of a method with its options, as `glassdb spectral` prints it
+/// and figures caption it.
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Method::Paper(cmf) => write!(f, "paper method (eqs. 15–20), {cmf} RGB CMFs"),
+            Method::Colorimetric {
+                observer,
+                illuminant,
+                space,
+            } => write!(
+                f,
+                "colorimetric, {observer} observer, illuminant {illuminant}, {space} (linear)"
+            ),
+            Method::Luminous => f.write_str("luminous (ISO 9050: D65 × V(λ), 380–780 nm at 10 nm)"),
+        }
+    }
+}
+
 /// Everything an [`Integrator`] needs. Its JSON form is one flat object: `method` (a
 /// [`MethodKind`]), that method's options (`cmf`; `observer`, `illuminant`, `space`; absent
 /// ones take their defaults) and `extrapolate` (default false).

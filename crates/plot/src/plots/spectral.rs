@@ -23,26 +23,6 @@ pub struct SpectralPlotOptions {
 /// Wavelength range drawn (nm): the visible range of the CIE tables.
 pub const VISIBLE_NM: (f64, f64) = (360.0, 780.0);
 
-/// A readable name of a method.
-pub fn method_label(m: &Method) -> String {
-    match m {
-        Method::Paper(cmf) => format!("paper method, {} RGB CMFs", cmf.name()),
-        Method::Colorimetric {
-            observer,
-            illuminant,
-            space,
-        } => {
-            format!(
-                "colorimetric, {} observer, illuminant {}, {}",
-                observer.name(),
-                illuminant.name(),
-                space.name()
-            )
-        }
-        Method::Luminous => "luminous (ISO 9050: D65 × V(λ))".to_string(),
-    }
-}
-
 /// The wavelength at which each channel's weights peak (where its value is marked).
 fn channel_peaks(grid: &[f64], weights: &[[f64; 3]]) -> [f64; 3] {
     let mut peaks = [550.0; 3];
@@ -104,7 +84,7 @@ pub fn spectral_figure_of(
     main.title = Some(format!(
         "{} — {}",
         short_name(&data.source),
-        method_label(&opts.settings.method)
+        opts.settings.method
     ));
     main.legend = Some(LegendCorner::Auto);
     let mut summary = Vec::new();
