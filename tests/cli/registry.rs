@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage};
 
 use crate::util::{
-    CURVE_FIT_STATS, fails, glassdb, ok, registry_build as build, repo_path, repo_root, run_oracle,
-    write_file,
+    CURVE_FIT_STATS, fails, glassdb, make_ref, ok, registry_build as build, repo_path, repo_root,
+    run_oracle, write_file,
 };
 
 const EXPLICIT_GLASS: &str = "r0 = [0.08, 0.08, 0.08]\nt0 = [0.85, 0.86, 0.84]\n";
@@ -408,7 +408,7 @@ fn mask_filtered_build_keeps_only_the_ids_in_use() {
 }
 
 /// `data/registry.json` (the bundled default) is exactly what the documented command builds
-/// from `data/catalog.toml`; `GLASSDB_REGEN=1` rewrites it instead.
+/// from `data/catalog.toml`; `GLASSDB_MAKE_REF=1` rewrites it instead.
 #[test]
 fn bundled_registry_json_rebuilds_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
@@ -419,13 +419,13 @@ fn bundled_registry_json_rebuilds_byte_for_byte() {
         .arg(&out));
     let fresh = std::fs::read(&out).unwrap();
     let committed = repo_path("data/registry.json");
-    if std::env::var_os("GLASSDB_REGEN").is_some_and(|v| v == "1") {
+    if make_ref() {
         std::fs::write(&committed, &fresh).unwrap();
     }
     assert!(
         fresh == std::fs::read(&committed).unwrap(),
         "data/registry.json differs from `glassdb registry build data/catalog.toml -o data/registry.json` \
-         (run from the repository root); regenerate it with GLASSDB_REGEN=1 cargo test --test cli bundled_registry_json"
+         (run from the repository root); regenerate it with GLASSDB_MAKE_REF=1 cargo test --test cli bundled_registry_json"
     );
     // Nothing machine-specific: paths are relative to the repository or to the catalog.
     let text = String::from_utf8(fresh).unwrap();

@@ -64,6 +64,14 @@ pub enum SceneError {
     /// A `planes.json` is malformed, or a glass face lies on none of its planes.
     #[error("planes file {path}: {message}")]
     BadPlanes { path: PathBuf, message: String },
+    /// A planes file that is not valid JSON of the planes schema (serde's error gives the line
+    /// and column).
+    #[error("planes file {path}")]
+    PlanesJson {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
     /// An option value is out of range (tolerances, plane count).
     #[error("{message}")]
     BadOption { message: String },

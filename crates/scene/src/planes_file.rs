@@ -66,8 +66,11 @@ impl PlanesFile {
             path: path.to_path_buf(),
             source,
         })?;
-        let file: PlanesFile = serde_json::from_str(&text)
-            .map_err(|e| bad(format!("line {}, column {}: {e}", e.line(), e.column())))?;
+        let file: PlanesFile =
+            serde_json::from_str(&text).map_err(|source| SceneError::PlanesJson {
+                path: path.to_path_buf(),
+                source,
+            })?;
         if file.format != PLANES_FORMAT {
             return Err(bad(format!(
                 "format {:?} is not {PLANES_FORMAT:?}",
