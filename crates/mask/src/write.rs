@@ -49,129 +49,142 @@ pub fn write_mask_bytes(
     format: MaskFormat,
 ) -> Result<Vec<u8>, MaskError> {
     mask.check_consistent().map_err(MaskError::Inconsistent)?;
-    let w = mask.width as usize;
-    let not_representable = |i: usize, detail: String| MaskError::NotRepresentable {
-        path: path.to_path_buf(),
-        format: format.name(),
-        detail: format!("pixel (x {}, y {}): {detail}", i % w.max(1), i / w.max(1)),
-    };
+    let at = PixelErrors { path, mask, format };
     match format {
-        MaskFormat::Png8 | MaskFormat::Png16 => {
-            if mask.coverage.is_some() {
-                return Err(MaskError::NotRepresentable {
-                    path: path.to_path_buf(),
-                    format: format.name(),
-                    detail:
-                        "a PNG mask has no coverage channel; write EXR to keep antialiased edges"
-                            .into(),
-                });
-            }
-            let code_width = if format == MaskFormat::Png8 {
-                CosCode::Bits8
-            } else {
-                CosCode::Bits16
-            };
-            let limit = code_width.max_code();
-            let mut samples: Vec<u16> = Vec::with_capacity(mask.pixel_count() * 3);
-            for i in 0..mask.pixel_count() {
-                let id = mask.id[i];
-                let plane = mask.plane[i];
-                if id > limit {
-                    return Err(not_representable(
-                        i,
-                        format!("glass id {id} is above {limit}"),
-                    ));
-                }
-                if plane > limit {
-                    return Err(not_representable(
-                        i,
-                        format!("plane {plane} is above {limit}"),
-                    ));
-                }
-                let code = match (&mask.cos_theta, format) {
-                    (CosTheta::Quantized8(c), MaskFormat::Png8) => u16::from(c[i]),
-                    (CosTheta::Quantized8(c), _) => CosCode::Bits8.to_bits16(u16::from(c[i])),
-                    (CosTheta::Quantized16(c), MaskFormat::Png16) => c[i],
-                    (CosTheta::Normal, _) => limit,
-                    _ => {
-                        let c = mask.cos_theta_at(i);
-                        if !c.is_finite() {
-                            return Err(not_representable(i, format!("cos θ {c} is not a number")));
-                        }
-                        code_width.encode(c)
-                    }
-                };
-                samples.extend_from_slice(&[plane, id, code]);
-            }
-            encode_png_rgb(
-                path,
-                mask.width,
-                mask.height,
-                &samples,
-                format == MaskFormat::Png16,
-            )
-        }
-        MaskFormat::Binary => {
-            let mut glass_id = None;
-            let mut grey = Vec::with_capacity(mask.pixel_count());
-            for i in 0..mask.pixel_count() {
-                let id = mask.id[i];
-                if id == 0 {
-                    grey.push(0u8);
-                    continue;
-                }
-                match glass_id {
-                    None => glass_id = Some(id),
-                    Some(first) if first != id => {
-                        return Err(not_representable(
-                            i,
-                            format!(
-                                "glass id {id} after id {first}: a binary mask shows one glass; \
-                                 write a packed PNG or EXR mask for several"
-                            ),
-                        ));
-                    }
-                    Some(_) => {}
-                }
-                if mask.plane[i] != 0 {
-                    return Err(not_representable(
-                        i,
-                        format!(
-                            "plane {}: a binary mask has one plane; write a packed PNG or EXR mask",
-                            mask.plane[i]
-                        ),
-                    ));
-                }
-                let c = mask.coverage.as_ref().map_or(1.0, |c| c[i]);
-                if !c.is_finite() {
-                    return Err(not_representable(
-                        i,
-                        format!("coverage {c} is not a number"),
-                    ));
-                }
-                // A glass pixel never turns black: black means "no glass" to the reader.
-                grey.push(((c.clamp(0.0, 1.0) * 255.0).round() as u8).max(1));
-            }
-            encode_png_grey(path, mask.width, mask.height, &grey)
-        }
-        MaskFormat::Exr => {
-            let n = mask.pixel_count();
-            let id: Vec<f32> = mask.id.iter().map(|&v| f32::from(v)).collect();
-            let cos: Vec<f32> = match &mask.cos_theta {
-                CosTheta::Float(c) => c.clone(),
-                _ => (0..n).map(|i| mask.cos_theta_at(i) as f32).collect(),
-            };
-            let mut channels = vec![("id", id), ("cos_theta", cos)];
-            if mask.plane.iter().any(|&p| p != 0) {
-                channels.push(("plane", mask.plane.iter().map(|&p| f32::from(p)).collect()));
-            }
-            if let Some(c) = &mask.coverage {
-                channels.push(("coverage", c.clone()));
-            }
-            glassdb_image::encode_exr_f32(w, mask.height as usize, channels)
-                .map_err(|source| encode_err(path, source))
+        MaskFormat::Png8 => packed_png(mask, CosCode::Bits8, &at),
+        MaskFormat::Png16 => packed_png(mask, CosCode::Bits16, &at),
+        MaskFormat::Binary => binary_png(mask, &at),
+        MaskFormat::Exr => exr_channels(mask, path),
+    }
+}
+
+/// Builds the "cannot be stored" errors of one mask write, naming the pixel.
+struct PixelErrors<'a> {
+    path: &'a Path,
+    mask: &'a MaskImage,
+    format: MaskFormat,
+}
+
+impl PixelErrors<'_> {
+    fn whole(&self, detail: &str) -> MaskError {
+        MaskError::NotRepresentable {
+            path: self.path.to_path_buf(),
+            format: self.format.name(),
+            detail: detail.to_string(),
         }
     }
+
+    fn at(&self, i: usize, detail: String) -> MaskError {
+        let w = (self.mask.width as usize).max(1);
+        self.whole(&format!("pixel (x {}, y {}): {detail}", i % w, i / w))
+    }
+}
+
+/// The packed formats: R = plane, G = id, B = cos θ code of `code_width`'s precision.
+fn packed_png(
+    mask: &MaskImage,
+    code_width: CosCode,
+    at: &PixelErrors<'_>,
+) -> Result<Vec<u8>, MaskError> {
+    if mask.coverage.is_some() {
+        return Err(
+            at.whole("a PNG mask has no coverage channel; write EXR to keep antialiased edges")
+        );
+    }
+    let limit = code_width.max_code();
+    let mut samples: Vec<u16> = Vec::with_capacity(mask.pixel_count() * 3);
+    for i in 0..mask.pixel_count() {
+        let id = mask.id[i];
+        let plane = mask.plane[i];
+        if id > limit {
+            return Err(at.at(i, format!("glass id {id} is above {limit}")));
+        }
+        if plane > limit {
+            return Err(at.at(i, format!("plane {plane} is above {limit}")));
+        }
+        let code = match (&mask.cos_theta, code_width) {
+            (CosTheta::Quantized8(c), CosCode::Bits8) => u16::from(c[i]),
+            (CosTheta::Quantized8(c), _) => CosCode::Bits8.to_bits16(u16::from(c[i])),
+            (CosTheta::Quantized16(c), CosCode::Bits16) => c[i],
+            (CosTheta::Normal, _) => limit,
+            _ => {
+                let c = mask.cos_theta_at(i);
+                if !c.is_finite() {
+                    return Err(at.at(i, format!("cos θ {c} is not a number")));
+                }
+                code_width.encode(c)
+            }
+        };
+        samples.extend_from_slice(&[plane, id, code]);
+    }
+    encode_png_rgb(
+        at.path,
+        mask.width,
+        mask.height,
+        &samples,
+        code_width == CosCode::Bits16,
+    )
+}
+
+/// The paper's binary form: one glass on one plane, coverage as grey, never black on glass.
+fn binary_png(mask: &MaskImage, at: &PixelErrors<'_>) -> Result<Vec<u8>, MaskError> {
+    let mut glass_id = None;
+    let mut grey = Vec::with_capacity(mask.pixel_count());
+    for i in 0..mask.pixel_count() {
+        let id = mask.id[i];
+        if id == 0 {
+            grey.push(0u8);
+            continue;
+        }
+        match glass_id {
+            None => glass_id = Some(id),
+            Some(first) if first != id => {
+                return Err(at.at(
+                    i,
+                    format!(
+                        "glass id {id} after id {first}: a binary mask shows one glass; \
+                         write a packed PNG or EXR mask for several"
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+        if mask.plane[i] != 0 {
+            return Err(at.at(
+                i,
+                format!(
+                    "plane {}: a binary mask has one plane; write a packed PNG or EXR mask",
+                    mask.plane[i]
+                ),
+            ));
+        }
+        let c = mask.coverage.as_ref().map_or(1.0, |c| c[i]);
+        if !c.is_finite() {
+            return Err(at.at(i, format!("coverage {c} is not a number")));
+        }
+        // A glass pixel never turns black: black means "no glass" to the reader.
+        grey.push(((c.clamp(0.0, 1.0) * 255.0).round() as u8).max(1));
+    }
+    encode_png_grey(at.path, mask.width, mask.height, &grey)
+}
+
+/// Float EXR channels `id`, `cos_theta`, and `plane` / `coverage` where the mask has them.
+fn exr_channels(mask: &MaskImage, path: &Path) -> Result<Vec<u8>, MaskError> {
+    let n = mask.pixel_count();
+    let id: Vec<f32> = mask.id.iter().map(|&v| f32::from(v)).collect();
+    let cos: Vec<f32> = match &mask.cos_theta {
+        CosTheta::Float(c) => c.clone(),
+        _ => (0..n).map(|i| mask.cos_theta_at(i) as f32).collect(),
+    };
+    let mut channels = vec![("id", id), ("cos_theta", cos)];
+    if mask.plane.iter().any(|&p| p != 0) {
+        channels.push(("plane", mask.plane.iter().map(|&p| f32::from(p)).collect()));
+    }
+    if let Some(c) = &mask.coverage {
+        channels.push(("coverage", c.clone()));
+    }
+    glassdb_image::encode_exr_f32(mask.width as usize, mask.height as usize, channels)
+        .map_err(|source| encode_err(path, source))
 }
 
 fn encode_err(path: &Path, source: ImageError) -> MaskError {
