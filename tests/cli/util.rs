@@ -186,30 +186,7 @@ pub fn assert_images_match(name: &str, got: &Planes, want: &Planes, tolerance: f
     let Some((i, c, g, w)) = first_bad else {
         return;
     };
-    let path = diff_dir().join(format!("{name}.png"));
-    let grey: Vec<u8> = worst
-        .iter()
-        .map(|&d| {
-            if d > tolerance {
-                255
-            } else if tolerance > 0.0 {
-                (d / tolerance * 200.0).round() as u8
-            } else {
-                0
-            }
-        })
-        .collect();
-    let file = std::fs::File::create(&path).expect("create the diff image");
-    let mut enc = png::Encoder::new(
-        std::io::BufWriter::new(file),
-        got.width as u32,
-        got.height as u32,
-    );
-    enc.set_color(png::ColorType::Grayscale);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.write_header()
-        .and_then(|mut w| w.write_image_data(&grey))
-        .expect("write the diff image");
+    let path = write_diff_image(name, got.width, got.height, &worst, tolerance);
     panic!(
         "{name}: {bad} samples differ by more than {tolerance}; first at pixel (x {}, y {}) \
          channel {}: got {g}, want {w}; diff image: {}",
@@ -218,6 +195,45 @@ pub fn assert_images_match(name: &str, got: &Planes, want: &Planes, tolerance: f
         got.names[c],
         path.display()
     );
+}
+
+/// Writes `target/test-diffs/<name>.png` from a per-pixel difference: white where it exceeds
+/// `tolerance`, grey scaled to the tolerance below it (black: equal). Encoded by glassdb's one
+/// PNG encoder (what is checked here is never read back through it). Returns the path.
+pub fn write_diff_image(
+    name: &str,
+    width: usize,
+    height: usize,
+    per_pixel: &[f64],
+    tolerance: f64,
+) -> PathBuf {
+    let path = diff_dir().join(format!("{name}.png"));
+    let grey: Vec<u8> = per_pixel
+        .iter()
+        .map(|&d| {
+            if d.is_nan() || d > tolerance {
+                255
+            } else if tolerance > 0.0 {
+                (d / tolerance * 200.0).round() as u8
+            } else {
+                0
+            }
+        })
+        .collect();
+    let options = glassdb_image::PngEncodeOptions {
+        compression: glassdb_image::PngCompression::Fast,
+        srgb_chunk: false,
+    };
+    let bytes = glassdb_image::encode_png(
+        width as u32,
+        height as u32,
+        glassdb_image::PngColor::Grey,
+        glassdb_image::PngSampleSlice::U8(&grey),
+        options,
+    )
+    .expect("encode the diff image");
+    std::fs::write(&path, bytes).expect("write the diff image");
+    path
 }
 
 /// Every channel of an EXR's first layer as f64 planes, read with the `exr` crate (not with

@@ -16,7 +16,7 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
-use crate::util::{compose, make_ref, ok, registry_build, repo_path};
+use crate::util::{compose, make_ref, ok, registry_build, repo_path, write_diff_image};
 
 /// Number of reflection passes (glass planes) of the atrium, in `planes.json` order.
 const PLANES: usize = 3;
@@ -154,33 +154,60 @@ fn errors(a: &Rgb, b: &Rgb, select: impl Fn(usize) -> bool) -> Errors {
     }
 }
 
-/// Asserts `got` is within 1 dB of the measured `floor` (PSNR down by ≤ 1 dB, errors up by
-/// ≤ 10^(1/20)).
-fn assert_floor(region: &str, got: Errors, measured: Errors) {
+/// Whether `got` is within 1 dB of the measured `floor` (PSNR down by ≤ 1 dB, errors up by
+/// ≤ 10^(1/20)); the reasons it is not, otherwise.
+fn check_floor(region: &str, got: Errors, measured: Errors) -> Vec<String> {
     let amp = 10f64.powf(1.0 / 20.0);
     eprintln!("{region}: {got:?} (measured when the fixtures were made: {measured:?})");
-    assert_eq!(
-        got.pixels, measured.pixels,
-        "{region}: the region changed (mask changed?)"
-    );
-    assert!(
-        got.psnr_db >= measured.psnr_db - 1.0,
-        "{region}: PSNR {:.2} dB < {:.2} - 1 dB",
-        got.psnr_db,
-        measured.psnr_db
-    );
-    assert!(
-        got.mean_abs <= measured.mean_abs * amp,
-        "{region}: mean |error| {:.5} > {:.5}·1.122",
-        got.mean_abs,
-        measured.mean_abs
-    );
-    assert!(
-        got.max_abs <= measured.max_abs * amp,
-        "{region}: max |error| {:.4} > {:.4}·1.122",
-        got.max_abs,
-        measured.max_abs
-    );
+    let mut failures = Vec::new();
+    if got.pixels != measured.pixels {
+        failures.push(format!(
+            "{region}: the region changed (mask changed?): {} pixels, measured {}",
+            got.pixels, measured.pixels
+        ));
+    }
+    if got.psnr_db < measured.psnr_db - 1.0 {
+        failures.push(format!(
+            "{region}: PSNR {:.2} dB < {:.2} - 1 dB",
+            got.psnr_db, measured.psnr_db
+        ));
+    }
+    if got.mean_abs > measured.mean_abs * amp {
+        failures.push(format!(
+            "{region}: mean |error| {:.5} > {:.5}·1.122",
+            got.mean_abs, measured.mean_abs
+        ));
+    }
+    if got.max_abs > measured.max_abs * amp {
+        failures.push(format!(
+            "{region}: max |error| {:.4} > {:.4}·1.122",
+            got.max_abs, measured.max_abs
+        ));
+    }
+    failures
+}
+
+/// Per pixel, the largest channel difference of two images of one size.
+fn per_pixel_abs_diff(a: &Rgb, b: &Rgb) -> Vec<f64> {
+    a.px.iter()
+        .zip(&b.px)
+        .map(|(pa, pb)| {
+            (0..3)
+                .map(|c| (f64::from(pa[c]) - f64::from(pb[c])).abs())
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+/// Panics with `failures` (if any) after writing the diff image of `got` against `want`
+/// (`target/test-diffs/<name>.png`, white above `tolerance`).
+fn fail_with_diff_image(name: &str, failures: &[String], got: &Rgb, want: &Rgb, tolerance: f64) {
+    if failures.is_empty() {
+        return;
+    }
+    let diff = per_pixel_abs_diff(got, want);
+    let path = write_diff_image(name, got.width, got.height, &diff, tolerance);
+    panic!("{}\ndiff image: {}", failures.join("\n"), path.display());
 }
 
 fn atrium(rel: &str) -> std::path::PathBuf {
@@ -231,9 +258,16 @@ fn atrium_composite_against_path_traced_reference() {
         return;
     }
     let m = measured();
-    assert_floor("overall", overall, m.overall);
-    assert_floor("glass", glass, m.glass);
-    assert_floor("pane edges", edges, m.pane_edges);
+    let mut failures = check_floor("overall", overall, m.overall);
+    failures.extend(check_floor("glass", glass, m.glass));
+    failures.extend(check_floor("pane edges", edges, m.pane_edges));
+    fail_with_diff_image(
+        "atrium_vs_reference",
+        &failures,
+        &out,
+        &reference,
+        m.overall.max_abs,
+    );
 }
 
 #[test]
@@ -248,20 +282,26 @@ fn atrium_composite_matches_the_exact_formula_oracle() {
     let non_glass = errors(&out, &oracle, |i| !reg.glass[i]);
     eprintln!("composite vs oracle: {all:?}; outside the glass: {non_glass:?}");
     // Outside the glass the composite is the transmission pass itself (half → float is exact).
-    assert_eq!(
-        non_glass.max_abs, 0.0,
-        "outside the glass compose must copy the transmission pass"
-    );
-    assert!(
-        all.max_abs <= ORACLE_MAX_ABS,
-        "composite vs exact-formula oracle: max |diff| {} > {ORACLE_MAX_ABS}",
-        all.max_abs
-    );
-    assert!(
-        all.psnr_db >= ORACLE_MIN_PSNR_DB,
-        "composite vs oracle: PSNR {:.1} dB < {ORACLE_MIN_PSNR_DB}",
-        all.psnr_db
-    );
+    let mut failures = Vec::new();
+    if non_glass.max_abs != 0.0 {
+        failures.push(format!(
+            "outside the glass compose must copy the transmission pass (max |diff| {})",
+            non_glass.max_abs
+        ));
+    }
+    if all.max_abs > ORACLE_MAX_ABS {
+        failures.push(format!(
+            "composite vs exact-formula oracle: max |diff| {} > {ORACLE_MAX_ABS}",
+            all.max_abs
+        ));
+    }
+    if all.psnr_db < ORACLE_MIN_PSNR_DB {
+        failures.push(format!(
+            "composite vs oracle: PSNR {:.1} dB < {ORACLE_MIN_PSNR_DB}",
+            all.psnr_db
+        ));
+    }
+    fail_with_diff_image("atrium_vs_oracle", &failures, &out, &oracle, ORACLE_MAX_ABS);
 }
 
 #[test]
