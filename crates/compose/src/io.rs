@@ -73,7 +73,11 @@ pub fn read_pass_bytes(
         .map_err(|source| decode_err(path, source))?;
     match decoded {
         ImageFile::Png(png) => Ok(pass_from_png(png, opts.transfer)),
-        ImageFile::Exr(exr) => read_exr_pass(&exr, path, opts),
+        ImageFile::Exr(exr) => {
+            exr.require_full_frame()
+                .map_err(|source| decode_err(path, source))?;
+            read_exr_pass(&exr, path, opts)
+        }
     }
 }
 

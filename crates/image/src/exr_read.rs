@@ -55,6 +55,10 @@ pub struct ExrPart {
     /// Data window size in pixels.
     pub width: usize,
     pub height: usize,
+    /// The data window: the pixels the part stores, in the file's pixel coordinates.
+    pub data_window: PixelWindow,
+    /// The display window: the frame the image is meant to fill (shared by all parts).
+    pub display_window: PixelWindow,
     pub channels: Vec<ExrChannelInfo>,
     pub compression: exr::compression::Compression,
     pub deep: bool,
@@ -82,6 +86,29 @@ impl ExrPart {
     }
 }
 
+/// A rectangle of pixels in an EXR file's coordinates: the top-left pixel and the size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PixelWindow {
+    pub x: i32,
+    pub y: i32,
+    pub width: usize,
+    pub height: usize,
+}
+
+impl std::fmt::Display for PixelWindow {
+    /// OpenEXR's inclusive form, `(xMin, yMin)–(xMax, yMax)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "({}, {})–({}, {})",
+            self.x,
+            self.y,
+            i64::from(self.x) + self.width as i64 - 1,
+            i64::from(self.y) + self.height as i64 - 1
+        )
+    }
+}
+
 /// Finds the (part, channel) that `name` selects in a file's parts.
 pub fn find_channel(parts: &[ExrPart], name: &str) -> Option<(usize, usize)> {
     parts
@@ -103,6 +130,18 @@ fn part_from_header(h: &Header) -> ExrPart {
         layer_name: h.own_attributes.layer_name.as_ref().map(|t| t.to_string()),
         width: h.layer_size.width(),
         height: h.layer_size.height(),
+        data_window: PixelWindow {
+            x: h.own_attributes.layer_position.x(),
+            y: h.own_attributes.layer_position.y(),
+            width: h.layer_size.width(),
+            height: h.layer_size.height(),
+        },
+        display_window: PixelWindow {
+            x: h.shared_attributes.display_window.position.x(),
+            y: h.shared_attributes.display_window.position.y(),
+            width: h.shared_attributes.display_window.size.width(),
+            height: h.shared_attributes.display_window.size.height(),
+        },
         channels: h
             .channels
             .list

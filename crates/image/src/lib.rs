@@ -16,8 +16,8 @@ mod png_write;
 
 pub use error::{Codec, ImageError, ImageErrorKind};
 pub use exr_read::{
-    ExrChannelInfo, ExrPart, ExrSampleType, all_channel_names, find_channel, read_exr_channels,
-    read_exr_headers,
+    ExrChannelInfo, ExrPart, ExrSampleType, PixelWindow, all_channel_names, find_channel,
+    read_exr_channels, read_exr_headers,
 };
 pub use exr_write::{ExrPlane, ExrStorage, ExrWriteOptions, encode_exr_f32, write_exr_planes};
 pub use exr_zip::{DEFAULT_ZIP_LEVEL, zip_block_lines};
@@ -75,6 +75,24 @@ impl ExrFile<'_> {
         channels: &[usize],
     ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
         read_exr_channels(self.bytes, part, channels, self.max_pixels)
+    }
+
+    /// Refuses a file whose data window is not its display window (a cropped render, a render
+    /// border, overscan): its pixels cannot yet be placed in the frame by their coordinates,
+    /// and reading them index by index would shift them.
+    pub fn require_full_frame(&self) -> Result<(), ImageError> {
+        match self
+            .parts
+            .iter()
+            .find(|p| p.data_window != p.display_window)
+        {
+            Some(p) => Err(ImageError::WindowNotFrame {
+                part: p.layer_name.clone(),
+                data: p.data_window,
+                display: p.display_window,
+            }),
+            None => Ok(()),
+        }
     }
 }
 

@@ -32,6 +32,7 @@ pub fn read_mask_bytes(
             None => packed_from_png(&png, path)?,
         },
         ImageFile::Exr(exr) => {
+            exr.require_full_frame().map_err(decode_err)?;
             if opts.binary_glass_id.is_some() {
                 return Err(MaskError::BinaryMaskNotPng {
                     path: path.to_path_buf(),
