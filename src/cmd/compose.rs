@@ -170,7 +170,7 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
         bail!("--glass {id}: {label} has no glass with id {id}");
     }
     let mut plane_sides = match &args.planes {
-        Some(p) => glassdb_compose::sides_from_planes_json(p)?,
+        Some(p) => glassdb_compose::sides_from_planes_json(p, args.refl.len())?,
         None => Default::default(),
     };
     for spec in &args.side {

@@ -141,6 +141,9 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
             Some("repeat --refl: the k-th is the pass of plane k".into())
         }
         ComposeError::NoReflectionPass => Some("give one with --refl".into()),
+        ComposeError::PlaneCountMismatch { .. } => {
+            Some("give one --refl per plane of --planes, in its order".into())
+        }
         ComposeError::FrameList { .. } => Some("check --frames".into()),
         ComposeError::ZipLevelNotApplicable { .. } | ComposeError::ZipLevelOutOfRange { .. } => {
             Some("--zip-level sets it".into())

@@ -54,13 +54,25 @@ pub enum ComposeError {
     },
     /// Ids in the mask that the registry does not have.
     #[error(
-        "mask {mask} has glass ids with no registry entry in {registry}: {}",
-        list_counts(ids)
+        "mask {mask} has glass ids with no registry entry in {registry}: {}{}",
+        list_counts(ids),
+        if *none_known { NONE_KNOWN } else { "" }
     )]
     UnknownIds {
         mask: PathBuf,
         registry: String,
         ids: Vec<(u16, u64)>,
+        /// No id of the mask is in the registry (often a mask saved through a colour transform).
+        none_known: bool,
+    },
+    /// A `planes.json` describing another number of planes than the reflection passes given.
+    #[error(
+        "{planes_file} describes {planes} glass plane(s) but {passes} reflection pass(es) were given: one pass per plane, in the file's order"
+    )]
+    PlaneCountMismatch {
+        planes_file: PathBuf,
+        planes: usize,
+        passes: usize,
     },
     /// Glass pixels on a plane that has no reflection pass.
     #[error(
@@ -131,9 +143,24 @@ impl ComposeError {
     }
 }
 
+/// Ids listed in full in the unknown-ids message; the rest are counted.
+const LISTED_IDS: usize = 10;
+
+/// Said when none of the mask's ids is in the registry.
+const NONE_KNOWN: &str = "; none of the mask's ids is in the registry: if the mask was saved \
+    through a colour transform (sRGB or gamma encoding), its values are no longer the ids that \
+    were written; save it as raw data";
+
 fn list_counts(ids: &[(u16, u64)]) -> String {
-    ids.iter()
+    let mut listed: Vec<String> = ids
+        .iter()
+        .take(LISTED_IDS)
         .map(|(id, n)| format!("id {id} ({n} pixels)"))
-        .collect::<Vec<_>>()
-        .join(", ")
+        .collect();
+    if ids.len() > LISTED_IDS {
+        let rest = &ids[LISTED_IDS..];
+        let pixels: u64 = rest.iter().map(|(_, n)| n).sum();
+        listed.push(format!("and {} more id(s) ({pixels} pixels)", rest.len()));
+    }
+    listed.join(", ")
 }

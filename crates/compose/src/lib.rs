@@ -136,8 +136,18 @@ impl FrameReport {
 
 /// Plane sides from a `planes.json` written by `glassdb mirror` (`planes[k].eye_side`), read
 /// by the scene crate's own reader (format and plane order checked).
-pub fn sides_from_planes_json(path: &Path) -> Result<BTreeMap<usize, Side>, ComposeError> {
+pub fn sides_from_planes_json(
+    path: &Path,
+    passes: usize,
+) -> Result<BTreeMap<usize, Side>, ComposeError> {
     let file = glassdb_scene::PlanesFile::load(path)?;
+    if file.planes.len() != passes {
+        return Err(ComposeError::PlaneCountMismatch {
+            planes_file: path.to_path_buf(),
+            planes: file.planes.len(),
+            passes,
+        });
+    }
     Ok(file.planes.iter().map(|p| (p.index, p.eye_side)).collect())
 }
 
@@ -202,6 +212,7 @@ fn check_inputs(
         return Err(ComposeError::UnknownIds {
             mask: job.mask.clone(),
             registry: settings.registry_label.clone(),
+            none_known: unknown.len() == id_counts.len(),
             ids: unknown,
         });
     }

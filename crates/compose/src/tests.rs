@@ -206,11 +206,29 @@ fn planes_json_sides() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("planes.json");
     std::fs::write(&p, planes_json(&["front", "back"], &[0, 1])).unwrap();
-    let sides = sides_from_planes_json(&p).unwrap();
+    let sides = sides_from_planes_json(&p, 2).unwrap();
     assert_eq!(sides, BTreeMap::from([(0, Side::Front), (1, Side::Back)]));
+    // A planes file for another number of planes than the passes given is refused.
+    let err = sides_from_planes_json(&p, 3).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            ComposeError::PlaneCountMismatch {
+                planes: 2,
+                passes: 3,
+                ..
+            }
+        ),
+        "{err:?}"
+    );
+    assert!(
+        err.to_string()
+            .contains("2 glass plane(s) but 3 reflection pass(es)"),
+        "{err}"
+    );
     std::fs::write(&p, r#"{"planes":[{"eye_side":"up"}]}"#).unwrap();
     assert!(
-        sides_from_planes_json(&p)
+        sides_from_planes_json(&p, 1)
             .unwrap_err()
             .to_string()
             .contains("planes.json")
@@ -222,7 +240,7 @@ fn planes_json_sides() {
         planes_json(&["front"], &[0]).replace("glassdb-planes/1", "glassdb-planes/9"),
     ] {
         std::fs::write(&p, &bad).unwrap();
-        let err = sides_from_planes_json(&p).unwrap_err();
+        let err = sides_from_planes_json(&p, 2).unwrap_err();
         assert!(
             matches!(err, ComposeError::PlanesFile(_)) && err.to_string().contains("planes.json"),
             "{err}"
@@ -284,4 +302,31 @@ proptest! {
         let is_float = matches!(out.source, io::PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, .. });
         prop_assert!(is_float);
     }
+}
+
+#[test]
+fn unknown_ids_are_listed_up_to_ten_then_counted() {
+    let ids: Vec<(u16, u64)> = (1..=12).map(|id| (id, 100 + u64::from(id))).collect();
+    let err = ComposeError::UnknownIds {
+        mask: "m.png".into(),
+        registry: "r.json".into(),
+        ids,
+        none_known: false,
+    };
+    let message = err.to_string();
+    assert!(message.contains("id 10 (110 pixels)"), "{message}");
+    assert!(!message.contains("id 11 ("), "{message}");
+    // Ids 11 and 12: 111 + 112 pixels.
+    assert!(
+        message.contains("and 2 more id(s) (223 pixels)"),
+        "{message}"
+    );
+    assert!(!message.contains("colour transform"), "{message}");
+    let err = ComposeError::UnknownIds {
+        mask: "m.png".into(),
+        registry: "r.json".into(),
+        ids: vec![(187, 5)],
+        none_known: true,
+    };
+    assert!(err.to_string().contains("colour transform"), "{err}");
 }
