@@ -301,16 +301,7 @@ impl Sweep<'_> {
                 continue;
             };
             let rt = cos.rt(lut, j);
-            let rf = [fr, fg, fb];
-            let o = [
-                weighted(tr[0], rt.t[0], rf[0], rt.r[0]),
-                weighted(tr[1], rt.t[1], rf[1], rt.r[1]),
-                weighted(tr[2], rt.t[2], rf[2], rt.r[2]),
-            ];
-            *r_out = o[0];
-            *g_out = o[1];
-            *b_out = o[2];
-            count_composited(&mut counts, o, tr, rf);
+            composite_pixel(&mut counts, [r_out, g_out, b_out], &rt, [fr, fg, fb]);
         }
         counts
     }
@@ -357,16 +348,7 @@ impl Sweep<'_> {
             }
             let i = base + j;
             let rf = [pass.refl[0][i], pass.refl[1][i], pass.refl[2][i]];
-            let tr_in = [*r_out, *g_out, *b_out];
-            let o = [
-                weighted(tr_in[0], rt.t[0], rf[0], rt.r[0]),
-                weighted(tr_in[1], rt.t[1], rf[1], rt.r[1]),
-                weighted(tr_in[2], rt.t[2], rf[2], rt.r[2]),
-            ];
-            *r_out = o[0];
-            *g_out = o[1];
-            *b_out = o[2];
-            count_composited(&mut counts, o, tr_in, rf);
+            composite_pixel(&mut counts, [r_out, g_out, b_out], &rt, rf);
         }
         counts
     }
@@ -383,6 +365,18 @@ fn count_untouched(counts: &mut KernelCounts, px: [f32; 3]) {
 }
 
 /// Counts the non-finite samples of a composited pixel (the slow path runs only when one is).
+/// Eq. 8 on one glass pixel in place: `out = trans·t + refl·r` per channel, counting
+/// non-finite results by their source.
+#[inline(always)]
+fn composite_pixel(counts: &mut KernelCounts, out: [&mut f32; 3], rt: &RtTriple, rf: [f32; 3]) {
+    let tr = [*out[0], *out[1], *out[2]];
+    let o: [f32; 3] = std::array::from_fn(|c| weighted(tr[c], rt.t[c], rf[c], rt.r[c]));
+    for (slot, v) in out.into_iter().zip(o) {
+        *slot = v;
+    }
+    count_composited(counts, o, tr, rf);
+}
+
 #[inline(always)]
 fn count_composited(counts: &mut KernelCounts, o: [f32; 3], tr: [f32; 3], rf: [f32; 3]) {
     if !(o[0] + o[1] + o[2]).is_finite() {
