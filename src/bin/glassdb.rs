@@ -27,7 +27,7 @@ enum Command {
     /// Build, show and check the id-indexed glass table of a scene.
     Registry(cmd::registry::Args),
     /// Composite reflection and transmission passes through a mask (same as the `compose` binary).
-    Compose(cmd::compose::Args),
+    Compose(Box<cmd::compose::Args>),
     /// Mirror an OBJ scene across its glass planes (the virtual image for reflection passes).
     Mirror(cmd::scene::MirrorArgs),
     /// Rasterise the id + cos θ mask of an OBJ scene from a camera.
@@ -45,7 +45,7 @@ fn main() -> ExitCode {
         Command::Eval(a) => cmd::fit::run_eval(a),
         Command::Spectral(a) => cmd::spectral::run(a),
         Command::Registry(a) => cmd::registry::run(a),
-        Command::Compose(a) => cmd::compose::run(a),
+        Command::Compose(a) => cmd::compose::run(*a),
         Command::Mirror(a) => cmd::scene::run_mirror(a),
         Command::Mask(a) => cmd::scene::run_mask(a),
         Command::Plot(a) => cmd::plot::run(a),

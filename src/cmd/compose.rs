@@ -11,22 +11,27 @@ use glassdb_compose::io::{ExrDataType, OutputOptions, PassReadOptions, parse_exr
 use glassdb_compose::lut::GlassLut;
 use glassdb_compose::pixels::{InputTransfer, PngBits};
 use glassdb_compose::sequence::{self, FrameOutcome};
-use glassdb_compose::{ComposeJob, ComposeSettings, FrameReport, UnknownIds, compose_frame};
+use glassdb_compose::{
+    ComposeJob, ComposeSettings, FrameReport, InputLayers, OutsidePolicy, UnknownIds, compose_frame,
+};
 use glassdb_mask::{ExrMaskChannels, MaskReadOptions};
 use glassdb_registry::{Registry, Side};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Reflection pass (EXR or PNG). Repeat for several glass planes: the k-th is plane k of
-    /// the mask (R channel of a PNG mask, `plane` channel of an EXR mask).
-    #[arg(long, required = true, value_name = "FILE")]
+    /// Reflection pass (EXR or PNG; `FILE.exr:LAYER` picks its layer). Repeat for several
+    /// glass planes: the k-th is plane k of the mask (R channel of a PNG mask, `plane` channel
+    /// of an EXR mask). It may cover only part of the frame (an EXR data window).
+    #[arg(long, required = true, value_name = "FILE[:LAYER]")]
     pub refl: Vec<PathBuf>,
-    /// Transmission pass (the scene without glass); its alpha is kept.
-    #[arg(long, value_name = "FILE")]
+    /// Transmission pass (the scene without glass; `FILE.exr:LAYER` picks its layer); its
+    /// alpha, windows, attributes and other channels are kept.
+    #[arg(long, value_name = "FILE[:LAYER]")]
     pub trans: PathBuf,
     /// Glass mask: 8-bit RGB PNG (G = id, B = cos θ·255, R = plane), 16-bit RGB PNG, EXR with
-    /// `id` and `cos_theta` channels, or a binary PNG with --glass (docs/mask.md).
-    #[arg(long, value_name = "FILE")]
+    /// `id` and `cos_theta` channels (`FILE.exr:LAYER` reads them in LAYER), or a binary PNG
+    /// with --glass (docs/mask.md).
+    #[arg(long, value_name = "FILE[:LAYER]")]
     pub mask: PathBuf,
     /// Registry JSON (`glassdb registry build`); default: the bundled data/registry.json (built
     /// from data/catalog.toml).
@@ -35,10 +40,34 @@ pub struct Args {
     /// Output, .exr or .png (default: beside the transmission pass, `<name>.composite.<ext>`).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
-    /// EXR layer of the passes, e.g. `ViewLayer.Combined` (default: the only RGB layer, the
-    /// bare R, G, B, or the one named …Combined).
+    /// EXR layer of every pass without its own: a layer (`ViewLayer.Combined`, `Combined`), a
+    /// Nuke layer (`diffuse`) or a view (`left`) (default: the only RGB layer, the bare R, G,
+    /// B, or the one named …Combined).
     #[arg(long, value_name = "NAME")]
     pub layer: Option<String>,
+    /// EXR layer of the transmission pass (over --layer).
+    #[arg(long, value_name = "NAME")]
+    pub trans_layer: Option<String>,
+    /// EXR layer of every reflection pass (over --layer; `FILE:LAYER` sets one pass's).
+    #[arg(long, value_name = "NAME")]
+    pub refl_layer: Option<String>,
+    /// EXR layer the mask channel names are in, e.g. `ViewLayer` (then `id=IndexMA` reads
+    /// `ViewLayer.IndexMA.X`).
+    #[arg(long, value_name = "NAME")]
+    pub mask_layer: Option<String>,
+    /// Glass pixels of a plane that its (cropped) reflection pass does not cover: refuse
+    /// (`error`), composite them without reflection (`no-reflection`), or leave them as the
+    /// transmission pass (`transmission`).
+    #[arg(long, value_enum, default_value_t = OutsideArg::Error)]
+    pub outside_pass: OutsideArg,
+    /// EXR output: keep the transmission file's other channels and parts (`all`: Z, AOVs,
+    /// other views) or write only the composite (`none`). Its attributes are always kept.
+    #[arg(long, value_enum, default_value_t = KeepArg::All)]
+    pub keep_channels: KeepArg,
+    /// EXR output: write the composite as a new layer NAME (`NAME.R`, …) beside the original
+    /// channels instead of replacing the transmission pass's RGB.
+    #[arg(long, value_name = "NAME")]
+    pub output_layer: Option<String>,
     /// How PNG passes are encoded.
     #[arg(long, value_enum, default_value_t = TransferArg::Srgb)]
     pub input_transfer: TransferArg,
@@ -93,6 +122,19 @@ pub struct Args {
 pub enum TransferArg {
     Srgb,
     Linear,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutsideArg {
+    Error,
+    NoReflection,
+    Transmission,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum KeepArg {
+    All,
+    None,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -152,6 +194,20 @@ fn default_output(trans: &Path) -> PathBuf {
     trans.with_file_name(format!("{stem}.composite.{ext}"))
 }
 
+/// `FILE.exr:LAYER` → (`FILE.exr`, `LAYER`): split at the last `:` when what precedes it ends
+/// in `.exr` (any case) and what follows has no path separator; anything else is a plain path.
+fn split_layer(arg: &Path) -> (PathBuf, Option<String>) {
+    let text = arg.to_string_lossy();
+    if let Some((file, layer)) = text.rsplit_once(':')
+        && file.to_ascii_lowercase().ends_with(".exr")
+        && !layer.is_empty()
+        && !layer.contains(['/', '\\'])
+    {
+        return (PathBuf::from(file), Some(layer.to_string()));
+    }
+    (arg.to_path_buf(), None)
+}
+
 fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
     let (registry, label) = match &args.registry {
         Some(p) => (
@@ -164,6 +220,7 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
         ),
     };
     let lut = GlassLut::from_registry(&registry);
+    let registry_sha256 = registry.content_sha256()?;
     if let Some(id) = args.glass
         && !lut.contains(id)
     {
@@ -190,6 +247,19 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
         },
         binary_glass_id: args.glass,
         max_pixels: args.max_pixels,
+        layer: split_layer(&args.mask)
+            .1
+            .or_else(|| args.mask_layer.clone()),
+    };
+    let layers = InputLayers {
+        trans: split_layer(&args.trans)
+            .1
+            .or_else(|| args.trans_layer.clone()),
+        refl: args
+            .refl
+            .iter()
+            .map(|r| split_layer(r).1.or_else(|| args.refl_layer.clone()))
+            .collect(),
     };
     let pass = PassReadOptions {
         layer: args.layer.clone(),
@@ -218,10 +288,26 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
             }
         }),
         dither: args.dither == DitherArg::Ordered,
+        keep_channels: args.keep_channels == KeepArg::All,
+        output_layer: args.output_layer.clone(),
+        provenance: vec![
+            (
+                "glassdb/version".to_string(),
+                env!("CARGO_PKG_VERSION").to_string(),
+            ),
+            ("glassdb/registry".to_string(), label.clone()),
+            ("glassdb/registrySha256".to_string(), registry_sha256),
+        ],
     };
     let settings = ComposeSettings {
         pass,
+        layers,
         mask,
+        outside: match args.outside_pass {
+            OutsideArg::Error => OutsidePolicy::Error,
+            OutsideArg::NoReflection => OutsidePolicy::NoReflection,
+            OutsideArg::Transmission => OutsidePolicy::Transmission,
+        },
         plane_sides,
         unknown: match args.unknown {
             UnknownArg::Error => UnknownIds::Error,
@@ -244,6 +330,18 @@ fn print_stats(r: &FrameReport, lut: &GlassLut) {
         f64::from(r.width) * f64::from(r.height) / 1e6,
         r.planes
     );
+    if r.windows.data != r.windows.display {
+        println!(
+            "windows      data {} in display {}",
+            r.windows.data, r.windows.display
+        );
+    }
+    if r.output.kept_channels > 0 {
+        println!(
+            "kept         {} other channel(s) of the transmission file",
+            r.output.kept_channels
+        );
+    }
     println!(
         "decode       {:9.1} ms  (all inputs, in parallel)",
         ms(t.decode)
@@ -285,6 +383,18 @@ fn print_stats(r: &FrameReport, lut: &GlassLut) {
 }
 
 fn report_nonfinite(r: &FrameReport, label: &str) {
+    if r.output.half_overflow > 0 {
+        eprintln!(
+            "warning: {label}{} output samples exceed the half-float range (±65504) and were stored as infinite; write float (--data-type float) to keep them",
+            r.output.half_overflow
+        );
+    }
+    if r.outside_pixels > 0 {
+        eprintln!(
+            "warning: {label}{} glass pixels lie outside their plane's reflection pass (composited as --outside-pass says)",
+            r.outside_pixels
+        );
+    }
     let c = &r.counts;
     if c.nonfinite_output > 0 {
         eprintln!(
@@ -296,14 +406,15 @@ fn report_nonfinite(r: &FrameReport, label: &str) {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let (settings, lut) = settings_from(&args)?;
+    let trans = split_layer(&args.trans).0;
     let output = args
         .output
         .clone()
-        .unwrap_or_else(|| default_output(&args.trans));
+        .unwrap_or_else(|| default_output(&trans));
     let job = ComposeJob {
-        refl: args.refl.clone(),
-        trans: args.trans.clone(),
-        mask: args.mask.clone(),
+        refl: args.refl.iter().map(|r| split_layer(r).0).collect(),
+        trans,
+        mask: split_layer(&args.mask).0,
         output,
     };
 
@@ -412,6 +523,25 @@ fn parse_side_spec(spec: &str) -> anyhow::Result<(usize, Side)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn file_layer_specs_split_only_after_an_exr_name() {
+        let split = |s: &str| split_layer(Path::new(s));
+        assert_eq!(
+            split("r.exr:left"),
+            (PathBuf::from("r.exr"), Some("left".into()))
+        );
+        assert_eq!(
+            split("dir/R.####.EXR:ViewLayer.Combined"),
+            (
+                PathBuf::from("dir/R.####.EXR"),
+                Some("ViewLayer.Combined".into())
+            )
+        );
+        for plain in ["r.exr", "a:b/r.exr", "mask.png:x", "r.exr:", "r.exr:a/b"] {
+            assert_eq!(split(plain), (PathBuf::from(plain), None), "{plain}");
+        }
+    }
 
     #[test]
     fn side_specs_parse() {

@@ -131,7 +131,29 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
         ComposeError::Mask(e) => mask_hint(e),
         ComposeError::Registry(e) => registry_hint(e),
         ComposeError::PlanesFile(e) => scene_hint(e),
-        ComposeError::AmbiguousLayer { .. } => Some("choose one with --layer".into()),
+        ComposeError::AmbiguousLayer { .. } | ComposeError::LayerNotFound { .. } => Some(
+            "choose a layer with FILE.exr:LAYER, --trans-layer / --refl-layer, or --layer for \
+             every pass"
+                .into(),
+        ),
+        ComposeError::DisplayWindowMismatch { .. } => Some(
+            "render every pass and the mask with the same resolution (a render border or crop \
+             may change the data window, not the display window)"
+                .into(),
+        ),
+        ComposeError::MaskWithoutPlanes { .. } => Some(
+            "name the mask's plane channel with --mask-channels plane=NAME, or give one --refl"
+                .into(),
+        ),
+        ComposeError::GlassOutsidePass { .. } => Some(
+            "render the pass over its plane's whole screen rectangle, or choose \
+             --outside-pass no-reflection or --outside-pass transmission"
+                .into(),
+        ),
+        ComposeError::KeepChannels { .. } => {
+            Some("--keep-channels none writes only the composite".into())
+        }
+        ComposeError::BadLayerName { .. } => Some("check --output-layer".into()),
         ComposeError::UnknownIds { .. } => Some(
             "add them to the registry, or pass --unknown passthrough to leave those pixels as \
              the transmission pass"

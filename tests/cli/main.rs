@@ -5,6 +5,7 @@ mod architecture;
 mod compose;
 mod fit;
 mod fixtures;
+mod passes;
 mod plot;
 mod registry;
 mod scene;

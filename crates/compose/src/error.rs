@@ -25,7 +25,15 @@ pub enum ComposeError {
     #[error(transparent)]
     Registry(#[from] glassdb_registry::RegistryError),
     /// No R, G, B channel triple in an EXR pass.
-    #[error("{path} has no R, G, B channels (it has: {})", available.join(", "))]
+    #[error(
+        "{path} has no R, G, B channels (it has: {}){}",
+        available.join(", "),
+        if available.iter().any(|c| c == "Y" || c.ends_with(".Y")) {
+            ": luminance (Y) and luminance/chroma (Y, RY, BY) images are not composited; convert it to RGB"
+        } else {
+            ""
+        }
+    )]
     NoRgb {
         path: PathBuf,
         available: Vec<String>,
@@ -52,6 +60,42 @@ pub enum ComposeError {
         b: PathBuf,
         b_size: (u32, u32),
     },
+    /// Two inputs whose frames (display windows) differ: they are not images of one frame.
+    #[error(
+        "{a} frames the display window {a_window} but {b} frames {b_window}: every pass and the mask must be images of the same frame (their data windows may differ)"
+    )]
+    DisplayWindowMismatch {
+        a: PathBuf,
+        a_window: glassdb_image::PixelWindow,
+        b: PathBuf,
+        b_window: glassdb_image::PixelWindow,
+    },
+    /// Several reflection passes, but the mask does not say which plane each pixel is on.
+    #[error(
+        "mask {mask} stores no plane per pixel, but {passes} reflection passes were given: every glass pixel would take the first pass"
+    )]
+    MaskWithoutPlanes { mask: PathBuf, passes: usize },
+    /// Glass pixels of a plane that its reflection pass (cropped) does not cover.
+    #[error(
+        "{pixels} glass pixels of plane {plane} lie outside its reflection pass {pass} (data window {pass_window}); those pixels span {bounds}"
+    )]
+    GlassOutsidePass {
+        plane: usize,
+        pass: PathBuf,
+        pixels: u64,
+        pass_window: glassdb_image::PixelWindow,
+        bounds: glassdb_image::PixelWindow,
+    },
+    /// The transmission file's other channels could not be read to be carried over.
+    #[error("cannot carry over the other channels of {path}")]
+    KeepChannels {
+        path: PathBuf,
+        #[source]
+        source: glassdb_image::ImageError,
+    },
+    /// An output layer name EXR cannot hold.
+    #[error("{name:?} cannot be an EXR layer name (Latin-1 text, not empty, no dot at either end)")]
+    BadLayerName { name: String },
     /// Ids in the mask that the registry does not have.
     #[error(
         "mask {mask} has glass ids with no registry entry in {registry}: {}{}",
@@ -134,9 +178,9 @@ impl ComposeError {
     /// (`None` for the compositor's own errors).
     pub fn image_error_kind(&self) -> Option<glassdb_image::ImageErrorKind> {
         match self {
-            ComposeError::Decode { source, .. } | ComposeError::Encode { source, .. } => {
-                Some(source.kind())
-            }
+            ComposeError::Decode { source, .. }
+            | ComposeError::Encode { source, .. }
+            | ComposeError::KeepChannels { source, .. } => Some(source.kind()),
             ComposeError::Mask(mask) => mask.image_error_kind(),
             _ => None,
         }

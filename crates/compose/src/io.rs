@@ -5,9 +5,13 @@
 use std::path::{Path, PathBuf};
 
 use glassdb_image::{
-    ExrFile, ExrPart, ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions, ImageError, ImageFile,
-    PngColor, PngCompression, PngEncodeOptions, PngPixels, PngSampleSlice, PngSamples,
+    ExactExr, ExactPart, ExrFile, ExrImageAttributes, ExrImageOut, ExrLayerAttributes, ExrPartOut,
+    ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions, ExrWriteReport, ImageError, ImageFile,
+    ImageWindows, LayerChoiceError, PlaneSamples, PngColor, PngCompression, PngEncodeOptions,
+    PngPixels, PngSampleSlice, PngSamples,
 };
+
+use exr::meta::attribute::{AttributeValue, Text};
 
 use crate::ComposeError;
 use crate::pixels::{EncodedImage, EncodedSamples, InputTransfer, LinearImage, PngBits};
@@ -34,33 +38,43 @@ impl Default for PassReadOptions {
     }
 }
 
-/// What a pass was stored as (to pick output defaults and report).
+/// What a pass was stored as (to pick output defaults, report, and write the output like it).
 #[derive(Debug, Clone, PartialEq)]
 pub enum PassSource {
     Exr {
         sample_type: ExrSampleType,
         compression: exr::compression::Compression,
+        /// The layer's name (`""` for bare R, G, B).
         layer: String,
+        /// The part holding it, and the names of its R, G, B (and A) channels as stored.
+        part: usize,
+        channel_names: Vec<String>,
     },
     Png {
         bits: PngBits,
     },
 }
 
-/// A decoded pass.
+/// A decoded pass: linear, premultiplied RGB(A) over its data window.
 #[derive(Debug, Clone)]
 pub struct Pass {
     pub image: LinearImage,
+    pub windows: ImageWindows,
     pub source: PassSource,
 }
 
 /// Reads a pass file (format from its bytes).
 pub fn read_pass(path: &Path, opts: &PassReadOptions) -> Result<Pass, ComposeError> {
-    let bytes = std::fs::read(path).map_err(|cause| ComposeError::Read {
+    let bytes = read_file(path)?;
+    read_pass_bytes(&bytes, path, opts)
+}
+
+/// The bytes of an input file.
+pub fn read_file(path: &Path) -> Result<Vec<u8>, ComposeError> {
+    std::fs::read(path).map_err(|cause| ComposeError::Read {
         path: path.to_path_buf(),
         cause,
-    })?;
-    read_pass_bytes(&bytes, path, opts)
+    })
 }
 
 /// Reads a pass from bytes in memory; `path` names it in errors.
@@ -73,11 +87,7 @@ pub fn read_pass_bytes(
         .map_err(|source| decode_err(path, source))?;
     match decoded {
         ImageFile::Png(png) => Ok(pass_from_png(png, opts.transfer)),
-        ImageFile::Exr(exr) => {
-            exr.require_full_frame()
-                .map_err(|source| decode_err(path, source))?;
-            read_exr_pass(&exr, path, opts)
-        }
+        ImageFile::Exr(exr) => read_exr_pass(&exr, path, opts),
     }
 }
 
@@ -88,12 +98,14 @@ fn decode_err(path: &Path, source: ImageError) -> ComposeError {
     }
 }
 
-/// A PNG pass: its samples mapped to linear light by `transfer`.
+/// A PNG pass: its samples mapped to linear light by `transfer`, and its straight alpha (PNG's
+/// convention) premultiplied into the colour, as EXR passes store it.
 fn pass_from_png(png: PngPixels, transfer: InputTransfer) -> Pass {
     let bits = match png.samples {
         PngSamples::U8(_) => PngBits::Eight,
         PngSamples::U16(_) => PngBits::Sixteen,
     };
+    let windows = ImageWindows::full_frame(png.width as usize, png.height as usize);
     let encoded = EncodedImage {
         width: png.width,
         height: png.height,
@@ -103,38 +115,13 @@ fn pass_from_png(png: PngPixels, transfer: InputTransfer) -> Pass {
             PngSamples::U16(v) => EncodedSamples::U16(v),
         },
     };
+    let mut image = encoded.to_linear(transfer);
+    image.premultiply();
     Pass {
-        image: encoded.to_linear(transfer),
+        image,
+        windows,
         source: PassSource::Png { bits },
     }
-}
-
-/// RGB layers of an EXR: prefix (`""` for bare `R`, `G`, `B`) → (part, [r, g, b], alpha).
-fn rgb_layers(parts: &[ExrPart]) -> Vec<(String, usize, [usize; 3], Option<usize>)> {
-    let mut out = Vec::new();
-    for (p, part) in parts.iter().enumerate() {
-        let names: Vec<String> = (0..part.channels.len())
-            .filter_map(|i| part.qualified_name(i))
-            .collect();
-        for name in &names {
-            let prefix = match name.strip_suffix('R') {
-                Some(pre) if pre.is_empty() || pre.ends_with('.') => pre.trim_end_matches('.'),
-                _ => continue,
-            };
-            let find = |c: &str| {
-                let full = if prefix.is_empty() {
-                    c.to_string()
-                } else {
-                    format!("{prefix}.{c}")
-                };
-                names.iter().position(|n| *n == full)
-            };
-            if let (Some(r), Some(g), Some(b)) = (find("R"), find("G"), find("B")) {
-                out.push((prefix.to_string(), p, [r, g, b], find("A")));
-            }
-        }
-    }
-    out
 }
 
 fn read_exr_pass(
@@ -143,63 +130,39 @@ fn read_exr_pass(
     opts: &PassReadOptions,
 ) -> Result<Pass, ComposeError> {
     let parts = exr.parts();
-    let layers = rgb_layers(parts);
-    let candidates: Vec<String> = layers
-        .iter()
-        .map(|l| {
-            if l.0.is_empty() {
-                "(R, G, B)".to_string()
-            } else {
-                l.0.clone()
-            }
-        })
-        .collect();
-    let chosen = match &opts.layer {
-        Some(want) => {
-            let want = want.trim_end_matches('.');
-            layers
-                .iter()
-                .find(|l| l.0 == want)
-                .ok_or_else(|| ComposeError::LayerNotFound {
-                    path: path.to_path_buf(),
-                    layer: want.to_string(),
-                    candidates: candidates.clone(),
-                })?
+    let chosen = glassdb_image::choose_rgb_layer(parts, opts.layer.as_deref()).map_err(|e| {
+        let path = path.to_path_buf();
+        match e {
+            LayerChoiceError::NoRgb { available } => ComposeError::NoRgb { path, available },
+            LayerChoiceError::NotFound { wanted, layers } => ComposeError::LayerNotFound {
+                path,
+                layer: wanted,
+                candidates: layers,
+            },
+            LayerChoiceError::Ambiguous { layers, .. } => ComposeError::AmbiguousLayer {
+                path,
+                candidates: layers,
+            },
         }
-        None => match layers.as_slice() {
-            [] => {
-                return Err(ComposeError::NoRgb {
-                    path: path.to_path_buf(),
-                    available: glassdb_image::all_channel_names(parts),
-                });
-            }
-            [only] => only,
-            many => {
-                let combined: Vec<_> = many.iter().filter(|l| l.0.ends_with("Combined")).collect();
-                match (many.iter().find(|l| l.0.is_empty()), combined.as_slice()) {
-                    (Some(bare), _) => bare,
-                    (None, [one]) => one,
-                    _ => {
-                        return Err(ComposeError::AmbiguousLayer {
-                            path: path.to_path_buf(),
-                            candidates,
-                        });
-                    }
-                }
-            }
-        },
-    };
-    let (layer, part, rgb, alpha) = chosen.clone();
-    let mut channels = rgb.to_vec();
-    channels.extend(alpha);
+    })?;
+    let mut channels = chosen.rgb.to_vec();
+    channels.extend(chosen.alpha);
     let (info, mut buffers) = exr
-        .read_channels(part, &channels)
+        .read_channels(chosen.part, &channels)
         .map_err(|source| decode_err(path, source))?;
+    let channel_names = channels
+        .iter()
+        .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))
+        .collect();
     let sample_type = info
         .channels
-        .get(rgb[0])
+        .get(chosen.rgb[0])
         .map_or(ExrSampleType::Float, |c| c.sample_type);
-    let alpha_plane = if alpha.is_some() { buffers.pop() } else { None };
+    let alpha_plane = if chosen.alpha.is_some() {
+        buffers.pop()
+    } else {
+        None
+    };
     let b = buffers.pop().unwrap_or_default();
     let g = buffers.pop().unwrap_or_default();
     let r = buffers.pop().unwrap_or_default();
@@ -213,10 +176,13 @@ fn read_exr_pass(
             rgb: [r, g, b],
             alpha: alpha_plane,
         },
+        windows: info.windows(),
         source: PassSource::Exr {
             sample_type,
             compression: info.compression,
-            layer,
+            layer: chosen.name,
+            part: chosen.part,
+            channel_names,
         },
     })
 }
@@ -300,6 +266,14 @@ pub struct OutputOptions {
     pub png_bits: Option<PngBits>,
     /// Ordered dither for 8-bit PNG output.
     pub dither: bool,
+    /// EXR output keeps the transmission file's other channels and parts (Z, AOVs, other
+    /// views), unchanged.
+    pub keep_channels: bool,
+    /// EXR output writes the composite as this new layer (`NAME.R`, …) beside the original
+    /// channels instead of replacing the transmission pass's RGB.
+    pub output_layer: Option<String>,
+    /// Attributes glassdb adds to EXR output (name, text): its version, the registry's hash.
+    pub provenance: Vec<(String, String)>,
 }
 
 impl Default for OutputOptions {
@@ -310,7 +284,97 @@ impl Default for OutputOptions {
             exr_zip_level: None,
             png_bits: None,
             dither: true,
+            keep_channels: true,
+            output_layer: None,
+            provenance: Vec::new(),
         }
+    }
+}
+
+/// What of the transmission pass's file the output carries besides the composite.
+#[derive(Debug, Clone)]
+pub struct OutputFrame {
+    /// The output's data and display windows: the transmission pass's.
+    pub windows: ImageWindows,
+    /// For an EXR transmission pass: its attributes, and its other channels when kept.
+    pub exr: Option<ExrCarried>,
+}
+
+/// The parts of an EXR transmission file written into the output.
+#[derive(Debug, Clone)]
+pub enum ExrCarried {
+    /// The file's shared attributes and the chosen part's own; no other channels.
+    Attributes {
+        image: Box<ExrImageAttributes>,
+        part: Box<ExrLayerAttributes>,
+    },
+    /// Every part exactly as stored; the composite replaces (or goes beside) the chosen layer's
+    /// channels `channel_names` (R, G, B, then A if any) of part `part`.
+    Whole {
+        file: ExactExr,
+        part: usize,
+        channel_names: Vec<String>,
+    },
+}
+
+impl OutputFrame {
+    /// A whole frame of `width × height` at the origin, with nothing carried over.
+    pub fn whole(width: u32, height: u32) -> OutputFrame {
+        OutputFrame {
+            windows: ImageWindows::full_frame(width as usize, height as usize),
+            exr: None,
+        }
+    }
+
+    /// The frame of a transmission pass read from `bytes` (the file `path`): attributes always,
+    /// every part and channel when `keep_channels` and the file holds more than the layer.
+    pub fn of_transmission(
+        pass: &Pass,
+        bytes: &[u8],
+        path: &Path,
+        keep_channels: bool,
+        max_pixels: u64,
+    ) -> Result<OutputFrame, ComposeError> {
+        let PassSource::Exr {
+            part,
+            channel_names,
+            ..
+        } = &pass.source
+        else {
+            return Ok(OutputFrame {
+                windows: pass.windows,
+                exr: None,
+            });
+        };
+        let parts = glassdb_image::read_exr_headers(bytes).map_err(|s| decode_err(path, s))?;
+        let only_the_layer = parts.len() == 1
+            && parts
+                .first()
+                .is_some_and(|p| p.channels.len() == channel_names.len());
+        let exr = if keep_channels && !only_the_layer {
+            let file = glassdb_image::read_exr_exact(bytes, max_pixels).map_err(|source| {
+                ComposeError::KeepChannels {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
+            ExrCarried::Whole {
+                file,
+                part: *part,
+                channel_names: channel_names.clone(),
+            }
+        } else {
+            let (image, part) = glassdb_image::read_exr_attributes(bytes, *part)
+                .map_err(|s| decode_err(path, s))?;
+            ExrCarried::Attributes {
+                image: Box::new(image),
+                part: Box::new(part),
+            }
+        };
+        Ok(OutputFrame {
+            windows: pass.windows,
+            exr: Some(exr),
+        })
     }
 }
 
@@ -322,6 +386,10 @@ pub struct WrittenOutput {
     /// e.g. "half, zip" or "8-bit, dithered".
     pub encoding: String,
     pub bytes: u64,
+    /// Finite samples too large for half float, written as ±Inf (half output only).
+    pub half_overflow: u64,
+    /// Channels and parts carried over from the transmission file besides the composite.
+    pub kept_channels: usize,
 }
 
 /// Writes `image` to `path` (format from the extension), atomically. `source` (the
@@ -333,7 +401,22 @@ pub fn write_output(
     source: &PassSource,
     opts: &OutputOptions,
 ) -> Result<WrittenOutput, ComposeError> {
+    let frame = OutputFrame::whole(image.width, image.height);
+    write_output_in_frame(path, image, frame, source, opts)
+}
+
+/// [`write_output`] into `frame`: the transmission pass's windows, and for EXR output its
+/// attributes and the channels carried over.
+pub fn write_output_in_frame(
+    path: &Path,
+    mut image: LinearImage,
+    frame: OutputFrame,
+    source: &PassSource,
+    opts: &OutputOptions,
+) -> Result<WrittenOutput, ComposeError> {
     let format = output_format(path)?;
+    let mut half_overflow = 0;
+    let mut kept_channels = 0;
     let (bytes_written, encoding) = match format {
         OutputFormat::Exr => {
             let data_type = opts.exr_data_type.unwrap_or(match source {
@@ -365,7 +448,18 @@ pub fn write_output(
             if let Some(level) = zip_level.filter(|&l| l > 9) {
                 return Err(ComposeError::ZipLevelOutOfRange { level });
             }
-            let n = write_exr(path, image, data_type, compression, zip_level)?;
+            let out = exr_output(image, frame, opts);
+            kept_channels = out.1;
+            let options = ExrWriteOptions {
+                storage: match data_type {
+                    ExrDataType::Half => ExrStorage::Half,
+                    ExrDataType::Float => ExrStorage::Float,
+                },
+                compression,
+                zip_level,
+            };
+            let (n, report) = write_exr(path, out.0, options)?;
+            half_overflow = report.half_overflow;
             let ty = if data_type == ExrDataType::Half {
                 "half"
             } else {
@@ -383,6 +477,7 @@ pub fn write_output(
                 PassSource::Png { bits } => *bits,
                 PassSource::Exr { .. } => PngBits::Eight,
             });
+            image.unpremultiply();
             let encoded = image.to_encoded(bits, opts.dither);
             let n = write_png(path, &encoded)?;
             let desc = match bits {
@@ -398,55 +493,206 @@ pub fn write_output(
         format,
         encoding,
         bytes: bytes_written,
+        half_overflow,
+        kept_channels,
     })
 }
 
-fn write_exr(
-    path: &Path,
-    image: LinearImage,
-    data_type: ExrDataType,
-    compression: exr::compression::Compression,
-    zip_level: Option<u32>,
-) -> Result<u64, ComposeError> {
-    let (w, h) = (image.width as usize, image.height as usize);
+/// The R, G, B (and A) planes of the composite, named `prefix` + channel.
+fn composite_planes(image: LinearImage, names: &[String]) -> Vec<ExrPlane> {
     let LinearImage {
         rgb: [r, g, b],
         alpha,
         ..
     } = image;
-    let mut planes = vec![
-        ExrPlane::new("R", r),
-        ExrPlane::new("G", g),
-        ExrPlane::new("B", b),
-    ];
-    if let Some(a) = alpha {
+    let mut planes: Vec<ExrPlane> = [r, g, b]
+        .into_iter()
+        .zip(names)
+        .map(|(v, n)| ExrPlane::new(n, v))
+        .collect();
+    if let (Some(a), Some(name)) = (alpha, names.get(3)) {
         // Alpha is linear data: quantise it linearly in lossy compressions.
         planes.push(ExrPlane {
             linear: true,
-            ..ExrPlane::new("A", a)
+            ..ExrPlane::new(name, a)
         });
     }
-    let options = ExrWriteOptions {
-        storage: match data_type {
-            ExrDataType::Half => ExrStorage::Half,
-            ExrDataType::Float => ExrStorage::Float,
-        },
-        compression,
-        zip_level,
+    planes
+}
+
+/// `R`, `G`, `B`, `A` under `layer` (`layer.R`, …), or bare.
+fn layer_channel_names(layer: Option<&str>) -> Vec<String> {
+    ["R", "G", "B", "A"]
+        .iter()
+        .map(|c| match layer {
+            Some(l) => format!("{l}.{c}"),
+            None => c.to_string(),
+        })
+        .collect()
+}
+
+/// The EXR file to write: the composite in the transmission pass's windows, with its file's
+/// attributes, its other channels and parts when carried, and glassdb's provenance. Returns
+/// the file and the number of channels carried over.
+fn exr_output(
+    image: LinearImage,
+    frame: OutputFrame,
+    opts: &OutputOptions,
+) -> (ExrImageOut, usize) {
+    let OutputFrame { windows, exr } = frame;
+    let new_layer = opts.output_layer.as_deref();
+    let (mut attributes, parts, kept) = match exr {
+        None => (
+            ExrImageAttributes::new(to_bounds(&windows.display)),
+            vec![ExrPartOut {
+                data_window: windows.data,
+                attributes: ExrLayerAttributes::default(),
+                planes: composite_planes(image, &layer_channel_names(new_layer)),
+            }],
+            0,
+        ),
+        Some(ExrCarried::Attributes {
+            image: shared,
+            part,
+        }) => (
+            *shared,
+            vec![ExrPartOut {
+                data_window: windows.data,
+                attributes: *part,
+                planes: composite_planes(image, &layer_channel_names(new_layer)),
+            }],
+            0,
+        ),
+        Some(ExrCarried::Whole {
+            file,
+            part,
+            channel_names,
+        }) => {
+            let (parts, kept) = carried_parts(image, file.parts, part, &channel_names, new_layer);
+            (file.attributes, parts, kept)
+        }
     };
+    for (name, value) in &opts.provenance {
+        if let (Some(name), Some(value)) = (exr_text(name), exr_text(value)) {
+            attributes.other.insert(name, AttributeValue::Text(value));
+        }
+    }
+    (
+        ExrImageOut {
+            display_window: windows.display,
+            attributes,
+            parts,
+        },
+        kept,
+    )
+}
+
+/// Every part of the transmission file with the composite in part `part`: replacing the
+/// layer's R, G, B (its alpha is the composite's alpha, unchanged), or as the new layer
+/// `new_layer` (a new part of that name in a multi-part file).
+fn carried_parts(
+    image: LinearImage,
+    parts: Vec<ExactPart>,
+    part: usize,
+    channel_names: &[String],
+    new_layer: Option<&str>,
+) -> (Vec<ExrPartOut>, usize) {
+    let multi_part = parts.len() > 1;
+    let mut kept = 0;
+    let mut out: Vec<ExrPartOut> = Vec::with_capacity(parts.len() + 1);
+    let mut composite = Some(image);
+    for (k, p) in parts.into_iter().enumerate() {
+        let mut planes: Vec<ExrPlane> = Vec::with_capacity(p.channels.len() + 4);
+        let replacing = k == part && new_layer.is_none();
+        for (name, samples) in p.channels {
+            // The layer's R, G, B are replaced; its A is kept exactly (it is the output's).
+            if replacing && channel_names.iter().take(3).any(|n| *n == name) {
+                continue;
+            }
+            kept += 1;
+            planes.push(ExrPlane {
+                name,
+                samples: PlaneSamples::Exact(samples),
+                linear: false,
+            });
+        }
+        if k == part
+            && let Some(mut image) = composite.take()
+        {
+            let names = match new_layer {
+                None => channel_names.to_vec(),
+                Some(l) => layer_channel_names(Some(l)),
+            };
+            if new_layer.is_none() {
+                image.alpha = None;
+            }
+            if multi_part && new_layer.is_some() {
+                let mut attributes = p.attributes.clone();
+                attributes.layer_name = new_layer.and_then(exr_text);
+                out.push(ExrPartOut {
+                    data_window: p.data_window,
+                    attributes: p.attributes,
+                    planes,
+                });
+                out.push(ExrPartOut {
+                    data_window: p.data_window,
+                    attributes,
+                    planes: composite_planes(image, &names),
+                });
+                continue;
+            }
+            planes.extend(composite_planes(image, &names));
+        }
+        out.push(ExrPartOut {
+            data_window: p.data_window,
+            attributes: p.attributes,
+            planes,
+        });
+    }
+    (out, kept)
+}
+
+/// EXR text (Latin-1 bytes); `None` for text it cannot hold.
+fn exr_text(s: &str) -> Option<Text> {
+    Text::new_or_none(s)
+}
+
+/// Checks that `name` can be an EXR layer name (Latin-1, not empty, no dot at either end).
+pub fn check_layer_name(name: &str) -> Result<(), ComposeError> {
+    if exr_text(name).is_none() || name.is_empty() || name.starts_with('.') || name.ends_with('.') {
+        return Err(ComposeError::BadLayerName {
+            name: name.to_string(),
+        });
+    }
+    Ok(())
+}
+
+fn to_bounds(w: &glassdb_image::PixelWindow) -> exr::meta::attribute::IntegerBounds {
+    exr::meta::attribute::IntegerBounds::new(
+        exr::math::Vec2(w.x, w.y),
+        exr::math::Vec2(w.width, w.height),
+    )
+}
+
+fn write_exr(
+    path: &Path,
+    image: ExrImageOut,
+    options: ExrWriteOptions,
+) -> Result<(u64, ExrWriteReport), ComposeError> {
     let mut size = 0u64;
+    let mut report = ExrWriteReport::default();
     glassdb_io::write_atomic(path, |out| {
         let mut counting = CountingWriter {
             inner: out,
             pos: 0,
             len: 0,
         };
-        glassdb_image::write_exr_planes(&mut counting, w, h, planes, options)
+        report = glassdb_image::write_exr_image(&mut counting, image, options)
             .map_err(std::io::Error::other)?;
         size = counting.len;
         Ok(())
     })?;
-    Ok(size)
+    Ok((size, report))
 }
 
 /// Tracks the file length through seeks (exr seeks back to fill its offset table).

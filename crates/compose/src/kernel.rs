@@ -15,6 +15,7 @@
 
 use std::ops::Range;
 
+use glassdb_image::PixelWindow;
 use glassdb_mask::{CosCode, CosTheta, MaskImage};
 use glassdb_registry::Side;
 use rayon::prelude::*;
@@ -30,6 +31,41 @@ const BAND_ROWS: usize = 16;
 struct PlanePass<'a> {
     refl: [&'a [f32]; 3],
     side: usize,
+    /// The pixels the pass holds, relative to the frame's top-left pixel; `None` when it holds
+    /// exactly the frame.
+    window: Option<PixelWindow>,
+}
+
+impl PlanePass<'_> {
+    /// Index into the pass of frame pixel `i` (frame `width` pixels wide), if the pass holds it.
+    #[inline(always)]
+    fn index(&self, i: usize, width: usize) -> Option<usize> {
+        match &self.window {
+            None => Some(i),
+            Some(w) => w.index_of((i % width) as i64, (i / width) as i64),
+        }
+    }
+}
+
+/// A reflection pass placed in the frame: its R, G, B planes hold the pixels of `window`
+/// (coordinates relative to the frame's top-left pixel; it may cover only part of the frame,
+/// e.g. its pane's screen rectangle, or reach beyond it).
+#[derive(Clone, Copy)]
+pub struct PlacedRefl<'a> {
+    pub rgb: [&'a [f32]; 3],
+    pub window: PixelWindow,
+    pub side: Side,
+}
+
+/// What the kernel does with a glass pixel whose plane's reflection pass does not hold it
+/// (the caller refuses such pixels first unless the user chose one of these).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OutsidePass {
+    /// Composite with no reflection there (black): `out = trans·t`.
+    #[default]
+    NoReflection,
+    /// Leave the pixel as the transmission pass (counted as passed through).
+    Transmission,
 }
 
 /// Everything the kernel reads and the transmission pass it overwrites, checked once by
@@ -42,6 +78,7 @@ pub struct KernelInput<'a> {
     planes: Vec<PlanePass<'a>>,
     mask: &'a MaskImage,
     lut: &'a GlassLut,
+    outside: OutsidePass,
 }
 
 /// The kernel's inputs do not fit together (the caller checks files first; this guards the
@@ -62,7 +99,7 @@ pub enum KernelShapeError {
     },
     /// A plane of a reflection pass has the wrong number of samples.
     #[error(
-        "kernel input sizes disagree: reflection pass {pass} channel {channel} has {samples} samples for {pixels} mask pixels"
+        "kernel input sizes disagree: reflection pass {pass} channel {channel} has {samples} samples for the {pixels} pixels of its window"
     )]
     Reflection {
         pass: usize,
@@ -85,6 +122,34 @@ impl<'a> KernelInput<'a> {
         mask: &'a MaskImage,
         lut: &'a GlassLut,
     ) -> Result<KernelInput<'a>, KernelShapeError> {
+        if refl.len() != plane_sides.len() {
+            return Err(KernelShapeError::SidesPerPass {
+                passes: refl.len(),
+                sides: plane_sides.len(),
+            });
+        }
+        let frame = PixelWindow::at_origin(mask.width as usize, mask.height as usize);
+        let placed: Vec<PlacedRefl<'a>> = refl
+            .iter()
+            .zip(plane_sides)
+            .map(|(&rgb, &side)| PlacedRefl {
+                rgb,
+                window: frame,
+                side,
+            })
+            .collect();
+        KernelInput::placed(trans, &placed, mask, lut, OutsidePass::default())
+    }
+
+    /// Checks the inputs against the mask: `trans` holds one sample per mask pixel, every
+    /// reflection pass one per pixel of its window.
+    pub fn placed(
+        trans: [&'a mut [f32]; 3],
+        refl: &[PlacedRefl<'a>],
+        mask: &'a MaskImage,
+        lut: &'a GlassLut,
+        outside: OutsidePass,
+    ) -> Result<KernelInput<'a>, KernelShapeError> {
         mask.check_consistent().map_err(KernelShapeError::Mask)?;
         let pixels = mask.pixel_count();
         if let Some((channel, p)) = trans.iter().enumerate().find(|(_, p)| p.len() != pixels) {
@@ -94,31 +159,32 @@ impl<'a> KernelInput<'a> {
                 pixels,
             });
         }
-        for (pass, planes) in refl.iter().enumerate() {
-            if let Some((channel, p)) = planes.iter().enumerate().find(|(_, p)| p.len() != pixels) {
+        let frame = PixelWindow::at_origin(mask.width as usize, mask.height as usize);
+        for (pass, placed) in refl.iter().enumerate() {
+            let expected = placed.window.width * placed.window.height;
+            if let Some((channel, p)) = placed
+                .rgb
+                .iter()
+                .enumerate()
+                .find(|(_, p)| p.len() != expected)
+            {
                 return Err(KernelShapeError::Reflection {
                     pass,
                     channel,
                     samples: p.len(),
-                    pixels,
+                    pixels: expected,
                 });
             }
         }
-        if refl.len() != plane_sides.len() {
-            return Err(KernelShapeError::SidesPerPass {
-                passes: refl.len(),
-                sides: plane_sides.len(),
-            });
-        }
         let planes = refl
             .iter()
-            .zip(plane_sides)
-            .map(|(&refl, &side)| PlanePass {
-                refl,
-                side: match side {
+            .map(|p| PlanePass {
+                refl: p.rgb,
+                side: match p.side {
                     Side::Front => 0,
                     Side::Back => 1,
                 },
+                window: (p.window != frame).then_some(p.window),
             })
             .collect();
         Ok(KernelInput {
@@ -126,6 +192,7 @@ impl<'a> KernelInput<'a> {
             planes,
             mask,
             lut,
+            outside,
         })
     }
 }
@@ -216,6 +283,7 @@ pub fn compose_in_place(input: KernelInput<'_>) -> KernelCounts {
         planes,
         mask,
         lut,
+        outside,
     } = input;
     if mask.pixel_count() == 0 {
         return KernelCounts::default();
@@ -224,6 +292,7 @@ pub fn compose_in_place(input: KernelInput<'_>) -> KernelCounts {
         planes: &planes,
         mask,
         lut,
+        outside,
     };
     match &mask.cos_theta {
         CosTheta::Quantized8(c) => sweep.run(trans, &Code8(c)),
@@ -238,6 +307,7 @@ struct Sweep<'a> {
     planes: &'a [PlanePass<'a>],
     mask: &'a MaskImage,
     lut: &'a GlassLut,
+    outside: OutsidePass,
 }
 
 impl Sweep<'_> {
@@ -245,7 +315,9 @@ impl Sweep<'_> {
     fn run<C: CosLookup>(&self, trans: [&mut [f32]; 3], cos: &C) -> KernelCounts {
         let band = self.mask.width as usize * BAND_ROWS;
         let [tr, tg, tb] = trans;
-        let simple = self.planes.len() == 1 && self.mask.coverage.is_none();
+        let simple = self.planes.len() == 1
+            && self.mask.coverage.is_none()
+            && self.planes[0].window.is_none();
         tr.par_chunks_mut(band)
             .zip(tg.par_chunks_mut(band))
             .zip(tb.par_chunks_mut(band))
@@ -318,6 +390,7 @@ impl Sweep<'_> {
         let ids = &mask.id[pixels.clone()];
         let planes = &mask.plane[pixels.clone()];
         let coverage = mask.coverage.as_deref().map(|c| &c[pixels]);
+        let width = mask.width as usize;
         let mut counts = KernelCounts::default();
         let [or, og, ob] = out;
         for (j, (((&id, &plane), r_out), (g_out, b_out))) in ids
@@ -346,8 +419,17 @@ impl Sweep<'_> {
                     rt.r[c] *= k;
                 }
             }
-            let i = base + j;
-            let rf = [pass.refl[0][i], pass.refl[1][i], pass.refl[2][i]];
+            let rf = match pass.index(base + j, width) {
+                Some(i) => [pass.refl[0][i], pass.refl[1][i], pass.refl[2][i]],
+                None if self.outside == OutsidePass::Transmission => {
+                    counts.passthrough_pixels += 1;
+                    continue;
+                }
+                None => {
+                    rt.r = [0.0; 3];
+                    [0.0; 3]
+                }
+            };
             composite_pixel(&mut counts, [r_out, g_out, b_out], &rt, rf);
         }
         counts

@@ -22,12 +22,13 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 pub use error::ComposeError;
-use glassdb_mask::{MaskImage, MaskReadOptions};
+use glassdb_image::{ImageWindows, PixelWindow};
+use glassdb_mask::{MaskImage, MaskReadOptions, PlacedMask};
 pub use glassdb_registry::Side;
 use rayon::prelude::*;
 
-use crate::io::{OutputOptions, Pass, PassReadOptions, WrittenOutput};
-use crate::kernel::{KernelCounts, KernelInput};
+use crate::io::{OutputFrame, OutputOptions, Pass, PassReadOptions, WrittenOutput};
+use crate::kernel::{KernelCounts, KernelInput, OutsidePass, PlacedRefl};
 use crate::lut::GlassLut;
 
 /// What to do with mask ids the registry does not have.
@@ -38,6 +39,28 @@ pub enum UnknownIds {
     Error,
     /// Leave those pixels as the transmission pass.
     Passthrough,
+}
+
+/// What to do with glass pixels of a plane that its reflection pass does not cover (a pass
+/// cropped to less than its pane).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OutsidePolicy {
+    /// Refuse, naming the plane, the pixel count and their bounding box.
+    #[default]
+    Error,
+    /// Composite them with no reflection (`out = trans·t`).
+    NoReflection,
+    /// Leave them as the transmission pass.
+    Transmission,
+}
+
+/// The EXR layer each input is read from (`None`: the default choice, see
+/// [`glassdb_image::choose_rgb_layer`]).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct InputLayers {
+    pub trans: Option<String>,
+    /// Per reflection pass, in order; missing entries take `None`.
+    pub refl: Vec<Option<String>>,
 }
 
 /// The input and output files of one image.
@@ -63,8 +86,13 @@ impl ComposeJob {
 /// Settings shared by every frame.
 #[derive(Debug, Clone)]
 pub struct ComposeSettings {
+    /// How passes are read; its `layer` is the default for inputs without their own.
     pub pass: PassReadOptions,
+    /// Layers chosen per input (over `pass.layer`).
+    pub layers: InputLayers,
     pub mask: MaskReadOptions,
+    /// Glass outside its plane's (cropped) reflection pass.
+    pub outside: OutsidePolicy,
     /// Side of each plane that faces the camera; planes not listed show the front.
     pub plane_sides: BTreeMap<usize, Side>,
     pub unknown: UnknownIds,
@@ -79,7 +107,9 @@ impl Default for ComposeSettings {
     fn default() -> Self {
         ComposeSettings {
             pass: PassReadOptions::default(),
+            layers: InputLayers::default(),
             mask: MaskReadOptions::default(),
+            outside: OutsidePolicy::Error,
             plane_sides: BTreeMap::new(),
             unknown: UnknownIds::Error,
             output: OutputOptions::default(),
@@ -110,8 +140,11 @@ impl StageTimings {
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameReport {
     pub output: WrittenOutput,
+    /// Size of the output's data window.
     pub width: u32,
     pub height: u32,
+    /// The output's data and display windows (the transmission pass's).
+    pub windows: ImageWindows,
     pub timings: StageTimings,
     /// Glass pixels per id (id 0 not counted).
     pub id_counts: BTreeMap<u16, u64>,
@@ -120,6 +153,9 @@ pub struct FrameReport {
     pub counts: KernelCounts,
     /// Number of reflection passes (planes).
     pub planes: usize,
+    /// Glass pixels outside their plane's reflection pass (composited as the chosen
+    /// [`OutsidePolicy`] says).
+    pub outside_pixels: u64,
 }
 
 impl FrameReport {
@@ -151,58 +187,111 @@ pub fn sides_from_planes_json(
     Ok(file.planes.iter().map(|p| (p.index, p.eye_side)).collect())
 }
 
-/// Reads the inputs of one image in parallel.
+/// The decoded inputs of one image.
+struct DecodedInputs {
+    trans: Pass,
+    frame: OutputFrame,
+    refl: Vec<Pass>,
+    mask: PlacedMask,
+}
+
+impl ComposeSettings {
+    /// Read options for a pass whose own layer is `layer` (else the default).
+    fn pass_options(&self, layer: Option<&Option<String>>) -> PassReadOptions {
+        let mut opts = self.pass.clone();
+        if let Some(Some(l)) = layer {
+            opts.layer = Some(l.clone());
+        }
+        opts
+    }
+}
+
+/// Reads the inputs of one image in parallel; the transmission file's attributes (and other
+/// channels, when kept) come with it.
 fn decode_inputs(
     job: &ComposeJob,
     settings: &ComposeSettings,
-) -> Result<(Pass, Vec<Pass>, MaskImage), ComposeError> {
-    let (trans, (mask, refl)) = rayon::join(
-        || io::read_pass(&job.trans, &settings.pass),
-        || {
-            rayon::join(
-                || glassdb_mask::read_mask(&job.mask, &settings.mask),
-                || {
-                    job.refl
-                        .par_iter()
-                        .map(|p| io::read_pass(p, &settings.pass))
-                        .collect::<Result<Vec<_>, _>>()
-                },
-            )
-        },
-    );
-    Ok((trans?, refl?, mask?))
+) -> Result<DecodedInputs, ComposeError> {
+    let read_trans = || -> Result<(Pass, OutputFrame), ComposeError> {
+        let opts = settings.pass_options(Some(&settings.layers.trans));
+        let bytes = io::read_file(&job.trans)?;
+        let pass = io::read_pass_bytes(&bytes, &job.trans, &opts)?;
+        let keep = settings.output.keep_channels
+            && io::output_format(&job.output)? == io::OutputFormat::Exr;
+        let frame = OutputFrame::of_transmission(
+            &pass,
+            &bytes,
+            &job.trans,
+            keep,
+            settings.pass.max_pixels,
+        )?;
+        Ok((pass, frame))
+    };
+    let (trans, (mask, refl)) = rayon::join(read_trans, || {
+        rayon::join(
+            || glassdb_mask::read_placed_mask(&job.mask, &settings.mask),
+            || {
+                job.refl
+                    .par_iter()
+                    .enumerate()
+                    .map(|(k, p)| {
+                        io::read_pass(p, &settings.pass_options(settings.layers.refl.get(k)))
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+            },
+        )
+    });
+    let (trans, frame) = trans?;
+    Ok(DecodedInputs {
+        trans,
+        frame,
+        refl: refl?,
+        mask: mask?,
+    })
 }
 
-/// Checks sizes, ids and planes before compositing.
+/// Every input must frame the same display window; sizes are named when both are whole frames
+/// at the origin (PNGs, full renders).
+fn check_frames(
+    job: &ComposeJob,
+    trans: &ImageWindows,
+    others: &[(&Path, ImageWindows)],
+) -> Result<(), ComposeError> {
+    for (path, w) in others {
+        if w.display == trans.display {
+            continue;
+        }
+        let whole = |w: &ImageWindows| w.data == w.display && w.display.x == 0 && w.display.y == 0;
+        let size = |w: &PixelWindow| (w.width as u32, w.height as u32);
+        return Err(if whole(trans) && whole(w) {
+            ComposeError::SizeMismatch {
+                a: job.trans.clone(),
+                a_size: size(&trans.display),
+                b: path.to_path_buf(),
+                b_size: size(&w.display),
+            }
+        } else {
+            ComposeError::DisplayWindowMismatch {
+                a: job.trans.clone(),
+                a_window: trans.display,
+                b: path.to_path_buf(),
+                b_window: w.display,
+            }
+        });
+    }
+    Ok(())
+}
+
+/// Checks ids and planes of the mask (placed in the frame) before compositing.
 fn check_inputs(
     job: &ComposeJob,
     settings: &ComposeSettings,
     lut: &GlassLut,
-    trans: &Pass,
-    refl: &[Pass],
+    refl_count: usize,
     mask: &MaskImage,
+    stores_planes: bool,
     id_counts: &BTreeMap<u16, u64>,
 ) -> Result<(), ComposeError> {
-    let size = |i: &pixels::LinearImage| (i.width, i.height);
-    let t_size = size(&trans.image);
-    for (p, path) in refl.iter().zip(&job.refl) {
-        if size(&p.image) != t_size {
-            return Err(ComposeError::SizeMismatch {
-                a: job.trans.clone(),
-                a_size: t_size,
-                b: path.clone(),
-                b_size: size(&p.image),
-            });
-        }
-    }
-    if (mask.width, mask.height) != t_size {
-        return Err(ComposeError::SizeMismatch {
-            a: job.trans.clone(),
-            a_size: t_size,
-            b: job.mask.clone(),
-            b_size: (mask.width, mask.height),
-        });
-    }
     let unknown: Vec<(u16, u64)> = id_counts
         .iter()
         .filter(|(id, _)| !lut.contains(**id))
@@ -216,10 +305,16 @@ fn check_inputs(
             ids: unknown,
         });
     }
-    if mask.max_plane() as usize >= refl.len() {
+    if refl_count > 1 && !stores_planes {
+        return Err(ComposeError::MaskWithoutPlanes {
+            mask: job.mask.clone(),
+            passes: refl_count,
+        });
+    }
+    if mask.max_plane() as usize >= refl_count {
         let mut per_plane: BTreeMap<u16, u64> = BTreeMap::new();
         for (&id, &p) in mask.id.iter().zip(&mask.plane) {
-            if id != 0 && p as usize >= refl.len() {
+            if id != 0 && p as usize >= refl_count {
                 *per_plane.entry(p).or_default() += 1;
             }
         }
@@ -228,15 +323,94 @@ fn check_inputs(
                 mask: job.mask.clone(),
                 plane,
                 pixels,
-                passes: refl.len(),
+                passes: refl_count,
             });
         }
     }
     Ok(())
 }
 
-/// Composites one image end to end: decode (all inputs in parallel), check, composite in
-/// place, encode and write atomically. The output may not be one of the inputs.
+/// Glass pixels (with a table) outside their plane's reflection pass: per plane, the count and
+/// bounding box in frame-relative coordinates. `windows[k]` is pass k's window relative to the
+/// frame.
+fn glass_outside_passes(
+    mask: &MaskImage,
+    lut: &GlassLut,
+    windows: &[PixelWindow],
+) -> BTreeMap<usize, (u64, PixelWindow)> {
+    let width = mask.width as usize;
+    let frame = PixelWindow::at_origin(width, mask.height as usize);
+    let mut out: BTreeMap<usize, (u64, [i64; 4])> = BTreeMap::new();
+    if windows.iter().all(|w| w.contains_window(&frame)) {
+        return BTreeMap::new();
+    }
+    for (i, (&id, &plane)) in mask.id.iter().zip(&mask.plane).enumerate() {
+        if id == 0 || !lut.contains(id) {
+            continue;
+        }
+        let k = usize::from(plane);
+        let Some(w) = windows.get(k) else { continue };
+        let (x, y) = ((i % width) as i64, (i / width) as i64);
+        if w.contains(x, y) {
+            continue;
+        }
+        let e = out.entry(k).or_insert((0, [x, y, x, y]));
+        e.0 += 1;
+        e.1 = [e.1[0].min(x), e.1[1].min(y), e.1[2].max(x), e.1[3].max(y)];
+    }
+    out.into_iter()
+        .map(|(k, (n, b))| {
+            let window = PixelWindow {
+                x: b[0] as i32,
+                y: b[1] as i32,
+                width: (b[2] - b[0] + 1) as usize,
+                height: (b[3] - b[1] + 1) as usize,
+            };
+            (k, (n, window))
+        })
+        .collect()
+}
+
+/// The windows of an input in the frame `display`: an image without coordinates (a PNG) of the
+/// frame's size is that frame, wherever it lies; anything else keeps its own windows.
+fn in_frame(
+    windows: ImageWindows,
+    without_coordinates: bool,
+    display: &PixelWindow,
+) -> ImageWindows {
+    let same_size =
+        windows.display.width == display.width && windows.display.height == display.height;
+    if without_coordinates && same_size {
+        ImageWindows {
+            data: *display,
+            display: *display,
+        }
+    } else {
+        windows
+    }
+}
+
+/// `w` in coordinates relative to `origin`'s top-left pixel.
+fn relative_to(w: &PixelWindow, origin: &PixelWindow) -> PixelWindow {
+    PixelWindow {
+        x: w.x - origin.x,
+        y: w.y - origin.y,
+        ..*w
+    }
+}
+
+/// `w` (relative to `origin`'s top-left pixel) in absolute coordinates.
+fn absolute_from(w: &PixelWindow, origin: &PixelWindow) -> PixelWindow {
+    PixelWindow {
+        x: w.x + origin.x,
+        y: w.y + origin.y,
+        ..*w
+    }
+}
+
+/// Composites one image end to end: decode (all inputs in parallel), place every input in the
+/// transmission pass's frame by its pixel coordinates, check, composite in place, encode and
+/// write atomically. The output may not be one of the inputs.
 pub fn compose_frame(
     job: &ComposeJob,
     settings: &ComposeSettings,
@@ -246,6 +420,9 @@ pub fn compose_frame(
         return Err(ComposeError::NoReflectionPass);
     }
     io::output_format(&job.output)?;
+    if let Some(name) = &settings.output.output_layer {
+        io::check_layer_name(name)?;
+    }
     glassdb_io::refuse_input_as_output(
         &job.output,
         job.inputs()
@@ -253,40 +430,114 @@ pub fn compose_frame(
     )?;
 
     let t0 = Instant::now();
-    let (mut trans, refl, mask) = decode_inputs(job, settings)?;
+    let DecodedInputs {
+        mut trans,
+        frame,
+        refl,
+        mask,
+    } = decode_inputs(job, settings)?;
     let decode = t0.elapsed();
 
     let t1 = Instant::now();
-    let id_counts = mask.id_pixel_counts();
-    check_inputs(job, settings, lut, &trans, &refl, &mask, &id_counts)?;
-    let plane_sides: Vec<Side> = (0..refl.len())
-        .map(|k| settings.plane_sides.get(&k).copied().unwrap_or(Side::Front))
-        .collect();
-    let refl_planes: Vec<[&[f32]; 3]> = refl
+    let data = trans.windows.data;
+    let display = trans.windows.display;
+    let mask_windows = in_frame(mask.windows, !mask.has_coordinates, &display);
+    let refl_windows: Vec<ImageWindows> = refl
         .iter()
         .map(|p| {
-            let [r, g, b] = &p.image.rgb;
-            [r.as_slice(), g.as_slice(), b.as_slice()]
+            in_frame(
+                p.windows,
+                matches!(p.source, io::PassSource::Png { .. }),
+                &display,
+            )
         })
         .collect();
+    let mut others: Vec<(&Path, ImageWindows)> = vec![(job.mask.as_path(), mask_windows)];
+    others.extend(
+        job.refl
+            .iter()
+            .map(PathBuf::as_path)
+            .zip(refl_windows.iter().copied()),
+    );
+    check_frames(job, &trans.windows, &others)?;
+    let PlacedMask {
+        image: mask,
+        stores_planes,
+        ..
+    } = mask;
+    let mask = if mask_windows.data == data {
+        mask
+    } else {
+        mask.placed(&mask_windows.data, &data)
+    };
+    let id_counts = mask.id_pixel_counts();
+    check_inputs(
+        job,
+        settings,
+        lut,
+        refl.len(),
+        &mask,
+        stores_planes,
+        &id_counts,
+    )?;
+    let windows: Vec<PixelWindow> = refl_windows
+        .iter()
+        .map(|w| relative_to(&w.data, &data))
+        .collect();
+    let outside = glass_outside_passes(&mask, lut, &windows);
+    if let (OutsidePolicy::Error, Some((&plane, &(pixels, bounds)))) =
+        (settings.outside, outside.iter().next())
+    {
+        return Err(ComposeError::GlassOutsidePass {
+            plane,
+            pass: job.refl[plane].clone(),
+            pixels,
+            pass_window: refl_windows[plane].data,
+            bounds: absolute_from(&bounds, &data),
+        });
+    }
+    let placed: Vec<PlacedRefl<'_>> = refl
+        .iter()
+        .zip(&windows)
+        .enumerate()
+        .map(|(k, (p, &window))| {
+            let [r, g, b] = &p.image.rgb;
+            PlacedRefl {
+                rgb: [r.as_slice(), g.as_slice(), b.as_slice()],
+                window,
+                side: settings.plane_sides.get(&k).copied().unwrap_or(Side::Front),
+            }
+        })
+        .collect();
+    let outside_mode = match settings.outside {
+        OutsidePolicy::Transmission => OutsidePass::Transmission,
+        OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
+    };
     let [r, g, b] = &mut trans.image.rgb;
-    let input = KernelInput::new([r, g, b], &refl_planes, &plane_sides, &mask, lut)?;
+    let input = KernelInput::placed([r, g, b], &placed, &mask, lut, outside_mode)?;
     let counts = kernel::compose_in_place(input);
     let cos_range = mask.cos_theta_range();
     let (width, height) = (trans.image.width, trans.image.height);
-    drop(refl_planes);
+    drop(placed);
     drop(refl);
     drop(mask);
     let compose = t1.elapsed();
 
     let t2 = Instant::now();
-    let output = io::write_output(&job.output, trans.image, &trans.source, &settings.output)?;
+    let output = io::write_output_in_frame(
+        &job.output,
+        trans.image,
+        frame,
+        &trans.source,
+        &settings.output,
+    )?;
     let encode = t2.elapsed();
 
     Ok(FrameReport {
         output,
         width,
         height,
+        windows: trans.windows,
         timings: StageTimings {
             decode,
             compose,
@@ -296,6 +547,7 @@ pub fn compose_frame(
         cos_range,
         counts,
         planes: job.refl.len(),
+        outside_pixels: outside.values().map(|(n, _)| n).sum(),
     })
 }
 

@@ -31,6 +31,38 @@ impl LinearImage {
         self.width as usize * self.height as usize
     }
 
+    /// Straight alpha (PNG's convention) to premultiplied (EXR's and the compositor's):
+    /// colour × alpha. Without alpha nothing changes.
+    pub fn premultiply(&mut self) {
+        if let Some(alpha) = &self.alpha {
+            for plane in &mut self.rgb {
+                plane
+                    .par_iter_mut()
+                    .zip(alpha.par_iter())
+                    .for_each(|(c, &a)| *c *= a);
+            }
+        }
+    }
+
+    /// Premultiplied to straight alpha, for PNG output: colour ÷ alpha where alpha > 0;
+    /// where alpha is 0 (or not a number) the colour is left as it is, as oiiotool's
+    /// `--unpremult` does (light with no coverage, e.g. a reflection on a transparent
+    /// background, cannot be stored straight).
+    pub fn unpremultiply(&mut self) {
+        if let Some(alpha) = &self.alpha {
+            for plane in &mut self.rgb {
+                plane
+                    .par_iter_mut()
+                    .zip(alpha.par_iter())
+                    .for_each(|(c, &a)| {
+                        if a > 0.0 {
+                            *c /= a;
+                        }
+                    });
+            }
+        }
+    }
+
     /// An image of one colour.
     pub fn filled(width: u32, height: u32, rgb: [f32; 3], alpha: Option<f32>) -> LinearImage {
         let n = width as usize * height as usize;

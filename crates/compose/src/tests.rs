@@ -287,7 +287,7 @@ proptest! {
         let m_path = dir.path().join("m.png");
         let write = |p: &Path, v: &[f32]| {
             let img = pixels::LinearImage { width: 4, height: 3, rgb: planes(v), alpha: None };
-            let src = io::PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, compression: exr::compression::Compression::ZIP16, layer: String::new() };
+            let src = io::PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, compression: exr::compression::Compression::ZIP16, layer: String::new(), part: 0, channel_names: vec!["R".into(), "G".into(), "B".into()] };
             io::write_output(p, img, &src, &OutputOptions::default()).unwrap();
         };
         write(&t_path, &trans);

@@ -52,16 +52,6 @@ pub enum ImageError {
     /// A feature this crate does not handle (deep data, subsampled channels, an empty image).
     #[error("unsupported: {feature}")]
     Unsupported { feature: String },
-    /// An EXR part whose data window differs from the display window (cropped or overscan).
-    #[error(
-        "{}data window {data} is not the display window {display}: cropped, render-border and overscan images are not composited yet; render the full frame",
-        part.as_ref().map(|p| format!("part {p:?}: ")).unwrap_or_default()
-    )]
-    WindowNotFrame {
-        part: Option<String>,
-        data: crate::PixelWindow,
-        display: crate::PixelWindow,
-    },
     /// Larger than the allowed number of pixels (checked from the header, before allocating).
     #[error("{width}×{height} pixels exceeds the limit of {max_pixels} pixels")]
     TooLarge {
@@ -92,9 +82,9 @@ impl ImageError {
     /// The class of this error (what a user can act on).
     pub fn kind(&self) -> ImageErrorKind {
         match self {
-            ImageError::UnknownFormat { .. }
-            | ImageError::Unsupported { .. }
-            | ImageError::WindowNotFrame { .. } => ImageErrorKind::Unsupported,
+            ImageError::UnknownFormat { .. } | ImageError::Unsupported { .. } => {
+                ImageErrorKind::Unsupported
+            }
             ImageError::ExrDecode(e) | ImageError::ExrEncode(e) => exr_kind(e),
             ImageError::PngDecode(e) => match e {
                 png::DecodingError::IoError(io) => io_kind(io),

@@ -10,11 +10,12 @@ use exr::block::chunk::Chunk;
 use exr::math::Vec2;
 use exr::meta::BlockDescription;
 use exr::meta::attribute::SampleType;
-use exr::meta::header::Header;
+use exr::meta::header::{Header, ImageAttributes, LayerAttributes};
+use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
 use rayon::prelude::*;
 
 use crate::guard::catch_codec_panic;
-use crate::{Codec, ImageError};
+use crate::{Codec, ImageError, ImageWindows, PixelWindow};
 
 /// The sample type of one EXR channel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,67 +63,26 @@ pub struct ExrPart {
     pub channels: Vec<ExrChannelInfo>,
     pub compression: exr::compression::Compression,
     pub deep: bool,
+    /// The part's `view` attribute (multi-part stereo files: `left`, `right`).
+    pub view: Option<String>,
+    /// The `multiView` attribute of a single-part multi-view file: the view names, the first
+    /// (the "hero" view) stored in the bare channels, the others as `view.channel`.
+    pub multi_view: Vec<String>,
+    /// Mip-map or rip-map levels beyond the full resolution (only level 0 is read).
+    pub multi_resolution: bool,
+    /// Whether the file has several parts: only then does a part's name qualify its channel
+    /// names (a single-part file's channel names are complete, even when it has a `name`).
+    pub multi_part: bool,
 }
 
 impl ExrPart {
-    /// The name a user gives to select channel `index`: `layer.channel` for a named part,
-    /// the bare channel name otherwise.
-    pub fn qualified_name(&self, index: usize) -> Option<String> {
-        let c = self.channels.get(index)?;
-        Some(match &self.layer_name {
-            Some(layer) if !layer.is_empty() => format!("{layer}.{}", c.name),
-            _ => c.name.clone(),
-        })
+    /// Where the part's pixels lie: its data window inside the display window.
+    pub fn windows(&self) -> ImageWindows {
+        ImageWindows {
+            data: self.data_window,
+            display: self.display_window,
+        }
     }
-
-    /// Index of the channel that `name` selects: an exact channel name, or `layer.channel`.
-    pub fn find_channel(&self, name: &str) -> Option<usize> {
-        self.channels
-            .iter()
-            .position(|c| c.name == name)
-            .or_else(|| {
-                (0..self.channels.len()).find(|&i| self.qualified_name(i).as_deref() == Some(name))
-            })
-    }
-}
-
-/// A rectangle of pixels in an EXR file's coordinates: the top-left pixel and the size.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PixelWindow {
-    pub x: i32,
-    pub y: i32,
-    pub width: usize,
-    pub height: usize,
-}
-
-impl std::fmt::Display for PixelWindow {
-    /// OpenEXR's inclusive form, `(xMin, yMin)–(xMax, yMax)`.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "({}, {})–({}, {})",
-            self.x,
-            self.y,
-            i64::from(self.x) + self.width as i64 - 1,
-            i64::from(self.y) + self.height as i64 - 1
-        )
-    }
-}
-
-/// Finds the (part, channel) that `name` selects in a file's parts.
-pub fn find_channel(parts: &[ExrPart], name: &str) -> Option<(usize, usize)> {
-    parts
-        .iter()
-        .enumerate()
-        .find_map(|(p, part)| part.find_channel(name).map(|c| (p, c)))
-}
-
-/// Every selectable channel name in the file (for error messages).
-pub fn all_channel_names(parts: &[ExrPart]) -> Vec<String> {
-    parts
-        .iter()
-        .flat_map(|p| (0..p.channels.len()).filter_map(|i| p.qualified_name(i)))
-        .collect()
 }
 
 fn part_from_header(h: &Header) -> ExrPart {
@@ -154,13 +114,34 @@ fn part_from_header(h: &Header) -> ExrPart {
             .collect(),
         compression: h.compression,
         deep: h.deep,
+        view: h.own_attributes.view_name.as_ref().map(|t| t.to_string()),
+        multi_view: h
+            .own_attributes
+            .multi_view_names
+            .iter()
+            .flatten()
+            .map(|t| t.to_string())
+            .collect(),
+        multi_part: false,
+        multi_resolution: match h.blocks {
+            BlockDescription::Tiles(t) => t.level_mode != exr::meta::attribute::LevelMode::Singular,
+            BlockDescription::ScanLines => false,
+        },
     }
 }
 
 /// Reads only the headers of an EXR held in memory (no pixel data is touched or allocated).
 pub fn read_exr_headers(bytes: &[u8]) -> Result<Vec<ExrPart>, ImageError> {
     let meta = guarded(|| exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false))?;
-    Ok(meta.headers.iter().map(part_from_header).collect())
+    let multi_part = meta.headers.len() > 1;
+    Ok(meta
+        .headers
+        .iter()
+        .map(|h| ExrPart {
+            multi_part,
+            ..part_from_header(h)
+        })
+        .collect())
 }
 
 /// Runs an `exr` call that sees file bytes: a panic becomes `CodecPanic`, an error `ExrDecode`.
@@ -433,4 +414,103 @@ fn convert_samples(bytes: &[u8], ty: ExrSampleType, dst: &mut [f32]) -> Result<(
         }
     }
     Ok(())
+}
+
+/// The attributes of an EXR held in memory, as the `exr` crate models them: those shared by
+/// every part (display window, chromaticities, pixel aspect, custom ones) and part `part`'s own
+/// (name, view, renderer attributes). No pixel data is touched.
+pub fn read_exr_attributes(
+    bytes: &[u8],
+    part: usize,
+) -> Result<(ImageAttributes, LayerAttributes), ImageError> {
+    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false))?;
+    let header = meta
+        .headers
+        .get(part)
+        .ok_or_else(|| unsupported(format!("part {part} (the file has {})", meta.headers.len())))?;
+    Ok((
+        header.shared_attributes.clone(),
+        header.own_attributes.clone(),
+    ))
+}
+
+/// One part of an [`ExactExr`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExactPart {
+    pub attributes: LayerAttributes,
+    pub data_window: PixelWindow,
+    /// Channel names as stored, and their full-resolution samples as stored (half, float or
+    /// uint), row-major over the data window.
+    pub channels: Vec<(String, FlatSamples)>,
+}
+
+/// Every part of an EXR with its full-resolution samples exactly as stored, and the attributes:
+/// what is copied, unchanged, into a file written from it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExactExr {
+    pub attributes: ImageAttributes,
+    pub parts: Vec<ExactPart>,
+}
+
+/// Reads every part of an EXR exactly (see [`ExactExr`]); parts over `max_pixels` in total,
+/// deep parts and subsampled channels are refused from the headers, before any pixel is decoded.
+pub fn read_exr_exact(bytes: &[u8], max_pixels: u64) -> Result<ExactExr, ImageError> {
+    let parts = read_exr_headers(bytes)?;
+    let total: u64 = parts
+        .iter()
+        .map(|p| p.data_window.pixel_count())
+        .fold(0, u64::saturating_add);
+    if total > max_pixels {
+        let largest = parts
+            .iter()
+            .map(|p| p.data_window)
+            .max_by_key(|w| w.pixel_count());
+        return Err(ImageError::TooLarge {
+            width: largest.map_or(0, |w| w.width as u64),
+            height: largest.map_or(0, |w| w.height as u64),
+            max_pixels,
+        });
+    }
+    for part in &parts {
+        if part.deep {
+            return Err(unsupported("deep EXR data".into()));
+        }
+        if let Some(c) = part.channels.iter().find(|c| c.sampling != (1, 1)) {
+            return Err(unsupported(format!(
+                "subsampled channel {} ({}×{})",
+                c.name, c.sampling.0, c.sampling.1
+            )));
+        }
+    }
+    let image = guarded(|| {
+        exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .all_layers()
+            .all_attributes()
+            .from_buffered(Cursor::new(bytes))
+    })?;
+    Ok(ExactExr {
+        attributes: image.attributes,
+        parts: image
+            .layer_data
+            .into_iter()
+            .map(|layer| ExactPart {
+                data_window: PixelWindow {
+                    x: layer.attributes.layer_position.x(),
+                    y: layer.attributes.layer_position.y(),
+                    width: layer.size.width(),
+                    height: layer.size.height(),
+                },
+                attributes: layer.attributes,
+                channels: layer
+                    .channel_data
+                    .list
+                    .into_iter()
+                    .map(|c| (c.name.to_string(), c.sample_data))
+                    .collect(),
+            })
+            .collect(),
+    })
 }

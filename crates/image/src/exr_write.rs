@@ -1,17 +1,21 @@
-//! Encoding flat `f32` planes as a single-part scan-line OpenEXR file: composited passes
-//! (half or float, any compression, ZIP at a chosen level) and EXR masks alike.
+//! Encoding flat planes as a scan-line OpenEXR file: composited passes (half or float, any
+//! compression, ZIP at a chosen level; with the transmission pass's windows, attributes and
+//! other channels, in one part or several) and EXR masks alike.
 
 use std::io::{Cursor, Seek, Write};
 
 use exr::compression::Compression;
+use exr::math::Vec2;
+use exr::meta::attribute::IntegerBounds;
+use exr::meta::header::{ImageAttributes, LayerAttributes};
 use exr::prelude::{
-    AnyChannel, AnyChannels, Blocks, Encoding, FlatSamples, Image, Layer, LayerAttributes,
-    LineOrder, SmallVec, WritableImage,
+    AnyChannel, AnyChannels, Blocks, Encoding, FlatSamples, Image, Layer, LineOrder, SmallVec,
+    WritableImage,
 };
 use half::slice::HalfFloatSliceExt;
 use rayon::prelude::*;
 
-use crate::ImageError;
+use crate::{ImageError, PixelWindow};
 
 /// How samples are stored in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -22,28 +26,70 @@ pub enum ExrStorage {
     Float,
 }
 
-/// One channel to write: its name and `width * height` row-major samples.
+/// The samples of one plane: linear `f32` values to store as the options' [`ExrStorage`], or
+/// samples kept exactly as another file stored them (half, float or uint).
+#[derive(Debug, Clone, PartialEq)]
+pub enum PlaneSamples {
+    Converted(Vec<f32>),
+    Exact(FlatSamples),
+}
+
+impl PlaneSamples {
+    fn len(&self) -> usize {
+        match self {
+            PlaneSamples::Converted(v) => v.len(),
+            PlaneSamples::Exact(FlatSamples::F16(v)) => v.len(),
+            PlaneSamples::Exact(FlatSamples::F32(v)) => v.len(),
+            PlaneSamples::Exact(FlatSamples::U32(v)) => v.len(),
+        }
+    }
+}
+
+/// One channel to write: its name and one sample per pixel of its part's data window,
+/// row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExrPlane {
     pub name: String,
-    pub samples: Vec<f32>,
+    pub samples: PlaneSamples,
     /// Quantise linearly in lossy compressions (alpha and other data); `false` leaves it to
     /// the `exr` crate's guess from the channel name.
     pub linear: bool,
 }
 
 impl ExrPlane {
-    /// A plane whose quantisation is guessed from its name.
+    /// A plane of `f32` samples whose quantisation is guessed from its name.
     pub fn new(name: &str, samples: Vec<f32>) -> Self {
         ExrPlane {
             name: name.to_string(),
-            samples,
+            samples: PlaneSamples::Converted(samples),
             linear: false,
         }
     }
 }
 
-/// Encoding settings of [`write_exr_planes`].
+/// One part of the file to write.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExrPartOut {
+    /// The pixels the part stores, in the file's coordinates.
+    pub data_window: PixelWindow,
+    /// The part's own attributes (its name, view, renderer attributes); the data window is
+    /// set from `data_window`.
+    pub attributes: LayerAttributes,
+    pub planes: Vec<ExrPlane>,
+}
+
+/// A whole file to write: the display window and attributes shared by every part, and the
+/// parts (several make a multi-part file, each of which needs a name).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExrImageOut {
+    pub display_window: PixelWindow,
+    /// Attributes shared by the parts (chromaticities, pixel aspect, time code, custom ones);
+    /// the display window is set from `display_window`.
+    pub attributes: ImageAttributes,
+    pub parts: Vec<ExrPartOut>,
+}
+
+/// Encoding settings of [`write_exr_image`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExrWriteOptions {
     pub storage: ExrStorage,
@@ -53,57 +99,132 @@ pub struct ExrWriteOptions {
     pub zip_level: Option<u32>,
 }
 
-/// Writes `planes` as one scan-line layer to `out` (channels are sorted by name, as EXR
-/// requires).
+/// What [`write_exr_image`] did beyond writing the samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ExrWriteReport {
+    /// Finite `f32` samples too large for half float, stored as ±Inf (half storage only).
+    pub half_overflow: u64,
+}
+
+/// The largest finite half-float value.
+const HALF_MAX: f32 = 65504.0;
+
+/// Writes `planes` as one scan-line part covering `width × height` at the origin (channels
+/// sorted by name, as EXR requires).
 pub fn write_exr_planes<W: Write + Seek>(
     out: W,
     width: usize,
     height: usize,
     planes: Vec<ExrPlane>,
     options: ExrWriteOptions,
-) -> Result<(), ImageError> {
-    if let Some(bad) = planes.iter().find(|p| p.samples.len() != width * height) {
-        return Err(ImageError::SampleCount {
-            samples: bad.samples.len(),
-            width: u32::try_from(width).unwrap_or(u32::MAX),
-            height: u32::try_from(height).unwrap_or(u32::MAX),
-            channels: 1,
-        });
-    }
+) -> Result<ExrWriteReport, ImageError> {
+    let frame = PixelWindow::at_origin(width, height);
+    let image = ExrImageOut {
+        display_window: frame,
+        attributes: ImageAttributes::new(to_bounds(&frame)),
+        parts: vec![ExrPartOut {
+            data_window: frame,
+            attributes: LayerAttributes::default(),
+            planes,
+        }],
+    };
+    write_exr_image(out, image, options)
+}
+
+/// Writes a whole file: every part as scan lines with the options' compression.
+pub fn write_exr_image<W: Write + Seek>(
+    out: W,
+    image: ExrImageOut,
+    options: ExrWriteOptions,
+) -> Result<ExrWriteReport, ImageError> {
     if let Some(level) = options.zip_level.filter(|&l| l > 9) {
         return Err(ImageError::Unsupported {
             feature: format!("zlib level {level} (levels are 0–9)"),
         });
     }
-    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
-    for plane in planes {
-        let samples = match options.storage {
-            ExrStorage::Float => FlatSamples::F32(plane.samples),
-            ExrStorage::Half => FlatSamples::F16(to_half(&plane.samples)),
-        };
-        let mut channel = AnyChannel::new(plane.name.as_str(), samples);
-        if plane.linear {
-            channel.quantize_linearly = true;
+    if image.parts.is_empty() {
+        return Err(ImageError::Unsupported {
+            feature: "a file without parts".into(),
+        });
+    }
+    let mut report = ExrWriteReport::default();
+    let mut attributes = image.attributes;
+    attributes.display_window = to_bounds(&image.display_window);
+    let multi_part = image.parts.len() > 1;
+    let mut layers: Vec<Layer<AnyChannels<FlatSamples>>> = Vec::with_capacity(image.parts.len());
+    for part in image.parts {
+        let (w, h) = (part.data_window.width, part.data_window.height);
+        if let Some(bad) = part.planes.iter().find(|p| p.samples.len() != w * h) {
+            return Err(ImageError::SampleCount {
+                samples: bad.samples.len(),
+                width: u32::try_from(w).unwrap_or(u32::MAX),
+                height: u32::try_from(h).unwrap_or(u32::MAX),
+                channels: 1,
+            });
         }
-        list.push(channel);
+        if multi_part && part.attributes.layer_name.is_none() {
+            return Err(ImageError::Unsupported {
+                feature: "a part without a name in a multi-part file".into(),
+            });
+        }
+        let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+        for plane in part.planes {
+            let samples = match plane.samples {
+                PlaneSamples::Converted(v) => match options.storage {
+                    ExrStorage::Float => FlatSamples::F32(v),
+                    ExrStorage::Half => {
+                        report.half_overflow += count_half_overflow(&v);
+                        FlatSamples::F16(to_half(&v))
+                    }
+                },
+                PlaneSamples::Exact(s) => s,
+            };
+            let mut channel = AnyChannel::new(plane.name.as_str(), samples);
+            if plane.linear {
+                channel.quantize_linearly = true;
+            }
+            list.push(channel);
+        }
+        let encoding = Encoding {
+            compression: options.compression,
+            blocks: Blocks::ScanLines,
+            line_order: LineOrder::Increasing,
+        };
+        let mut layer_attributes = part.attributes;
+        layer_attributes.layer_position = Vec2(part.data_window.x, part.data_window.y);
+        layers.push(Layer::new(
+            (w, h),
+            layer_attributes,
+            encoding,
+            AnyChannels::sort(list),
+        ));
     }
-    let encoding = Encoding {
-        compression: options.compression,
-        blocks: Blocks::ScanLines,
-        line_order: LineOrder::Increasing,
-    };
-    let layer = Layer::new(
-        (width, height),
-        LayerAttributes::default(),
-        encoding,
-        AnyChannels::sort(list),
-    );
-    let image = Image::from_layer(layer);
     match options.zip_level {
-        Some(level) => crate::exr_zip::write_zip_image(&image, level, out),
-        None => image.write().to_buffered(out),
+        Some(level) => crate::exr_zip::write_zip_layers(&attributes, &layers, level, out),
+        None => {
+            let layers: SmallVec<[Layer<AnyChannels<FlatSamples>>; 2]> = layers.into();
+            Image::from_layers(attributes, layers)
+                .write()
+                .to_buffered(out)
+        }
     }
-    .map_err(ImageError::ExrEncode)
+    .map_err(ImageError::ExrEncode)?;
+    Ok(report)
+}
+
+fn to_bounds(w: &PixelWindow) -> IntegerBounds {
+    IntegerBounds::new(Vec2(w.x, w.y), Vec2(w.width, w.height))
+}
+
+/// Finite samples beyond the half-float range.
+fn count_half_overflow(v: &[f32]) -> u64 {
+    v.par_chunks(1 << 16)
+        .map(|c| {
+            c.iter()
+                .filter(|s| s.is_finite() && s.abs() > HALF_MAX)
+                .count() as u64
+        })
+        .sum()
 }
 
 /// `f32` to half in parallel chunks.
@@ -133,4 +254,15 @@ pub fn encode_exr_f32(
     };
     write_exr_planes(&mut out, width, height, planes, options)?;
     Ok(out.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_overflow_counts_only_finite_samples_beyond_the_range() {
+        let v = [1.0, 65504.0, 65520.0, -1e6, f32::INFINITY, f32::NAN];
+        assert_eq!(count_half_overflow(&v), 2);
+    }
 }

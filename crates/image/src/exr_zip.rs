@@ -14,7 +14,8 @@ use exr::block::chunk::{Chunk, CompressedBlock, CompressedScanLineBlock};
 use exr::block::writer::ChunksWriter;
 use exr::compression::Compression;
 use exr::image::write::layers::WritableLayers;
-use exr::prelude::{AnyChannels, FlatSamples, Image, Layer};
+use exr::meta::header::ImageAttributes;
+use exr::prelude::{AnyChannels, FlatSamples, Layer, SmallVec};
 use rayon::prelude::*;
 
 /// OpenEXR's default zlib level for ZIP and ZIPS (`Imf::getDefaultZipCompressionLevel`).
@@ -29,56 +30,75 @@ pub fn zip_block_lines(compression: Compression) -> Option<usize> {
     }
 }
 
-/// Writes a single-layer scan-line image whose encoding is ZIP or ZIPS, deflating at `level`
-/// (0–9). Blocks are compressed in parallel, a batch at a time, and written in order.
-pub fn write_zip_image<W: Write + Seek>(
-    image: &Image<Layer<AnyChannels<FlatSamples>>>,
+/// Writes scan-line layers (one part each) whose encoding is ZIP or ZIPS, deflating at
+/// `level` (0–9). Blocks are compressed in parallel, a batch at a time, and written in order.
+pub fn write_zip_layers<W: Write + Seek>(
+    attributes: &ImageAttributes,
+    layers: &[Layer<AnyChannels<FlatSamples>>],
     level: u32,
     out: W,
 ) -> exr::error::UnitResult {
-    let layer = &image.layer_data;
-    let lines_per_block = zip_block_lines(layer.encoding.compression).ok_or_else(|| {
-        exr::error::Error::NotSupported("write_zip_image needs ZIP or ZIPS compression".into())
-    })?;
-    let headers = layer.infer_headers(&image.attributes);
+    let mut headers: exr::meta::Headers = SmallVec::new();
+    for layer in layers {
+        if zip_block_lines(layer.encoding.compression).is_none() {
+            return Err(exr::error::Error::NotSupported(
+                "write_zip_layers needs ZIP or ZIPS compression".into(),
+            ));
+        }
+        headers.extend(layer.infer_headers(attributes));
+    }
+    exr::block::write(out, headers, true, |_meta, writer| {
+        for (layer_index, layer) in layers.iter().enumerate() {
+            write_layer_blocks(layer_index, layer, level, writer)?;
+        }
+        Ok(())
+    })
+}
+
+/// Compresses and writes the blocks of one layer.
+fn write_layer_blocks(
+    layer_index: usize,
+    layer: &Layer<AnyChannels<FlatSamples>>,
+    level: u32,
+    writer: &mut impl ChunksWriter,
+) -> exr::error::UnitResult {
+    let lines_per_block = zip_block_lines(layer.encoding.compression).unwrap_or(16);
     let width = layer.size.width();
     let height = layer.size.height();
     let y_origin = layer.attributes.layer_position.y();
     let channels = &layer.channel_data.list;
     let blocks = height.div_ceil(lines_per_block);
-    exr::block::write(out, headers, true, |_meta, writer| {
-        // A batch of blocks per round keeps both cores busy and the compressed bytes of only
-        // one batch in memory.
-        let batch = (rayon::current_num_threads() * 4).max(1);
-        for first in (0..blocks).step_by(batch) {
-            let last = (first + batch).min(blocks);
-            let chunks: Vec<Chunk> = (first..last)
-                .into_par_iter()
-                .map(|block| {
-                    let y0 = block * lines_per_block;
-                    let y1 = (y0 + lines_per_block).min(height);
-                    let raw = block_bytes_le(channels, width, y0..y1);
-                    let packed = deflate_block(&raw, level)?;
-                    Ok(Chunk {
-                        layer_index: 0,
-                        compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
-                            y_coordinate: y_origin + y0 as i32,
-                            // OpenEXR stores a block raw when deflate does not make it smaller.
-                            compressed_pixels_le: if packed.len() < raw.len() {
-                                packed
-                            } else {
-                                raw
-                            },
-                        }),
-                    })
+    // A batch of blocks per round keeps both cores busy and the compressed bytes of only one
+    // batch in memory.
+    let batch = (rayon::current_num_threads() * 4).max(1);
+    for first in (0..blocks).step_by(batch) {
+        let last = (first + batch).min(blocks);
+        let chunks: Vec<Chunk> = (first..last)
+            .into_par_iter()
+            .map(|block| {
+                let y0 = block * lines_per_block;
+                let y1 = (y0 + lines_per_block).min(height);
+                let raw = block_bytes_le(channels, width, y0..y1);
+                let packed = deflate_block(&raw, level)?;
+                Ok(Chunk {
+                    layer_index,
+                    compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
+                        y_coordinate: y_origin + y0 as i32,
+                        // OpenEXR stores a block raw when deflate does not make it smaller.
+                        compressed_pixels_le: if packed.len() < raw.len() {
+                            packed
+                        } else {
+                            raw
+                        },
+                    }),
                 })
-                .collect::<exr::error::Result<_>>()?;
-            for (offset, chunk) in chunks.into_iter().enumerate() {
-                writer.write_chunk(first + offset, chunk)?;
-            }
+            })
+            .collect::<exr::error::Result<_>>()?;
+        for (offset, chunk) in chunks.into_iter().enumerate() {
+            writer.write_chunk(first + offset, chunk)?;
         }
-        Ok(())
-    })
+    }
+    Ok(())
 }
 
 /// The uncompressed bytes of lines `lines`: per line, per channel (sorted by name, as in the
@@ -158,6 +178,22 @@ mod tests {
     use half::f16;
 
     use super::*;
+    use exr::prelude::Image;
+
+    /// Writes a single-layer scan-line image whose encoding is ZIP or ZIPS, deflating at `level`
+    /// (0–9); see [`write_zip_layers`].
+    pub fn write_zip_image<W: Write + Seek>(
+        image: &Image<Layer<AnyChannels<FlatSamples>>>,
+        level: u32,
+        out: W,
+    ) -> exr::error::UnitResult {
+        write_zip_layers(
+            &image.attributes,
+            std::slice::from_ref(&image.layer_data),
+            level,
+            out,
+        )
+    }
 
     /// A deterministic mix of smooth and noisy samples (noise defeats deflate in places, so
     /// both the compressed and the stored-raw block paths run).

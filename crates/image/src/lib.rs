@@ -7,22 +7,37 @@
 //! [`ImageError::CodecPanic`] (class [`ImageErrorKind::Internal`]), never a claim about the file.
 
 mod error;
+mod exr_layers;
 pub mod exr_read;
 mod exr_write;
 mod exr_zip;
 mod guard;
 pub mod png_read;
 mod png_write;
+mod window;
 
 pub use error::{Codec, ImageError, ImageErrorKind};
-pub use exr_read::{
-    ExrChannelInfo, ExrPart, ExrSampleType, PixelWindow, all_channel_names, find_channel,
-    read_exr_channels, read_exr_headers,
+/// The `exr` crate's attribute and sample types that cross this crate's API.
+pub use exr::meta::header::{
+    ImageAttributes as ExrImageAttributes, LayerAttributes as ExrLayerAttributes,
 };
-pub use exr_write::{ExrPlane, ExrStorage, ExrWriteOptions, encode_exr_f32, write_exr_planes};
+pub use exr::prelude::FlatSamples;
+pub use exr_layers::{
+    ChannelMatch, LayerChoiceError, RgbLayer, all_channel_names, choose_rgb_layer, find_channel,
+    rgb_layers,
+};
+pub use exr_read::{
+    ExactExr, ExactPart, ExrChannelInfo, ExrPart, ExrSampleType, read_exr_attributes,
+    read_exr_channels, read_exr_exact, read_exr_headers,
+};
+pub use exr_write::{
+    ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport, PlaneSamples,
+    encode_exr_f32, write_exr_image, write_exr_planes,
+};
 pub use exr_zip::{DEFAULT_ZIP_LEVEL, zip_block_lines};
 pub use png_read::{PngPixels, PngSamples, decode_png};
 pub use png_write::{PngColor, PngCompression, PngEncodeOptions, PngSampleSlice, encode_png};
+pub use window::{ImageWindows, PixelWindow, place_plane};
 
 /// Default pixel limit: 2^27 (134 million pixels, e.g. 16384×8192).
 pub const DEFAULT_MAX_PIXELS: u64 = 1 << 27;
@@ -67,6 +82,11 @@ impl ExrFile<'_> {
         &self.parts
     }
 
+    /// The file's bytes.
+    pub fn bytes(&self) -> &[u8] {
+        self.bytes
+    }
+
     /// Decodes channels `channels` of part `part`, one `f32` plane each (see
     /// [`read_exr_channels`]).
     pub fn read_channels(
@@ -75,24 +95,6 @@ impl ExrFile<'_> {
         channels: &[usize],
     ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
         read_exr_channels(self.bytes, part, channels, self.max_pixels)
-    }
-
-    /// Refuses a file whose data window is not its display window (a cropped render, a render
-    /// border, overscan): its pixels cannot yet be placed in the frame by their coordinates,
-    /// and reading them index by index would shift them.
-    pub fn require_full_frame(&self) -> Result<(), ImageError> {
-        match self
-            .parts
-            .iter()
-            .find(|p| p.data_window != p.display_window)
-        {
-            Some(p) => Err(ImageError::WindowNotFrame {
-                part: p.layer_name.clone(),
-                data: p.data_window,
-                display: p.display_window,
-            }),
-            None => Ok(()),
-        }
     }
 }
 

@@ -1,8 +1,13 @@
 //! EXR data and display windows, read from OpenEXR's own samples (`fixtures/exr_windows/`):
-//! the windows are reported as the file states them, and a file whose data window is not its
-//! display window is refused as unsupported, never read index by index (which shifts it).
+//! the windows are reported as the file states them, the pixels decoded are those of the data
+//! window, and a file written from an exact read keeps windows, attributes and samples.
 
-use glassdb_image::{ImageErrorKind, ImageFile, PixelWindow, open_image};
+use std::io::Cursor;
+
+use glassdb_image::{
+    ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ImageFile, PixelWindow,
+    PlaneSamples, open_image, read_exr_exact, read_exr_headers, write_exr_image,
+};
 
 fn sample(name: &str) -> Vec<u8> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -20,33 +25,74 @@ fn window(x: i32, y: i32, width: usize, height: usize) -> PixelWindow {
     }
 }
 
-#[test]
-fn full_frame_sample_reports_equal_windows_and_is_accepted() {
-    let bytes = sample("t01.exr");
-    let ImageFile::Exr(exr) = open_image(&bytes, 1 << 24).unwrap() else {
-        panic!("t01.exr is an EXR");
+fn rgb(bytes: &[u8]) -> Vec<Vec<f32>> {
+    let ImageFile::Exr(exr) = open_image(bytes, 1 << 24).unwrap() else {
+        panic!("not an EXR");
     };
     let part = &exr.parts()[0];
-    assert_eq!(part.data_window, window(0, 0, 400, 300));
-    assert_eq!(part.display_window, part.data_window);
-    exr.require_full_frame().unwrap();
+    let channels: Vec<usize> = ["R", "G", "B"]
+        .iter()
+        .map(|n| part.channels.iter().position(|c| c.name == *n).unwrap())
+        .collect();
+    exr.read_channels(0, &channels).unwrap().1
 }
 
 #[test]
-fn cropped_sample_reports_its_windows_and_is_refused_as_unsupported() {
-    let bytes = sample("t08.exr");
-    let ImageFile::Exr(exr) = open_image(&bytes, 1 << 24).unwrap() else {
-        panic!("t08.exr is an EXR");
-    };
-    let part = &exr.parts()[0];
+fn windows_are_reported_as_stored_and_the_data_window_is_decoded() {
+    let full = read_exr_headers(&sample("t01.exr")).unwrap();
+    assert_eq!(full[0].data_window, window(0, 0, 400, 300));
+    assert_eq!(full[0].display_window, full[0].data_window);
     // DisplayWindow/README.rst: the same 400 × 300 pixels, data window (30, 40)–(429, 339)
     // inside the display window (0, 0)–(500, 400).
-    assert_eq!(part.data_window, window(30, 40, 400, 300));
-    assert_eq!(part.display_window, window(0, 0, 501, 401));
-    let err = exr.require_full_frame().unwrap_err();
-    assert_eq!(err.kind(), ImageErrorKind::Unsupported);
-    let message = err.to_string();
-    for part in ["(30, 40)–(429, 339)", "(0, 0)–(500, 400)"] {
-        assert!(message.contains(part), "{message}");
-    }
+    let cropped = read_exr_headers(&sample("t08.exr")).unwrap();
+    assert_eq!(cropped[0].data_window, window(30, 40, 400, 300));
+    assert_eq!(cropped[0].display_window, window(0, 0, 501, 401));
+    assert_eq!(cropped[0].windows().data.to_string(), "(30, 40)–(429, 339)");
+    assert_eq!(rgb(&sample("t01.exr")), rgb(&sample("t08.exr")));
+}
+
+#[test]
+fn an_exact_copy_keeps_windows_attributes_and_samples() {
+    let bytes = sample("t08.exr");
+    let exact = read_exr_exact(&bytes, 1 << 24).unwrap();
+    let display = read_exr_headers(&bytes).unwrap()[0].display_window;
+    let image = ExrImageOut {
+        display_window: display,
+        attributes: exact.attributes.clone(),
+        parts: exact
+            .parts
+            .iter()
+            .map(|p| ExrPartOut {
+                data_window: p.data_window,
+                attributes: p.attributes.clone(),
+                planes: p
+                    .channels
+                    .iter()
+                    .map(|(name, s)| ExrPlane {
+                        name: name.clone(),
+                        samples: PlaneSamples::Exact(s.clone()),
+                        linear: false,
+                    })
+                    .collect(),
+            })
+            .collect(),
+    };
+    let mut out = Cursor::new(Vec::new());
+    let options = ExrWriteOptions {
+        storage: ExrStorage::Float,
+        compression: exr::compression::Compression::ZIP16,
+        zip_level: Some(4),
+    };
+    write_exr_image(&mut out, image, options).unwrap();
+    let copy = out.into_inner();
+    let headers = read_exr_headers(&copy).unwrap();
+    assert_eq!(headers[0].data_window, window(30, 40, 400, 300));
+    assert_eq!(headers[0].display_window, display);
+    let again = read_exr_exact(&copy, 1 << 24).unwrap();
+    assert_eq!(again.parts[0].channels, exact.parts[0].channels);
+    assert_eq!(
+        again.attributes.chromaticities,
+        exact.attributes.chromaticities
+    );
+    assert_eq!(again.attributes.pixel_aspect, exact.attributes.pixel_aspect);
 }

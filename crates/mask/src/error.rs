@@ -39,6 +39,15 @@ pub enum MaskError {
         available: Vec<String>,
     },
     /// A pixel value that the format does not allow.
+    #[error(
+        "mask {path}: the channel name {channel:?} fits several channels ({}); give the full name",
+        candidates.join(", ")
+    )]
+    AmbiguousChannel {
+        path: PathBuf,
+        channel: String,
+        candidates: Vec<String>,
+    },
     #[error("mask {path}, pixel (x {x}, y {y}): {detail}")]
     BadPixel {
         path: PathBuf,

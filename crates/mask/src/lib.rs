@@ -22,7 +22,8 @@ use std::collections::BTreeMap;
 pub use cos_code::CosCode;
 pub use error::MaskError;
 pub use glassdb_image::DEFAULT_MAX_PIXELS;
-pub use read::{read_mask, read_mask_bytes};
+use glassdb_image::PixelWindow;
+pub use read::{read_mask, read_mask_bytes, read_placed_mask, read_placed_mask_bytes};
 pub use write::{MaskFormat, write_mask, write_mask_bytes};
 
 /// A decoded mask, row-major, row 0 at the top. All per-pixel vectors have `width * height`
@@ -39,6 +40,43 @@ pub struct MaskImage {
     pub plane: Vec<u16>,
     /// Fraction of the pixel covered by glass, when the mask carries it (antialiased edges).
     pub coverage: Option<Vec<f32>>,
+}
+
+/// A mask as read from a file: its pixels, where they lie in the frame, and whether the file
+/// stores a plane per pixel (a mask without planes has every glass pixel on plane 0).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlacedMask {
+    pub image: MaskImage,
+    pub windows: glassdb_image::ImageWindows,
+    pub stores_planes: bool,
+    /// Whether the file states its pixels' coordinates (EXR); a PNG holds a whole frame at
+    /// (0, 0), wherever the frame of the passes lies.
+    pub has_coordinates: bool,
+}
+
+impl MaskImage {
+    /// The mask over window `to` of the frame, from a mask holding window `from`: pixels of
+    /// `to` outside `from` have no glass (id 0).
+    pub fn placed(&self, from: &PixelWindow, to: &PixelWindow) -> MaskImage {
+        use glassdb_image::place_plane;
+        let (width, height) = (to.width as u32, to.height as u32);
+        MaskImage {
+            width,
+            height,
+            id: place_plane(&self.id, from, to, 0),
+            cos_theta: match &self.cos_theta {
+                CosTheta::Quantized8(c) => CosTheta::Quantized8(place_plane(c, from, to, 0)),
+                CosTheta::Quantized16(c) => CosTheta::Quantized16(place_plane(c, from, to, 0)),
+                CosTheta::Float(c) => CosTheta::Float(place_plane(c, from, to, 0.0)),
+                CosTheta::Normal => CosTheta::Normal,
+            },
+            plane: place_plane(&self.plane, from, to, 0),
+            coverage: self
+                .coverage
+                .as_ref()
+                .map(|c| place_plane(c, from, to, 0.0)),
+        }
+    }
 }
 
 /// cos θ as the mask stores it: quantised codes ([`CosCode`]) are kept as codes so that
@@ -176,11 +214,15 @@ pub struct MaskReadOptions {
     pub binary_glass_id: Option<u16>,
     /// Refuse images with more pixels than this (checked from the header before allocating).
     pub max_pixels: u64,
+    /// EXR layer the channel names are relative to (`ViewLayer`: `IndexMA` is then
+    /// `ViewLayer.IndexMA`); `None`: names as given, or found by their last components.
+    pub layer: Option<String>,
 }
 
 impl Default for MaskReadOptions {
     fn default() -> Self {
         MaskReadOptions {
+            layer: None,
             exr_channels: ExrMaskChannels::default(),
             binary_glass_id: None,
             max_pixels: DEFAULT_MAX_PIXELS,

@@ -3,17 +3,26 @@
 
 use std::path::Path;
 
-use glassdb_image::{ExrFile, ExrPart, ImageFile, PngPixels, PngSamples};
+use glassdb_image::{
+    ChannelMatch, ExrFile, ExrPart, ImageFile, ImageWindows, PngPixels, PngSamples,
+};
 
-use crate::{CosTheta, MaskError, MaskImage, MaskReadOptions};
+use crate::{CosTheta, MaskError, MaskImage, MaskReadOptions, PlacedMask};
 
 /// Reads a mask file (PNG or EXR, detected from its bytes); see the crate docs for the formats.
+/// The pixels are those the file stores (an EXR's data window); [`read_placed_mask`] also says
+/// where they lie.
 pub fn read_mask(path: &Path, opts: &MaskReadOptions) -> Result<MaskImage, MaskError> {
+    read_placed_mask(path, opts).map(|m| m.image)
+}
+
+/// Reads a mask file with its windows and whether it stores planes.
+pub fn read_placed_mask(path: &Path, opts: &MaskReadOptions) -> Result<PlacedMask, MaskError> {
     let bytes = std::fs::read(path).map_err(|source| MaskError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    read_mask_bytes(&bytes, path, opts)
+    read_placed_mask_bytes(&bytes, path, opts)
 }
 
 /// Reads a mask from bytes in memory; `path` is only used in error messages.
@@ -22,17 +31,38 @@ pub fn read_mask_bytes(
     path: &Path,
     opts: &MaskReadOptions,
 ) -> Result<MaskImage, MaskError> {
+    read_placed_mask_bytes(bytes, path, opts).map(|m| m.image)
+}
+
+/// Reads a mask from bytes in memory with its windows; `path` is only used in error messages.
+pub fn read_placed_mask_bytes(
+    bytes: &[u8],
+    path: &Path,
+    opts: &MaskReadOptions,
+) -> Result<PlacedMask, MaskError> {
     let decode_err = |source| MaskError::Decode {
         path: path.to_path_buf(),
         source,
     };
-    let mask = match glassdb_image::open_image(bytes, opts.max_pixels).map_err(decode_err)? {
-        ImageFile::Png(png) => match opts.binary_glass_id {
-            Some(id) => binary_from_png(&png, id, path)?,
-            None => packed_from_png(&png, path)?,
-        },
+    let placed = match glassdb_image::open_image(bytes, opts.max_pixels).map_err(decode_err)? {
+        ImageFile::Png(png) => {
+            let windows = ImageWindows::full_frame(png.width as usize, png.height as usize);
+            match opts.binary_glass_id {
+                Some(id) => PlacedMask {
+                    image: binary_from_png(&png, id, path)?,
+                    windows,
+                    stores_planes: false,
+                    has_coordinates: false,
+                },
+                None => PlacedMask {
+                    image: packed_from_png(&png, path)?,
+                    windows,
+                    stores_planes: true,
+                    has_coordinates: false,
+                },
+            }
+        }
         ImageFile::Exr(exr) => {
-            exr.require_full_frame().map_err(decode_err)?;
             if opts.binary_glass_id.is_some() {
                 return Err(MaskError::BinaryMaskNotPng {
                     path: path.to_path_buf(),
@@ -41,8 +71,11 @@ pub fn read_mask_bytes(
             mask_from_exr(&exr, path, opts)?
         }
     };
-    mask.check_consistent().map_err(MaskError::Inconsistent)?;
-    Ok(mask)
+    placed
+        .image
+        .check_consistent()
+        .map_err(MaskError::Inconsistent)?;
+    Ok(placed)
 }
 
 /// The packed formats: R = plane, G = id, B = cos θ code (8- or 16-bit). Alpha is ignored.
@@ -127,15 +160,18 @@ fn mask_from_exr(
     exr: &ExrFile<'_>,
     path: &Path,
     opts: &MaskReadOptions,
-) -> Result<MaskImage, MaskError> {
+) -> Result<PlacedMask, MaskError> {
     let names = &opts.exr_channels;
+    let layer = opts.layer.as_deref();
     let wanted = [
-        locate_channel(exr.parts(), &names.id, true, path)?,
-        locate_channel(exr.parts(), &names.cos_theta, true, path)?,
-        locate_channel(exr.parts(), &names.plane, false, path)?,
-        locate_channel(exr.parts(), &names.coverage, false, path)?,
+        locate_channel(exr.parts(), &names.id, layer, true, path)?,
+        locate_channel(exr.parts(), &names.cos_theta, layer, true, path)?,
+        locate_channel(exr.parts(), &names.plane, layer, false, path)?,
+        locate_channel(exr.parts(), &names.coverage, layer, false, path)?,
     ];
-    let (w, h, [id_f, cos_f, plane_f, cov_f]) = decode_wanted_channels(exr, &wanted, path)?;
+    let stores_planes = wanted[2].is_some();
+    let (windows, [id_f, cos_f, plane_f, cov_f]) = decode_wanted_channels(exr, &wanted, path)?;
+    let (w, h) = (windows.data.width, windows.data.height);
     let layout_err = |detail: &str| MaskError::Layout {
         path: path.to_path_buf(),
         detail: detail.into(),
@@ -157,46 +193,61 @@ fn mask_from_exr(
         }
         None => None,
     };
-    Ok(MaskImage {
-        width,
-        height,
-        id,
-        cos_theta: CosTheta::Float(cos_f),
-        plane,
-        coverage,
+    Ok(PlacedMask {
+        image: MaskImage {
+            width,
+            height,
+            id,
+            cos_theta: CosTheta::Float(cos_f),
+            plane,
+            coverage,
+        },
+        windows,
+        stores_planes,
+        has_coordinates: true,
     })
 }
 
-/// Finds the (part, channel) named `name`; a required channel that is missing is an error
-/// listing the channels the file has.
+/// Finds the (part, channel) named `name` (in `layer`, when given); a required channel that is
+/// missing is an error listing the channels the file has.
 fn locate_channel(
     parts: &[ExrPart],
     name: &str,
+    layer: Option<&str>,
     required: bool,
     path: &Path,
 ) -> Result<Option<(usize, usize)>, MaskError> {
-    match glassdb_image::find_channel(parts, name) {
-        Some(found) => Ok(Some(found)),
-        None if required => Err(MaskError::MissingChannel {
+    match glassdb_image::find_channel(parts, name, layer) {
+        ChannelMatch::Found(p, c) => Ok(Some((p, c))),
+        ChannelMatch::Ambiguous(candidates) => Err(MaskError::AmbiguousChannel {
             path: path.to_path_buf(),
             channel: name.to_string(),
+            candidates,
+        }),
+        ChannelMatch::Missing if required => Err(MaskError::MissingChannel {
+            path: path.to_path_buf(),
+            channel: match layer {
+                Some(l) => format!("{l}.{name}"),
+                None => name.to_string(),
+            },
             available: glassdb_image::all_channel_names(parts),
         }),
-        None => Ok(None),
+        ChannelMatch::Missing => Ok(None),
     }
 }
 
-/// The decoded planes of the wanted channels, in the order asked, with the image size.
-type WantedPlanes = (usize, usize, [Option<Vec<f32>>; 4]);
+/// The decoded planes of the wanted channels, in the order asked, with their windows.
+type WantedPlanes = (ImageWindows, [Option<Vec<f32>>; 4]);
 
-/// Decodes each part once, with all its wanted channels; every part must have the same size.
+/// Decodes each part once, with all its wanted channels; every part must have the same data
+/// window.
 fn decode_wanted_channels(
     exr: &ExrFile<'_>,
     wanted: &[Option<(usize, usize)>; 4],
     path: &Path,
 ) -> Result<WantedPlanes, MaskError> {
     let mut decoded: [Option<Vec<f32>>; 4] = [None, None, None, None];
-    let mut size: Option<(usize, usize)> = None;
+    let mut windows: Option<ImageWindows> = None;
     let mut part_indices: Vec<usize> = wanted.iter().flatten().map(|(p, _)| *p).collect();
     part_indices.sort_unstable();
     part_indices.dedup();
@@ -214,14 +265,14 @@ fn decode_wanted_channels(
                     path: path.to_path_buf(),
                     source,
                 })?;
-        match size {
-            None => size = Some((info.width, info.height)),
-            Some(s) if s != (info.width, info.height) => {
+        match windows {
+            None => windows = Some(info.windows()),
+            Some(s) if s.data != info.data_window => {
                 return Err(MaskError::Layout {
                     path: path.to_path_buf(),
                     detail: format!(
-                        "the mask channels lie in parts of different sizes ({}×{} and {}×{})",
-                        s.0, s.1, info.width, info.height
+                        "the mask channels lie in parts with different data windows ({} and {})",
+                        s.data, info.data_window
                     ),
                 });
             }
@@ -231,11 +282,11 @@ fn decode_wanted_channels(
             decoded[k] = Some(buf);
         }
     }
-    let (w, h) = size.ok_or_else(|| MaskError::Layout {
+    let windows = windows.ok_or_else(|| MaskError::Layout {
         path: path.to_path_buf(),
         detail: "no mask channels".into(),
     })?;
-    Ok((w, h, decoded))
+    Ok((windows, decoded))
 }
 
 /// Builds [`MaskError::BadPixel`] for a pixel index of a mask file.

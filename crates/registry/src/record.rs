@@ -340,6 +340,12 @@ impl Registry {
         self.glasses.iter().find(|g| g.id == id)
     }
 
+    /// SHA-256 (hex) of the registry's canonical JSON ([`Registry::to_json_string`]): names
+    /// the glass data a composite was made with, whatever the file's formatting.
+    pub fn content_sha256(&self) -> Result<String, RegistryError> {
+        Ok(crate::build::sha256_hex(self.to_json_string()?.as_bytes()))
+    }
+
     /// The registry as pretty JSON text.
     pub fn to_json_string(&self) -> Result<String, RegistryError> {
         let mut s = serde_json::to_string_pretty(self).map_err(RegistryError::Serialize)?;
