@@ -14,7 +14,10 @@ use glassdb_compose::sequence::{self, FrameOutcome};
 use glassdb_compose::{
     ComposeJob, ComposeSettings, FrameReport, InputLayers, OutsidePolicy, UnknownIds, compose_frame,
 };
-use glassdb_mask::{ExrMaskChannels, MaskReadOptions};
+use glassdb_mask::{
+    AovWeighting, CosSource, CryptomatteOptions, ExrMaskChannels, GlassMapping, GlassNames,
+    MaskReadOptions,
+};
 use glassdb_registry::{Registry, Side};
 
 #[derive(Debug, clap::Args)]
@@ -71,10 +74,28 @@ pub struct Args {
     /// How PNG passes are encoded.
     #[arg(long, value_enum, default_value_t = TransferArg::Srgb)]
     pub input_transfer: TransferArg,
-    /// EXR mask channel names, e.g. `id=ViewLayer.IndexMA,cos=ViewLayer.Facing` (keys id, cos,
-    /// plane, coverage).
+    /// EXR mask channel names, e.g. `id=IndexMA,cos=facing` (keys id, cos, plane, coverage;
+    /// with --mask-cryptomatte: cos, plane, or normal and position with --camera).
     #[arg(long, value_name = "KEY=NAME,...")]
     pub mask_channels: Option<String>,
+    /// Build the mask from the render's Cryptomatte layer (e.g. `CryptoMaterial`; without a
+    /// value the only layer, or the one named …CryptoMaterial), the glasses named by
+    /// --mask-glass, cos θ from an AOV (`--mask-channels cos=facing`, the default) or from the
+    /// Normal and Position passes and --camera.
+    #[arg(long, value_name = "LAYER", num_args = 0..=1, default_missing_value = "")]
+    pub mask_cryptomatte: Option<String>,
+    /// PATTERN=ID: Cryptomatte names (materials or objects) matching the glob PATTERN are glass
+    /// with registration id ID (repeat; the first match wins).
+    #[arg(long, value_name = "PATTERN=ID")]
+    pub mask_glass: Vec<String>,
+    /// How the cos θ and plane AOVs were written: by the glass materials only (`glass-only`,
+    /// 0 elsewhere: divided by the glass coverage at edges) or by every material.
+    #[arg(long, value_enum, default_value_t = AovsArg::GlassOnly)]
+    pub mask_aovs: AovsArg,
+    /// Camera JSON (docs/scene.md): its position gives the view ray for cos θ from the Normal
+    /// and Position passes.
+    #[arg(long, value_name = "JSON")]
+    pub camera: Option<PathBuf>,
     /// Read the mask as the paper's binary mask (white = glass, black = not) showing glass ID
     /// at its normal-incidence values.
     #[arg(long, value_name = "ID")]
@@ -125,6 +146,12 @@ pub enum TransferArg {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum AovsArg {
+    GlassOnly,
+    EveryMaterial,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum OutsideArg {
     Error,
     NoReflection,
@@ -155,25 +182,91 @@ pub enum DitherArg {
     None,
 }
 
+/// `--mask-channels KEY=NAME,…` as (key, name) pairs, keys checked against `keys`.
+fn parse_channel_spec(spec: &str, keys: &[&str]) -> anyhow::Result<Vec<(String, String)>> {
+    let known = keys.join(", ");
+    spec.split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|item| {
+            let (key, name) = item.split_once('=').with_context(|| {
+                format!("--mask-channels: {item:?} is not KEY=NAME (keys: {known})")
+            })?;
+            let key = match key.trim() {
+                "cos_theta" => "cos",
+                k => k,
+            };
+            if !keys.contains(&key) {
+                bail!("--mask-channels: unknown key {key:?} here (keys: {known})");
+            }
+            Ok((key.to_string(), name.trim().to_string()))
+        })
+        .collect()
+}
+
 /// `--mask-channels id=…,cos=…,plane=…,coverage=…` over the defaults.
 fn parse_mask_channels(spec: &str) -> anyhow::Result<ExrMaskChannels> {
     let mut ch = ExrMaskChannels::default();
-    for item in spec.split(',').filter(|s| !s.trim().is_empty()) {
-        let (key, name) = item.split_once('=').with_context(|| {
-            format!("--mask-channels: {item:?} is not KEY=NAME (keys: id, cos, plane, coverage)")
-        })?;
-        let name = name.trim().to_string();
-        match key.trim() {
+    for (key, name) in parse_channel_spec(spec, &["id", "cos", "plane", "coverage"])? {
+        match key.as_str() {
             "id" => ch.id = name,
-            "cos" | "cos_theta" => ch.cos_theta = name,
+            "cos" => ch.cos_theta = name,
             "plane" => ch.plane = name,
-            "coverage" => ch.coverage = name,
-            other => {
-                bail!("--mask-channels: unknown key {other:?} (keys: id, cos, plane, coverage)")
-            }
+            _ => ch.coverage = name,
         }
     }
     Ok(ch)
+}
+
+/// The Cryptomatte mask options: the layer, the glasses, cos θ from an AOV (`cos=`, default
+/// `facing`) or from `normal=` and `position=` with the camera, the plane AOV (`plane=`).
+fn cryptomatte_options(args: &Args, layer: &str) -> anyhow::Result<CryptomatteOptions> {
+    if args.mask_glass.is_empty() {
+        bail!("--mask-cryptomatte needs --mask-glass PATTERN=ID for each glass (e.g. 'Glass*=1')");
+    }
+    let mappings = args
+        .mask_glass
+        .iter()
+        .map(|g| GlassMapping::parse(g))
+        .collect::<Result<Vec<_>, _>>()?;
+    let spec = args.mask_channels.as_deref().unwrap_or("");
+    let pairs = parse_channel_spec(spec, &["cos", "plane", "normal", "position"])?;
+    let get = |k: &str| {
+        pairs
+            .iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.clone())
+    };
+    let cos = match (get("cos"), get("normal"), get("position")) {
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+            bail!("--mask-channels: give cos=AOV, or normal= and position= with --camera, not both")
+        }
+        (_, Some(normal), Some(position)) => {
+            let camera = args.camera.as_ref().context(
+                "cos θ from the Normal and Position passes needs the camera position: --camera camera.json",
+            )?;
+            CosSource::Geometry {
+                normal,
+                position,
+                camera_origin: glassdb_scene::Camera::load(camera)?.origin,
+            }
+        }
+        (_, Some(_), None) | (_, None, Some(_)) => {
+            bail!("--mask-channels: cos θ from geometry needs both normal= and position=")
+        }
+        (cos, None, None) => CosSource::Aov {
+            channel: cos.unwrap_or_else(|| "facing".into()),
+        },
+    };
+    Ok(CryptomatteOptions {
+        layer: (!layer.is_empty()).then(|| layer.to_string()),
+        glass: GlassNames::new(&mappings)?,
+        cos,
+        plane_aov: get("plane"),
+        weighting: match args.mask_aovs {
+            AovsArg::GlassOnly => AovWeighting::GlassOnly,
+            AovsArg::EveryMaterial => AovWeighting::EveryMaterial,
+        },
+    })
 }
 
 /// `t.exr` → `t.composite.exr` (PNG passes give a PNG), beside the transmission pass.
@@ -240,11 +333,16 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
         }
         plane_sides.insert(k, side);
     }
+    let cryptomatte = match &args.mask_cryptomatte {
+        Some(layer) => Some(cryptomatte_options(args, layer)?),
+        None => None,
+    };
     let mask = MaskReadOptions {
-        exr_channels: match &args.mask_channels {
-            Some(s) => parse_mask_channels(s)?,
-            None => ExrMaskChannels::default(),
+        exr_channels: match (&args.mask_channels, &cryptomatte) {
+            (Some(s), None) => parse_mask_channels(s)?,
+            _ => ExrMaskChannels::default(),
         },
+        cryptomatte,
         binary_glass_id: args.glass,
         max_pixels: args.max_pixels,
         layer: split_layer(&args.mask)

@@ -5,6 +5,7 @@ mod architecture;
 mod compose;
 mod fit;
 mod fixtures;
+mod masks;
 mod passes;
 mod plot;
 mod registry;

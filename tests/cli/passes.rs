@@ -19,17 +19,17 @@ use std::process::Command;
 use crate::util::{compose, fails, ok, oracle_python, repo_path, run, run_oracle};
 
 /// One part of an EXR as the `exr` crate reads it.
-struct Part {
+pub(crate) struct Part {
     name: Option<String>,
     data: PixelWindow,
-    channels: HashMap<String, Vec<f32>>,
+    pub(crate) channels: HashMap<String, Vec<f32>>,
     types: HashMap<String, &'static str>,
     other: HashMap<String, String>,
 }
 
 /// Every part of an EXR (largest level), read with the `exr` crate, and the display window
 /// and shared text attributes.
-fn read_parts(path: &Path) -> (PixelWindow, HashMap<String, String>, Vec<Part>) {
+pub(crate) fn read_parts(path: &Path) -> (PixelWindow, HashMap<String, String>, Vec<Part>) {
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()

@@ -201,7 +201,21 @@ pub fn read_exr_channels(
         height: info.height,
         band_height,
     };
-    let outputs = decode_bands(&meta, &header, &info, channels, band_chunks, &layout)?;
+    // A channel asked for twice is decoded once and copied.
+    let mut unique: Vec<usize> = channels.to_vec();
+    unique.sort_unstable();
+    unique.dedup();
+    let decoded = decode_bands(&meta, &header, &info, &unique, band_chunks, &layout)?;
+    if unique.as_slice() == channels {
+        return Ok((info, decoded));
+    }
+    let outputs = channels
+        .iter()
+        .map(|c| {
+            let k = unique.binary_search(c).unwrap_or_default();
+            decoded.get(k).cloned().unwrap_or_default()
+        })
+        .collect();
     Ok((info, outputs))
 }
 
@@ -513,4 +527,27 @@ pub fn read_exr_exact(bytes: &[u8], max_pixels: u64) -> Result<ExactExr, ImageEr
             })
             .collect(),
     })
+}
+
+/// Every text attribute of an EXR held in memory, from the attributes shared by its parts and
+/// each part's own, as (part, name, value); no pixel data is touched. Renderers keep metadata
+/// here (Cryptomatte's `cryptomatte/<key>/manifest`, Blender's `colorInteropID`).
+pub fn read_exr_text_attributes(bytes: &[u8]) -> Result<Vec<(usize, String, String)>, ImageError> {
+    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false))?;
+    let mut out = Vec::new();
+    for (k, header) in meta.headers.iter().enumerate() {
+        for map in [
+            &header.shared_attributes.other,
+            &header.own_attributes.other,
+        ] {
+            for (name, value) in map {
+                if let exr::meta::attribute::AttributeValue::Text(text) = value {
+                    out.push((k, name.to_string(), text.to_string()));
+                }
+            }
+        }
+    }
+    out.sort();
+    out.dedup();
+    Ok(out)
 }

@@ -28,7 +28,7 @@ pub use exr_layers::{
 };
 pub use exr_read::{
     ExactExr, ExactPart, ExrChannelInfo, ExrPart, ExrSampleType, read_exr_attributes,
-    read_exr_channels, read_exr_exact, read_exr_headers,
+    read_exr_channels, read_exr_exact, read_exr_headers, read_exr_text_attributes,
 };
 pub use exr_write::{
     ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport, PlaneSamples,

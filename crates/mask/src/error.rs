@@ -48,6 +48,21 @@ pub enum MaskError {
         channel: String,
         candidates: Vec<String>,
     },
+    /// Glass patterns that name nothing in a Cryptomatte manifest.
+    #[error(
+        "mask {path}: no name in the Cryptomatte layer {layer} matches {} (its names: {})",
+        patterns.join(", "),
+        names.join(", ")
+    )]
+    UnmatchedGlassNames {
+        path: PathBuf,
+        layer: String,
+        patterns: Vec<String>,
+        names: Vec<String>,
+    },
+    /// A `PATTERN=ID` glass mapping is malformed or its id is out of range.
+    #[error("invalid glass mapping {spec:?}: {message}")]
+    BadGlassMapping { spec: String, message: String },
     #[error("mask {path}, pixel (x {x}, y {y}): {detail}")]
     BadPixel {
         path: PathBuf,

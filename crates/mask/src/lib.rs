@@ -13,14 +13,21 @@
 //! this crate maps the formats' layouts to and from [`MaskImage`].
 
 mod cos_code;
+mod cryptomatte;
 mod error;
+mod glass_names;
 mod read;
 mod write;
 
 use std::collections::BTreeMap;
 
 pub use cos_code::CosCode;
+pub use cryptomatte::{
+    AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, cryptomatte_layers,
+    mask_from_cryptomatte,
+};
 pub use error::MaskError;
+pub use glass_names::{GlassMapping, GlassNames};
 pub use glassdb_image::DEFAULT_MAX_PIXELS;
 use glassdb_image::PixelWindow;
 pub use read::{read_mask, read_mask_bytes, read_placed_mask, read_placed_mask_bytes};
@@ -205,7 +212,7 @@ impl Default for ExrMaskChannels {
 }
 
 /// How to read a mask file. The format (PNG or EXR) is detected from the file's bytes.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MaskReadOptions {
     /// EXR channel names.
     pub exr_channels: ExrMaskChannels,
@@ -214,6 +221,8 @@ pub struct MaskReadOptions {
     pub binary_glass_id: Option<u16>,
     /// Refuse images with more pixels than this (checked from the header before allocating).
     pub max_pixels: u64,
+    /// Build the mask from the render's Cryptomatte instead of id and cos θ channels.
+    pub cryptomatte: Option<CryptomatteOptions>,
     /// EXR layer the channel names are relative to (`ViewLayer`: `IndexMA` is then
     /// `ViewLayer.IndexMA`); `None`: names as given, or found by their last components.
     pub layer: Option<String>,
@@ -222,6 +231,7 @@ pub struct MaskReadOptions {
 impl Default for MaskReadOptions {
     fn default() -> Self {
         MaskReadOptions {
+            cryptomatte: None,
             layer: None,
             exr_channels: ExrMaskChannels::default(),
             binary_glass_id: None,

@@ -68,7 +68,10 @@ pub fn read_placed_mask_bytes(
                     path: path.to_path_buf(),
                 });
             }
-            mask_from_exr(&exr, path, opts)?
+            match &opts.cryptomatte {
+                Some(crypto) => crate::mask_from_cryptomatte(&exr, path, crypto)?,
+                None => mask_from_exr(&exr, path, opts)?,
+            }
         }
     };
     placed

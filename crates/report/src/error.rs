@@ -32,4 +32,7 @@ pub enum ReportError {
     /// An error from the scene crate (OBJ loading, rasterising a mask).
     #[error(transparent)]
     Scene(#[from] glassdb_scene::SceneError),
+    /// An error from the mask crate (a glass mapping).
+    #[error(transparent)]
+    Mask(#[from] glassdb_mask::MaskError),
 }

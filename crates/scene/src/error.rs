@@ -36,9 +36,6 @@ pub enum SceneError {
     /// A glass pattern is not a valid glob pattern.
     #[error("invalid glass material pattern {pattern:?}: {message}")]
     BadPattern { pattern: String, message: String },
-    /// A `--glass PATTERN=ID` argument is malformed or its id is out of range.
-    #[error("invalid glass mapping {spec:?}: {message}")]
-    BadGlassMapping { spec: String, message: String },
     /// A plane equation with a zero (or non-finite) normal, or glass faces that are all degenerate.
     #[error("degenerate plane: {message}")]
     DegeneratePlane { message: String },

@@ -11,39 +11,7 @@ use crate::obj::Scene;
 use crate::planes::{MaterialMatcher, Plane, PlaneTolerance, assign_to_planes, detect_planes};
 use crate::raster::{GlassLabel, PaneRect, RasterOutput, RasterScene};
 
-/// `PATTERN=ID`: faces whose material matches the glob pattern are glass with registration id ID.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct GlassMapping {
-    pub pattern: String,
-    pub id: u16,
-}
-
-impl GlassMapping {
-    /// Parses `PATTERN=ID` (split at the last `=`; ID in 1…65535, 0 means "no glass").
-    pub fn parse(spec: &str) -> Result<GlassMapping, SceneError> {
-        let bad = |message: &str| SceneError::BadGlassMapping {
-            spec: spec.to_string(),
-            message: message.into(),
-        };
-        let (pattern, id) = spec
-            .rsplit_once('=')
-            .ok_or_else(|| bad("expected PATTERN=ID, e.g. \"Clear*=1\""))?;
-        if pattern.is_empty() {
-            return Err(bad("empty material pattern"));
-        }
-        let id: u32 = id
-            .trim()
-            .parse()
-            .map_err(|_| bad("the id after '=' is not a whole number"))?;
-        if id == 0 || id > u16::MAX as u32 {
-            return Err(bad("the id must be between 1 and 65535 (0 means no glass)"));
-        }
-        Ok(GlassMapping {
-            pattern: pattern.to_string(),
-            id: id as u16,
-        })
-    }
-}
+pub use glassdb_mask::GlassMapping;
 
 /// Where the plane indices come from.
 #[derive(Debug, Clone)]
@@ -299,25 +267,5 @@ pub fn to_mask_image(out: RasterOutput, enc: CosEncoding) -> MaskImage {
         cos_theta,
         plane: out.plane,
         coverage: out.coverage,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn glass_mappings_parse_and_reject() {
-        assert_eq!(
-            GlassMapping::parse("Clear*=1").unwrap(),
-            GlassMapping {
-                pattern: "Clear*".into(),
-                id: 1
-            }
-        );
-        assert_eq!(GlassMapping::parse("a=b=7").unwrap().pattern, "a=b");
-        for bad in ["Clear", "=3", "X=0", "X=65536", "X=-1", "X=one"] {
-            assert!(GlassMapping::parse(bad).is_err(), "{bad}");
-        }
     }
 }

@@ -1,0 +1,569 @@
+//! Masks straight from a render: Cryptomatte (Psyop's specification, v1.1) for which glass is
+//! where and how much of each pixel it covers, a renderer AOV (or the Normal and Position
+//! passes with the camera position) for cos θ, and optionally a plane AOV.
+//!
+//! Cryptomatte in brief: a layer `NAME` has channels `NAME00.r/g/b/a`, `NAME01.r/…`, …, holding
+//! ranked (id, coverage) pairs per pixel (`00.r` id of rank 0, `00.g` its coverage, `00.b` id of
+//! rank 1, `00.a` its coverage, …). An id is the MurmurHash3_32 of a name, stored as the bits of
+//! an `f32` (`conversion: uint32_to_float32`); the header attributes
+//! `cryptomatte/<key>/{name,hash,conversion,manifest}` give the layer's name and the manifest
+//! (JSON `{"name": "hex hash"}`), or `manif_file`, a JSON side file beside the image.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+use glassdb_image::{ExrFile, ImageWindows};
+
+use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
+
+/// A manifest side file larger than this is refused (a manifest is a list of names).
+const MAX_MANIFEST_BYTES: u64 = 64 << 20;
+
+/// How an AOV relates to the glass it describes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AovWeighting {
+    /// Written by the glass materials only (0 elsewhere): the filtered value is the glass's
+    /// value times its coverage, so it is divided by the pixel's glass coverage.
+    #[default]
+    GlassOnly,
+    /// Written by every material: taken as it is (at a pane's edge it mixes in what lies
+    /// behind).
+    EveryMaterial,
+}
+
+/// Where cos θ comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CosSource {
+    /// An AOV channel holding |N·I| (e.g. Blender: Geometry Normal · Incoming, absolute).
+    Aov { channel: String },
+    /// World-space Normal and Position passes (channel layers, e.g. `Normal`, `Position`, with
+    /// `.X/.Y/.Z` or `.R/.G/.B`) and the camera position: cos θ = |N·(P − C)| / |P − C|.
+    Geometry {
+        normal: String,
+        position: String,
+        camera_origin: [f64; 3],
+    },
+}
+
+/// How to build a mask from a render's Cryptomatte.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CryptomatteOptions {
+    /// The Cryptomatte layer: its name as in `cryptomatte/<key>/name` (`ViewLayer.CryptoMaterial`)
+    /// or its last component (`CryptoMaterial`); `None`: the only layer, or the one named
+    /// `…CryptoMaterial`.
+    pub layer: Option<String>,
+    /// Which manifest names are glass, with their registration ids.
+    pub glass: GlassNames,
+    pub cos: CosSource,
+    /// An AOV holding each glass pixel's plane index (`None`: every pixel on plane 0).
+    pub plane_aov: Option<String>,
+    pub weighting: AovWeighting,
+}
+
+/// One Cryptomatte layer found in a file's header.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CryptomatteLayer {
+    pub name: String,
+    /// Name → hash, from the manifest.
+    pub manifest: BTreeMap<String, u32>,
+}
+
+fn layout(path: &Path, detail: String) -> MaskError {
+    MaskError::Layout {
+        path: path.to_path_buf(),
+        detail,
+    }
+}
+
+/// The Cryptomatte layers a file's header describes, with their manifests (read from the
+/// header or the `manif_file` side file, relative to the image's folder).
+pub fn cryptomatte_layers(
+    attributes: &[(usize, String, String)],
+    path: &Path,
+) -> Result<Vec<CryptomatteLayer>, MaskError> {
+    let mut by_key: BTreeMap<&str, HashMap<&str, &str>> = BTreeMap::new();
+    for (_, name, value) in attributes {
+        if let Some(rest) = name.strip_prefix("cryptomatte/")
+            && let Some((key, field)) = rest.split_once('/')
+        {
+            by_key.entry(key).or_default().insert(field, value.as_str());
+        }
+    }
+    let mut layers = Vec::new();
+    for (key, fields) in by_key {
+        let name = fields
+            .get("name")
+            .ok_or_else(|| layout(path, format!("Cryptomatte {key} has no name attribute")))?;
+        if let Some(hash) = fields.get("hash").filter(|h| **h != "MurmurHash3_32") {
+            return Err(layout(
+                path,
+                format!("Cryptomatte {name}: hash {hash:?} is not MurmurHash3_32"),
+            ));
+        }
+        if let Some(c) = fields
+            .get("conversion")
+            .filter(|c| **c != "uint32_to_float32")
+        {
+            return Err(layout(
+                path,
+                format!("Cryptomatte {name}: conversion {c:?} is not uint32_to_float32"),
+            ));
+        }
+        let json = match (fields.get("manifest"), fields.get("manif_file")) {
+            (Some(m), _) => m.to_string(),
+            (None, Some(file)) => read_side_manifest(path, file)?,
+            (None, None) => {
+                return Err(layout(
+                    path,
+                    format!(
+                        "Cryptomatte {name} has no manifest (neither manifest nor manif_file): its ids cannot be named"
+                    ),
+                ));
+            }
+        };
+        layers.push(CryptomatteLayer {
+            name: name.to_string(),
+            manifest: parse_manifest(&json, name, path)?,
+        });
+    }
+    Ok(layers)
+}
+
+fn read_side_manifest(image: &Path, file: &str) -> Result<String, MaskError> {
+    let side: PathBuf = image.parent().unwrap_or(Path::new("")).join(file);
+    let read_err = |source| MaskError::Read {
+        path: side.clone(),
+        source,
+    };
+    let meta = std::fs::metadata(&side).map_err(read_err)?;
+    if !meta.is_file() || meta.len() > MAX_MANIFEST_BYTES {
+        return Err(layout(
+            &side,
+            format!(
+                "a manifest side file must be a regular file of at most {MAX_MANIFEST_BYTES} bytes"
+            ),
+        ));
+    }
+    std::fs::read_to_string(&side).map_err(read_err)
+}
+
+/// `{"name": "hex"}` → name → hash.
+fn parse_manifest(
+    json: &str,
+    layer: &str,
+    path: &Path,
+) -> Result<BTreeMap<String, u32>, MaskError> {
+    let map: BTreeMap<String, String> = serde_json::from_str(json)
+        .map_err(|e| layout(path, format!("Cryptomatte {layer}: the manifest is not a JSON object of names and hex hashes: {e}")))?;
+    map.into_iter()
+        .map(|(name, hex)| {
+            u32::from_str_radix(hex.trim_start_matches("0x"), 16)
+                .map(|h| (name.clone(), h))
+                .map_err(|_| layout(path, format!("Cryptomatte {layer}: manifest entry {name:?} has hash {hex:?}, not 8 hex digits")))
+        })
+        .collect()
+}
+
+/// Chooses the layer `wanted` names (full name or its last component), or the only one, or
+/// the one named `…CryptoMaterial`.
+fn choose_layer<'a>(
+    layers: &'a [CryptomatteLayer],
+    wanted: Option<&str>,
+    path: &Path,
+) -> Result<&'a CryptomatteLayer, MaskError> {
+    let names = || {
+        layers
+            .iter()
+            .map(|l| l.name.clone())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let fits = |l: &&CryptomatteLayer, w: &str| l.name == w || l.name.ends_with(&format!(".{w}"));
+    let found: Vec<&CryptomatteLayer> = match wanted {
+        Some(w) => layers.iter().filter(|l| fits(l, w)).collect(),
+        None if layers.len() == 1 => layers.iter().collect(),
+        None => layers
+            .iter()
+            .filter(|l| fits(l, "CryptoMaterial"))
+            .collect(),
+    };
+    match found.as_slice() {
+        [one] => Ok(one),
+        [] if layers.is_empty() => Err(layout(
+            path,
+            "has no Cryptomatte layer (no cryptomatte/…/name attribute)".into(),
+        )),
+        _ => Err(layout(
+            path,
+            format!(
+                "{} Cryptomatte layer{} (it has: {})",
+                if found.is_empty() {
+                    "no matching"
+                } else {
+                    "more than one matching"
+                },
+                wanted.map(|w| format!(" {w:?}")).unwrap_or_default(),
+                names()
+            ),
+        )),
+    }
+}
+
+/// The (part, channel) of each rank channel of `layer`: `NAME00.r`, `.g`, `.b`, `.a`, `NAME01.r`,
+/// … (any case), in rank order, as long as a level exists.
+fn rank_channels(exr: &ExrFile<'_>, layer: &str) -> Vec<[(usize, usize); 4]> {
+    let parts = exr.parts();
+    let find = |name: &str| {
+        parts.iter().enumerate().find_map(|(p, part)| {
+            (0..part.channels.len()).find_map(|c| {
+                part.qualified_name(c)
+                    .filter(|q| q.eq_ignore_ascii_case(name))
+                    .map(|_| (p, c))
+            })
+        })
+    };
+    let mut levels = Vec::new();
+    for level in 0..100 {
+        let channels: Option<Vec<(usize, usize)>> = ["r", "g", "b", "a"]
+            .iter()
+            .map(|c| find(&format!("{layer}{level:02}.{c}")))
+            .collect();
+        match channels {
+            Some(c) => levels.push([c[0], c[1], c[2], c[3]]),
+            None => break,
+        }
+    }
+    levels
+}
+
+/// Decodes channels (part, channel) of the file; every part must share one data window.
+fn decode(
+    exr: &ExrFile<'_>,
+    wanted: &[(usize, usize)],
+    path: &Path,
+) -> Result<(ImageWindows, Vec<Vec<f32>>), MaskError> {
+    let mut out: Vec<Option<Vec<f32>>> = vec![None; wanted.len()];
+    let mut windows: Option<ImageWindows> = None;
+    let mut parts: Vec<usize> = wanted.iter().map(|w| w.0).collect();
+    parts.sort_unstable();
+    parts.dedup();
+    for p in parts {
+        let slots: Vec<usize> = (0..wanted.len()).filter(|&k| wanted[k].0 == p).collect();
+        let channels: Vec<usize> = slots.iter().map(|&k| wanted[k].1).collect();
+        let (info, buffers) =
+            exr.read_channels(p, &channels)
+                .map_err(|source| MaskError::Decode {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
+        match windows {
+            None => windows = Some(info.windows()),
+            Some(w) if w.data != info.data_window => {
+                return Err(layout(
+                    path,
+                    format!(
+                        "the channels lie in parts with different data windows ({} and {})",
+                        w.data, info.data_window
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+        for (k, b) in slots.into_iter().zip(buffers) {
+            out[k] = Some(b);
+        }
+    }
+    let windows = windows.ok_or_else(|| layout(path, "no channels to read".into()))?;
+    Ok((
+        windows,
+        out.into_iter().map(Option::unwrap_or_default).collect(),
+    ))
+}
+
+/// A channel (or a vector pass's three channels) by the name a user gives.
+fn locate(exr: &ExrFile<'_>, name: &str, path: &Path) -> Result<(usize, usize), MaskError> {
+    match glassdb_image::find_channel(exr.parts(), name, None) {
+        glassdb_image::ChannelMatch::Found(p, c) => Ok((p, c)),
+        glassdb_image::ChannelMatch::Ambiguous(candidates) => Err(MaskError::AmbiguousChannel {
+            path: path.to_path_buf(),
+            channel: name.to_string(),
+            candidates,
+        }),
+        glassdb_image::ChannelMatch::Missing => Err(MaskError::MissingChannel {
+            path: path.to_path_buf(),
+            channel: name.to_string(),
+            available: glassdb_image::all_channel_names(exr.parts()),
+        }),
+    }
+}
+
+/// The three channels of a vector pass: `NAME.X/.Y/.Z` or `NAME.R/.G/.B`.
+fn locate_vector(
+    exr: &ExrFile<'_>,
+    name: &str,
+    path: &Path,
+) -> Result<[(usize, usize); 3], MaskError> {
+    for letters in [["X", "Y", "Z"], ["R", "G", "B"], ["x", "y", "z"]] {
+        let found: Result<Vec<_>, _> = letters
+            .iter()
+            .map(|l| locate(exr, &format!("{name}.{l}"), path))
+            .collect();
+        if let Ok(f) = found {
+            return Ok([f[0], f[1], f[2]]);
+        }
+    }
+    Err(MaskError::MissingChannel {
+        path: path.to_path_buf(),
+        channel: format!("{name}.X/.Y/.Z"),
+        available: glassdb_image::all_channel_names(exr.parts()),
+    })
+}
+
+/// Builds a mask from the Cryptomatte layer of an EXR render (see the module docs): per pixel
+/// the glass id with the largest coverage among the ranks whose manifest name is glass, its
+/// coverage, cos θ from the chosen source, and the plane from the plane AOV.
+pub fn mask_from_cryptomatte(
+    exr: &ExrFile<'_>,
+    path: &Path,
+    opts: &CryptomatteOptions,
+) -> Result<PlacedMask, MaskError> {
+    let attributes = glassdb_image::read_exr_text_attributes(exr.bytes()).map_err(|source| {
+        MaskError::Decode {
+            path: path.to_path_buf(),
+            source,
+        }
+    })?;
+    let layers = cryptomatte_layers(&attributes, path)?;
+    let layer = choose_layer(&layers, opts.layer.as_deref(), path)?;
+    let unmatched = opts
+        .glass
+        .unmatched(layer.manifest.keys().map(String::as_str));
+    if !unmatched.is_empty() {
+        return Err(MaskError::UnmatchedGlassNames {
+            path: path.to_path_buf(),
+            layer: layer.name.clone(),
+            patterns: unmatched,
+            names: layer.manifest.keys().cloned().collect(),
+        });
+    }
+    // hash → glass id, for the glass names only.
+    let glass_of: HashMap<u32, u16> = layer
+        .manifest
+        .iter()
+        .filter_map(|(name, &hash)| opts.glass.id_of(name).map(|id| (hash, id)))
+        .collect();
+    let ranks = rank_channels(exr, &layer.name);
+    if ranks.is_empty() {
+        return Err(MaskError::MissingChannel {
+            path: path.to_path_buf(),
+            channel: format!("{}00.r", layer.name),
+            available: glassdb_image::all_channel_names(exr.parts()),
+        });
+    }
+    let mut wanted: Vec<(usize, usize)> = ranks.iter().flatten().copied().collect();
+    let rank_count = wanted.len();
+    match &opts.cos {
+        CosSource::Aov { channel } => wanted.push(locate(exr, channel, path)?),
+        CosSource::Geometry {
+            normal, position, ..
+        } => {
+            wanted.extend(locate_vector(exr, normal, path)?);
+            wanted.extend(locate_vector(exr, position, path)?);
+        }
+    }
+    if let Some(plane) = &opts.plane_aov {
+        wanted.push(locate(exr, plane, path)?);
+    }
+    let (windows, planes) = decode(exr, &wanted, path)?;
+    let (ranks_data, rest) = planes.split_at(rank_count);
+    let glass = dominant_glass(ranks_data, &glass_of);
+    let pixel = PixelAt {
+        path,
+        width: windows.data.width,
+    };
+    let divide = |v: f32, i: usize| match opts.weighting {
+        AovWeighting::GlassOnly if glass.total[i] > 0.0 => v / glass.total[i],
+        _ => v,
+    };
+    let (cos, after_cos) = match &opts.cos {
+        CosSource::Aov { channel } => (
+            cos_from_aov(&rest[0], &glass.id, channel, &divide, &pixel)?,
+            &rest[1..],
+        ),
+        CosSource::Geometry { camera_origin, .. } => (
+            cos_from_geometry(&rest[..6], &glass.id, *camera_origin, &pixel)?,
+            &rest[6..],
+        ),
+    };
+    let plane = match (&opts.plane_aov, after_cos.first()) {
+        (Some(name), Some(values)) => planes_from_aov(values, &glass.id, name, &divide, &pixel)?,
+        _ => vec![0; glass.id.len()],
+    };
+    let partial = glass
+        .coverage
+        .iter()
+        .zip(&glass.id)
+        .any(|(&c, &g)| g != 0 && c < 1.0);
+    Ok(PlacedMask {
+        image: MaskImage {
+            width: windows.data.width as u32,
+            height: windows.data.height as u32,
+            id: glass.id,
+            cos_theta: CosTheta::Float(cos),
+            plane,
+            coverage: partial.then_some(glass.coverage),
+        },
+        windows,
+        stores_planes: opts.plane_aov.is_some(),
+        has_coordinates: true,
+    })
+}
+
+/// Per pixel: the glass id with the largest coverage, that coverage, and the coverage of all
+/// glass together.
+struct DominantGlass {
+    id: Vec<u16>,
+    coverage: Vec<f32>,
+    total: Vec<f32>,
+}
+
+/// Sums each glass's coverage over the ranks (`ranks` alternates id and coverage planes) and
+/// keeps the largest; ids that are not glass (or not in the manifest) count as no glass.
+fn dominant_glass(ranks: &[Vec<f32>], glass_of: &HashMap<u32, u16>) -> DominantGlass {
+    let n = ranks.first().map_or(0, Vec::len);
+    let mut out = DominantGlass {
+        id: vec![0; n],
+        coverage: vec![0.0; n],
+        total: vec![0.0; n],
+    };
+    let mut per_glass: Vec<(u16, f32)> = Vec::with_capacity(8);
+    for i in 0..n {
+        per_glass.clear();
+        for pair in ranks.chunks_exact(2) {
+            let cov = pair[1][i];
+            if !(cov.is_finite() && cov > 0.0) {
+                continue;
+            }
+            let Some(&g) = glass_of.get(&pair[0][i].to_bits()) else {
+                continue;
+            };
+            out.total[i] += cov;
+            match per_glass.iter_mut().find(|(gid, _)| *gid == g) {
+                Some(slot) => slot.1 += cov,
+                None => per_glass.push((g, cov)),
+            }
+        }
+        let best = per_glass
+            .iter()
+            .copied()
+            .reduce(|a, b| if b.1 > a.1 { b } else { a });
+        if let Some((g, c)) = best {
+            out.id[i] = g;
+            out.coverage[i] = c.min(1.0);
+        }
+    }
+    out
+}
+
+/// Names a pixel of the mask in errors.
+struct PixelAt<'a> {
+    path: &'a Path,
+    width: usize,
+}
+
+impl PixelAt<'_> {
+    fn error(&self, i: usize, detail: String) -> MaskError {
+        MaskError::BadPixel {
+            path: self.path.to_path_buf(),
+            x: (i % self.width) as u32,
+            y: (i / self.width) as u32,
+            detail,
+        }
+    }
+}
+
+/// cos θ on glass pixels from an |N·I| AOV (divided by the glass coverage when the AOV is
+/// written by glass only).
+fn cos_from_aov(
+    aov: &[f32],
+    id: &[u16],
+    channel: &str,
+    divide: &impl Fn(f32, usize) -> f32,
+    pixel: &PixelAt<'_>,
+) -> Result<Vec<f32>, MaskError> {
+    let mut cos = vec![0f32; id.len()];
+    for (i, c) in cos.iter_mut().enumerate() {
+        if id[i] == 0 {
+            continue;
+        }
+        let v = divide(aov[i], i);
+        if !(v.is_finite() && (-1e-3..=1.0 + 1e-2).contains(&v)) {
+            return Err(pixel.error(
+                i,
+                format!(
+                    "cos θ {v} from AOV {channel:?} is not in [0, 1] (is the AOV |N·I|, written as --mask-aovs says?)"
+                ),
+            ));
+        }
+        *c = v.clamp(0.0, 1.0);
+    }
+    Ok(cos)
+}
+
+/// cos θ on glass pixels from world-space Normal (planes 0–2) and Position (planes 3–5) passes
+/// and the camera position: |N·(P − C)| / (|N| |P − C|).
+fn cos_from_geometry(
+    passes: &[Vec<f32>],
+    id: &[u16],
+    camera_origin: [f64; 3],
+    pixel: &PixelAt<'_>,
+) -> Result<Vec<f32>, MaskError> {
+    let mut cos = vec![0f32; id.len()];
+    for (i, c) in cos.iter_mut().enumerate() {
+        if id[i] == 0 {
+            continue;
+        }
+        let nrm: [f64; 3] = std::array::from_fn(|k| f64::from(passes[k][i]));
+        let v: [f64; 3] = std::array::from_fn(|k| f64::from(passes[3 + k][i]) - camera_origin[k]);
+        let (ln, lv) = (norm(nrm), norm(v));
+        if !(ln > 0.0 && lv > 0.0) {
+            return Err(pixel.error(
+                i,
+                "the Normal or Position pass is zero on a glass pixel".into(),
+            ));
+        }
+        let dot = nrm[0] * v[0] + nrm[1] * v[1] + nrm[2] * v[2];
+        *c = (dot.abs() / (ln * lv)).clamp(0.0, 1.0) as f32;
+    }
+    Ok(cos)
+}
+
+/// Plane indices on glass pixels from a plane AOV, rounded.
+fn planes_from_aov(
+    aov: &[f32],
+    id: &[u16],
+    name: &str,
+    divide: &impl Fn(f32, usize) -> f32,
+    pixel: &PixelAt<'_>,
+) -> Result<Vec<u16>, MaskError> {
+    let mut plane = vec![0u16; id.len()];
+    for (i, p) in plane.iter_mut().enumerate() {
+        if id[i] == 0 {
+            continue;
+        }
+        let v = divide(aov[i], i);
+        let r = v.round();
+        if !(0.0..=65535.0).contains(&r) {
+            return Err(pixel.error(
+                i,
+                format!("plane {v} from AOV {name:?} is not an index in 0–65535"),
+            ));
+        }
+        *p = r as u16;
+    }
+    Ok(plane)
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}

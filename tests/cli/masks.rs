@@ -1,0 +1,235 @@
+//! Masks as renderers make them (issue 13): Cryptomatte read per its specification from real
+//! Cycles renders (Blender 3.4 single-part and 5.0 multi-part; `fixtures/blender/` and
+//! `fixtures/blender/masks/`), checked against the same render's Material Index pass (exact,
+//! not filtered: it agrees with Cryptomatte's dominant glass wherever one glass covers the
+//! whole pixel), a coverage AOV, the object index (plane + 1) of a separate render, and cos θ
+//! computed another way (Normal and Position passes and the camera).
+
+use std::path::Path;
+
+use glassdb_mask::{
+    AovWeighting, CosSource, CosTheta, CryptomatteOptions, GlassMapping, GlassNames,
+    MaskReadOptions, PlacedMask, read_placed_mask,
+};
+
+use crate::util::{compose, fails, ok, repo_path};
+
+fn crypto(cos: CosSource, plane_aov: Option<&str>, weighting: AovWeighting) -> MaskReadOptions {
+    let glass = GlassNames::new(&[
+        GlassMapping::parse("Glass_clear=1").unwrap(),
+        GlassMapping::parse("Tinted*=5").unwrap(),
+    ])
+    .unwrap();
+    MaskReadOptions {
+        cryptomatte: Some(CryptomatteOptions {
+            layer: None,
+            glass,
+            cos,
+            plane_aov: plane_aov.map(str::to_string),
+            weighting,
+        }),
+        ..MaskReadOptions::default()
+    }
+}
+
+fn facing() -> CosSource {
+    CosSource::Aov {
+        channel: "facing".into(),
+    }
+}
+
+/// A mask whose id (and cos θ) are plain channels of the file.
+fn channels(path: &Path, id: &str, cos: &str) -> PlacedMask {
+    let mut o = MaskReadOptions::default();
+    o.exr_channels.id = id.into();
+    o.exr_channels.cos_theta = cos.into();
+    o.exr_channels.plane = "(none)".into();
+    o.exr_channels.coverage = "(none)".into();
+    read_placed_mask(path, &o).unwrap()
+}
+
+/// The samples of the channel whose name ends with `.NAME` for the first of `names` found
+/// (Blender 3 and 5 spell some passes differently), read with the `exr` crate.
+fn channel(path: &Path, names: &[&str]) -> Vec<f32> {
+    let (_, _, parts) = crate::passes::read_parts(path);
+    let all: Vec<(String, Vec<f32>)> = parts.into_iter().flat_map(|p| p.channels).collect();
+    names
+        .iter()
+        .find_map(|name| {
+            let suffix = format!(".{name}");
+            all.iter()
+                .find(|(n, _)| n.ends_with(&suffix))
+                .map(|c| c.1.clone())
+        })
+        .unwrap_or_else(|| panic!("{}: none of {names:?}", path.display()))
+}
+
+fn floats(c: &CosTheta) -> &[f32] {
+    match c {
+        CosTheta::Float(v) => v,
+        _ => panic!("float cos θ expected"),
+    }
+}
+
+/// Pixels fully covered by one glass in a Cryptomatte mask.
+fn covered(m: &PlacedMask) -> Vec<usize> {
+    let coverage = m.image.coverage.as_ref().expect("edges are partly covered");
+    (0..m.image.pixel_count())
+        .filter(|&i| m.image.id[i] != 0 && coverage[i] >= 0.999)
+        .collect()
+}
+
+#[test]
+fn cryptomatte_ids_agree_with_the_material_index_pass_on_covered_pixels() {
+    for render in [
+        "fixtures/blender/b34/multilayer.exr",
+        "fixtures/blender/b50/multilayer.exr",
+    ] {
+        let path = repo_path(render);
+        let options = crypto(facing(), None, AovWeighting::EveryMaterial);
+        let mask = read_placed_mask(&path, &options).unwrap();
+        let index = channels(&path, "IndexMA", "facing");
+        assert_eq!(mask.windows, index.windows);
+        let full = covered(&mask);
+        assert!(full.len() > 600, "{render}: {} covered pixels", full.len());
+        for &i in &full {
+            assert_eq!(mask.image.id[i], index.image.id[i], "{render} pixel {i}");
+            // cos θ on covered pixels is the AOV itself.
+            let (a, b) = (
+                floats(&mask.image.cos_theta)[i],
+                floats(&index.image.cos_theta)[i],
+            );
+            assert!((a - b).abs() < 1e-6, "{render} pixel {i}: {a} vs {b}");
+        }
+        // Wherever the Material Index pass sees glass, Cryptomatte has that glass at some
+        // coverage (the index pass holds one sample's value; coverage counts all of them).
+        for (i, (&m, &c)) in index.image.id.iter().zip(&mask.image.id).enumerate() {
+            assert!(
+                m == 0 || c != 0,
+                "{render} pixel {i}: index {m}, Cryptomatte none"
+            );
+        }
+    }
+}
+
+#[test]
+fn glass_only_aovs_are_divided_by_coverage_and_give_planes_and_cos_theta() {
+    let dir = repo_path("fixtures/blender/masks");
+    let camera: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("camera.0001.json")).unwrap())
+            .unwrap();
+    let m = &camera["matrix_world"];
+    let origin: [f64; 3] = std::array::from_fn(|r| m[r][3].as_f64().unwrap());
+    for version in ["b34", "b50"] {
+        let beauty = dir.join(version).join("beauty.0001.exr");
+        let options = crypto(facing(), Some("plane"), AovWeighting::GlassOnly);
+        let mask = read_placed_mask(&beauty, &options).unwrap();
+        assert!(mask.stores_planes);
+        // Coverage: Cryptomatte's glass coverage is the `glass_coverage` AOV (1 on glass).
+        let aov = channel(&beauty, &["glass_coverage.X"]);
+        let coverage = mask.image.coverage.as_ref().unwrap();
+        for (i, (&c, &a)) in coverage.iter().zip(&aov).enumerate() {
+            if mask.image.id[i] != 0 {
+                assert!(
+                    (c - a).abs() < 1e-6,
+                    "{version} pixel {i}: coverage {c} vs AOV {a}"
+                );
+            }
+        }
+        // Planes: the index render's Object Index is plane + 1 (fixtures/blender/masks/README.md).
+        let index = dir.join(version).join("index.0001.exr");
+        let object_index = channel(&index, &["IndexOB.X", "Object Index.X"]);
+        let full = covered(&mask);
+        let wrong_plane = full
+            .iter()
+            .filter(|&&i| f32::from(mask.image.plane[i] + 1) != object_index[i])
+            .count();
+        assert!(full.len() > 2500, "{version}: {} covered", full.len());
+        assert!(
+            wrong_plane <= 1,
+            "{version}: {wrong_plane} covered pixels on the wrong plane"
+        );
+        let planes: std::collections::BTreeSet<u16> =
+            full.iter().map(|&i| mask.image.plane[i]).collect();
+        assert_eq!(planes.into_iter().collect::<Vec<_>>(), [0, 1, 2]);
+        // cos θ: the AOV route against the Normal and Position passes with the camera position.
+        let geometry = CosSource::Geometry {
+            normal: "Normal".into(),
+            position: "Position".into(),
+            camera_origin: origin,
+        };
+        let by_geometry =
+            read_placed_mask(&beauty, &crypto(geometry, None, AovWeighting::GlassOnly)).unwrap();
+        let (a, g) = (
+            floats(&mask.image.cos_theta),
+            floats(&by_geometry.image.cos_theta),
+        );
+        let worst = full
+            .iter()
+            .map(|&i| (a[i] - g[i]).abs())
+            .fold(0f32, f32::max);
+        assert!(
+            worst < 5e-3,
+            "{version}: cos θ by AOV and by geometry differ by {worst}"
+        );
+        // Without dividing, edge pixels come out too small (the issue's 65° for a ≤ 35° pane).
+        let raw = read_placed_mask(
+            &beauty,
+            &crypto(facing(), None, AovWeighting::EveryMaterial),
+        )
+        .unwrap();
+        let edge = (0..coverage.len())
+            .find(|&i| mask.image.id[i] != 0 && coverage[i] < 0.5)
+            .unwrap();
+        assert!(floats(&raw.image.cos_theta)[edge] < a[edge] * 0.6);
+    }
+}
+
+#[test]
+fn cryptomatte_errors_name_what_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = repo_path("fixtures/blender/b34/multilayer.exr");
+    let base = |extra: &[&str]| {
+        let mut c = compose();
+        c.arg("--refl").arg(&render).arg("--trans").arg(&render);
+        c.arg("--mask")
+            .arg(&render)
+            .arg("--mask-cryptomatte")
+            .args(extra);
+        c.arg("-o").arg(dir.path().join("o.exr"));
+        c
+    };
+    let err = fails(&mut base(&[]));
+    assert!(err.contains("--mask-glass"), "{err}");
+    let err = fails(&mut base(&["--mask-glass", "Mirror*=3"]));
+    for part in ["Mirror*", "Glass_clear", "CryptoMaterial"] {
+        assert!(err.contains(part), "{part}: {err}");
+    }
+    let err = fails(&mut base(&["CryptoLight", "--mask-glass", "Glass*=1"]));
+    assert!(
+        err.contains("CryptoLight") && err.contains("ViewLayer.CryptoObject"),
+        "{err}"
+    );
+    let err = fails(&mut base(&[
+        "--mask-glass",
+        "Glass*=1",
+        "--mask-channels",
+        "cos=Nope",
+    ]));
+    assert!(err.contains("Nope"), "{err}");
+    let err = fails(&mut base(&[
+        "--mask-glass",
+        "Glass*=1",
+        "--mask-channels",
+        "normal=Normal",
+    ]));
+    assert!(err.contains("position="), "{err}");
+    // The pass fixture's AOV is written by every material: read as glass-only it is refused
+    // only where dividing makes it exceed 1; read as written it composites.
+    ok(&mut base(&[
+        "--mask-glass",
+        "Glass*=1",
+        "--mask-aovs",
+        "every-material",
+    ]));
+}
