@@ -16,7 +16,7 @@ use glassdb_compose::{
 };
 use glassdb_mask::{
     AovWeighting, CosSource, CryptomatteOptions, ExrMaskChannels, GlassMapping, GlassNames,
-    MaskReadOptions,
+    MaskReadOptions, PlaneSource,
 };
 use glassdb_registry::{Registry, Side};
 
@@ -81,7 +81,9 @@ pub struct Args {
     /// Build the mask from the render's Cryptomatte layer (e.g. `CryptoMaterial`; without a
     /// value the only layer, or the one named …CryptoMaterial), the glasses named by
     /// --mask-glass, cos θ from an AOV (`--mask-channels cos=facing`, the default) or from the
-    /// Normal and Position passes and --camera.
+    /// Normal and Position passes and --camera; planes from a plane AOV
+    /// (`--mask-channels plane=NAME`) or, with several --refl and --planes, from the Normal and
+    /// Position passes matched against planes.json.
     #[arg(long, value_name = "LAYER", num_args = 0..=1, default_missing_value = "")]
     pub mask_cryptomatte: Option<String>,
     /// PATTERN=ID: Cryptomatte names (materials or objects) matching the glob PATTERN are glass
@@ -217,6 +219,10 @@ fn parse_mask_channels(spec: &str) -> anyhow::Result<ExrMaskChannels> {
     Ok(ch)
 }
 
+/// How far (degrees) a glass pixel's Normal pass may lie from its plane's normal when planes are
+/// matched from geometry (a pass is filtered at edges; panes meet at far larger angles).
+const PLANE_MATCH_DEG: f64 = 10.0;
+
 /// The Cryptomatte mask options: the layer, the glasses, cos θ from an AOV (`cos=`, default
 /// `facing`) or from `normal=` and `position=` with the camera, the plane AOV (`plane=`).
 fn cryptomatte_options(args: &Args, layer: &str) -> anyhow::Result<CryptomatteOptions> {
@@ -230,6 +236,25 @@ fn cryptomatte_options(args: &Args, layer: &str) -> anyhow::Result<CryptomatteOp
         .collect::<Result<Vec<_>, _>>()?;
     let spec = args.mask_channels.as_deref().unwrap_or("");
     let pairs = parse_channel_spec(spec, &["cos", "plane", "normal", "position"])?;
+    let planes = match (&args.planes, pairs.iter().find(|(k, _)| k == "plane")) {
+        (_, Some((_, aov))) => PlaneSource::Aov(aov.clone()),
+        (Some(file), None) if args.refl.len() > 1 => {
+            let get = |k: &str, default: &str| {
+                pairs
+                    .iter()
+                    .find(|(key, _)| key == k)
+                    .map_or(default.to_string(), |(_, v)| v.clone())
+            };
+            let planes = glassdb_scene::PlanesFile::load(file)?;
+            PlaneSource::Geometry {
+                normal: get("normal", "Normal"),
+                position: get("position", "Position"),
+                equations: planes.planes.iter().map(|p| p.equation).collect(),
+                max_angle_deg: PLANE_MATCH_DEG,
+            }
+        }
+        _ => PlaneSource::Single,
+    };
     let get = |k: &str| {
         pairs
             .iter()
@@ -261,7 +286,7 @@ fn cryptomatte_options(args: &Args, layer: &str) -> anyhow::Result<CryptomatteOp
         layer: (!layer.is_empty()).then(|| layer.to_string()),
         glass: GlassNames::new(&mappings)?,
         cos,
-        plane_aov: get("plane"),
+        planes,
         weighting: match args.mask_aovs {
             AovsArg::GlassOnly => AovWeighting::GlassOnly,
             AovsArg::EveryMaterial => AovWeighting::EveryMaterial,

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use glassdb_mask::{
     AovWeighting, CosSource, CosTheta, CryptomatteOptions, GlassMapping, GlassNames,
-    MaskReadOptions, PlacedMask, read_placed_mask,
+    MaskReadOptions, PlacedMask, PlaneSource, read_placed_mask,
 };
 
 use crate::util::{compose, fails, ok, repo_path};
@@ -25,7 +25,7 @@ fn crypto(cos: CosSource, plane_aov: Option<&str>, weighting: AovWeighting) -> M
             layer: None,
             glass,
             cos,
-            plane_aov: plane_aov.map(str::to_string),
+            planes: plane_aov.map_or(PlaneSource::Single, |p| PlaneSource::Aov(p.to_string())),
             weighting,
         }),
         ..MaskReadOptions::default()
@@ -232,4 +232,55 @@ fn cryptomatte_errors_name_what_is_missing() {
         "--mask-aovs",
         "every-material",
     ]));
+}
+
+#[test]
+fn planes_from_normals_match_the_plane_aov() {
+    // planes.json from `glassdb mirror` on the scene Blender rendered; the Normal and Position
+    // passes pick each glass pixel's plane, as the plane AOV does.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = repo_path("fixtures/blender/masks/scene.obj");
+    ok(crate::util::glassdb()
+        .arg("mirror")
+        .arg(&scene)
+        .args([
+            "--glass-material",
+            "Glass*",
+            "--glass-material",
+            "Tinted*",
+            "--out-dir",
+        ])
+        .arg(dir.path()));
+    let planes = glassdb_scene::PlanesFile::load(&dir.path().join("planes.json")).unwrap();
+    assert_eq!(planes.planes.len(), 3);
+    let equations: Vec<[f64; 4]> = planes.planes.iter().map(|p| p.equation).collect();
+    for version in ["b34", "b50"] {
+        let beauty = repo_path(&format!("fixtures/blender/masks/{version}/beauty.0001.exr"));
+        let by_aov = read_placed_mask(
+            &beauty,
+            &crypto(facing(), Some("plane"), AovWeighting::GlassOnly),
+        )
+        .unwrap();
+        let mut options = crypto(facing(), None, AovWeighting::GlassOnly);
+        if let Some(c) = options.cryptomatte.as_mut() {
+            c.planes = PlaneSource::Geometry {
+                normal: "Normal".into(),
+                position: "Position".into(),
+                equations: equations.clone(),
+                max_angle_deg: 10.0,
+            };
+        }
+        let by_geometry = read_placed_mask(&beauty, &options).unwrap();
+        let full = covered(&by_aov);
+        let differ = full
+            .iter()
+            .filter(|&&i| by_aov.image.plane[i] != by_geometry.image.plane[i])
+            .count();
+        assert_eq!(
+            differ,
+            0,
+            "{version}: {differ} of {} covered pixels",
+            full.len()
+        );
+    }
 }

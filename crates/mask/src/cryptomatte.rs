@@ -55,9 +55,28 @@ pub struct CryptomatteOptions {
     /// Which manifest names are glass, with their registration ids.
     pub glass: GlassNames,
     pub cos: CosSource,
-    /// An AOV holding each glass pixel's plane index (`None`: every pixel on plane 0).
-    pub plane_aov: Option<String>,
+    /// Where each glass pixel's plane index comes from.
+    pub planes: PlaneSource,
     pub weighting: AovWeighting,
+}
+
+/// Where the plane of each glass pixel comes from.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum PlaneSource {
+    /// Every glass pixel on plane 0 (one plane).
+    #[default]
+    Single,
+    /// An AOV holding the plane index (written by each glass material).
+    Aov(String),
+    /// The Normal and Position passes matched against the planes' equations `[a, b, c, d]`
+    /// (`planes.json`): the plane nearest the pixel's position among those whose normal is
+    /// within `max_angle_deg` of the pixel's normal (either orientation).
+    Geometry {
+        normal: String,
+        position: String,
+        equations: Vec<[f64; 4]>,
+        max_angle_deg: f64,
+    },
 }
 
 /// One Cryptomatte layer found in a file's header.
@@ -371,8 +390,15 @@ pub fn mask_from_cryptomatte(
             wanted.extend(locate_vector(exr, position, path)?);
         }
     }
-    if let Some(plane) = &opts.plane_aov {
-        wanted.push(locate(exr, plane, path)?);
+    match &opts.planes {
+        PlaneSource::Single => {}
+        PlaneSource::Aov(plane) => wanted.push(locate(exr, plane, path)?),
+        PlaneSource::Geometry {
+            normal, position, ..
+        } => {
+            wanted.extend(locate_vector(exr, normal, path)?);
+            wanted.extend(locate_vector(exr, position, path)?);
+        }
     }
     let (windows, planes) = decode(exr, &wanted, path)?;
     let (ranks_data, rest) = planes.split_at(rank_count);
@@ -395,9 +421,14 @@ pub fn mask_from_cryptomatte(
             &rest[6..],
         ),
     };
-    let plane = match (&opts.plane_aov, after_cos.first()) {
-        (Some(name), Some(values)) => planes_from_aov(values, &glass.id, name, &divide, &pixel)?,
-        _ => vec![0; glass.id.len()],
+    let plane = match &opts.planes {
+        PlaneSource::Single => vec![0; glass.id.len()],
+        PlaneSource::Aov(name) => planes_from_aov(&after_cos[0], &glass.id, name, &divide, &pixel)?,
+        PlaneSource::Geometry {
+            equations,
+            max_angle_deg,
+            ..
+        } => planes_from_geometry(after_cos, &glass.id, equations, *max_angle_deg, &pixel)?,
     };
     let partial = glass
         .coverage
@@ -414,7 +445,7 @@ pub fn mask_from_cryptomatte(
             coverage: partial.then_some(glass.coverage),
         },
         windows,
-        stores_planes: opts.plane_aov.is_some(),
+        stores_planes: opts.planes != PlaneSource::Single,
         has_coordinates: true,
     })
 }
@@ -560,6 +591,51 @@ fn planes_from_aov(
             ));
         }
         *p = r as u16;
+    }
+    Ok(plane)
+}
+
+/// Plane indices on glass pixels from world-space Normal (planes 0–2) and Position (3–5)
+/// passes: among the planes whose normal lies within `max_angle_deg` of the pixel's normal
+/// (either orientation), the one nearest the pixel's position. At a pane's edge both passes
+/// average over what the pixel sees, so where no plane is that close in angle the best
+/// aligned one is taken.
+fn planes_from_geometry(
+    passes: &[Vec<f32>],
+    id: &[u16],
+    equations: &[[f64; 4]],
+    max_angle_deg: f64,
+    pixel: &PixelAt<'_>,
+) -> Result<Vec<u16>, MaskError> {
+    let min_cos = max_angle_deg.to_radians().cos();
+    let mut plane = vec![0u16; id.len()];
+    for (i, p) in plane.iter_mut().enumerate() {
+        if id[i] == 0 {
+            continue;
+        }
+        let nrm: [f64; 3] = std::array::from_fn(|k| f64::from(passes[k][i]));
+        let pos: [f64; 3] = std::array::from_fn(|k| f64::from(passes[3 + k][i]));
+        let ln = norm(nrm);
+        if ln.is_nan() || ln <= 0.0 {
+            return Err(pixel.error(i, "the Normal pass is zero on a glass pixel".into()));
+        }
+        let scored: Vec<(usize, f64, f64)> = equations
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                let alignment = (e[0] * nrm[0] + e[1] * nrm[1] + e[2] * nrm[2]).abs() / ln;
+                let distance = (e[0] * pos[0] + e[1] * pos[1] + e[2] * pos[2] + e[3]).abs();
+                (k, alignment, distance)
+            })
+            .collect();
+        let nearest_aligned = scored
+            .iter()
+            .filter(|s| s.1 >= min_cos)
+            .min_by(|a, b| a.2.total_cmp(&b.2));
+        let best_aligned = scored.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some(&(k, _, _)) = nearest_aligned.or(best_aligned) {
+            *p = k as u16;
+        }
     }
     Ok(plane)
 }

@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 
 pub use cos_code::CosCode;
 pub use cryptomatte::{
-    AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, cryptomatte_layers,
+    AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, PlaneSource, cryptomatte_layers,
     mask_from_cryptomatte,
 };
 pub use error::MaskError;
