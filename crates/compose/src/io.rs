@@ -303,10 +303,13 @@ pub struct OutputFrame {
 /// The parts of an EXR transmission file written into the output.
 #[derive(Debug, Clone)]
 pub enum ExrCarried {
-    /// The file's shared attributes and the chosen part's own; no other channels.
+    /// The file's shared attributes and the chosen part's own; no other channels. The
+    /// composite keeps the layer's channel names (`names`: R, G, B, then A) when the file holds
+    /// nothing else and channels are kept; `None`: bare `R`, `G`, `B`, `A`.
     Attributes {
         image: Box<ExrImageAttributes>,
         part: Box<ExrLayerAttributes>,
+        names: Option<Vec<String>>,
     },
     /// Every part exactly as stored; the composite replaces (or goes beside) the chosen layer's
     /// channels `channel_names` (R, G, B, then A if any) of part `part`.
@@ -327,12 +330,13 @@ impl OutputFrame {
     }
 
     /// The frame of a transmission pass read from `bytes` (the file `path`): attributes always,
-    /// every part and channel when `keep_channels` and the file holds more than the layer.
+    /// every part and channel when `keep_channels` and the file holds more than the layer or
+    /// the composite goes `beside` the original layer.
     pub fn of_transmission(
         pass: &Pass,
         bytes: &[u8],
         path: &Path,
-        keep_channels: bool,
+        (keep_channels, beside): (bool, bool),
         max_pixels: u64,
     ) -> Result<OutputFrame, ComposeError> {
         let PassSource::Exr {
@@ -351,7 +355,7 @@ impl OutputFrame {
             && parts
                 .first()
                 .is_some_and(|p| p.channels.len() == channel_names.len());
-        let exr = if keep_channels && !only_the_layer {
+        let exr = if keep_channels && (beside || !only_the_layer) {
             let file = glassdb_image::read_exr_exact(bytes, max_pixels).map_err(|source| {
                 ComposeError::KeepChannels {
                     path: path.to_path_buf(),
@@ -369,6 +373,7 @@ impl OutputFrame {
             ExrCarried::Attributes {
                 image: Box::new(image),
                 part: Box::new(part),
+                names: (keep_channels && only_the_layer).then(|| channel_names.clone()),
             }
         };
         Ok(OutputFrame {
@@ -554,15 +559,22 @@ fn exr_output(
         Some(ExrCarried::Attributes {
             image: shared,
             part,
-        }) => (
-            *shared,
-            vec![ExrPartOut {
-                data_window: windows.data,
-                attributes: *part,
-                planes: composite_planes(image, &layer_channel_names(new_layer)),
-            }],
-            0,
-        ),
+            names,
+        }) => {
+            let names = match (names, new_layer) {
+                (Some(names), None) => names,
+                _ => layer_channel_names(new_layer),
+            };
+            (
+                *shared,
+                vec![ExrPartOut {
+                    data_window: windows.data,
+                    attributes: *part,
+                    planes: composite_planes(image, &names),
+                }],
+                0,
+            )
+        }
         Some(ExrCarried::Whole {
             file,
             part,

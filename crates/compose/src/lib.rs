@@ -218,11 +218,12 @@ fn decode_inputs(
         let pass = io::read_pass_bytes(&bytes, &job.trans, &opts)?;
         let keep = settings.output.keep_channels
             && io::output_format(&job.output)? == io::OutputFormat::Exr;
+        let beside = settings.output.output_layer.is_some();
         let frame = OutputFrame::of_transmission(
             &pass,
             &bytes,
             &job.trans,
-            keep,
+            (keep, beside),
             settings.pass.max_pixels,
         )?;
         Ok((pass, frame))
