@@ -56,6 +56,11 @@ fn hint(cause: &(dyn std::error::Error + 'static)) -> Option<String> {
     if let Some(e) = cause.downcast_ref::<PlotError>() {
         return plot_hint(e);
     }
+    if let Some(glassdb_io::FrameError::List { .. }) =
+        cause.downcast_ref::<glassdb_io::FrameError>()
+    {
+        return Some("check --frames".into());
+    }
     None
 }
 
@@ -120,6 +125,9 @@ fn scene_hint(e: &SceneError) -> Option<String> {
         SceneError::MeshOutOfRange { .. } => Some("set it with --mesh".into()),
         SceneError::NoGlassSelected => {
             Some("pass --glass-material PATTERN or --plane a,b,c,d".into())
+        }
+        SceneError::CameraNeedsFrame { .. } => {
+            Some("choose the frames with --frames (e.g. 1-24)".into())
         }
         _ => None,
     }

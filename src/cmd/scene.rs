@@ -9,9 +9,9 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use glassdb_mask::{MaskFormat, write_mask};
 use glassdb_scene::{
-    Camera, CosEncoding, CosMode, GlassMapping, MirrorRequest, PlaneSource, PlaneTolerance,
-    PlanesFile, RasterOptions, build_mask_scene, load_obj, rasterize, to_mask_image,
-    write_virtual_scenes,
+    Camera, CameraSource, CosEncoding, CosMode, GlassMapping, MaskScene, MirrorRequest,
+    PlaneSource, PlaneTolerance, PlanesFile, RasterOptions, build_mask_scene, load_obj, rasterize,
+    to_mask_image, write_virtual_scenes,
 };
 
 #[derive(Debug, clap::Args)]
@@ -65,16 +65,25 @@ pub enum FormatArg {
 pub struct MaskArgs {
     /// The OBJ scene.
     pub scene: PathBuf,
-    /// Camera JSON: origin, target, up, fov_x_deg, width, height (docs/scene.md).
+    /// Camera JSON (docs/scene.md): origin, target, up or Blender's matrix_world; fov_x_deg or
+    /// Blender's focal_length_mm, sensor and sensor_fit; shift_x, shift_y, pixel_aspect; width,
+    /// height. Animations: `camera.####.json` (one file per frame, with --frames) or one file
+    /// with a "frames" object.
     #[arg(long, value_name = "CAMERA.json")]
     pub camera: PathBuf,
     /// PATTERN=ID: faces whose material matches the glob PATTERN are glass with registration
     /// id ID (1–65535); repeatable, first match wins. Every other face is opaque.
     #[arg(long = "glass", value_name = "PATTERN=ID", required = true)]
     pub glass: Vec<String>,
-    /// Output mask: .png (8-bit packed unless --format png16 or binary) or .exr.
+    /// Output mask: .png (8-bit packed unless --format png16 or binary) or .exr; with several
+    /// frames, `####` is replaced by the zero-padded frame number (`mask.####.png`).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Frames of an animation, e.g. `1-24` or `1,5,10-20`: `####` in --camera and -o is
+    /// replaced by the zero-padded frame number (default: every frame of a camera file with a
+    /// "frames" object).
+    #[arg(long, value_name = "LIST")]
+    pub frames: Option<String>,
     /// Output format, overriding the one the extension implies.
     #[arg(long, value_enum)]
     pub format: Option<FormatArg>,
@@ -268,16 +277,38 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             mappings.len()
         );
     }
-    let camera = Camera::load(&args.camera)?;
-    glassdb_io::refuse_input_as_output(
-        &args.output,
-        [args.scene.as_path(), args.camera.as_path()],
-    )?;
+    let source = CameraSource::open(&args.camera)?;
+    let frames = match (&args.frames, source.frames()) {
+        (Some(spec), _) => Some(glassdb_io::parse_frame_list(spec)?),
+        (None, in_file) => in_file,
+    };
+    match &frames {
+        None if source.is_animated() => bail!(
+            "the camera {} has one file per frame: choose the frames with --frames (e.g. 1-24)",
+            args.camera.display()
+        ),
+        None if glassdb_io::is_frame_pattern(&args.output) => bail!(
+            "the output {} has #### for a frame number, but there are no frames: give --frames \
+             with an animated camera",
+            args.output.display()
+        ),
+        Some(f) if f.len() > 1 && !glassdb_io::is_frame_pattern(&args.output) => bail!(
+            "the output {} has no #### for the frame number, so every frame would overwrite it",
+            args.output.display()
+        ),
+        _ => {}
+    }
+    if frames.is_none() {
+        glassdb_io::refuse_input_as_output(
+            &args.output,
+            [args.scene.as_path(), args.camera.as_path()],
+        )?;
+    }
 
     let t0 = Instant::now();
     let scene = load_obj(&args.scene)?;
     print_warnings(&scene.warnings);
-    let source = match &args.planes {
+    let source_planes = match &args.planes {
         Some(p) => {
             let file = PlanesFile::load(p)?;
             let mut tolerance = file.tolerance();
@@ -302,48 +333,149 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
     let labelled = build_mask_scene(
         &scene,
         &mappings,
-        &source,
+        &source_planes,
         matches!(cos, CosMode::Gouraud { .. }),
     )?;
     for p in &labelled.unmatched_patterns {
         eprintln!("warning: --glass {p} matches no material with faces");
     }
     let t_load = t0.elapsed();
-    let t1 = Instant::now();
-    let out = rasterize(&labelled.raster, &camera, &options)?;
-    let t_raster = t1.elapsed();
-    let drawn = out.triangles_drawn;
-    let encoding = match format {
-        MaskFormat::Png8 | MaskFormat::Binary => CosEncoding::Quantized8,
-        MaskFormat::Png16 => CosEncoding::Quantized16,
-        MaskFormat::Exr => CosEncoding::Float,
+    let job = MaskJob {
+        labelled: &labelled,
+        options: &options,
+        format,
     };
-    let mask = to_mask_image(out, encoding);
-    write_mask(&args.output, &mask, format)?;
 
+    let Some(frames) = frames else {
+        let camera = source.camera(None)?;
+        let t1 = Instant::now();
+        let mask = job.render(&camera, &args.output)?;
+        let t_raster = t1.elapsed();
+        println!(
+            "{}x{} mask of {} ({} triangles, {} glass on {} plane{}; {} in view) -> {}",
+            mask.width,
+            mask.height,
+            args.scene.display(),
+            scene.triangle_count(),
+            labelled.glass_triangles,
+            labelled.planes.len(),
+            if labelled.planes.len() == 1 { "" } else { "s" },
+            mask.drawn,
+            args.output.display()
+        );
+        if mask.id_pixels.is_empty() {
+            println!("no glass is visible from this camera");
+        }
+        for (id, n) in &mask.id_pixels {
+            println!("id {id}: {n} pixels");
+        }
+        println!(
+            "load {:.3} s, rasterise {:.3} s",
+            t_load.as_secs_f64(),
+            t_raster.as_secs_f64()
+        );
+        return Ok(ExitCode::SUCCESS);
+    };
+
+    // An animation: the scene is labelled once; each frame has its own camera and output. A
+    // frame that fails is reported and the others go on.
     println!(
-        "{}x{} mask of {} ({} triangles, {} glass on {} plane{}; {} in view) -> {}",
-        mask.width,
-        mask.height,
+        "{} ({} triangles, {} glass on {} plane{}), {} frame(s)",
         args.scene.display(),
         scene.triangle_count(),
         labelled.glass_triangles,
         labelled.planes.len(),
         if labelled.planes.len() == 1 { "" } else { "s" },
-        drawn,
-        args.output.display()
+        frames.len()
     );
-    let counts = mask.id_pixel_counts();
-    if counts.is_empty() {
-        println!("no glass is visible from this camera");
-    }
-    for (id, n) in counts {
-        println!("id {id}: {n} pixels");
+    let t1 = Instant::now();
+    let mut failed: Vec<u32> = Vec::new();
+    for &frame in &frames {
+        let result = (|| -> anyhow::Result<(PathBuf, FrameMask)> {
+            let output = if glassdb_io::is_frame_pattern(&args.output) {
+                glassdb_io::expand_frame_pattern(&args.output, frame)?
+            } else {
+                args.output.clone()
+            };
+            let camera_path = source.path(Some(frame));
+            glassdb_io::refuse_input_as_output(
+                &output,
+                [args.scene.as_path(), camera_path.as_path()],
+            )?;
+            let camera = source.camera(Some(frame))?;
+            let mask = job.render(&camera, &output)?;
+            Ok((output, mask))
+        })();
+        match result {
+            Ok((output, mask)) => {
+                let glass: u64 = mask.id_pixels.values().sum();
+                println!(
+                    "frame {frame}: {}x{}, {glass} glass pixels -> {}",
+                    mask.width,
+                    mask.height,
+                    output.display()
+                );
+            }
+            Err(e) => {
+                eprintln!(
+                    "frame {frame}: error: {}",
+                    crate::cmd::hints::with_hints(&e)
+                );
+                failed.push(frame);
+            }
+        }
     }
     println!(
-        "load {:.3} s, rasterise {:.3} s",
+        "load {:.3} s, rasterise and write {:.3} s",
         t_load.as_secs_f64(),
-        t_raster.as_secs_f64()
+        t1.elapsed().as_secs_f64()
     );
-    Ok(ExitCode::SUCCESS)
+    if failed.is_empty() {
+        Ok(ExitCode::SUCCESS)
+    } else {
+        let list: Vec<String> = failed.iter().map(u32::to_string).collect();
+        eprintln!(
+            "error: {} of {} frame(s) failed: {}",
+            failed.len(),
+            frames.len(),
+            list.join(", ")
+        );
+        Ok(ExitCode::from(crate::cmd::EXIT_FAILURE))
+    }
+}
+
+/// What one frame needs besides its camera: the labelled scene and the output settings.
+struct MaskJob<'a> {
+    labelled: &'a MaskScene,
+    options: &'a RasterOptions,
+    format: MaskFormat,
+}
+
+/// The facts of one written mask that the report prints.
+struct FrameMask {
+    width: u32,
+    height: u32,
+    drawn: usize,
+    id_pixels: std::collections::BTreeMap<u16, u64>,
+}
+
+impl MaskJob<'_> {
+    /// Rasterises the scene from `camera` and writes the mask to `output`.
+    fn render(&self, camera: &Camera, output: &Path) -> anyhow::Result<FrameMask> {
+        let out = rasterize(&self.labelled.raster, camera, self.options)?;
+        let drawn = out.triangles_drawn;
+        let encoding = match self.format {
+            MaskFormat::Png8 | MaskFormat::Binary => CosEncoding::Quantized8,
+            MaskFormat::Png16 => CosEncoding::Quantized16,
+            MaskFormat::Exr => CosEncoding::Float,
+        };
+        let mask = to_mask_image(out, encoding);
+        write_mask(output, &mask, self.format)?;
+        Ok(FrameMask {
+            width: mask.width,
+            height: mask.height,
+            drawn,
+            id_pixels: mask.id_pixel_counts(),
+        })
+    }
 }

@@ -2,6 +2,7 @@
 //! One module per area; shared helpers in `util`.
 
 mod architecture;
+mod cameras;
 mod compose;
 mod fit;
 mod fixtures;

@@ -187,6 +187,16 @@ impl ComposeError {
     }
 }
 
+/// The shared frame helpers' errors keep compose's own variants (and their hints).
+impl From<glassdb_io::FrameError> for ComposeError {
+    fn from(e: glassdb_io::FrameError) -> Self {
+        match e {
+            glassdb_io::FrameError::List { spec, why } => ComposeError::FrameList { spec, why },
+            glassdb_io::FrameError::NoPattern { path } => ComposeError::NoFramePattern { path },
+        }
+    }
+}
+
 /// Ids listed in full in the unknown-ids message; the rest are counted.
 const LISTED_IDS: usize = 10;
 

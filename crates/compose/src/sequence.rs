@@ -1,5 +1,5 @@
 //! Animations: file patterns with a `#` run for the frame number (`r.####.exr` → `r.0007.exr`),
-//! frame lists (`1-240`, `1,5,10-20`), and every frame composed with two frames in flight at
+//! frame lists (`1-240`, `1,5,10-20`) (both from `glassdb_io::frames`), and every frame composed with two frames in flight at
 //! a time (so one frame's decoding overlaps another's encoding); a frame with missing or bad
 //! inputs is reported and the others go on.
 
@@ -10,54 +10,19 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use crate::lut::GlassLut;
 use crate::{ComposeError, ComposeJob, ComposeSettings, FrameReport, compose_frame};
 
-/// Whether `pattern` contains a `#` run.
+/// Whether `pattern` contains a `#` run (`glassdb_io::frames`, shared with `glassdb mask`).
 pub fn is_pattern(pattern: &Path) -> bool {
-    pattern.to_string_lossy().contains('#')
+    glassdb_io::is_frame_pattern(pattern)
 }
 
 /// Replaces the last run of `#` in `pattern` by `frame`, zero-padded to the run's length.
 pub fn expand(pattern: &Path, frame: u32) -> Result<PathBuf, ComposeError> {
-    let s = pattern.to_string_lossy();
-    let end = s.rfind('#').ok_or_else(|| ComposeError::NoFramePattern {
-        path: pattern.to_path_buf(),
-    })? + 1;
-    let start = s[..end].trim_end_matches('#').len();
-    let width = end - start;
-    Ok(PathBuf::from(format!(
-        "{}{:0width$}{}",
-        &s[..start],
-        frame,
-        &s[end..],
-        width = width
-    )))
+    glassdb_io::expand_frame_pattern(pattern, frame).map_err(ComposeError::from)
 }
 
 /// Parses a frame list: `N`, `A-B`, comma-separated, e.g. `1-240` or `1,5,10-20`.
 pub fn parse_frames(spec: &str) -> Result<Vec<u32>, ComposeError> {
-    let bad = |why: &str| ComposeError::FrameList {
-        spec: spec.to_string(),
-        why: why.to_string(),
-    };
-    let mut frames = Vec::new();
-    for item in spec.split(',') {
-        let item = item.trim();
-        let (a, b) = match item.split_once('-') {
-            Some((a, b)) => (a.trim(), b.trim()),
-            None => (item, item),
-        };
-        let a: u32 = a.parse().map_err(|_| bad("not a frame number"))?;
-        let b: u32 = b.parse().map_err(|_| bad("not a frame number"))?;
-        if b < a {
-            return Err(bad("a range ends before it starts"));
-        }
-        if frames.len() as u64 + u64::from(b - a) + 1 > 1_000_000 {
-            return Err(bad("more than a million frames"));
-        }
-        frames.extend(a..=b);
-    }
-    frames.sort_unstable();
-    frames.dedup();
-    Ok(frames)
+    glassdb_io::parse_frame_list(spec).map_err(ComposeError::from)
 }
 
 /// The job of frame `frame`: every path with a `#` run expanded (paths without one, such as a

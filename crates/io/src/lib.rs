@@ -1,10 +1,13 @@
 //! Atomic output for every glassdb tool: a file is written to a temporary file in the target's
 //! own directory and renamed over the target only when complete, so a failed run never leaves a
-//! half-written or lost output.
+//! half-written or lost output. [`frames`]: frame patterns and frame lists of animations.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+
+pub mod frames;
+pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
 
 /// Failures of [`write_atomic`] and [`refuse_input_as_output`], each naming the path involved.
 #[derive(Debug, thiserror::Error)]

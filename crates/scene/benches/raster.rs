@@ -86,14 +86,14 @@ fn soup(n: usize) -> RasterScene {
 }
 
 fn camera() -> Camera {
-    let spec = CameraSpec {
-        origin: [0.0, 0.0, 1.0],
-        target: [0.0, -0.3, -5.0],
-        up: [0.0, 1.0, 0.0],
-        fov_x_deg: 70.0,
-        width: 1920,
-        height: 1080,
-    };
+    let spec = CameraSpec::look_at(
+        [0.0, 0.0, 1.0],
+        [0.0, -0.3, -5.0],
+        [0.0, 1.0, 0.0],
+        70.0,
+        1920,
+        1080,
+    );
     Camera::new(&spec, Path::new("bench")).expect("bench camera")
 }
 

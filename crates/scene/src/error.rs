@@ -48,9 +48,25 @@ pub enum SceneError {
         plane: usize,
         distance: f64,
     },
-    /// The camera JSON is malformed or describes an impossible camera.
-    #[error("camera {path}: {message}")]
-    BadCamera { path: PathBuf, message: String },
+    /// The camera JSON is malformed or describes an impossible camera (the message names the
+    /// field; `frame` is the animation frame whose camera it is).
+    #[error("camera {path}{}: {message}", frame_suffix(*.frame))]
+    BadCamera {
+        path: PathBuf,
+        frame: Option<u32>,
+        message: String,
+    },
+    /// An animation has no camera for a frame: its per-frame file does not exist, or the
+    /// animation file has no such frame.
+    #[error("no camera for frame {frame}: {path} {why}")]
+    MissingCameraFrame {
+        path: PathBuf,
+        frame: u32,
+        why: String,
+    },
+    /// An animated camera (one per frame) where one camera is needed: no frame was chosen.
+    #[error("camera {path} {what}: choose the frames to render")]
+    CameraNeedsFrame { path: PathBuf, what: String },
     /// The requested image is empty or too large to allocate.
     #[error("image size {width}x{height}: {message}")]
     BadImageSize {
@@ -96,4 +112,9 @@ pub enum SceneError {
     /// Writing an output failed (atomic: the target is left as it was).
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),
+}
+
+/// `, frame N` for errors about one frame of an animation.
+fn frame_suffix(frame: Option<u32>) -> String {
+    frame.map(|f| format!(", frame {f}")).unwrap_or_default()
 }

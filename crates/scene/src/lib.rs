@@ -14,7 +14,7 @@ pub mod planes_file;
 pub mod raster;
 pub mod virtual_scene;
 
-pub use camera::{Camera, CameraSpec};
+pub use camera::{Camera, CameraSource, CameraSpec, SensorFit, ViewPlane};
 pub use error::SceneError;
 pub use mask::{
     CosEncoding, GlassMapping, MaskScene, PlaneSource, build_mask_scene, to_mask_image,

@@ -123,22 +123,15 @@ fn spec(width: u32, height: u32, fov: f64) -> CameraSpec {
 /// A camera at `origin` looking at `target`, +y up, `fov_x_deg` wide, `size` (width, height)
 /// pixels.
 fn camera(origin: V, target: V, fov_x_deg: f64, size: (u32, u32)) -> CameraSpec {
-    CameraSpec {
-        origin,
-        target,
-        up: [0.0, 1.0, 0.0],
-        fov_x_deg,
-        width: size.0,
-        height: size.1,
-    }
+    CameraSpec::look_at(origin, target, [0.0, 1.0, 0.0], fov_x_deg, size.0, size.1)
 }
 
 /// The ray through image point (x, y), from the camera spec alone (docs/scene.md conventions).
 fn ray(s: &CameraSpec, x: f64, y: f64) -> V {
-    let f = unit(sub(s.target, s.origin));
-    let r = unit(cross(f, s.up));
+    let f = unit(sub(s.target.unwrap(), s.origin.unwrap()));
+    let r = unit(cross(f, s.up.unwrap()));
     let u = cross(r, f);
-    let tx = (s.fov_x_deg.to_radians() / 2.0).tan();
+    let tx = (s.fov_x_deg.unwrap().to_radians() / 2.0).tan();
     let ty = tx * s.height as f64 / s.width as f64;
     let sx = (2.0 * x / s.width as f64 - 1.0) * tx;
     let sy = (1.0 - 2.0 * y / s.height as f64) * ty;
@@ -195,7 +188,7 @@ fn check_against_ray_caster(quads: &[Quad], out: &RasterOutput, s: &CameraSpec) 
         for i in 0..s.width {
             let d = ray(s, i as f64 + 0.5, j as f64 + 0.5);
             let p = (j * s.width + i) as usize;
-            let hit = cast(quads, s.origin, d);
+            let hit = cast(quads, s.origin.unwrap(), d);
             if hit.is_some_and(|(_, m)| m < 1e-6) {
                 continue; // the ray grazes a border: either answer is right
             }
@@ -295,7 +288,10 @@ fn a_box_in_front_of_the_glass_hides_it() {
     check_against_ray_caster(&quads, &out, &s);
     // The box really hides part of the pane: the image centre shows the box, not glass.
     let d = ray(&s, 48.5, 36.5);
-    assert_eq!(cast(&quads, s.origin, d).map(|h| quads[h.0].id), Some(0));
+    assert_eq!(
+        cast(&quads, s.origin.unwrap(), d).map(|h| quads[h.0].id),
+        Some(0)
+    );
     assert_eq!(out.id[36 * 96 + 48], 0);
 }
 
@@ -387,7 +383,7 @@ fn coverage_counts_the_sub_pixel_rays() {
                         i as f64 + (a as f64 + 0.5) / k as f64,
                         j as f64 + (b as f64 + 0.5) / k as f64,
                     );
-                    match cast(&quads, s.origin, d) {
+                    match cast(&quads, s.origin.unwrap(), d) {
                         Some((_, m)) if m < 1e-6 => grazing = true,
                         Some(_) => hits += 1,
                         None => {}
