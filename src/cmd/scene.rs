@@ -10,7 +10,7 @@ use anyhow::{Context, bail};
 use glassdb_mask::{MaskFormat, write_mask};
 use glassdb_scene::{
     Camera, CosEncoding, CosMode, GlassMapping, MirrorRequest, PlaneSource, PlaneTolerance,
-    PlanesFile, RasterOptions, build_mask_scene, load_obj, rasterize, to_mask_image,
+    PlanesFile, RasterOptions, SceneWarning, build_mask_scene, load_obj, rasterize, to_mask_image,
     write_virtual_scenes,
 };
 
@@ -120,7 +120,7 @@ fn parse_numbers<const N: usize>(text: &str, what: &str) -> anyhow::Result<[f64;
     Ok(out)
 }
 
-fn print_warnings(warnings: &[String]) {
+fn print_warnings(warnings: &[SceneWarning]) {
     for w in warnings {
         eprintln!("warning: {w}");
     }
