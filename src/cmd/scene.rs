@@ -10,8 +10,8 @@ use anyhow::{Context, bail};
 use glassdb_mask::{MaskFormat, write_mask};
 use glassdb_scene::{
     Camera, CameraSource, CosEncoding, CosMode, GlassMapping, MaskScene, MirrorRequest,
-    PlaneSource, PlaneTolerance, PlanesFile, RasterOptions, build_mask_scene, load_obj, rasterize,
-    to_mask_image, write_virtual_scenes,
+    PlaneSource, PlaneTolerance, PlanesFile, RasterOptions, SceneWarning, build_mask_scene,
+    load_obj, rasterize, to_mask_image, write_virtual_scenes,
 };
 
 #[derive(Debug, clap::Args)]
@@ -129,7 +129,7 @@ fn parse_numbers<const N: usize>(text: &str, what: &str) -> anyhow::Result<[f64;
     Ok(out)
 }
 
-fn print_warnings(warnings: &[String]) {
+fn print_warnings(warnings: &[SceneWarning]) {
     for w in warnings {
         eprintln!("warning: {w}");
     }

@@ -471,3 +471,96 @@ fn bad_input_gives_clear_errors() {
     // Nothing was written by the failed runs.
     assert!(!d.join("m.png").exists() && !d.join("o").join("planes.json").exists());
 }
+
+/// A scene with one U-shaped glass pane in the plane z = 0 (3 wide, 2 high, a 1 × 1 notch from
+/// the top middle, x ∈ [1, 2], y ∈ [1, 2]) behind an opaque floor strip, with its materials in
+/// two MTL files named on one `mtllib` line and a third on another; and a camera 4 units in
+/// front of the pane, looking at it straight on (64 × 64 pixels, 60° wide).
+fn u_pane_scene(dir: &Path) -> (PathBuf, PathBuf) {
+    write_file(dir, "glass.mtl", b"newmtl Glass_U\nKd 0.9 0.9 0.9\n");
+    write_file(dir, "wood.mtl", b"newmtl Wood\nKd 0.5 0.3 0.1\n");
+    write_file(dir, "my stone.mtl", b"newmtl Stone\nKd 0.5 0.5 0.5\n");
+    let obj = write_file(
+        dir,
+        "u.obj",
+        b"mtllib glass.mtl wood.mtl\nmtllib my stone.mtl\n\
+          v 0 0 0\nv 3 0 0\nv 3 2 0\nv 2 2 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n\
+          v -1 -0.5 1\nv 4 -0.5 1\nv 4 -0.5 -1\nv -1 -0.5 -1\n\
+          g pane\nusemtl Glass_U\nf 1 2 3 4 5 6 7 8\n\
+          g floor\nusemtl Wood\nf 9 10 11 12\nusemtl Stone\nf 9 11 10\n",
+    );
+    let camera = write_file(
+        dir,
+        "u_camera.json",
+        br#"{"origin": [1.5, 1.0, 4.0], "target": [1.5, 1.0, 0.0], "up": [0, 1, 0], "fov_x_deg": 60, "width": 64, "height": 64}"#,
+    );
+    (obj, camera)
+}
+
+#[test]
+fn mask_of_a_u_shaped_pane_leaves_its_notch_clear() {
+    let dir = tempfile::tempdir().unwrap();
+    let (obj, camera) = u_pane_scene(dir.path());
+    let out = dir.path().join("u.png");
+    let mut cmd = glassdb();
+    cmd.arg("mask")
+        .arg(&obj)
+        .arg("--camera")
+        .arg(&camera)
+        .args(["--glass", "Glass*=3", "-o"])
+        .arg(&out);
+    let (status, _, stderr) = crate::util::run(&mut cmd);
+    assert!(status.status.success(), "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
+    let m = read_mask(&out, &MaskReadOptions::default()).unwrap();
+    assert_eq!((m.width, m.height), (64, 64));
+    // Where each pixel's centre ray meets z = 0 (the camera looks down −z; x right, y up).
+    let t = 30f64.to_radians().tan();
+    let (mut in_notch, mut in_pane) = (0, 0);
+    for j in 0..64u32 {
+        for i in 0..64u32 {
+            let x = 1.5 + 4.0 * ((i as f64 + 0.5) / 32.0 - 1.0) * t;
+            let y = 1.0 + 4.0 * (1.0 - (j as f64 + 0.5) / 32.0) * t;
+            let id = m.id[(j * 64 + i) as usize];
+            let inside = |lo: f64, hi: f64, v: f64| v > lo + 0.03 && v < hi - 0.03;
+            if inside(1.0, 2.0, x) && inside(1.0, 2.0, y) {
+                assert_eq!(
+                    id, 0,
+                    "pixel ({i}, {j}) at ({x:.3}, {y:.3}) in the notch is glass"
+                );
+                in_notch += 1;
+            } else if inside(0.0, 3.0, x)
+                && inside(0.0, 2.0, y)
+                && !(inside(0.97, 2.03, x) && y > 0.97)
+            {
+                assert_eq!(
+                    id, 3,
+                    "pixel ({i}, {j}) at ({x:.3}, {y:.3}) on the pane is not glass"
+                );
+                in_pane += 1;
+            }
+        }
+    }
+    assert!(in_notch > 30 && in_pane > 150, "{in_notch} {in_pane}");
+}
+
+#[test]
+fn mirror_refers_to_every_material_library_of_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let (obj, _) = u_pane_scene(dir.path());
+    let out = dir.path().join("virtual");
+    ok(&mut mirror(&obj, &["--glass-material", "Glass*"], &out));
+    let text = std::fs::read_to_string(out.join("plane_0.obj")).unwrap();
+    let libs: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("mtllib "))
+        .collect();
+    assert_eq!(libs, ["../glass.mtl", "../wood.mtl", "../my stone.mtl"]);
+    for lib in libs {
+        assert!(out.join(lib).exists(), "{lib}");
+    }
+    // The pane's area is the U's (3·2 − 1), not its bounding rectangle's.
+    let planes = json(&out.join("planes.json"));
+    let area = planes["planes"][0]["area"].as_f64().unwrap();
+    assert!((area - 5.0).abs() < 1e-9, "{area}");
+}

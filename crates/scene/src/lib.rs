@@ -12,7 +12,9 @@ pub mod obj;
 pub mod planes;
 pub mod planes_file;
 pub mod raster;
+pub mod triangulate;
 pub mod virtual_scene;
+pub mod warning;
 
 pub use camera::{Camera, CameraSource, CameraSpec, SensorFit, ViewPlane};
 pub use error::SceneError;
@@ -25,3 +27,4 @@ pub use planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_plan
 pub use planes_file::PlanesFile;
 pub use raster::{CosMode, RasterOptions, RasterOutput, RasterScene, rasterize};
 pub use virtual_scene::{MirrorReport, MirrorRequest, write_virtual_scenes};
+pub use warning::{FanReason, SceneWarning};

@@ -7,6 +7,14 @@
 //! `tobj` with a material loader that knows every `usemtl` name, whether or not its MTL file
 //! exists. Material *properties* are never needed: the mirror writes an `mtllib` reference to
 //! the original files, and the mask only matches material names.
+//!
+//! `tobj` returns the polygons as written; each is triangulated here by ear clipping in its
+//! own plane ([`crate::triangulate`]), or fanned with a [`SceneWarning`] naming its line.
+//!
+//! `mtllib` may name several files, on one line or on several. Whitespace separates the names;
+//! a name containing spaces is either written in double quotes or ends in `.mtl` (words are
+//! joined up to the next one ending in `.mtl`, as Blender's importer does, and words left at
+//! the end of the line make one name, as `tobj` reads them).
 
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -16,24 +24,30 @@ use std::path::{Path, PathBuf};
 
 use crate::error::SceneError;
 use crate::math::Vec3;
+use crate::triangulate::triangulate_polygon;
+use crate::warning::SceneWarning;
 
 /// Most vertices/faces accepted in one OBJ, so that a hostile file cannot exhaust memory
 /// through index arithmetic (the text itself bounds real data).
 const MAX_ELEMENTS: usize = 1 << 31;
+
+/// Fanned polygons warned about one by one; the rest are counted in one more warning.
+const MAX_POLYGON_WARNINGS: usize = 20;
 
 /// A triangulated OBJ scene, one [`Mesh`] per group/object and material run.
 #[derive(Debug, Clone, Default)]
 pub struct Scene {
     /// The OBJ file it was read from.
     pub source: PathBuf,
-    /// `mtllib` arguments as written in the OBJ (relative to its directory).
+    /// The material libraries named by `mtllib` (relative to the OBJ's directory), each once,
+    /// in order of first mention (see the module docs for names with spaces).
     pub mtllibs: Vec<String>,
     /// Material names in order of first `usemtl`.
     pub materials: Vec<String>,
     /// The meshes, in file order.
     pub meshes: Vec<Mesh>,
-    /// Non-fatal remarks for the user (missing MTL file, undefined material, ...).
-    pub warnings: Vec<String>,
+    /// Non-fatal remarks for the user (missing MTL file, undefined material, fanned polygon).
+    pub warnings: Vec<SceneWarning>,
 }
 
 /// One run of triangles sharing a group name and material, with its own vertex arrays.
@@ -46,7 +60,8 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub texcoords: Vec<[f64; 2]>,
     pub normals: Vec<Vec3>,
-    /// Position indices per triangle, counter-clockwise seen from the front.
+    /// Position indices per triangle, counter-clockwise seen from the front (each polygon's
+    /// triangles keep its winding).
     pub triangles: Vec<[u32; 3]>,
     /// Texture-coordinate indices per triangle (empty when the mesh has none).
     pub tex_triangles: Vec<[u32; 3]>,
@@ -111,9 +126,13 @@ impl Scene {
 /// What the validation pass learned besides the normalised text.
 struct ObjScan {
     text: String,
-    mtllibs: Vec<String>,
+    /// Material library names, each once, with the line that first names it.
+    mtllibs: Vec<(String, usize)>,
     usemtl: Vec<String>,
-    faces: usize,
+    /// The line of each name's first `usemtl`, parallel to `usemtl`.
+    usemtl_lines: Vec<usize>,
+    /// The line of every face, in file order.
+    face_lines: Vec<usize>,
 }
 
 /// OBJ statements that are valid but carry nothing this tool uses (free-form geometry,
@@ -291,8 +310,10 @@ fn check_index(
 fn scan_obj(text: &str, path: &Path) -> Result<ObjScan, SceneError> {
     let mut out = String::with_capacity(text.len() + 64);
     let (mut nv, mut nvt, mut nvn, mut faces) = (0usize, 0usize, 0usize, 0usize);
-    let mut mtllibs = Vec::new();
+    let mut mtllibs: Vec<(String, usize)> = Vec::new();
     let mut usemtl: Vec<String> = Vec::new();
+    let mut usemtl_lines = Vec::new();
+    let mut face_lines = Vec::new();
     for (line, l) in logical_lines(text) {
         let trimmed = l.trim();
         let mut words = trimmed.split_whitespace();
@@ -407,6 +428,7 @@ fn scan_obj(text: &str, path: &Path) -> Result<ObjScan, SceneError> {
                     ));
                 }
                 faces += 1;
+                face_lines.push(line);
                 if faces > MAX_ELEMENTS || nv > MAX_ELEMENTS {
                     return Err(syntax(path, line, "too many elements"));
                 }
@@ -420,6 +442,7 @@ fn scan_obj(text: &str, path: &Path) -> Result<ObjScan, SceneError> {
                 }
                 if !usemtl.iter().any(|m| m == rest) {
                     usemtl.push(rest.to_string());
+                    usemtl_lines.push(line);
                 }
                 let _ = writeln!(out, "usemtl {rest}");
             }
@@ -427,7 +450,11 @@ fn scan_obj(text: &str, path: &Path) -> Result<ObjScan, SceneError> {
                 if rest.is_empty() {
                     return Err(syntax(path, line, "mtllib without a file name"));
                 }
-                mtllibs.push(rest.to_string());
+                for name in split_mtllib(rest, path, line)? {
+                    if !mtllibs.iter().any(|(m, _)| *m == name) {
+                        mtllibs.push((name, line));
+                    }
+                }
             }
             k if IGNORED_STATEMENTS.contains(&k) => {}
             other => {
@@ -443,8 +470,55 @@ fn scan_obj(text: &str, path: &Path) -> Result<ObjScan, SceneError> {
         text: out,
         mtllibs,
         usemtl,
-        faces,
+        usemtl_lines,
+        face_lines,
     })
+}
+
+/// The file names of one `mtllib` statement (see the module docs): whitespace-separated,
+/// a double-quoted name taken as it is, and unquoted words joined up to one ending in `.mtl`.
+fn split_mtllib(rest: &str, path: &Path, line: usize) -> Result<Vec<String>, SceneError> {
+    let mut names = Vec::new();
+    // Byte offset where the unquoted name being gathered starts.
+    let mut pending: Option<usize> = None;
+    let mut i = 0;
+    let bytes = rest.as_bytes();
+    while i < bytes.len() {
+        if bytes[i] == b' ' {
+            i += 1;
+            continue;
+        }
+        if bytes[i] == b'"' {
+            if let Some(start) = pending.take() {
+                names.push(rest[start..i].trim_end().to_string());
+            }
+            let Some(len) = rest[i + 1..].find('"') else {
+                return Err(syntax(
+                    path,
+                    line,
+                    "mtllib: a double-quoted file name has no closing quote",
+                ));
+            };
+            let name = &rest[i + 1..i + 1 + len];
+            if name.trim().is_empty() {
+                return Err(syntax(path, line, "mtllib: empty file name"));
+            }
+            names.push(name.to_string());
+            i += len + 2;
+            continue;
+        }
+        let end = rest[i..].find(' ').map_or(rest.len(), |k| i + k);
+        let start = *pending.get_or_insert(i);
+        if rest[i..end].to_ascii_lowercase().ends_with(".mtl") {
+            names.push(rest[start..end].to_string());
+            pending = None;
+        }
+        i = end;
+    }
+    if let Some(start) = pending {
+        names.push(rest[start..].trim_end().to_string());
+    }
+    Ok(names)
 }
 
 /// Validates an MTL file and returns the material names it defines.
@@ -490,11 +564,12 @@ fn scan_mtl(text: &str, path: &Path) -> Result<Vec<String>, SceneError> {
     Ok(names)
 }
 
-/// Reads, validates and triangulates an OBJ scene. Polygons are fan-triangulated.
+/// Reads, validates and triangulates an OBJ scene. Polygons are ear-clipped in their plane;
+/// one that cannot be (non-planar, self-intersecting) is fanned with a warning.
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
     let text = read_text(path)?;
     let scan = scan_obj(&text, path)?;
-    if scan.faces == 0 {
+    if scan.face_lines.is_empty() {
         return Err(SceneError::EmptyScene {
             path: path.to_path_buf(),
         });
@@ -502,24 +577,27 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
     let mut warnings = Vec::new();
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut defined: Vec<String> = Vec::new();
-    for lib in &scan.mtllibs {
+    for (lib, line) in &scan.mtllibs {
         let mtl_path = dir.join(lib);
         if !mtl_path.exists() {
-            warnings.push(format!(
-                "material library {} not found (material names still used)",
-                mtl_path.display()
-            ));
+            warnings.push(SceneWarning::MissingMaterialLibrary {
+                obj: path.to_path_buf(),
+                line: *line,
+                library: mtl_path,
+            });
             continue;
         }
         let mtl_text = read_text(&mtl_path)?;
         defined.extend(scan_mtl(&mtl_text, &mtl_path)?);
     }
     if !scan.mtllibs.is_empty() {
-        for m in &scan.usemtl {
+        for (m, &line) in scan.usemtl.iter().zip(&scan.usemtl_lines) {
             if !defined.contains(m) {
-                warnings.push(format!(
-                    "material {m:?} is used but defined in no material library"
-                ));
+                warnings.push(SceneWarning::UndefinedMaterial {
+                    obj: path.to_path_buf(),
+                    line,
+                    name: m.clone(),
+                });
             }
         }
     }
@@ -531,9 +609,10 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
         let _ = writeln!(placeholder, "newmtl {m}");
     }
     let fed = format!("mtllib glassdb-material-names\n{}", scan.text);
+    // Polygons as written (`triangulate: false`): they are triangulated below.
     let options = tobj::LoadOptions {
         single_index: false,
-        triangulate: true,
+        triangulate: false,
         ignore_points: true,
         ignore_lines: true,
     };
@@ -563,6 +642,13 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
         .enumerate()
         .map(|(i, n)| (n.as_str(), i))
         .collect();
+    let load_error = |message: &str| SceneError::Load {
+        path: path.to_path_buf(),
+        message: message.into(),
+    };
+    // tobj keeps the faces in file order across its models, so they pair with the scan's lines.
+    let mut face_lines = scan.face_lines.iter().copied();
+    let mut fanned = 0usize;
     let mut meshes = Vec::with_capacity(models.len());
     for model in models {
         let m = model.mesh;
@@ -584,48 +670,104 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
             .chunks_exact(3)
             .map(|c| [c[0], c[1], c[2]])
             .collect();
-        let tri = |idx: &[u32]| -> Vec<[u32; 3]> {
-            idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
-        };
-        let triangles = tri(&m.indices);
-        let tex_triangles = if m.texcoord_indices.len() == m.indices.len() {
-            tri(&m.texcoord_indices)
-        } else {
-            Vec::new()
-        };
-        let normal_triangles = if m.normal_indices.len() == m.indices.len() {
-            tri(&m.normal_indices)
-        } else {
-            Vec::new()
-        };
-        let in_range = |t: &[[u32; 3]], n: usize| t.iter().flatten().all(|&i| (i as usize) < n);
-        if !in_range(&triangles, positions.len())
-            || !in_range(&tex_triangles, texcoords.len())
-            || !in_range(&normal_triangles, normals.len())
+        let in_range = |idx: &[u32], n: usize| idx.iter().all(|&i| (i as usize) < n);
+        let has_t = m.texcoord_indices.len() == m.indices.len();
+        let has_n = m.normal_indices.len() == m.indices.len();
+        if !in_range(&m.indices, positions.len())
+            || (has_t && !in_range(&m.texcoord_indices, texcoords.len()))
+            || (has_n && !in_range(&m.normal_indices, normals.len()))
         {
-            return Err(SceneError::Load {
-                path: path.to_path_buf(),
-                message: "face index out of range after loading".into(),
-            });
+            return Err(load_error("face index out of range after loading"));
         }
-        meshes.push(Mesh {
+        // `face_arities` is empty when every face is a triangle.
+        let arities: Cow<'_, [u32]> = if m.face_arities.is_empty() {
+            Cow::Owned(vec![3; m.indices.len() / 3])
+        } else {
+            Cow::Borrowed(&m.face_arities)
+        };
+        let mut mesh = Mesh {
             group: model.name,
             material,
             positions,
             texcoords,
             normals,
-            triangles,
-            tex_triangles,
-            normal_triangles,
+            ..Mesh::default()
+        };
+        let mut offset = 0usize;
+        let mut corners: Vec<Vec3> = Vec::new();
+        for &arity in arities.iter() {
+            let arity = arity as usize;
+            let end = offset + arity;
+            let line = face_lines
+                .next()
+                .ok_or_else(|| load_error("more faces after loading than in the file"))?;
+            let v = m
+                .indices
+                .get(offset..end)
+                .ok_or_else(|| load_error("face sizes do not match the indices after loading"))?;
+            corners.clear();
+            corners.extend(v.iter().map(|&i| mesh.positions[i as usize]));
+            let t = triangulate_polygon(&corners);
+            if let Some(reason) = t.fallback {
+                fanned += 1;
+                if fanned <= MAX_POLYGON_WARNINGS {
+                    warnings.push(SceneWarning::PolygonFanned {
+                        obj: path.to_path_buf(),
+                        line,
+                        vertices: arity,
+                        reason,
+                    });
+                }
+            }
+            // Texture-coordinate and normal indices follow the corners.
+            let pick = |idx: &[u32], [a, b, c]: [usize; 3]| {
+                [idx[offset + a], idx[offset + b], idx[offset + c]]
+            };
+            for &tri in &t.triangles {
+                mesh.triangles.push(pick(&m.indices, tri));
+                if has_t {
+                    mesh.tex_triangles.push(pick(&m.texcoord_indices, tri));
+                }
+                if has_n {
+                    mesh.normal_triangles.push(pick(&m.normal_indices, tri));
+                }
+            }
+            offset = end;
+        }
+        if offset != m.indices.len() {
+            return Err(load_error(
+                "face sizes do not match the indices after loading",
+            ));
+        }
+        meshes.push(mesh);
+    }
+    if face_lines.next().is_some() {
+        return Err(load_error("fewer faces after loading than in the file"));
+    }
+    if fanned > MAX_POLYGON_WARNINGS {
+        warnings.push(SceneWarning::MorePolygonsFanned {
+            obj: path.to_path_buf(),
+            count: fanned - MAX_POLYGON_WARNINGS,
         });
     }
     Ok(Scene {
         source: path.to_path_buf(),
-        mtllibs: scan.mtllibs,
+        mtllibs: scan.mtllibs.into_iter().map(|(name, _)| name).collect(),
         materials: scan.usemtl,
         meshes,
         warnings,
     })
+}
+
+/// `name` as one `mtllib` argument: as it is when [`split_mtllib`] reads it back as one name,
+/// else in double quotes (a name with spaces not ending in `.mtl`, say).
+fn mtllib_argument(name: &str) -> Cow<'_, str> {
+    let plain = split_mtllib(name, Path::new(""), 0).is_ok_and(|n| n.len() == 1 && n[0] == name);
+    if plain || name.contains('"') {
+        Cow::Borrowed(name)
+    } else {
+        Cow::Owned(format!("\"{name}\""))
+    }
 }
 
 /// Writes meshes as an OBJ (atomically), with `mtllib` lines pointing at `mtllibs` (already
@@ -642,7 +784,7 @@ pub fn write_obj(
             writeln!(w, "# {h}")?;
         }
         for lib in mtllibs {
-            writeln!(w, "mtllib {lib}")?;
+            writeln!(w, "mtllib {}", mtllib_argument(lib))?;
         }
         let (mut ov, mut ot, mut on) = (1u64, 1u64, 1u64);
         for m in meshes {
@@ -754,7 +896,14 @@ mod tests {
         assert_eq!(s.material_name(&s.meshes[1]), "Glass_Clear");
         assert_eq!(s.meshes[1].group, "pane");
         assert_eq!(s.meshes[0].tex_triangles.len(), 2);
-        assert!(s.warnings.iter().any(|w| w.contains("missing.mtl")));
+        assert!(
+            s.warnings.iter().any(|w| w
+                .to_string()
+                .starts_with(&format!("{}:1: ", s.source.display()))
+                && w.to_string().contains("missing.mtl")),
+            "{:?}",
+            s.warnings
+        );
     }
 
     #[test]
@@ -791,5 +940,192 @@ mod tests {
         assert!(e.contains("s.obj:1:"), "{e}");
         let e = load_str("v 1 2 3 0\n").unwrap_err().to_string();
         assert!(e.contains("w is 0"), "{e}");
+    }
+
+    /// The U-shaped pane of the triangulation tests (3 × 2, a 1 × 1 notch from the top
+    /// middle) as OBJ corners, with texture coordinates (x/3, y/2) and one normal.
+    const U_PANE: &str = "v 0 0 0\nv 3 0 0\nv 3 2 0\nv 2 2 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0.6666666666666666 1\nvt 0.6666666666666666 0.5\n\
+        vt 0.3333333333333333 0.5\nvt 0.3333333333333333 1\nvt 0 1\nvn 0 0 1\n";
+
+    /// Whether the (x, y) point lies in triangle t of a mesh in the plane z = 0.
+    fn covers(m: &Mesh, t: usize, x: [f64; 2]) -> bool {
+        let [a, b, c] = m.corners(t);
+        let o = |p: Vec3, q: Vec3| (q[0] - p[0]) * (x[1] - p[1]) - (q[1] - p[1]) * (x[0] - p[0]);
+        let (o1, o2, o3) = (o(a, b), o(b, c), o(c, a));
+        (o1 >= 0.0 && o2 >= 0.0 && o3 >= 0.0) || (o1 <= 0.0 && o2 <= 0.0 && o3 <= 0.0)
+    }
+
+    #[test]
+    fn a_concave_pane_is_ear_clipped_and_its_attributes_follow_the_corners() {
+        for (face, z_sign) in [
+            ("f 1/1/1 2/2/1 3/3/1 4/4/1 5/5/1 6/6/1 7/7/1 8/8/1", 1.0),
+            ("f 8/8/1 7/7/1 6/6/1 5/5/1 4/4/1 3/3/1 2/2/1 1/1/1", -1.0),
+        ] {
+            let s = load_str(&format!("{U_PANE}usemtl Glass\n{face}\n")).unwrap();
+            assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+            let m = &s.meshes[0];
+            assert_eq!(m.triangles.len(), 6);
+            let mut area = 0.0;
+            for t in 0..m.triangles.len() {
+                let [a, b, c] = m.corners(t);
+                let n = crate::math::triangle_normal_area2(a, b, c);
+                // Every triangle keeps the face's winding.
+                assert!(n[2] * z_sign > 0.0, "triangle {t} flipped: {n:?}");
+                area += n[2].abs() / 2.0;
+                // Texture coordinates and normals follow the corners.
+                for k in 0..3 {
+                    let p = m.positions[m.triangles[t][k] as usize];
+                    let uv = m.texcoords[m.tex_triangles[t][k] as usize];
+                    assert!(
+                        (uv[0] - p[0] / 3.0).abs() < 1e-12 && (uv[1] - p[1] / 2.0).abs() < 1e-12
+                    );
+                    assert_eq!(
+                        m.normals[m.normal_triangles[t][k] as usize],
+                        [0.0, 0.0, 1.0]
+                    );
+                }
+            }
+            assert!((area - 5.0).abs() < 1e-12, "{area}");
+            let covered = |x: [f64; 2]| (0..m.triangles.len()).any(|t| covers(m, t, x));
+            for x in [[1.5, 1.5], [1.8, 1.3], [1.2, 1.9], [1.01, 1.01]] {
+                assert!(!covered(x), "notch point {x:?} covered");
+            }
+            for x in [[0.5, 1.9], [2.5, 1.9], [1.5, 0.5], [2.9, 0.1]] {
+                assert!(covered(x), "pane point {x:?} missed");
+            }
+        }
+    }
+
+    #[test]
+    fn convex_quads_keep_the_fan_of_before() {
+        let s =
+            load_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 3\n").unwrap();
+        let m = &s.meshes[0];
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [1, 4, 2]]);
+        assert!(s.warnings.is_empty());
+    }
+
+    #[test]
+    fn polygons_that_cannot_be_ear_clipped_are_fanned_with_a_warning_naming_the_line() {
+        // Line 7: a quad bent out of its plane; line 8: a quad whose edges cross.
+        let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0.4\nv 0 1 0\nv 2 0 0\nv 1 2 0\n\
+                   f 1 2 3 4\nf 1 5 4 6\nf 1 2 4\n";
+        let s = load_str(obj).unwrap();
+        let m = &s.meshes[0];
+        assert_eq!(
+            m.triangles,
+            vec![[0, 1, 2], [0, 2, 3], [0, 4, 3], [0, 3, 5], [0, 1, 3]]
+        );
+        let w: Vec<String> = s.warnings.iter().map(ToString::to_string).collect();
+        assert_eq!(w.len(), 2, "{w:?}");
+        let file = s.source.display().to_string();
+        assert!(
+            w[0].starts_with(&format!("{file}:7: polygon of 4 vertices is not planar")),
+            "{w:?}"
+        );
+        assert!(
+            w[1].starts_with(&format!(
+                "{file}:8: polygon of 4 vertices crosses itself (its edges from corners 2 and 4 cross)"
+            )),
+            "{w:?}"
+        );
+        assert!(w.iter().all(|x| x.contains("fan-triangulated")), "{w:?}");
+        assert!(matches!(
+            s.warnings[0],
+            SceneWarning::PolygonFanned {
+                line: 7,
+                vertices: 4,
+                reason: crate::FanReason::NonPlanar { .. },
+                ..
+            }
+        ));
+
+        // Many bad polygons: the first ones listed, the rest counted.
+        let mut many = String::from("v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\n");
+        for _ in 0..MAX_POLYGON_WARNINGS + 5 {
+            many.push_str("f 1 2 3 4\n");
+        }
+        let s = load_str(&many).unwrap();
+        assert_eq!(s.warnings.len(), MAX_POLYGON_WARNINGS + 1);
+        assert_eq!(
+            s.warnings.last().unwrap().to_string(),
+            format!(
+                "{}: 5 more polygons fan-triangulated (not listed)",
+                s.source.display()
+            )
+        );
+    }
+
+    #[test]
+    fn mtllib_names_split_at_whitespace_quotes_and_mtl_endings() {
+        let p = Path::new("s.obj");
+        let split = |t: &str| split_mtllib(t, p, 3).unwrap();
+        assert_eq!(split("a.mtl b.mtl"), ["a.mtl", "b.mtl"]);
+        assert_eq!(
+            split("my scene.mtl  other.MTL"),
+            ["my scene.mtl", "other.MTL"]
+        );
+        assert_eq!(split("\"two  words\" c.mtl"), ["two  words", "c.mtl"]);
+        assert_eq!(split("lib \"q.mtl\""), ["lib", "q.mtl"]);
+        assert_eq!(split("materials file"), ["materials file"]);
+        assert_eq!(split("a.mtl tail"), ["a.mtl", "tail"]);
+        // What the mirror writes reads back as the same name.
+        for name in [
+            "a.mtl",
+            "../my stone.mtl",
+            "dir/mats",
+            "lib a.mtl b",
+            " lead.mtl",
+        ] {
+            assert_eq!(split(&mtllib_argument(name)), [name], "{name}");
+        }
+        let e = split_mtllib("\"open.mtl", p, 3).unwrap_err().to_string();
+        assert!(
+            e.starts_with("s.obj:3:") && e.contains("closing quote"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn several_material_libraries_are_each_validated_and_all_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("a.mtl"), "newmtl Glass\nKd 1 1 1\n").unwrap();
+        std::fs::write(d.join("b.mtl"), "newmtl Wood\nKd 0.5 0.3 0.1\n").unwrap();
+        std::fs::write(d.join("my lib.mtl"), "newmtl Stone\n").unwrap();
+        let p = d.join("s.obj");
+        let body = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl Glass\nf 1 2 3\nusemtl Wood\nf 1 3 2\n\
+                    usemtl Stone\nf 2 1 3\n";
+        std::fs::write(
+            &p,
+            format!("mtllib a.mtl b.mtl\nmtllib my lib.mtl a.mtl\n{body}"),
+        )
+        .unwrap();
+        let s = load_obj(&p).unwrap();
+        assert_eq!(s.mtllibs, ["a.mtl", "b.mtl", "my lib.mtl"]);
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+
+        // An error in the second file of a line names that file and its line.
+        std::fs::write(d.join("b.mtl"), "newmtl Wood\nKd 0.5 0.3\n").unwrap();
+        let e = load_obj(&p).unwrap_err().to_string();
+        assert!(e.contains("b.mtl:2:"), "{e}");
+
+        // A missing one is a warning naming the OBJ line; its materials are then undefined
+        // (warned at their first usemtl).
+        std::fs::remove_file(d.join("b.mtl")).unwrap();
+        let s = load_obj(&p).unwrap();
+        let w: Vec<String> = s.warnings.iter().map(ToString::to_string).collect();
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].starts_with(&format!("{}:1: material library", p.display())),
+            "{w:?}"
+        );
+        assert!(w[0].contains("b.mtl not found"), "{w:?}");
+        assert!(
+            w[1].starts_with(&format!("{}:8: material \"Wood\"", p.display())),
+            "{w:?}"
+        );
+        assert_eq!(s.mtllibs, ["a.mtl", "b.mtl", "my lib.mtl"]);
     }
 }
