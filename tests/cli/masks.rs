@@ -284,3 +284,172 @@ fn planes_from_normals_match_the_plane_aov() {
         );
     }
 }
+
+/// The glass ids Blender's index render of `frame` has per pixel (Material Index; the portrait
+/// of Blender 5 is the emission stand-in, fixtures/blender/masks/README.md).
+fn blender_ids(version: &str, file: &str) -> Vec<f32> {
+    let path = repo_path(&format!("fixtures/blender/masks/{version}/{file}"));
+    if file.contains("emission") {
+        return crate::passes::read_parts(&path).2[0].channels["R"].clone();
+    }
+    channel(&path, &["IndexMA.X", "Material Index.X"])
+}
+
+/// Agreement of `glassdb mask` (8-bit PNG: G = id) with Blender's ids, as a fraction.
+fn agreement(mask: &Path, ids: &[f32]) -> f64 {
+    let png = crate::util::read_png_planes(mask);
+    let ours = &png.channels[1];
+    assert_eq!(ours.len(), ids.len(), "{}", mask.display());
+    let same = ours
+        .iter()
+        .zip(ids)
+        .filter(|(a, b)| **a as f32 == **b)
+        .count();
+    same as f64 / ids.len() as f64
+}
+
+#[test]
+fn glassdb_mask_agrees_with_blenders_material_index_for_an_animated_shifted_camera() {
+    // scene.obj and the cameras Blender rendered (lens shift, AUTO fit, an animated camera; a
+    // portrait with vertical fit and 2:1 pixels); the index renders sample each pixel's centre
+    // once, as glassdb mask does. The U-shaped pane is one concave polygon in the OBJ.
+    let fixture = repo_path("fixtures/blender/masks");
+    let dir = tempfile::tempdir().unwrap();
+    let glass = ["--glass", "Glass_clear=1", "--glass", "Tinted*=5"];
+    let out = dir.path().join("mask.####.png");
+    ok(crate::util::glassdb()
+        .arg("mask")
+        .arg(fixture.join("scene.obj"))
+        .arg("--camera")
+        .arg(fixture.join("cameras.json"))
+        .args(["--frames", "1-3"])
+        .args(glass)
+        .arg("-o")
+        .arg(&out));
+    let portrait = dir.path().join("portrait.png");
+    ok(crate::util::glassdb()
+        .arg("mask")
+        .arg(fixture.join("scene.obj"))
+        .arg("--camera")
+        .arg(fixture.join("camera_portrait.json"))
+        .args(glass)
+        .arg("-o")
+        .arg(&portrait));
+    for version in ["b34", "b50"] {
+        for frame in 1..=3 {
+            let ids = blender_ids(version, &format!("index.{frame:04}.exr"));
+            let a = agreement(&dir.path().join(format!("mask.{frame:04}.png")), &ids);
+            assert!(
+                a >= 0.999,
+                "{version} frame {frame}: {:.4} % agree",
+                a * 100.0
+            );
+        }
+        let file = if version == "b34" {
+            "index_portrait.exr"
+        } else {
+            "index_portrait_emission.exr"
+        };
+        let a = agreement(&portrait, &blender_ids(version, file));
+        assert!(a >= 0.999, "{version} portrait: {:.4} % agree", a * 100.0);
+    }
+}
+
+#[test]
+fn the_cryptomatte_mask_agrees_with_glassdb_mask_and_so_do_the_composites() {
+    // The README's Blender example: Cycles' passes through the Cryptomatte mask, against the
+    // same passes through `glassdb mask` of the scene and camera Blender rendered.
+    let fixture = repo_path("fixtures/blender/masks");
+    let dir = tempfile::tempdir().unwrap();
+    let readme = std::fs::read_to_string(repo_path("README.md")).unwrap();
+    let block: String = readme
+        .split("```sh\nD=fixtures/blender/masks/b34\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```").next())
+        .expect("the README's Blender example")
+        .replace("\\\n", " ");
+    let words: Vec<String> = block
+        .split_whitespace()
+        .map(|w| {
+            w.trim_matches('\'')
+                .replace("$D", "fixtures/blender/masks/b34")
+        })
+        .collect();
+    let args = &words[words.iter().position(|w| w == "--").unwrap() + 1..];
+    let out_at = args.iter().position(|w| w == "-o").unwrap();
+    let crypto_out = dir.path().join("crypto.exr");
+    let mut readme_cmd = compose();
+    readme_cmd
+        .current_dir(crate::util::repo_root())
+        .args(&args[..out_at])
+        .arg("-o")
+        .arg(&crypto_out);
+    ok(&mut readme_cmd);
+
+    let mask = dir.path().join("mask.exr");
+    ok(crate::util::glassdb()
+        .arg("mask")
+        .arg(fixture.join("scene.obj"))
+        .arg("--camera")
+        .arg(fixture.join("camera.0001.json"))
+        .args(["--glass", "Glass_clear=1", "--glass", "Tinted*=5"])
+        .arg("-o")
+        .arg(&mask));
+    let beauty = fixture.join("b34/beauty.0001.exr");
+    let crypto = read_placed_mask(
+        &beauty,
+        &crypto(facing(), Some("plane"), AovWeighting::GlassOnly),
+    )
+    .unwrap();
+    let ours = read_placed_mask(&mask, &MaskReadOptions::default()).unwrap();
+    let full = covered(&crypto);
+    let (c, o) = (
+        floats(&crypto.image.cos_theta),
+        floats(&ours.image.cos_theta),
+    );
+    for &i in &full {
+        assert_eq!(crypto.image.id[i], ours.image.id[i], "pixel {i}");
+        assert_eq!(crypto.image.plane[i], ours.image.plane[i], "pixel {i}");
+        assert!(
+            (c[i] - o[i]).abs() <= 1.0 / 255.0,
+            "pixel {i}: cos θ {} vs {}",
+            c[i],
+            o[i]
+        );
+    }
+    // The composites: the same on every pixel without glass in either mask, and within what
+    // cos θ's 8-bit step changes on every fully covered pixel.
+    let plain_out = dir.path().join("plain.exr");
+    let d = fixture.join("b34");
+    let mut plain = compose();
+    plain.arg("--trans").arg(d.join("trans.0001.exr"));
+    for k in 0..3 {
+        plain
+            .arg("--refl")
+            .arg(d.join(format!("refl_{k}.0001.exr")));
+    }
+    ok(plain.arg("--mask").arg(&mask).arg("-o").arg(&plain_out));
+    let (_, _, a) = crate::passes::read_parts(&crypto_out);
+    let (_, _, b) = crate::passes::read_parts(&plain_out);
+    assert!(
+        a[0].channels.contains_key("ViewLayer.Combined.R"),
+        "the layer keeps its names"
+    );
+    for ch in ["R", "G", "B"] {
+        let name = format!("ViewLayer.Combined.{ch}");
+        let (x, y) = (&a[0].channels[&name], &b[0].channels[&name]);
+        for i in 0..x.len() {
+            if crypto.image.id[i] == 0 && ours.image.id[i] == 0 {
+                assert_eq!(x[i], y[i], "{ch} pixel {i} without glass");
+            }
+        }
+        for &i in &full {
+            assert!(
+                (x[i] - y[i]).abs() <= 0.01 * y[i].abs().max(0.05),
+                "{ch} pixel {i}: {} vs {}",
+                x[i],
+                y[i]
+            );
+        }
+    }
+}
