@@ -453,3 +453,81 @@ fn the_cryptomatte_mask_agrees_with_glassdb_mask_and_so_do_the_composites() {
         }
     }
 }
+
+#[test]
+fn a_manifest_side_file_names_the_ids_like_the_header_manifest() {
+    // The same render with its manifest moved out of the header into `manif_file` (the
+    // specification's side file, relative to the image).
+    use exr::meta::attribute::{AttributeValue, Text};
+    let dir = tempfile::tempdir().unwrap();
+    let render = repo_path("fixtures/blender/b34/multilayer.exr");
+    let bytes = std::fs::read(&render).unwrap();
+    let mut exact = glassdb_image::read_exr_exact(&bytes, 1 << 24).unwrap();
+    let headers = glassdb_image::read_exr_headers(&bytes).unwrap();
+    let mut manifests = Vec::new();
+    let mut move_out = |other: &mut std::collections::HashMap<Text, AttributeValue>| {
+        let keys: Vec<Text> = other
+            .keys()
+            .filter(|k| k.to_string().ends_with("/manifest"))
+            .cloned()
+            .collect();
+        for key in keys {
+            if let Some(AttributeValue::Text(json)) = other.remove(&key) {
+                let file = format!("manifest{}.json", manifests.len());
+                manifests.push((file.clone(), json.to_string()));
+                let side = key.to_string().replace("/manifest", "/manif_file");
+                other.insert(
+                    Text::from(side.as_str()),
+                    AttributeValue::Text(Text::from(file.as_str())),
+                );
+            }
+        }
+    };
+    move_out(&mut exact.attributes.other);
+    for part in &mut exact.parts {
+        move_out(&mut part.attributes.other);
+    }
+    assert_eq!(manifests.len(), 2, "material and object manifests");
+    for (file, json) in &manifests {
+        std::fs::write(dir.path().join(file), json).unwrap();
+    }
+    let image = glassdb_image::ExrImageOut {
+        display_window: headers[0].display_window,
+        attributes: exact.attributes,
+        parts: exact
+            .parts
+            .into_iter()
+            .map(|p| glassdb_image::ExrPartOut {
+                data_window: p.data_window,
+                attributes: p.attributes,
+                planes: p
+                    .channels
+                    .into_iter()
+                    .map(|(name, s)| glassdb_image::ExrPlane {
+                        name,
+                        samples: glassdb_image::PlaneSamples::Exact(s),
+                        linear: false,
+                    })
+                    .collect(),
+            })
+            .collect(),
+    };
+    let copy = dir.path().join("side.exr");
+    let mut out = std::io::Cursor::new(Vec::new());
+    let options = glassdb_image::ExrWriteOptions {
+        storage: glassdb_image::ExrStorage::Float,
+        compression: exr::compression::Compression::ZIP16,
+        zip_level: None,
+    };
+    glassdb_image::write_exr_image(&mut out, image, options).unwrap();
+    std::fs::write(&copy, out.into_inner()).unwrap();
+    let options = crypto(facing(), None, AovWeighting::EveryMaterial);
+    let from_header = read_placed_mask(&render, &options).unwrap();
+    let from_side = read_placed_mask(&copy, &options).unwrap();
+    assert_eq!(from_side.image, from_header.image);
+    // Without the side file the ids cannot be named: an error naming the file.
+    std::fs::remove_file(dir.path().join(&manifests[0].0)).unwrap();
+    std::fs::remove_file(dir.path().join(&manifests[1].0)).unwrap();
+    let err = read_placed_mask(&copy, &options).unwrap_err().to_string();
+    assert!(err.contains("manifest"), "{err}");
+}
