@@ -619,18 +619,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             last.output.path.display()
         );
     }
-    if failed.is_empty() {
-        Ok(ExitCode::SUCCESS)
-    } else {
-        let list: Vec<String> = failed.iter().map(u32::to_string).collect();
-        eprintln!(
-            "error: {} of {} frame(s) failed: {}",
-            failed.len(),
-            frames.len(),
-            list.join(", ")
-        );
-        Ok(ExitCode::from(crate::cmd::EXIT_FAILURE))
-    }
+    Ok(crate::cmd::frames_exit(&failed, frames.len()))
 }
 
 /// Parses a `--side` value, `K=front` / `K=back` (plane index K).

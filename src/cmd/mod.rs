@@ -28,3 +28,17 @@ pub fn finish(result: anyhow::Result<ExitCode>) -> ExitCode {
         }
     }
 }
+
+/// The exit of a command over frames: success, or the failed frames listed and exit code 1.
+pub(crate) fn frames_exit(failed: &[u32], total: usize) -> ExitCode {
+    if failed.is_empty() {
+        return ExitCode::SUCCESS;
+    }
+    let list: Vec<String> = failed.iter().map(u32::to_string).collect();
+    eprintln!(
+        "error: {} of {total} frame(s) failed: {}",
+        failed.len(),
+        list.join(", ")
+    );
+    ExitCode::from(EXIT_FAILURE)
+}

@@ -430,18 +430,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         t_load.as_secs_f64(),
         t1.elapsed().as_secs_f64()
     );
-    if failed.is_empty() {
-        Ok(ExitCode::SUCCESS)
-    } else {
-        let list: Vec<String> = failed.iter().map(u32::to_string).collect();
-        eprintln!(
-            "error: {} of {} frame(s) failed: {}",
-            failed.len(),
-            frames.len(),
-            list.join(", ")
-        );
-        Ok(ExitCode::from(crate::cmd::EXIT_FAILURE))
-    }
+    Ok(crate::cmd::frames_exit(&failed, frames.len()))
 }
 
 /// What one frame needs besides its camera: the labelled scene and the output settings.

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 use glassdb_image::{ExrFile, ImageWindows};
 
+use crate::read::PixelError;
 use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
 
 /// A manifest side file larger than this is refused (a manifest is a list of names).
@@ -403,7 +404,7 @@ pub fn mask_from_cryptomatte(
     let (windows, planes) = decode(exr, &wanted, path)?;
     let (ranks_data, rest) = planes.split_at(rank_count);
     let glass = dominant_glass(ranks_data, &glass_of);
-    let pixel = PixelAt {
+    let pixel = PixelError {
         path,
         width: windows.data.width,
     };
@@ -496,23 +497,6 @@ fn dominant_glass(ranks: &[Vec<f32>], glass_of: &HashMap<u32, u16>) -> DominantG
     out
 }
 
-/// Names a pixel of the mask in errors.
-struct PixelAt<'a> {
-    path: &'a Path,
-    width: usize,
-}
-
-impl PixelAt<'_> {
-    fn error(&self, i: usize, detail: String) -> MaskError {
-        MaskError::BadPixel {
-            path: self.path.to_path_buf(),
-            x: (i % self.width) as u32,
-            y: (i / self.width) as u32,
-            detail,
-        }
-    }
-}
-
 /// cos θ on glass pixels from an |N·I| AOV (divided by the glass coverage when the AOV is
 /// written by glass only).
 fn cos_from_aov(
@@ -520,7 +504,7 @@ fn cos_from_aov(
     id: &[u16],
     channel: &str,
     divide: &impl Fn(f32, usize) -> f32,
-    pixel: &PixelAt<'_>,
+    pixel: &PixelError<'_>,
 ) -> Result<Vec<f32>, MaskError> {
     let mut cos = vec![0f32; id.len()];
     for (i, c) in cos.iter_mut().enumerate() {
@@ -529,7 +513,7 @@ fn cos_from_aov(
         }
         let v = divide(aov[i], i);
         if !(v.is_finite() && (-1e-3..=1.0 + 1e-2).contains(&v)) {
-            return Err(pixel.error(
+            return Err(pixel.at(
                 i,
                 format!(
                     "cos θ {v} from AOV {channel:?} is not in [0, 1] (is the AOV |N·I|, written as --mask-aovs says?)"
@@ -547,7 +531,7 @@ fn cos_from_geometry(
     passes: &[Vec<f32>],
     id: &[u16],
     camera_origin: [f64; 3],
-    pixel: &PixelAt<'_>,
+    pixel: &PixelError<'_>,
 ) -> Result<Vec<f32>, MaskError> {
     let mut cos = vec![0f32; id.len()];
     for (i, c) in cos.iter_mut().enumerate() {
@@ -558,7 +542,7 @@ fn cos_from_geometry(
         let v: [f64; 3] = std::array::from_fn(|k| f64::from(passes[3 + k][i]) - camera_origin[k]);
         let (ln, lv) = (norm(nrm), norm(v));
         if !(ln > 0.0 && lv > 0.0) {
-            return Err(pixel.error(
+            return Err(pixel.at(
                 i,
                 "the Normal or Position pass is zero on a glass pixel".into(),
             ));
@@ -575,7 +559,7 @@ fn planes_from_aov(
     id: &[u16],
     name: &str,
     divide: &impl Fn(f32, usize) -> f32,
-    pixel: &PixelAt<'_>,
+    pixel: &PixelError<'_>,
 ) -> Result<Vec<u16>, MaskError> {
     let mut plane = vec![0u16; id.len()];
     for (i, p) in plane.iter_mut().enumerate() {
@@ -585,7 +569,7 @@ fn planes_from_aov(
         let v = divide(aov[i], i);
         let r = v.round();
         if !(0.0..=65535.0).contains(&r) {
-            return Err(pixel.error(
+            return Err(pixel.at(
                 i,
                 format!("plane {v} from AOV {name:?} is not an index in 0–65535"),
             ));
@@ -605,7 +589,7 @@ fn planes_from_geometry(
     id: &[u16],
     equations: &[[f64; 4]],
     max_angle_deg: f64,
-    pixel: &PixelAt<'_>,
+    pixel: &PixelError<'_>,
 ) -> Result<Vec<u16>, MaskError> {
     let min_cos = max_angle_deg.to_radians().cos();
     let mut plane = vec![0u16; id.len()];
@@ -617,7 +601,7 @@ fn planes_from_geometry(
         let pos: [f64; 3] = std::array::from_fn(|k| f64::from(passes[3 + k][i]));
         let ln = norm(nrm);
         if ln.is_nan() || ln <= 0.0 {
-            return Err(pixel.error(i, "the Normal pass is zero on a glass pixel".into()));
+            return Err(pixel.at(i, "the Normal pass is zero on a glass pixel".into()));
         }
         let scored: Vec<(usize, f64, f64)> = equations
             .iter()

@@ -293,13 +293,13 @@ fn decode_wanted_channels(
 }
 
 /// Builds [`MaskError::BadPixel`] for a pixel index of a mask file.
-struct PixelError<'a> {
-    path: &'a Path,
-    width: usize,
+pub(crate) struct PixelError<'a> {
+    pub(crate) path: &'a Path,
+    pub(crate) width: usize,
 }
 
 impl PixelError<'_> {
-    fn at(&self, i: usize, detail: String) -> MaskError {
+    pub(crate) fn at(&self, i: usize, detail: String) -> MaskError {
         MaskError::BadPixel {
             path: self.path.to_path_buf(),
             x: (i % self.width) as u32,
