@@ -11,6 +11,7 @@ use glassdb_compose::io::{ExrDataType, OutputOptions, PassReadOptions, parse_exr
 use glassdb_compose::lut::GlassLut;
 use glassdb_compose::pixels::{InputTransfer, PngBits};
 use glassdb_compose::sequence::{self, FrameOutcome};
+use glassdb_compose::view::ViewTransform;
 use glassdb_compose::{
     ComposeJob, ComposeSettings, FrameReport, InputLayers, OutsidePolicy, UnknownIds, compose_frame,
 };
@@ -126,6 +127,12 @@ pub struct Args {
     /// PNG output bits per sample (default: the transmission pass's, 8 for EXR input).
     #[arg(long, value_parser = ["8", "16"])]
     pub png_bits: Option<String>,
+    /// View transform of PNG output: `standard` (the sRGB transfer, clipped) or a `.cube` LUT
+    /// (1D, 3D, or a 1D shaper then 3D, e.g. AgX, Filmic or ACES baked by `ociobakelut --format
+    /// resolve_cube`; docs/colour.md) whose output is display-encoded. EXR output stays
+    /// scene-linear, so --view with a .exr output is refused. [default: standard]
+    #[arg(long, value_name = "standard|FILE.cube")]
+    pub view: Option<String>,
     /// Dither for 8-bit PNG output.
     #[arg(long, value_enum, default_value_t = DitherArg::Ordered)]
     pub dither: DitherArg,
@@ -411,6 +418,11 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
             }
         }),
         dither: args.dither == DitherArg::Ordered,
+        view: args
+            .view
+            .as_deref()
+            .map(ViewTransform::from_arg)
+            .transpose()?,
         keep_channels: args.keep_channels == KeepArg::All,
         output_layer: args.output_layer.clone(),
         provenance: vec![

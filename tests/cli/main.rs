@@ -14,3 +14,4 @@ mod scene;
 mod spectral;
 mod util;
 mod validation;
+mod view;

@@ -171,6 +171,27 @@ pub enum ComposeError {
         "the output {path} has no #### for the frame number, so every frame would overwrite it"
     )]
     OutputWithoutFramePattern { path: PathBuf },
+    /// A `.cube` line that cannot be read (docs/colour.md).
+    #[error("{path}, line {line}: {problem} (line: {text:?})")]
+    CubeSyntax {
+        path: PathBuf,
+        line: usize,
+        text: String,
+        problem: String,
+    },
+    /// A `.cube` file whose header and tables do not agree, or that is no LUT at all.
+    #[error("{path}: {problem}")]
+    CubeInvalid { path: PathBuf, problem: String },
+    /// A `.cube` file too large to be a LUT this reader accepts (checked before reading).
+    #[error(
+        "{path} is {bytes} bytes; a .cube file of at most {max} bytes is read (LUT_3D_SIZE ≤ 129)"
+    )]
+    CubeTooLarge { path: PathBuf, bytes: u64, max: u64 },
+    /// A view transform asked of an EXR output, which stays scene-linear.
+    #[error(
+        "--view applies to PNG output only, but {path} is EXR, which stays scene-linear: write a .png to see the view, or apply the view later in your viewer or compositor (OCIO)"
+    )]
+    ViewOnExr { path: PathBuf },
 }
 
 impl ComposeError {

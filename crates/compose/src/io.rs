@@ -15,6 +15,7 @@ use exr::meta::attribute::{AttributeValue, Text};
 
 use crate::ComposeError;
 use crate::pixels::{EncodedImage, EncodedSamples, InputTransfer, LinearImage, PngBits};
+use crate::view::ViewTransform;
 
 /// How to read a pass.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -266,6 +267,9 @@ pub struct OutputOptions {
     pub png_bits: Option<PngBits>,
     /// Ordered dither for 8-bit PNG output.
     pub dither: bool,
+    /// View transform of PNG output (`None`: [`ViewTransform::Standard`]). Given for an EXR
+    /// output, which stays scene-linear, it is an error ([`ComposeError::ViewOnExr`]).
+    pub view: Option<ViewTransform>,
     /// EXR output keeps the transmission file's other channels and parts (Z, AOVs, other
     /// views), unchanged.
     pub keep_channels: bool,
@@ -284,6 +288,7 @@ impl Default for OutputOptions {
             exr_zip_level: None,
             png_bits: None,
             dither: true,
+            view: None,
             keep_channels: true,
             output_layer: None,
             provenance: Vec::new(),
@@ -420,6 +425,7 @@ pub fn write_output_in_frame(
     opts: &OutputOptions,
 ) -> Result<WrittenOutput, ComposeError> {
     let format = output_format(path)?;
+    check_view(path, opts)?;
     let mut half_overflow = 0;
     let mut kept_channels = 0;
     let (bytes_written, encoding) = match format {
@@ -483,14 +489,18 @@ pub fn write_output_in_frame(
                 PassSource::Exr { .. } => PngBits::Eight,
             });
             image.unpremultiply();
-            let encoded = image.to_encoded(bits, opts.dither);
+            let view = opts.view.clone().unwrap_or_default();
+            let encoded = image.to_encoded_view(bits, opts.dither, &view);
             let n = write_png(path, &encoded)?;
-            let desc = match bits {
-                PngBits::Eight if opts.dither => "8-bit sRGB, ordered dither",
-                PngBits::Eight => "8-bit sRGB",
-                PngBits::Sixteen => "16-bit sRGB",
+            let depth = match bits {
+                PngBits::Eight => "8-bit",
+                PngBits::Sixteen => "16-bit",
             };
-            (n, desc.to_string())
+            let mut desc = format!("{depth} {}", view.describe());
+            if bits == PngBits::Eight && opts.dither {
+                desc += ", ordered dither";
+            }
+            (n, desc)
         }
     };
     Ok(WrittenOutput {
@@ -501,6 +511,16 @@ pub fn write_output_in_frame(
         half_overflow,
         kept_channels,
     })
+}
+
+/// Refuses a view transform for an EXR output (scene-linear) before any work is done.
+pub fn check_view(path: &Path, opts: &OutputOptions) -> Result<(), ComposeError> {
+    if opts.view.is_some() && output_format(path)? == OutputFormat::Exr {
+        return Err(ComposeError::ViewOnExr {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(())
 }
 
 /// The R, G, B (and A) planes of the composite, named `prefix` + channel.

@@ -16,6 +16,7 @@ pub mod kernel;
 pub mod lut;
 pub mod pixels;
 pub mod sequence;
+pub mod view;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -421,6 +422,7 @@ pub fn compose_frame(
         return Err(ComposeError::NoReflectionPass);
     }
     io::output_format(&job.output)?;
+    io::check_view(&job.output, &settings.output)?;
     if let Some(name) = &settings.output.output_layer {
         io::check_layer_name(name)?;
     }

@@ -14,6 +14,8 @@
 
 use rayon::prelude::*;
 
+use crate::view::ViewTransform;
+
 /// Linear-light RGB(A), planar, row-major, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearImage {
@@ -78,18 +80,34 @@ impl LinearImage {
     /// with an 8×8 ordered (Bayer) pattern when `dither` is set. Values outside [0, 1] are
     /// clamped, NaN becomes 0.
     pub fn to_encoded(&self, bits: PngBits, dither: bool) -> EncodedImage {
+        self.to_encoded_view(bits, dither, &ViewTransform::Standard)
+    }
+
+    /// Encodes into PNG samples through `view`: [`ViewTransform::Standard`] is the sRGB
+    /// transfer of [`LinearImage::to_encoded`]; a LUT's output is taken as display-encoded and
+    /// only clamped to [0, 1] (NaN → 0) before the same quantisation (and dither).
+    pub fn to_encoded_view(
+        &self,
+        bits: PngBits,
+        dither: bool,
+        view: &ViewTransform,
+    ) -> EncodedImage {
         let w = self.width as usize;
         let channels = if self.alpha.is_some() { 4 } else { 3 };
         let n = self.pixel_count();
-        let encode_row = |y: usize, x: usize, c: usize| -> f32 {
+        let linear = |i: usize, c: usize| self.rgb[c].get(i).copied().unwrap_or(0.0);
+        let encode_pixel = |y: usize, x: usize| -> [f32; 4] {
             let i = y * w + x;
-            match self.rgb.get(c) {
-                Some(plane) => linear_to_srgb(plane.get(i).copied().unwrap_or(0.0)),
-                None => self
-                    .alpha
-                    .as_ref()
-                    .map_or(1.0, |a| sanitize(a.get(i).copied().unwrap_or(1.0))),
-            }
+            let rgb = [linear(i, 0), linear(i, 1), linear(i, 2)];
+            let [r, g, b] = match view {
+                ViewTransform::Standard => rgb.map(linear_to_srgb),
+                ViewTransform::Lut(lut) => lut.apply(rgb).map(sanitize),
+            };
+            let a = self
+                .alpha
+                .as_ref()
+                .map_or(1.0, |a| sanitize(a.get(i).copied().unwrap_or(1.0)));
+            [r, g, b, a]
         };
         let samples = match bits {
             PngBits::Eight => {
@@ -99,11 +117,11 @@ impl LinearImage {
                     .for_each(|(y, row)| {
                         for (x, px) in row.chunks_exact_mut(channels).enumerate() {
                             let threshold = if dither { BAYER8[y % 8][x % 8] } else { 0.5 };
+                            let v = encode_pixel(y, x);
                             for (c, s) in px.iter_mut().enumerate() {
-                                let v = encode_row(y, x, c);
                                 // Alpha is never dithered.
                                 let t = if c == 3 { 0.5 } else { threshold };
-                                *s = (v * 255.0 + t).floor().clamp(0.0, 255.0) as u8;
+                                *s = (v[c] * 255.0 + t).floor().clamp(0.0, 255.0) as u8;
                             }
                         }
                     });
@@ -115,11 +133,9 @@ impl LinearImage {
                     .enumerate()
                     .for_each(|(y, row)| {
                         for (x, px) in row.chunks_exact_mut(channels).enumerate() {
+                            let v = encode_pixel(y, x);
                             for (c, s) in px.iter_mut().enumerate() {
-                                *s = (encode_row(y, x, c) * 65535.0 + 0.5)
-                                    .floor()
-                                    .clamp(0.0, 65535.0)
-                                    as u16;
+                                *s = (v[c] * 65535.0 + 0.5).floor().clamp(0.0, 65535.0) as u16;
                             }
                         }
                     });
