@@ -175,6 +175,18 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
             Some("give one --refl per plane of --planes, in its order".into())
         }
         ComposeError::FrameList { .. } => Some("check --frames".into()),
+        ComposeError::ViewOnExr { .. } => Some(
+            "write a .png (-o NAME.png) to see --view, or drop --view and apply the view to the \
+             EXR in your viewer or compositor (OCIO)"
+                .into(),
+        ),
+        ComposeError::CubeSyntax { .. }
+        | ComposeError::CubeInvalid { .. }
+        | ComposeError::CubeTooLarge { .. } => Some(
+            "--view takes `standard` or a .cube LUT, e.g. baked by ociobakelut --format \
+             resolve_cube (docs/colour.md)"
+                .into(),
+        ),
         ComposeError::ZipLevelNotApplicable { .. } | ComposeError::ZipLevelOutOfRange { .. } => {
             Some("--zip-level sets it".into())
         }

@@ -189,7 +189,7 @@ pub enum ComposeError {
     CubeTooLarge { path: PathBuf, bytes: u64, max: u64 },
     /// A view transform asked of an EXR output, which stays scene-linear.
     #[error(
-        "--view applies to PNG output only, but {path} is EXR, which stays scene-linear: write a .png to see the view, or apply the view later in your viewer or compositor (OCIO)"
+        "a view transform applies to PNG output only, but {path} is EXR, which stays scene-linear"
     )]
     ViewOnExr { path: PathBuf },
 }
