@@ -9,8 +9,10 @@ Prints one JSON object keyed by the file path as given. For every quantity prese
   (`SpectralDistribution.align`), then sum(value * c) / sum(c) per channel (method.md eqs. 15-20);
 - `colorimetric`: {observer: {illuminant: {space: [r, g, b]}}}: `colour.sd_to_XYZ(method=
   "Integration")` of the spectrum with the CMFs trimmed to 360-780 nm at 1 nm and the illuminant,
-  then `colour.XYZ_to_RGB(chromatic_adaptation_transform=None)`, divided channel by channel by
-  the same for a perfect (1.0) spectrum, i.e. the illuminant itself;
+  then `colour.XYZ_to_RGB(XYZ, space, illuminant=CCS_ILLUMINANTS[observer][illuminant])` with
+  colour's default chromatic adaptation (CAT02, from the illuminant's white to the space's;
+  a no-op up to rounding where they are equal), divided channel by channel by the same for a
+  perfect (1.0) spectrum, i.e. the illuminant itself; space `xyz` is XYZ itself;
 - `luminous_iso`: Y / 100 with CMFs and D65 aligned to 380-780 nm at 10 nm (ISO 9050 grid);
 - `luminous_1nm`: the same at 1 nm (D65 linearly interpolated by colour).
 
@@ -45,7 +47,14 @@ OBSERVERS = {
     "cie1964": "CIE 1964 10 Degree Standard Observer",
 }
 ILLUMINANTS = ["D65", "A", "E"]
-SPACES = {"srgb": "sRGB", "acescg": "ACEScg", "display-p3": "Display P3"}
+SPACES = {
+    "srgb": "sRGB",
+    "rec2020": "ITU-R BT.2020",
+    "acescg": "ACEScg",
+    "aces2065-1": "ACES2065-1",
+    "display-p3": "Display P3",
+    "xyz": None,
+}
 QUANTITIES = ["transmittance", "reflectance", "reflectance_back"]
 
 
@@ -131,8 +140,11 @@ def colorimetric(sd, observer, illuminant, space):
     white = SpectralDistribution(np.ones(len(sd.wavelengths)), sd.wavelengths)
     XYZ_w = colour.sd_to_XYZ(white, cmfs, ill, method="Integration")
     cs = SPACES[space]
-    RGB = colour.XYZ_to_RGB(XYZ / 100, cs, chromatic_adaptation_transform=None)
-    RGB_w = colour.XYZ_to_RGB(XYZ_w / 100, cs, chromatic_adaptation_transform=None)
+    if cs is None:
+        return list(XYZ / XYZ_w)
+    white = colour.CCS_ILLUMINANTS[OBSERVERS[observer]][illuminant]
+    RGB = colour.XYZ_to_RGB(XYZ / 100, cs, illuminant=white)
+    RGB_w = colour.XYZ_to_RGB(XYZ_w / 100, cs, illuminant=white)
     return list(RGB / RGB_w)
 
 

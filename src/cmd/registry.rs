@@ -52,7 +52,8 @@ pub struct BuildArgs {
     /// Illuminant for --method colorimetric: D65, A or E.
     #[arg(long, default_value = "D65")]
     pub illuminant: String,
-    /// RGB working space for --method colorimetric: srgb, acescg or display-p3.
+    /// RGB working space for --method colorimetric: srgb (alias rec709), rec2020, acescg,
+    /// aces2065-1, display-p3 or xyz.
     #[arg(long, default_value = "srgb")]
     pub space: String,
     /// Hold end values where a spectrum does not cover the method's range (else an error).

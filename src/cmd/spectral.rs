@@ -49,10 +49,21 @@ pub enum IlluminantArg {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum SpaceArg {
+    /// Linear Rec.709 / sRGB (alias rec709).
+    #[value(name = "srgb", alias = "rec709")]
     Srgb,
+    /// Linear Rec.2020.
+    Rec2020,
+    /// ACEScg (AP1).
     Acescg,
+    /// ACES2065-1 (AP0).
+    #[value(name = "aces2065-1")]
+    Aces2065_1,
+    /// Display P3 (linear).
     #[value(name = "display-p3")]
     DisplayP3,
+    /// CIE XYZ (the identity).
+    Xyz,
 }
 
 /// How a spectral file is read and becomes three numbers: the method, its options and the
@@ -145,8 +156,11 @@ impl SpectralSettingsArgs {
                     },
                     space: match self.space.unwrap_or(SpaceArg::Srgb) {
                         SpaceArg::Srgb => RgbSpace::Srgb,
+                        SpaceArg::Rec2020 => RgbSpace::Rec2020,
                         SpaceArg::Acescg => RgbSpace::AcesCg,
+                        SpaceArg::Aces2065_1 => RgbSpace::Aces2065_1,
                         SpaceArg::DisplayP3 => RgbSpace::DisplayP3,
+                        SpaceArg::Xyz => RgbSpace::Xyz,
                     },
                 }
             }

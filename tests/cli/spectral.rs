@@ -162,6 +162,71 @@ fn every_fixture_matches_colour_science_to_1e9() {
     compare_with_oracle(&files, &ReadOptions::default(), false, 1e-9);
 }
 
+/// Every RGB space (docs/spectral.md "Working spaces") against colour-science's `XYZ_to_RGB`
+/// with the integration's illuminant and its default CAT02 adaptation, on a clear and two
+/// tinted glasses, every quantity, observer and illuminant: the largest relative difference per
+/// space (the numbers docs/spectral.md quotes, printed with `--nocapture`).
+#[test]
+fn every_rgb_space_matches_colour_science_on_clear_and_tinted_glass() {
+    let files: Vec<PathBuf> = ["CLEAR_3.DAT", "913.json", "nfrc_20748.oag"]
+        .iter()
+        .map(|f| fixture(f))
+        .collect();
+    let args: Vec<&OsStr> = files.iter().map(|p| p.as_os_str()).collect();
+    let oracle: Value =
+        serde_json::from_str(&run_oracle("spectral_oracle.py", &args)).expect("oracle JSON");
+    for space in RgbSpace::ALL {
+        let (mut worst, mut count) = (0.0f64, 0);
+        for path in &files {
+            let data = read_spectral_file(path, &ReadOptions::default()).unwrap();
+            let expected = &oracle[path.to_str().unwrap()];
+            for (q, values) in quantities(&data) {
+                for observer in Observer::ALL {
+                    for illuminant in Illuminant::ALL {
+                        let it = Integrator::new(&IntegrationSettings {
+                            method: Method::Colorimetric {
+                                observer: *observer,
+                                illuminant: *illuminant,
+                                space: *space,
+                            },
+                            extrapolate: false,
+                        })
+                        .unwrap();
+                        let got = it.channels(&data.wavelength_nm, values).unwrap();
+                        let want = rgb_of(
+                            &expected[q]["colorimetric"][observer.name()][illuminant.name()]
+                                [space.name()],
+                        );
+                        for c in 0..3 {
+                            let rel = (got[c] - want[c]).abs() / want[c].abs().max(1e-3);
+                            assert!(
+                                rel <= 1e-9,
+                                "{path:?} {q} {observer} {illuminant} {space} channel {c}: \
+                                 got {}, colour-science {} (relative {rel:e})",
+                                got[c],
+                                want[c]
+                            );
+                            worst = worst.max(rel);
+                            count += 1;
+                        }
+                    }
+                }
+            }
+        }
+        println!("{space}: {count} numbers, largest relative difference {worst:.1e}");
+    }
+    // The CLI exposes every space by name, and rec709 as sRGB.
+    let clear = fixture("CLEAR_3.DAT");
+    let srgb = transmittance_rgb(&["--space", "srgb"], &clear);
+    assert_eq!(transmittance_rgb(&["--space", "rec709"], &clear), srgb);
+    let v = spectral_json(&["--space", "rec709"], &clear);
+    assert_eq!(v["space"], "srgb");
+    for space in RgbSpace::ALL {
+        let v = spectral_json(&["--space", space.name()], &clear);
+        assert_eq!(v["space"].as_str(), Some(space.name()));
+    }
+}
+
 #[test]
 fn cli_json_matches_the_library_and_has_the_documented_keys() {
     for name in ["CLEAR_3.DAT", "913.json", "nfrc_20748.oag"] {

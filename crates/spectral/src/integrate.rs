@@ -56,17 +56,31 @@ pub enum Illuminant {
     E,
 }
 
-/// Linear RGB working space of the renderer (colorimetric method).
+/// Linear RGB working space of the renderer (colorimetric method). Each space's XYZ→RGB matrix
+/// is colour-science 0.4.7's `RGB_COLOURSPACES[...].matrix_XYZ_to_RGB`; XYZ integrated under an
+/// illuminant whose white differs from the space's white is first adapted with CAT02, as
+/// colour's `XYZ_to_RGB` does by default (see [`rgb_matrix`] and docs/spectral.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
 pub enum RgbSpace {
-    /// ITU-R BT.709 / sRGB primaries, D65 white (IEC 61966-2-1 matrix, as colour uses it).
+    /// Linear ITU-R BT.709 / sRGB primaries, D65 white (IEC 61966-2-1 matrix, as colour's
+    /// `sRGB` holds it). `rec709` is accepted as an alias on input; it is written `srgb`.
+    #[serde(rename = "srgb", alias = "rec709")]
     Srgb,
-    /// ACEScg (AP1 primaries, ACES white).
+    /// ITU-R BT.2020 primaries, D65 white.
+    #[serde(rename = "rec2020")]
+    Rec2020,
+    /// ACEScg (AP1 primaries, ACES white ≈ D60).
     #[serde(rename = "acescg")]
     AcesCg,
+    /// ACES2065-1 (AP0 primaries, ACES white ≈ D60; the SMPTE ST 2065-1 matrix).
+    #[serde(rename = "aces2065-1")]
+    Aces2065_1,
     /// Display P3 (P3 primaries, D65 white).
+    #[serde(rename = "display-p3")]
     DisplayP3,
+    /// CIE XYZ itself (the identity; no white point, no adaptation).
+    #[serde(rename = "xyz")]
+    Xyz,
 }
 
 /// How a spectrum becomes three numbers.
@@ -78,7 +92,9 @@ pub enum Method {
     /// below the smallest: that is the formula, not a defect.
     Paper(RgbCmf),
     /// `RGB(value × illuminant) / RGB(illuminant)` per channel, XYZ through the observer over
-    /// 360–780 nm at 1 nm, then the space's XYZ→RGB matrix (no chromatic adaptation).
+    /// 360–780 nm at 1 nm, then CAT02 from the illuminant's white to the space's white (identity
+    /// when they are equal, and for [`RgbSpace::Xyz`]) and the space's XYZ→RGB matrix
+    /// ([`rgb_matrix`]).
     Colorimetric {
         observer: Observer,
         illuminant: Illuminant,
@@ -286,7 +302,7 @@ impl Integrator {
                 };
                 let grid: Vec<f64> = (360..=780).map(f64::from).collect();
                 let xyz_weights = xyz_weights(cmfs, illuminant_on(&grid, illuminant)?, &grid)?;
-                let m = xyz_to_rgb(space);
+                let m = rgb_matrix(observer, illuminant, space);
                 let white_xyz = xyz_weights
                     .iter()
                     .fold(Vector3::zeros(), |acc, w| acc + Vector3::from(*w));
@@ -508,22 +524,98 @@ fn luminous_weights(grid: LuminousGrid) -> Result<(Vec<f64>, Vec<f64>), Spectral
     Ok((grid, xyz.iter().map(|w| w[1] / total).collect()))
 }
 
-/// XYZ → linear RGB matrix of a working space, as colour-science 0.4.7 holds it.
+/// XYZ → linear RGB matrix of a working space, as colour-science 0.4.7 holds it
+/// (`RGB_COLOURSPACES[...].matrix_XYZ_to_RGB`; the identity for [`RgbSpace::Xyz`]).
+/// It expects XYZ relative to the space's own white ([`RgbSpace::whitepoint_xy`]).
 pub fn xyz_to_rgb(space: RgbSpace) -> Matrix3<f64> {
     match space {
         // colour uses the IEC 61966-2-1 published (rounded) matrix for sRGB.
         RgbSpace::Srgb => Matrix3::new(
             3.2406, -1.5372, -0.4986, -0.9689, 1.8758, 0.0415, 0.0557, -0.2040, 1.0570,
         ),
+        RgbSpace::Rec2020 => invert(normalised_primary_matrix(
+            [0.708, 0.292, 0.170, 0.797, 0.131, 0.046],
+            D65_XY,
+        )),
         RgbSpace::AcesCg => invert(normalised_primary_matrix(
             [0.713, 0.293, 0.165, 0.830, 0.128, 0.044],
-            [0.32168, 0.33767],
+            ACES_XY,
         )),
+        // colour uses the published (10-decimal) XYZ→AP0 matrix of SMPTE ST 2065-1 / ACES
+        // TB-2014-004, not the one derived from the primaries (they differ by 4e-11).
+        RgbSpace::Aces2065_1 => Matrix3::new(
+            1.0498110175,
+            0.0,
+            -0.0000974845,
+            -0.4959030231,
+            1.3733130458,
+            0.0982400361,
+            0.0,
+            0.0,
+            0.9912520182,
+        ),
         RgbSpace::DisplayP3 => invert(normalised_primary_matrix(
             [0.680, 0.320, 0.265, 0.690, 0.150, 0.060],
-            [0.3127, 0.3290],
+            D65_XY,
         )),
+        RgbSpace::Xyz => Matrix3::identity(),
     }
+}
+
+/// CIE 1931 xy of D65 as colour holds it (the white of sRGB, BT.2020 and Display P3).
+const D65_XY: [f64; 2] = [0.3127, 0.3290];
+/// CIE 1931 xy of the ACES white (≈ D60; ACES TB-2014-004).
+const ACES_XY: [f64; 2] = [0.32168, 0.33767];
+
+impl RgbSpace {
+    /// The space's white point as CIE xy, as colour holds it; `None` for [`RgbSpace::Xyz`].
+    pub fn whitepoint_xy(self) -> Option<[f64; 2]> {
+        match self {
+            RgbSpace::Srgb | RgbSpace::Rec2020 | RgbSpace::DisplayP3 => Some(D65_XY),
+            RgbSpace::AcesCg | RgbSpace::Aces2065_1 => Some(ACES_XY),
+            RgbSpace::Xyz => None,
+        }
+    }
+}
+
+impl Illuminant {
+    /// The illuminant's white as CIE xy for `observer`, as colour's `CCS_ILLUMINANTS` holds it.
+    pub fn white_xy(self, observer: Observer) -> [f64; 2] {
+        match (self, observer) {
+            (Illuminant::D65, Observer::Cie1931) => D65_XY,
+            (Illuminant::D65, Observer::Cie1964) => [0.31382, 0.33100],
+            (Illuminant::A, Observer::Cie1931) => [0.44758, 0.40745],
+            (Illuminant::A, Observer::Cie1964) => [0.45117, 0.40594],
+            (Illuminant::E, _) => [1.0 / 3.0, 1.0 / 3.0],
+        }
+    }
+}
+
+/// XYZ (integrated with `observer` under `illuminant`) → linear RGB of `space`: what
+/// colour-science 0.4.7's `XYZ_to_RGB(XYZ, space, illuminant=CCS_ILLUMINANTS[observer]
+/// [illuminant])` does with its default `chromatic_adaptation_transform="CAT02"`, i.e.
+/// `xyz_to_rgb(space) · M_CAT02(illuminant white → space white)` (method.md eqs. 15–20 for the
+/// integration; von Kries in the CAT02 sharpened space). The adaptation is left out (exactly
+/// the identity) when the two whites are equal and for [`RgbSpace::Xyz`].
+pub fn rgb_matrix(observer: Observer, illuminant: Illuminant, space: RgbSpace) -> Matrix3<f64> {
+    let m = xyz_to_rgb(space);
+    match space.whitepoint_xy() {
+        Some(white) if white != illuminant.white_xy(observer) => {
+            m * cat02(illuminant.white_xy(observer), white)
+        }
+        _ => m,
+    }
+}
+
+/// Von Kries adaptation matrix in the CAT02 space from white `from_xy` to white `to_xy` (colour's
+/// `matrix_chromatic_adaptation_VonKries(..., transform="CAT02")`, whites at Y = 1).
+fn cat02(from_xy: [f64; 2], to_xy: [f64; 2]) -> Matrix3<f64> {
+    let m = Matrix3::new(
+        0.7328, 0.4296, -0.1624, -0.7036, 1.6975, 0.0061, 0.0030, 0.0136, 0.9834,
+    );
+    let xyz = |xy: [f64; 2]| Vector3::new(xy[0] / xy[1], 1.0, (1.0 - xy[0] - xy[1]) / xy[1]);
+    let (from, to) = (m * xyz(from_xy), m * xyz(to_xy));
+    invert(m) * Matrix3::from_diagonal(&to.component_div(&from)) * m
 }
 
 fn invert(m: Matrix3<f64>) -> Matrix3<f64> {
@@ -617,7 +709,7 @@ thread_local! {
 }
 
 macro_rules! names {
-    ($ty:ty { $($variant:ident => $name:literal),+ $(,)? }) => {
+    ($ty:ty { $($variant:ident => $name:literal $(| $alias:literal)*),+ $(,)? }) => {
         impl $ty {
             /// The name used on the command line and in JSON.
             pub fn name(self) -> &'static str {
@@ -634,7 +726,9 @@ macro_rules! names {
         impl FromStr for $ty {
             type Err = String;
             fn from_str(s: &str) -> Result<Self, String> {
-                $(if s.eq_ignore_ascii_case($name) { return Ok(<$ty>::$variant); })+
+                $(if s.eq_ignore_ascii_case($name) $(|| s.eq_ignore_ascii_case($alias))* {
+                    return Ok(<$ty>::$variant);
+                })+
                 Err(format!("unknown value `{s}`; expected one of: {}", [$($name),+].join(", ")))
             }
         }
@@ -645,7 +739,14 @@ names!(RgbCmf { WrightGuild1931 => "wright-guild-1931", StilesBurch1955 => "stil
 names!(Observer { Cie1931 => "cie1931", Cie1964 => "cie1964" });
 names!(Illuminant { D65 => "D65", A => "A", E => "E" });
 names!(MethodKind { Colorimetric => "colorimetric", Paper => "paper", Luminous => "luminous" });
-names!(RgbSpace { Srgb => "srgb", AcesCg => "acescg", DisplayP3 => "display-p3" });
+names!(RgbSpace {
+    Srgb => "srgb" | "rec709",
+    Rec2020 => "rec2020",
+    AcesCg => "acescg",
+    Aces2065_1 => "aces2065-1",
+    DisplayP3 => "display-p3",
+    Xyz => "xyz",
+});
 
 #[cfg(test)]
 mod tests {
@@ -709,6 +810,75 @@ mod tests {
             0.9883948585,
         );
         assert!((aces - spec).abs().max() < 1e-9);
+    }
+
+    #[test]
+    fn adaptation_is_cat02_to_the_space_white_and_identity_where_the_whites_agree() {
+        // D65 spaces under 1931 D65, and XYZ under anything: no adaptation at all (bit-exact).
+        for space in [RgbSpace::Srgb, RgbSpace::Rec2020, RgbSpace::DisplayP3] {
+            assert_eq!(
+                rgb_matrix(Observer::Cie1931, Illuminant::D65, space),
+                xyz_to_rgb(space)
+            );
+        }
+        for &o in Observer::ALL {
+            for &i in Illuminant::ALL {
+                assert_eq!(rgb_matrix(o, i, RgbSpace::Xyz), Matrix3::identity());
+            }
+        }
+        // colour 0.4.7: XYZ_to_RGB(np.identity(3), "ACEScg", illuminant=D65) (columns are the
+        // images of X, Y, Z), i.e. AP1 · CAT02(D65 → ACES).
+        let colour = Matrix3::new(
+            1.658854308471041,
+            -0.31185697539741886,
+            -0.24315600712571486,
+            -0.6622832871075869,
+            1.6121995708713222,
+            0.01585912660306284,
+            0.01148056645747657,
+            -0.00923632492424387,
+            0.91668651344913,
+        );
+        let ours = rgb_matrix(Observer::Cie1931, Illuminant::D65, RgbSpace::AcesCg);
+        assert!((ours - colour).abs().max() < 1e-12, "{ours}");
+        // The adapted D65 white lands on the ACES white, i.e. on equal AP1 channels.
+        let d65 = Vector3::new(0.3127 / 0.3290, 1.0, (1.0 - 0.3127 - 0.3290) / 0.3290);
+        let w = ours * d65;
+        assert!(
+            (w[0] - 1.0).abs() < 1e-12 && (w[1] - 1.0).abs() < 1e-12 && (w[2] - 1.0).abs() < 1e-12
+        );
+        // The AP0 matrix is the published ST 2065-1 one; it nearly inverts the primaries' NPM.
+        let npm = normalised_primary_matrix([0.7347, 0.2653, 0.0, 1.0, 0.0001, -0.077], ACES_XY);
+        assert!(
+            (xyz_to_rgb(RgbSpace::Aces2065_1) * npm - Matrix3::identity())
+                .abs()
+                .max()
+                < 1e-9
+        );
+    }
+
+    #[test]
+    fn rec709_is_an_input_alias_of_srgb() {
+        assert_eq!("rec709".parse::<RgbSpace>().unwrap(), RgbSpace::Srgb);
+        assert_eq!("Rec709".parse::<RgbSpace>().unwrap(), RgbSpace::Srgb);
+        let json: RgbSpace = serde_json::from_str(r#""rec709""#).unwrap();
+        assert_eq!(json, RgbSpace::Srgb);
+        assert_eq!(serde_json::to_string(&json).unwrap(), r#""srgb""#);
+        let names: Vec<&str> = RgbSpace::ALL.iter().map(|s| s.name()).collect();
+        assert_eq!(
+            names,
+            [
+                "srgb",
+                "rec2020",
+                "acescg",
+                "aces2065-1",
+                "display-p3",
+                "xyz"
+            ]
+        );
+        for &s in RgbSpace::ALL {
+            assert_eq!(s.name().parse::<RgbSpace>().unwrap(), s);
+        }
     }
 
     #[test]

@@ -22,7 +22,7 @@ mod tables;
 pub use error::SpectralError;
 pub use integrate::{
     Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind, Observer,
-    RgbCmf, RgbSpace, luminous, luminous_iso9050, xyz_to_rgb,
+    RgbCmf, RgbSpace, luminous, luminous_iso9050, rgb_matrix, xyz_to_rgb,
 };
 pub use interp::resample;
 pub use read::{
