@@ -12,9 +12,9 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
-use glassdb_image::{ExrFile, ImageWindows};
+use glassdb_image::ExrFile;
 
-use crate::read::PixelError;
+use crate::read::{PixelError, decode_channels, locate_channel};
 use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
 
 /// A manifest side file larger than this is refused (a manifest is a list of names).
@@ -256,65 +256,13 @@ fn rank_channels(exr: &ExrFile<'_>, layer: &str) -> Vec<[(usize, usize); 4]> {
     levels
 }
 
-/// Decodes channels (part, channel) of the file; every part must share one data window.
-fn decode(
-    exr: &ExrFile<'_>,
-    wanted: &[(usize, usize)],
-    path: &Path,
-) -> Result<(ImageWindows, Vec<Vec<f32>>), MaskError> {
-    let mut out: Vec<Option<Vec<f32>>> = vec![None; wanted.len()];
-    let mut windows: Option<ImageWindows> = None;
-    let mut parts: Vec<usize> = wanted.iter().map(|w| w.0).collect();
-    parts.sort_unstable();
-    parts.dedup();
-    for p in parts {
-        let slots: Vec<usize> = (0..wanted.len()).filter(|&k| wanted[k].0 == p).collect();
-        let channels: Vec<usize> = slots.iter().map(|&k| wanted[k].1).collect();
-        let (info, buffers) =
-            exr.read_channels(p, &channels)
-                .map_err(|source| MaskError::Decode {
-                    path: path.to_path_buf(),
-                    source,
-                })?;
-        match windows {
-            None => windows = Some(info.windows()),
-            Some(w) if w.data != info.data_window => {
-                return Err(layout(
-                    path,
-                    format!(
-                        "the channels lie in parts with different data windows ({} and {})",
-                        w.data, info.data_window
-                    ),
-                ));
-            }
-            Some(_) => {}
-        }
-        for (k, b) in slots.into_iter().zip(buffers) {
-            out[k] = Some(b);
-        }
-    }
-    let windows = windows.ok_or_else(|| layout(path, "no channels to read".into()))?;
-    Ok((
-        windows,
-        out.into_iter().map(Option::unwrap_or_default).collect(),
-    ))
-}
-
-/// A channel (or a vector pass's three channels) by the name a user gives.
+/// A required channel by the name a user gives.
 fn locate(exr: &ExrFile<'_>, name: &str, path: &Path) -> Result<(usize, usize), MaskError> {
-    match glassdb_image::find_channel(exr.parts(), name, None) {
-        glassdb_image::ChannelMatch::Found(p, c) => Ok((p, c)),
-        glassdb_image::ChannelMatch::Ambiguous(candidates) => Err(MaskError::AmbiguousChannel {
-            path: path.to_path_buf(),
-            channel: name.to_string(),
-            candidates,
-        }),
-        glassdb_image::ChannelMatch::Missing => Err(MaskError::MissingChannel {
-            path: path.to_path_buf(),
-            channel: name.to_string(),
-            available: glassdb_image::all_channel_names(exr.parts()),
-        }),
-    }
+    locate_channel(exr.parts(), name, None, true, path)?.ok_or_else(|| MaskError::MissingChannel {
+        path: path.to_path_buf(),
+        channel: name.to_string(),
+        available: glassdb_image::all_channel_names(exr.parts()),
+    })
 }
 
 /// The three channels of a vector pass: `NAME.X/.Y/.Z` or `NAME.R/.G/.B`.
@@ -401,7 +349,7 @@ pub fn mask_from_cryptomatte(
             wanted.extend(locate_vector(exr, position, path)?);
         }
     }
-    let (windows, planes) = decode(exr, &wanted, path)?;
+    let (windows, planes) = decode_channels(exr, &wanted, path)?;
     let (ranks_data, rest) = planes.split_at(rank_count);
     let glass = dominant_glass(ranks_data, &glass_of);
     let pixel = PixelError {

@@ -173,7 +173,11 @@ fn mask_from_exr(
         locate_channel(exr.parts(), &names.coverage, layer, false, path)?,
     ];
     let stores_planes = wanted[2].is_some();
-    let (windows, [id_f, cos_f, plane_f, cov_f]) = decode_wanted_channels(exr, &wanted, path)?;
+    let present: Vec<(usize, usize)> = wanted.iter().flatten().copied().collect();
+    let (windows, mut decoded) = decode_channels(exr, &present, path)?;
+    // Back to the four slots, in order: id, cos θ, plane, coverage (the absent ones None).
+    decoded.reverse();
+    let [id_f, cos_f, plane_f, cov_f] = wanted.map(|w| w.and_then(|_| decoded.pop()));
     let (w, h) = (windows.data.width, windows.data.height);
     let layout_err = |detail: &str| MaskError::Layout {
         path: path.to_path_buf(),
@@ -213,7 +217,7 @@ fn mask_from_exr(
 
 /// Finds the (part, channel) named `name` (in `layer`, when given); a required channel that is
 /// missing is an error listing the channels the file has.
-fn locate_channel(
+pub(crate) fn locate_channel(
     parts: &[ExrPart],
     name: &str,
     layer: Option<&str>,
@@ -239,29 +243,21 @@ fn locate_channel(
     }
 }
 
-/// The decoded planes of the wanted channels, in the order asked, with their windows.
-type WantedPlanes = (ImageWindows, [Option<Vec<f32>>; 4]);
-
-/// Decodes each part once, with all its wanted channels; every part must have the same data
-/// window.
-fn decode_wanted_channels(
+/// Decodes channels `wanted` (part, channel) of the file, each part once with all its wanted
+/// channels, in the order asked; every part must have the same data window.
+pub(crate) fn decode_channels(
     exr: &ExrFile<'_>,
-    wanted: &[Option<(usize, usize)>; 4],
+    wanted: &[(usize, usize)],
     path: &Path,
-) -> Result<WantedPlanes, MaskError> {
-    let mut decoded: [Option<Vec<f32>>; 4] = [None, None, None, None];
+) -> Result<(ImageWindows, Vec<Vec<f32>>), MaskError> {
+    let mut out: Vec<Vec<f32>> = vec![Vec::new(); wanted.len()];
     let mut windows: Option<ImageWindows> = None;
-    let mut part_indices: Vec<usize> = wanted.iter().flatten().map(|(p, _)| *p).collect();
-    part_indices.sort_unstable();
-    part_indices.dedup();
-    for p in part_indices {
-        let slots: Vec<usize> = (0..4)
-            .filter(|&k| matches!(wanted[k], Some((q, _)) if q == p))
-            .collect();
-        let channels: Vec<usize> = slots
-            .iter()
-            .filter_map(|&k| wanted[k].map(|(_, c)| c))
-            .collect();
+    let mut parts: Vec<usize> = wanted.iter().map(|w| w.0).collect();
+    parts.sort_unstable();
+    parts.dedup();
+    for p in parts {
+        let slots: Vec<usize> = (0..wanted.len()).filter(|&k| wanted[k].0 == p).collect();
+        let channels: Vec<usize> = slots.iter().map(|&k| wanted[k].1).collect();
         let (info, buffers) =
             exr.read_channels(p, &channels)
                 .map_err(|source| MaskError::Decode {
@@ -270,26 +266,26 @@ fn decode_wanted_channels(
                 })?;
         match windows {
             None => windows = Some(info.windows()),
-            Some(s) if s.data != info.data_window => {
+            Some(w) if w.data != info.data_window => {
                 return Err(MaskError::Layout {
                     path: path.to_path_buf(),
                     detail: format!(
                         "the mask channels lie in parts with different data windows ({} and {})",
-                        s.data, info.data_window
+                        w.data, info.data_window
                     ),
                 });
             }
             Some(_) => {}
         }
-        for (k, buf) in slots.into_iter().zip(buffers) {
-            decoded[k] = Some(buf);
+        for (k, b) in slots.into_iter().zip(buffers) {
+            out[k] = b;
         }
     }
     let windows = windows.ok_or_else(|| MaskError::Layout {
         path: path.to_path_buf(),
         detail: "no mask channels".into(),
     })?;
-    Ok((windows, decoded))
+    Ok((windows, out))
 }
 
 /// Builds [`MaskError::BadPixel`] for a pixel index of a mask file.
