@@ -27,9 +27,14 @@ Usage:
       Writes an 8-bit RGB packed mask (R plane 0, G id, B round(cos θ·255) = 255) the size of
       IN's display window (of its first part): id N inside the rectangle (display-window-relative
       pixel coordinates, inclusive, clipped to the image), zeros elsewhere.
-  exr_oracle.py gain --registry REGISTRY.json --id N
+  exr_oracle.py gain --registry REGISTRY.json --id N [--space SPACE]
       Prints r(id, θ=0) + t(id, θ=0) per channel (r0·C_r(cos θ = 1) + t0·C_t(cos θ = 1), the
-      curves evaluated from their powers and coefficients) as "R,G,B".
+      curves evaluated from their powers and coefficients) as "R,G,B", from the registry's table
+      in SPACE (schema 3; default its first table).
+  exr_oracle.py check-display --exr COMPOSITE.exr --png OUT.png --space SPACE [--tol 1.5]
+      Checks a `standard`-view PNG: the EXR's RGB (un-premultiplied) converted from SPACE to
+      linear sRGB by colour-science's RGB_to_RGB (CAT02), sRGB-encoded, clipped, quantised to
+      the PNG's depth; every sample within --tol codes (exit 1 otherwise).
 
 RGB layers: channels PREFIX.R, PREFIX.G, PREFIX.B (PREFIX "" for bare R, G, B) in one part;
 --layer PREFIX matches PREFIX itself or "PARTNAME.PREFIX" (a part's name qualifies its channels,
@@ -402,10 +407,25 @@ def _curve_at_normal(curve):
     return float(sum(float(c) for c, _ in zip(curve["coefficients"], curve["powers"])))
 
 
-def registry_gain(registry, glass_id):
+def registry_table(doc, registry, space=None):
+    """The glasses of one table: schema 3's table whose colorimetric space is `space` (default
+    the first table), or schema 2's only table."""
+    if "tables" not in doc:
+        return doc.get("glasses", [])
+    tables = doc["tables"]
+    if space is None:
+        return tables[0]["glasses"]
+    for table in tables:
+        if table["spectral"].get("method") == "colorimetric" and \
+                table["spectral"].get("space", "srgb") == space:
+            return table["glasses"]
+    raise OracleError(f"{registry}: no table in {space}")
+
+
+def registry_gain(registry, glass_id, space=None):
     with open(registry, encoding="utf-8") as f:
         doc = json.load(f)
-    for glass in doc.get("glasses", []):
+    for glass in registry_table(doc, registry, space):
         if glass.get("id") == glass_id:
             return [float(glass["r0"][c]) * _curve_at_normal(glass["c_r"][c])
                     + float(glass["t0"][c]) * _curve_at_normal(glass["c_t"][c])
@@ -414,7 +434,43 @@ def registry_gain(registry, glass_id):
 
 
 def cmd_gain(args):
-    print(",".join(repr(g) for g in registry_gain(args.registry, args.id)))
+    print(",".join(repr(g) for g in registry_gain(args.registry, args.id, args.space)))
+
+
+# colour-science's names of the spaces glassdb names.
+COLOUR_SPACES = {"srgb": "sRGB", "rec2020": "ITU-R BT.2020", "acescg": "ACEScg",
+                 "aces2065-1": "ACES2065-1", "display-p3": "Display P3"}
+
+
+def cmd_check_display(args):
+    """The PNG is the EXR's RGB (un-premultiplied where alpha > 0), converted from --space to
+    linear sRGB by colour-science's RGB_to_RGB (CAT02), sRGB-encoded, clipped to 0-1 and
+    quantised to the PNG's depth; within --tol codes."""
+    import colour
+    colour.utilities.filter_warnings(colour_runtime_warnings=True, colour_usage_warnings=True)
+    src = read_layer(args.exr, args.layer)
+    rgb = np.stack([src.planes[c] for c in "RGB"], axis=-1)
+    if "A" in src.planes:
+        a = src.planes["A"][..., None]
+        rgb = np.where(a > 0, rgb / np.where(a > 0, a, 1.0), rgb)
+    if args.space != "srgb":
+        rgb = colour.RGB_to_RGB(rgb, COLOUR_SPACES[args.space], "sRGB",
+                                chromatic_adaptation_transform="CAT02")
+    encoded = np.clip(colour.models.eotf_inverse_sRGB(np.clip(rgb, 0.0, None)), 0.0, 1.0)
+    png = read_png(args.png)
+    top = 65535.0 if png.dtype == np.uint16 else 255.0
+    if png.shape[:2] != encoded.shape[:2]:
+        raise Mismatch(f"{args.png} is {png.shape[1]}×{png.shape[0]}, {args.exr}'s layer is "
+                       f"{encoded.shape[1]}×{encoded.shape[0]}")
+    diff = np.abs(png[..., :3].astype(np.float64) - encoded * top)
+    worst = float(diff.max())
+    y, x, c = np.unravel_index(int(diff.argmax()), diff.shape)
+    summary = {"max_code_diff": worst, "at": [int(x), int(y), "RGB"[c]],
+               "mean_code_diff": float(diff.mean())}
+    print(json.dumps(summary))
+    if worst > args.tol:
+        raise Mismatch(f"{args.png} pixel (x {x}, y {y}) channel {'RGB'[c]}: {worst:.2f} codes "
+                       f"from colour-science's {args.space} → sRGB (tolerance {args.tol})")
 
 
 def _ulp_half(values):
@@ -605,7 +661,15 @@ def main(argv=None):
     p = sub.add_parser("gain", help="per-channel r + t at normal incidence from a registry")
     p.add_argument("--registry", required=True)
     p.add_argument("--id", type=int, required=True)
+    p.add_argument("--space", default=None, help="the table in this colorimetric space")
     p.set_defaults(func=cmd_gain)
+    p = sub.add_parser("check-display", help="a standard-view PNG against colour-science")
+    p.add_argument("--exr", required=True)
+    p.add_argument("--png", required=True)
+    p.add_argument("--space", required=True, choices=list(COLOUR_SPACES))
+    p.add_argument("--layer", default=None)
+    p.add_argument("--tol", type=float, default=1.5)
+    p.set_defaults(func=cmd_check_display)
     args = parser.parse_args(argv)
     try:
         args.func(args)

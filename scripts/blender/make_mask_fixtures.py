@@ -20,6 +20,9 @@ script:
    scene.mtl) and the cameras (camera.000N.json, camera_portrait.json, cameras.json), taken
    from Blender's objects, are written to --geometry with --write-geometry; without it they
    are compared with the files already there, and the run fails (exit 1) if any text differs.
+   `--working-space NAME` (Blender 5.0+, e.g. ACEScg; default: Blender's, Linear Rec.709)
+   sets the blend file's working colour space once the scene is built, with Blender
+   converting every colour in it, so that the same scene is rendered in that space.
 
 2. Check (plain Python with numpy and the `OpenEXR` package, pip OpenEXR==3.5.3; no Blender):
 
@@ -59,6 +62,14 @@ SHIFT_X, SHIFT_Y = -0.05, 0.12
 INDEX_SAMPLES, BEAUTY_SAMPLES = 1, 16
 INDEX_FILTER_WIDTH = 0.01
 CRYPTO_LEVELS = 6
+
+# Linear Rec.709 -> ACEScg as Blender 5.0.1 applies it when it converts a file's colours
+# (bpy.ops.wm.set_working_color_space, convert_colors=True): its OCIO config's Rec.709 -> CIE XYZ
+# D65, then OCIO's builtin ACES-AP1_to_CIE-XYZ-D65_BFD inverted (Bradford D65 -> ACES white).
+# Measured by converting (1, 0, 0), (0, 1, 0), (0, 0, 1); rows for column vectors.
+REC709_TO_ACESCG = ((0.61310, 0.33952, 0.04738),
+                    (0.07019, 0.91635, 0.01345),
+                    (0.02062, 0.10957, 0.86981))
 
 # Camera keyframes: body level (rotation x = 90°, no roll), moving sideways to the right while
 # turning a little to the left.
@@ -216,12 +227,17 @@ def parse_args(argv):
         argv = argv[argv.index("--") + 1:]
     else:
         argv = argv[1:]
-    opts = {"out": None, "geometry": None, "write_geometry": False, "mode": "render"}
+    opts = {"out": None, "geometry": None, "write_geometry": False, "mode": "render",
+            "working_space": None}
     i = 0
     while i < len(argv):
         a = argv[i]
         if a in ("--out", "--geometry") and i + 1 < len(argv):
             opts[a[2:]] = os.path.abspath(argv[i + 1])
+            i += 2
+            continue
+        if a == "--working-space" and i + 1 < len(argv):
+            opts["working_space"] = argv[i + 1]
             i += 2
             continue
         if a == "--write-geometry":
@@ -245,7 +261,47 @@ def parse_args(argv):
 # Step 1: render (bpy)
 # --------------------------------------------------------------------------------------------
 
-def render_all(out_dir, geo_dir, write_geometry):
+def set_working_space(bpy, name, mats):
+    """Make `name` the blend file's working colour space (Blender 5.0+). The file's colours
+    are Linear Rec.709 (the factory working space); Blender's operator converts every colour
+    in the file (material and world node sockets, viewport colours, lights) through CIE XYZ
+    into the new space, so the scene stays the same. `bpy.data.colorspace.working_space` is
+    read-only. Returns what it did, for check.json; exits when the colours were not
+    converted (for ACEScg: not by REC709_TO_ACESCG within 1e-4)."""
+    if tuple(bpy.app.version) < (5, 0, 0) or not hasattr(bpy.data, "colorspace"):
+        sys.exit("--working-space needs Blender 5.0 or later")
+    cs = bpy.data.colorspace
+    before = cs.working_space
+    if bpy.ops.wm.set_working_color_space(working_space=name,
+                                          convert_colors=True) != {"FINISHED"} \
+            or cs.working_space != name:
+        sys.exit("working space %r not set (it is %r)" % (name, cs.working_space))
+    colours = {}
+    for mname, mat in mats.items():
+        bsdf = [n for n in mat.node_tree.nodes
+                if n.bl_idname in ("ShaderNodeBsdfDiffuse", "ShaderNodeBsdfPrincipled")][0]
+        sock = bsdf.inputs["Color" if "Color" in bsdf.inputs else "Base Color"]
+        rgb = MATERIALS[mname][1]
+        got = tuple(sock.default_value)[:3]
+        colours[mname] = {"rec709": list(rgb), "converted": list(got)}
+        if name == "ACEScg":
+            want = [sum(REC709_TO_ACESCG[i][j] * rgb[j] for j in range(3)) for i in range(3)]
+            if max(abs(got[i] - want[i]) for i in range(3)) > 1e-4:
+                sys.exit("%s: colour %r, expected %r from Rec.709 %r" % (mname, got, want, rgb))
+        elif max(abs(got[i] - rgb[i]) for i in range(3)) < 1e-4:
+            sys.exit("%s: colour not converted to %s" % (mname, name))
+    return {"name": name, "was": before, "interop_id": cs.working_space_interop_id,
+            "set_by": "bpy.ops.wm.set_working_color_space(working_space=%r, "
+                      "convert_colors=True), after the scene was built" % name,
+            "material_colours": colours,
+            # grey and white stay grey and white (each row of the matrix sums to 1)
+            "world_background_colour": [list(n.inputs["Color"].default_value)[:3]
+                                        for w in bpy.data.worlds for n in w.node_tree.nodes
+                                        if n.bl_idname == "ShaderNodeBackground"],
+            "light_colours": {lt.name: list(lt.color) for lt in bpy.data.lights}}
+
+
+def render_all(out_dir, geo_dir, write_geometry, working_space=None):
     import bpy
     import bmesh
 
@@ -394,6 +450,12 @@ def render_all(out_dir, geo_dir, write_geometry):
         for kp in fc.keyframe_points:
             kp.interpolation = "LINEAR"
     scene.frame_start, scene.frame_end = FRAMES[0], FRAMES[-1]
+
+    # Working colour space: only when asked (--working-space); the colours above are
+    # Linear Rec.709 and Blender converts them.
+    space_info = None
+    if working_space is not None:
+        space_info = set_working_space(bpy, working_space, mats)
 
     # Render settings common to all renders.
     r = scene.render
@@ -649,6 +711,8 @@ def render_all(out_dir, geo_dir, write_geometry):
                       "color_depth": "16", "codec": "ZIP"},
         },
     }
+    if space_info is not None:
+        info["working_space"] = space_info
     with open(os.path.join(out_dir, "check.json"), "w") as fh:
         json.dump(info, fh, indent=1)
         fh.write("\n")
@@ -1139,7 +1203,7 @@ def main():
     elif opts["mode"] == "check":
         check_all(opts["out"], opts["geometry"])
     else:
-        render_all(opts["out"], opts["geometry"], opts["write_geometry"])
+        render_all(opts["out"], opts["geometry"], opts["write_geometry"], opts["working_space"])
 
 
 if __name__ == "__main__":

@@ -34,7 +34,9 @@ Two steps, one script:
        /work/bpyvenv/bin/python scripts/blender/make_reflection_passes.py \\
            --out fixtures/blender/masks/b50 --geometry fixtures/blender/masks --scratch DIR
 
-   writes refl_0.0001.exr, refl_1.0001.exr, refl_2.0001.exr into --out. Into --scratch (not
+   writes refl_0.0001.exr, refl_1.0001.exr, refl_2.0001.exr into --out (`--working-space NAME`,
+   Blender 5.0+: the scene in that working colour space, as make_mask_fixtures.py's option of
+   the same name makes it). Into --scratch (not
    committed): the whole fixture set again (`make_mask_fixtures.render_all` builds the scene
    and renders it; it also compares its scene.obj and cameras with --geometry and exits 1 on
    any difference), `trans_again.0001.exr` (the transmission pass rendered again after the
@@ -81,12 +83,17 @@ def parse_args(argv):
         argv = argv[argv.index("--") + 1:]
     else:
         argv = argv[1:]
-    opts = {"out": None, "geometry": None, "scratch": None, "mode": "render"}
+    opts = {"out": None, "geometry": None, "scratch": None, "mode": "render",
+            "working_space": None}
     i = 0
     while i < len(argv):
         a = argv[i]
         if a in ("--out", "--geometry", "--scratch") and i + 1 < len(argv):
             opts[a[2:]] = os.path.abspath(argv[i + 1])
+            i += 2
+            continue
+        if a == "--working-space" and i + 1 < len(argv):
+            opts["working_space"] = argv[i + 1]
             i += 2
             continue
         if a == "--check":
@@ -135,7 +142,7 @@ def reflection_rows(n, d):
 # Step 1: render (bpy)
 # --------------------------------------------------------------------------------------------
 
-def render_reflections(out_dir, geo_dir, scratch):
+def render_reflections(out_dir, geo_dir, scratch, working_space=None):
     import bpy
     from mathutils import Matrix, Vector
 
@@ -144,7 +151,7 @@ def render_reflections(out_dir, geo_dir, scratch):
     os.makedirs(fixtures_dir, exist_ok=True)
     # The scene, exactly as make_mask_fixtures builds it (it renders its own fixtures into the
     # scratch folder on the way and fails if its scene.obj / cameras differ from geo_dir's).
-    mmf.render_all(fixtures_dir, geo_dir, False)
+    mmf.render_all(fixtures_dir, geo_dir, False, working_space)
     version = tuple(bpy.app.version)
     scene = bpy.context.scene
     r = scene.render
@@ -317,6 +324,9 @@ def render_reflections(out_dir, geo_dir, scratch):
             "camera_frame_%d" % FRAME: [list(row) for row in m_real],
             "camera_vs_json_max_abs_difference": json_diff,
             "planes": {}}
+    if working_space is not None:
+        info["working_space"] = {"name": bpy.data.colorspace.working_space,
+                                 "interop_id": bpy.data.colorspace.working_space_interop_id}
     for k in PLANES:
         p = planes[k]
         rk = Matrix(p["reflection"])
@@ -788,7 +798,8 @@ def main():
     if opts["mode"] == "check":
         check_reflections(opts["out"], opts["geometry"], opts["scratch"])
     else:
-        render_reflections(opts["out"], opts["geometry"], opts["scratch"])
+        render_reflections(opts["out"], opts["geometry"], opts["scratch"],
+                           opts["working_space"])
 
 
 if __name__ == "__main__":

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
+use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::io::{ExrDataType, OutputOptions, PassReadOptions, parse_exr_compression};
-use glassdb_compose::lut::GlassLut;
 use glassdb_compose::pixels::{InputTransfer, PngBits};
 use glassdb_compose::sequence::{self, FrameOutcome};
 use glassdb_compose::view::ViewTransform;
@@ -19,7 +19,8 @@ use glassdb_mask::{
     AovWeighting, CosSource, CryptomatteOptions, ExrMaskChannels, GlassMapping, GlassNames,
     MaskReadOptions, PlaneSource,
 };
-use glassdb_registry::{Registry, Side};
+use glassdb_registry::{ColourBasis, Registry, Side};
+use glassdb_spectral::RgbSpace;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -75,6 +76,11 @@ pub struct Args {
     /// How PNG passes are encoded.
     #[arg(long, value_enum, default_value_t = TransferArg::Srgb)]
     pub input_transfer: TransferArg,
+    /// The passes' linear RGB space, over what their headers say (`colorInteropID`,
+    /// `chromaticities`; untagged passes are linear Rec.709): srgb (= rec709), rec2020, acescg,
+    /// aces2065-1, display-p3, xyz. The registry's table in that space is used.
+    #[arg(long, value_name = "SPACE")]
+    pub input_space: Option<RgbSpace>,
     /// EXR mask channel names, e.g. `id=IndexMA,cos=facing` (keys id, cos, plane, coverage;
     /// with --mask-cryptomatte: cos, plane, or normal and position with --camera).
     #[arg(long, value_name = "KEY=NAME,...")]
@@ -333,7 +339,7 @@ fn split_layer(arg: &Path) -> (PathBuf, Option<String>) {
     (arg.to_path_buf(), None)
 }
 
-fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
+fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)> {
     let (registry, label) = match &args.registry {
         Some(p) => (
             Registry::from_json_file(p).map_err(anyhow::Error::new)?,
@@ -344,10 +350,10 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
             "the bundled catalog".to_string(),
         ),
     };
-    let lut = GlassLut::from_registry(&registry);
+    let luts = RegistryLuts::new(&registry);
     let registry_sha256 = registry.content_sha256()?;
     if let Some(id) = args.glass
-        && !lut.contains(id)
+        && registry.default_table().glass(id).is_none()
     {
         bail!("--glass {id}: {label} has no glass with id {id}");
     }
@@ -451,11 +457,16 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, GlassLut)> {
         output,
         registry_label: label,
         protected: args.registry.iter().chain(&args.planes).cloned().collect(),
+        input_space: args.input_space,
     };
-    Ok((settings, lut))
+    Ok((settings, luts))
 }
 
-fn print_stats(r: &FrameReport, lut: &GlassLut) {
+fn print_stats(r: &FrameReport, luts: &RegistryLuts) {
+    let colour = &r.colour;
+    let Some(lut) = luts.get(colour.table.basis) else {
+        return;
+    };
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let t = &r.timings;
     println!(
@@ -475,6 +486,21 @@ fn print_stats(r: &FrameReport, lut: &GlassLut) {
         println!(
             "kept         {} other channel(s) of the transmission file",
             r.output.kept_channels
+        );
+    }
+    let table_note = match colour.table.basis {
+        ColourBasis::Luminous => " (grey: the same in every space)",
+        ColourBasis::PaperRgb => " (the paper's CIE 1931 RGB, not a renderer's space)",
+        ColourBasis::Space(_) => "",
+    };
+    println!(
+        "colour       passes in {}; registry table {}{table_note}",
+        colour.space, colour.table.basis
+    );
+    if colour.converted_for_display {
+        println!(
+            "             PNG converted from {} to linear Rec.709 (CAT02) for the standard view",
+            glassdb_compose::colour::space_label(colour.space.space)
         );
     }
     println!(
@@ -540,7 +566,7 @@ fn report_nonfinite(r: &FrameReport, label: &str) {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let (settings, lut) = settings_from(&args)?;
+    let (settings, luts) = settings_from(&args)?;
     let trans = split_layer(&args.trans).0;
     let output = args
         .output
@@ -554,10 +580,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
 
     let Some(frames_spec) = &args.frames else {
-        let report = compose_frame(&job, &settings, &lut)?;
+        let report = compose_frame(&job, &settings, &luts)?;
         report_nonfinite(&report, "");
         if args.stats {
-            print_stats(&report, &lut);
+            print_stats(&report, &luts);
         }
         println!(
             "wrote {} ({}×{}, {})",
@@ -602,7 +628,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             b.inc(1);
         }
     };
-    let outcomes = sequence::compose_sequence(&job, &frames, &settings, &lut, &on_done)?;
+    let outcomes = sequence::compose_sequence(&job, &frames, &settings, &luts, &on_done)?;
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -619,7 +645,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         for o in &outcomes {
             if let Ok(r) = &o.result {
                 println!("--- frame {}", o.frame);
-                print_stats(r, &lut);
+                print_stats(r, &luts);
             }
         }
     }

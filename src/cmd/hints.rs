@@ -187,6 +187,23 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
              resolve_cube (docs/colour.md)"
                 .into(),
         ),
+        ComposeError::UnsupportedPassSpace { .. } | ComposeError::ConflictingColourTags { .. } => {
+            Some(
+                "if the pixels are scene-linear RGB, say in which space with --input-space \
+                 (srgb, rec2020, acescg, aces2065-1, display-p3, xyz)"
+                    .into(),
+            )
+        }
+        ComposeError::PassSpacesDisagree { .. } => Some(
+            "render every pass in one working space; if a tag is wrong, --input-space SPACE \
+             declares the space of every pass"
+                .into(),
+        ),
+        ComposeError::NoTableForSpace { space_name, .. } => Some(format!(
+            "build the registry with that space too: glassdb registry build CATALOG --space \
+             srgb,{space_name} -o REGISTRY.json (docs/colour.md); if the passes' tag is wrong, \
+             --input-space declares their space"
+        )),
         ComposeError::ZipLevelNotApplicable { .. } | ComposeError::ZipLevelOutOfRange { .. } => {
             Some("--zip-level sets it".into())
         }

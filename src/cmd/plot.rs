@@ -2,6 +2,7 @@
 //! spectra. PNG or SVG by the `-o` extension (default: a PNG named after the input, in the
 //! current directory). All drawing is in `glassdb_plot`.
 
+use glassdb_registry::ColourBasis;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -79,6 +80,10 @@ pub struct RegistryArgs {
     /// Only this glass id (repeatable).
     #[arg(long = "id")]
     pub ids: Vec<u16>,
+    /// The registry table to draw: an RGB space (srgb, acescg, …), paper-rgb or luminous
+    /// (default: its first table).
+    #[arg(long, value_name = "SPACE")]
+    pub space: Option<ColourBasis>,
     #[command(flatten)]
     pub out: OutputArgs,
 }
@@ -117,6 +122,10 @@ pub struct MaskArgs {
     /// Read the PNG as the paper's binary mask (white = glass) with this glass id.
     #[arg(long)]
     pub glass: Option<u16>,
+    /// The registry table to evaluate: an RGB space (srgb, acescg, …), paper-rgb or luminous
+    /// (default: its first table).
+    #[arg(long, value_name = "SPACE")]
+    pub space: Option<ColourBasis>,
     #[command(flatten)]
     pub out: OutputArgs,
 }
@@ -218,7 +227,13 @@ fn run_fit(a: FitArgs) -> anyhow::Result<ExitCode> {
 
 fn run_registry(a: RegistryArgs) -> anyhow::Result<ExitCode> {
     let output = output_path(&a.out, &a.registry, "registry");
-    let fig = registry_figure(&a.registry, &RegistryPlotOptions { ids: a.ids })?;
+    let fig = registry_figure(
+        &a.registry,
+        &RegistryPlotOptions {
+            ids: a.ids,
+            basis: a.space,
+        },
+    )?;
     write(&fig, &output, &[&a.registry])
 }
 
@@ -240,6 +255,7 @@ fn parse_side(s: &str) -> anyhow::Result<(u16, bool)> {
 fn run_mask(a: MaskArgs) -> anyhow::Result<ExitCode> {
     let output = output_path(&a.out, &a.mask, "mask");
     let mut opts = MaskPlotOptions {
+        basis: a.space,
         quantity: match a.quantity {
             QuantityArg::Reflectance => MaskQuantity::Reflectance,
             QuantityArg::Transmittance => MaskQuantity::Transmittance,

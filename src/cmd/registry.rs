@@ -7,7 +7,8 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use glassdb_registry::{
-    AngleCurve, Application, BuildOptions, GlassRecord, MaskIds, Registry, Side,
+    AngleCurve, Application, BuildOptions, ColourBasis, GlassRecord, MaskIds, Registry,
+    SCHEMA_VERSION, Side,
 };
 use glassdb_spectral::{
     Illuminant, IntegrationSettings, Method, MethodKind, Observer, RgbCmf, RgbSpace,
@@ -52,10 +53,11 @@ pub struct BuildArgs {
     /// Illuminant for --method colorimetric: D65, A or E.
     #[arg(long, default_value = "D65")]
     pub illuminant: String,
-    /// RGB working space for --method colorimetric: srgb (alias rec709), rec2020, acescg,
-    /// aces2065-1, display-p3 or xyz.
-    #[arg(long, default_value = "srgb")]
-    pub space: String,
+    /// RGB working space(s) for --method colorimetric, comma-separated: srgb (alias rec709),
+    /// rec2020, acescg, aces2065-1, display-p3, xyz. One table per space, the first the
+    /// default; compose picks the one its passes are in. Default: srgb.
+    #[arg(long, value_name = "SPACE[,SPACE...]")]
+    pub space: Option<String>,
     /// Hold end values where a spectrum does not cover the method's range (else an error).
     #[arg(long)]
     pub extrapolate: bool,
@@ -77,6 +79,10 @@ pub struct ShowArgs {
     /// Show back-side reflectance instead of the front.
     #[arg(long)]
     pub back: bool,
+    /// The table to show: an RGB space (srgb, acescg, …), paper-rgb or luminous (default: the
+    /// registry's first table).
+    #[arg(long, value_name = "SPACE")]
+    pub space: Option<ColourBasis>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -100,20 +106,45 @@ fn parse<T: std::str::FromStr<Err = String>>(value: &str, flag: &str) -> anyhow:
         .map_err(|e| anyhow::anyhow!("--{flag}: {e}"))
 }
 
-fn settings(a: &BuildArgs) -> anyhow::Result<IntegrationSettings> {
-    let method = match parse::<MethodKind>(&a.method, "method")? {
-        MethodKind::Colorimetric => Method::Colorimetric {
-            observer: parse::<Observer>(&a.observer, "observer")?,
-            illuminant: parse::<Illuminant>(&a.illuminant, "illuminant")?,
-            space: parse::<RgbSpace>(&a.space, "space")?,
-        },
-        MethodKind::Paper => Method::Paper(parse::<RgbCmf>(&a.cmf, "cmf")?),
-        MethodKind::Luminous => Method::Luminous,
-    };
-    Ok(IntegrationSettings {
+/// The spectral settings of each table to build: one per `--space` for the colorimetric
+/// method, else the one method.
+fn table_settings(a: &BuildArgs) -> anyhow::Result<Vec<IntegrationSettings>> {
+    let with = |method| IntegrationSettings {
         method,
         extrapolate: a.extrapolate,
-    })
+    };
+    let kind = parse::<MethodKind>(&a.method, "method")?;
+    if kind != MethodKind::Colorimetric {
+        if let Some(space) = &a.space {
+            anyhow::bail!(
+                "--space {space}: only --method colorimetric integrates into an RGB space (--method {kind} has its own channels)"
+            );
+        }
+        return Ok(vec![with(match kind {
+            MethodKind::Paper => Method::Paper(parse::<RgbCmf>(&a.cmf, "cmf")?),
+            _ => Method::Luminous,
+        })]);
+    }
+    let observer = parse::<Observer>(&a.observer, "observer")?;
+    let illuminant = parse::<Illuminant>(&a.illuminant, "illuminant")?;
+    let mut spaces: Vec<RgbSpace> = Vec::new();
+    for name in a.space.as_deref().unwrap_or("srgb").split(',') {
+        let space = parse::<RgbSpace>(name.trim(), "space")?;
+        if spaces.contains(&space) {
+            anyhow::bail!("--space: {space} is listed twice (rec709 and srgb are one space)");
+        }
+        spaces.push(space);
+    }
+    Ok(spaces
+        .into_iter()
+        .map(|space| {
+            with(Method::Colorimetric {
+                observer,
+                illuminant,
+                space,
+            })
+        })
+        .collect())
 }
 
 fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
@@ -127,7 +158,7 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     inputs.extend(a.masks.iter().map(|m| m.as_path()));
     glassdb_io::refuse_input_as_output(&a.output, inputs)?;
     let opts = BuildOptions {
-        spectral: settings(&a)?,
+        tables: table_settings(&a)?,
         mask_ids: mask_ids(&a.masks)?,
         fit_tol: a.tol,
         max_degree: a.max_degree,
@@ -140,21 +171,19 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     let registry =
         glassdb_registry::build_registry(&a.catalog, &opts).map_err(anyhow::Error::new)?;
     registry.write_json(&a.output)?;
-    let ids: Vec<String> = registry.glasses.iter().map(|g| g.id.to_string()).collect();
+    let glasses = &registry.default_table().glasses;
+    let ids: Vec<String> = glasses.iter().map(|g| g.id.to_string()).collect();
     eprintln!(
-        "wrote {} ({} glass{}: id {})",
+        "wrote {} ({} glass{}: id {}; {})",
         a.output.display(),
-        registry.glasses.len(),
-        if registry.glasses.len() == 1 {
-            ""
-        } else {
-            "es"
-        },
+        glasses.len(),
+        if glasses.len() == 1 { "" } else { "es" },
         if ids.is_empty() {
             "none".to_string()
         } else {
             ids.join(", ")
-        }
+        },
+        tables_text(&registry)
     );
     Ok(ExitCode::SUCCESS)
 }
@@ -188,22 +217,43 @@ fn rgb(v: &[f64; 3]) -> String {
 fn show(a: ShowArgs) -> anyhow::Result<ExitCode> {
     let registry = Registry::from_json_file(&a.registry).map_err(anyhow::Error::new)?;
     let side = if a.back { Side::Back } else { Side::Front };
-    let method = method_text(&registry.spectral);
+    let table = registry
+        .table_or_error(a.space, &a.registry.display().to_string())
+        .map_err(anyhow::Error::new)?;
     println!(
-        "{}: schema {}, spectral method {method}, {} glasses",
+        "{}: schema {SCHEMA_VERSION}, {}, {} glasses",
         a.registry.display(),
-        registry.schema,
-        registry.glasses.len()
+        tables_text(&registry),
+        table.glasses.len()
+    );
+    println!(
+        "showing the {} table (spectral method {}); values per channel in it",
+        table.basis(),
+        method_text(&table.spectral)
     );
     if a.back {
         println!("reflectance: back side (r0_back, c_r_back)");
     }
     println!();
-    for g in &registry.glasses {
+    for g in &table.glasses {
         print_glass(g, side);
         println!();
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The tables a registry holds, e.g. `2 tables: srgb (default), acescg`.
+fn tables_text(registry: &Registry) -> String {
+    let bases: Vec<String> = registry.bases().iter().map(ToString::to_string).collect();
+    match bases.as_slice() {
+        [one] => format!("1 table: {one}"),
+        [first, rest @ ..] => format!(
+            "{} tables: {first} (default), {}",
+            bases.len(),
+            rest.join(", ")
+        ),
+        [] => "no table".to_string(),
+    }
 }
 
 /// The method and its options, e.g. `colorimetric cie1931 D65 srgb`.
@@ -279,10 +329,10 @@ fn check(a: CheckArgs) -> anyhow::Result<ExitCode> {
     for path in &a.registries {
         match Registry::from_json_file(path) {
             Ok(r) => println!(
-                "{}: ok (schema {}, {} glasses)",
+                "{}: ok (schema {SCHEMA_VERSION}, {} glasses, {})",
                 path.display(),
-                r.schema,
-                r.glasses.len()
+                r.default_table().glasses.len(),
+                tables_text(&r)
             ),
             Err(e) => {
                 eprintln!("FAILED: {}", super::hints::with_hints(&e.into()));

@@ -3,6 +3,7 @@
 
 mod architecture;
 mod cameras;
+mod colour;
 mod compose;
 mod fit;
 mod fixtures;

@@ -32,14 +32,14 @@ fn curve(v: &serde_json::Value, cos: f64) -> f64 {
         .sum()
 }
 
-/// The ids of a registry's glasses, in file order.
+/// The ids of a registry's glasses (its first table's), in file order.
 fn glass_ids(reg: &serde_json::Value) -> Vec<u64> {
-    let glasses = reg["glasses"].as_array().unwrap();
+    let glasses = reg["tables"][0]["glasses"].as_array().unwrap();
     glasses.iter().map(|g| g["id"].as_u64().unwrap()).collect()
 }
 
 fn glass_by_name<'a>(reg: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
-    reg["glasses"]
+    reg["tables"][0]["glasses"]
         .as_array()
         .unwrap()
         .iter()
@@ -237,8 +237,8 @@ fn build_show_check_and_json_round_trip() {
     let out = dir.path().join("reg.json");
     ok(&mut build(&catalog, &out, &["--method", "luminous"]));
     let reg = read_json(&out);
-    assert_eq!(reg["schema"], 2);
-    assert_eq!(reg["spectral"]["method"], "luminous");
+    assert_eq!(reg["schema"], 3);
+    assert_eq!(reg["tables"][0]["spectral"]["method"], "luminous");
     assert_eq!(glass_ids(&reg), [1, 3, 200], "glasses are sorted by id");
     let clear = glass_by_name(&reg, "Clear 3");
     // pywincalc 3.3.1 gives Tvis 0.899, Rf,vis 0.083 for CLEAR_3.DAT (data/glazing/README.md).
@@ -267,7 +267,7 @@ fn build_show_check_and_json_round_trip() {
         (lowe["r0"][1].as_f64().unwrap() - lowe["r0_back"][1].as_f64().unwrap() - 0.006).abs()
             < 0.002
     );
-    for g in reg["glasses"].as_array().unwrap() {
+    for g in reg["tables"][0]["glasses"].as_array().unwrap() {
         for key in ["c_r", "c_t", "c_r_back"] {
             for ch in 0..3 {
                 let c = &g[key][ch];
@@ -407,6 +407,10 @@ fn mask_filtered_build_keeps_only_the_ids_in_use() {
     assert!(err.contains("junk.png"), "{err}");
 }
 
+/// The spaces of the bundled registry's tables: Blender 5's three working spaces and ACES's
+/// interchange space.
+const BUNDLED_SPACES: &str = "srgb,acescg,rec2020,aces2065-1";
+
 /// `data/registry.json` (the bundled default) is exactly what the documented command builds
 /// from `data/catalog.toml`; `GLASSDB_MAKE_REF=1` rewrites it instead.
 #[test]
@@ -415,7 +419,14 @@ fn bundled_registry_json_rebuilds_byte_for_byte() {
     let out = dir.path().join("registry.json");
     ok(glassdb()
         .current_dir(repo_root())
-        .args(["registry", "build", "data/catalog.toml", "-o"])
+        .args([
+            "registry",
+            "build",
+            "data/catalog.toml",
+            "--space",
+            BUNDLED_SPACES,
+            "-o",
+        ])
         .arg(&out));
     let fresh = std::fs::read(&out).unwrap();
     let committed = repo_path("data/registry.json");
@@ -424,7 +435,7 @@ fn bundled_registry_json_rebuilds_byte_for_byte() {
     }
     assert!(
         fresh == std::fs::read(&committed).unwrap(),
-        "data/registry.json differs from `glassdb registry build data/catalog.toml -o data/registry.json` \
+        "data/registry.json differs from `glassdb registry build data/catalog.toml --space {BUNDLED_SPACES} -o data/registry.json` \
          (run from the repository root); regenerate it with GLASSDB_MAKE_REF=1 cargo test --test cli bundled_registry_json"
     );
     // Nothing machine-specific: paths are relative to the repository or to the catalog.
@@ -440,13 +451,14 @@ fn bundled_registry_json_rebuilds_byte_for_byte() {
 #[test]
 fn bundled_default_registry_builds_and_validates() {
     let reg = glassdb_registry::default_registry().expect("bundled catalog builds");
-    let ids: Vec<u16> = reg.glasses.iter().map(|g| g.id).collect();
+    let table = reg.default_table();
+    let ids: Vec<u16> = table.glasses.iter().map(|g| g.id).collect();
     for id in [1, 2, 4, 5, 6] {
         assert!(ids.contains(&id), "bundled registry lacks id {id}: {ids:?}");
     }
     reg.validate().unwrap();
     // Clear 3 mm under D65/sRGB: τv 0.899 (README); G close to it, R below (iron absorbs red).
-    let clear = reg.glass(1).unwrap();
+    let clear = table.glass(1).unwrap();
     assert!((clear.luminous.unwrap().transmittance - 0.899).abs() < 0.001);
     assert!(clear.t0[0] < clear.t0[1]);
     // The command-line build of the same catalog gives the same registry numbers.
@@ -454,8 +466,9 @@ fn bundled_default_registry_builds_and_validates() {
     let out = dir.path().join("default.json");
     ok(&mut build(&repo_path("data/catalog.toml"), &out, &[]));
     let disk = glassdb_registry::Registry::from_json_file(&out).unwrap();
-    assert_eq!(disk.glasses.len(), reg.glasses.len());
-    for (a, b) in disk.glasses.iter().zip(&reg.glasses) {
+    let disk = disk.default_table();
+    assert_eq!(disk.glasses.len(), table.glasses.len());
+    for (a, b) in disk.glasses.iter().zip(&table.glasses) {
         assert_eq!((a.id, a.r0, a.t0, &a.c_r), (b.id, b.r0, b.t0, &b.c_r));
     }
 }

@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         [_, id] => id.parse()?,
         _ => return Err("usage: oiiotool_colormaps MAX_ID".into()),
     };
-    let lut = GlassLut::from_registry(&default_registry()?);
+    let lut = GlassLut::from_table(default_registry()?.default_table());
     let knots = 256 * (usize::from(max_id) + 1);
     let mut r_knots = Vec::with_capacity(knots * 3);
     let mut t_knots = Vec::with_capacity(knots * 3);

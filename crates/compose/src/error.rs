@@ -24,6 +24,44 @@ pub enum ComposeError {
     Mask(#[from] glassdb_mask::MaskError),
     #[error(transparent)]
     Registry(#[from] glassdb_registry::RegistryError),
+    /// A pass's colour tag names a space that cannot be composited (data, non-linear, unknown).
+    #[error("{path}: {what} is {why}")]
+    UnsupportedPassSpace {
+        path: PathBuf,
+        what: String,
+        why: String,
+    },
+    /// A pass's two colour tags name different spaces.
+    #[error(
+        "{path}: colorInteropID \"{interop_id}\" and chromaticities {chromaticities:?} name different spaces"
+    )]
+    ConflictingColourTags {
+        path: PathBuf,
+        interop_id: String,
+        chromaticities: [f32; 8],
+    },
+    /// The passes of one frame are in different colour spaces.
+    #[error(
+        "{a} is in {a_space} but {b} is in {b_space}: the passes of a frame must share one space"
+    )]
+    PassSpacesDisagree {
+        a: PathBuf,
+        a_space: String,
+        b: PathBuf,
+        b_space: String,
+    },
+    /// The registry has no table for the passes' space.
+    #[error(
+        "{trans} is in {space}, but {registry} has no table in {space_name} (it holds: {})",
+        have.join(", ")
+    )]
+    NoTableForSpace {
+        trans: PathBuf,
+        space: String,
+        space_name: &'static str,
+        registry: String,
+        have: Vec<String>,
+    },
     /// No R, G, B channel triple in an EXR pass.
     #[error(
         "{path} has no R, G, B channels (it has: {}){}",

@@ -5,10 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use glassdb_image::{
-    ExactExr, ExactPart, ExrFile, ExrImageAttributes, ExrImageOut, ExrLayerAttributes, ExrPartOut,
-    ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions, ExrWriteReport, ImageError, ImageFile,
-    ImageWindows, LayerChoiceError, PlaneSamples, PngColor, PngCompression, PngEncodeOptions,
-    PngPixels, PngSampleSlice, PngSamples,
+    ExactExr, ExactPart, ExrColourTag, ExrFile, ExrImageAttributes, ExrImageOut,
+    ExrLayerAttributes, ExrPartOut, ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions,
+    ExrWriteReport, ImageError, ImageFile, ImageWindows, LayerChoiceError, PlaneSamples, PngColor,
+    PngCompression, PngEncodeOptions, PngPixels, PngSampleSlice, PngSamples,
 };
 
 use exr::meta::attribute::{AttributeValue, Text};
@@ -16,6 +16,7 @@ use exr::meta::attribute::{AttributeValue, Text};
 use crate::ComposeError;
 use crate::pixels::{EncodedImage, EncodedSamples, InputTransfer, LinearImage, PngBits};
 use crate::view::ViewTransform;
+use glassdb_colour::RgbSpace;
 
 /// How to read a pass.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -62,6 +63,8 @@ pub struct Pass {
     pub image: LinearImage,
     pub windows: ImageWindows,
     pub source: PassSource,
+    /// The colour attributes of the layer's part (none for a PNG).
+    pub colour: ExrColourTag,
 }
 
 /// Reads a pass file (format from its bytes).
@@ -122,6 +125,7 @@ fn pass_from_png(png: PngPixels, transfer: InputTransfer) -> Pass {
         image,
         windows,
         source: PassSource::Png { bits },
+        colour: ExrColourTag::default(),
     }
 }
 
@@ -185,6 +189,10 @@ fn read_exr_pass(
             part: chosen.part,
             channel_names,
         },
+        colour: parts
+            .get(chosen.part)
+            .map(|p| p.colour.clone())
+            .unwrap_or_default(),
     })
 }
 
@@ -303,6 +311,9 @@ pub struct OutputFrame {
     pub windows: ImageWindows,
     /// For an EXR transmission pass: its attributes, and its other channels when kept.
     pub exr: Option<ExrCarried>,
+    /// The colour space to tag an EXR output with (`chromaticities`, and `colorInteropID` on
+    /// the composite's part); `None` leaves the carried attributes as they are.
+    pub tag_space: Option<RgbSpace>,
 }
 
 /// The parts of an EXR transmission file written into the output.
@@ -331,6 +342,7 @@ impl OutputFrame {
         OutputFrame {
             windows: ImageWindows::full_frame(width as usize, height as usize),
             exr: None,
+            tag_space: None,
         }
     }
 
@@ -353,6 +365,7 @@ impl OutputFrame {
             return Ok(OutputFrame {
                 windows: pass.windows,
                 exr: None,
+                tag_space: None,
             });
         };
         let parts = glassdb_image::read_exr_headers(bytes).map_err(|s| decode_err(path, s))?;
@@ -384,6 +397,7 @@ impl OutputFrame {
         Ok(OutputFrame {
             windows: pass.windows,
             exr: Some(exr),
+            tag_space: None,
         })
     }
 }
@@ -564,7 +578,11 @@ fn exr_output(
     frame: OutputFrame,
     opts: &OutputOptions,
 ) -> (ExrImageOut, usize) {
-    let OutputFrame { windows, exr } = frame;
+    let OutputFrame {
+        windows,
+        exr,
+        tag_space,
+    } = frame;
     let new_layer = opts.output_layer.as_deref();
     let (mut attributes, parts, kept) = match exr {
         None => (
@@ -609,6 +627,10 @@ fn exr_output(
             attributes.other.insert(name, AttributeValue::Text(value));
         }
     }
+    let mut parts = parts;
+    if let Some(space) = tag_space {
+        tag_colour(&mut attributes, &mut parts, space);
+    }
     (
         ExrImageOut {
             display_window: windows.display,
@@ -617,6 +639,32 @@ fn exr_output(
         },
         kept,
     )
+}
+
+/// Tags the output with `space`: `chromaticities` (shared by every part), and
+/// `colorInteropID` on each part holding the composite's R, G, B (other parts, e.g. Blender's
+/// `data` passes, keep theirs).
+fn tag_colour(attributes: &mut ExrImageAttributes, parts: &mut [ExrPartOut], space: RgbSpace) {
+    let c = space.chromaticities().map(|v| v as f32);
+    attributes.chromaticities = Some(exr::meta::attribute::Chromaticities {
+        red: exr::math::Vec2(c[0], c[1]),
+        green: exr::math::Vec2(c[2], c[3]),
+        blue: exr::math::Vec2(c[4], c[5]),
+        white: exr::math::Vec2(c[6], c[7]),
+    });
+    let id = Text::from(space.interop_id());
+    for part in parts {
+        let holds_composite = part
+            .planes
+            .iter()
+            .any(|p| matches!(p.samples, PlaneSamples::Converted(_)) && !p.linear);
+        if holds_composite {
+            part.attributes.other.insert(
+                Text::from("colorInteropID"),
+                AttributeValue::Text(id.clone()),
+            );
+        }
+    }
 }
 
 /// Every part of the transmission file with the composite in part `part`: replacing the

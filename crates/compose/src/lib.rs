@@ -6,10 +6,12 @@
 //!   decoded), results out (EXR half/float with a chosen compression; PNG 8/16-bit sRGB).
 //! - [`pixels`]: linear and encoded pixels as different types.
 //! - [`lut`]: the per-id lookup tables built once from the registry.
+//! - [`colour`]: the passes' colour space and the registry table in it.
 //! - [`kernel`]: the per-pixel composite, in place, rayon over rows.
 //! - [`sequence`]: frame patterns (`r.####.exr`) and frames in parallel.
 //! - [`compose_frame`]: one image end to end, with per-stage timings for `--stats`.
 
+pub mod colour;
 pub mod error;
 pub mod io;
 pub mod kernel;
@@ -28,6 +30,7 @@ use glassdb_mask::{MaskImage, MaskReadOptions, PlacedMask};
 pub use glassdb_registry::Side;
 use rayon::prelude::*;
 
+use crate::colour::{ChosenTable, PassSpace, RegistryLuts, SpaceSource};
 use crate::io::{OutputFrame, OutputOptions, Pass, PassReadOptions, WrittenOutput};
 use crate::kernel::{KernelCounts, KernelInput, OutsidePass, PlacedRefl};
 use crate::lut::GlassLut;
@@ -102,6 +105,8 @@ pub struct ComposeSettings {
     pub registry_label: String,
     /// Files that must never be overwritten (e.g. the registry JSON).
     pub protected: Vec<PathBuf>,
+    /// The passes' linear RGB space, over what their headers say (`--input-space`).
+    pub input_space: Option<glassdb_colour::RgbSpace>,
 }
 
 impl Default for ComposeSettings {
@@ -116,6 +121,7 @@ impl Default for ComposeSettings {
             output: OutputOptions::default(),
             registry_label: "the registry".into(),
             protected: Vec::new(),
+            input_space: None,
         }
     }
 }
@@ -157,6 +163,20 @@ pub struct FrameReport {
     /// Glass pixels outside their plane's reflection pass (composited as the chosen
     /// [`OutsidePolicy`] says).
     pub outside_pixels: u64,
+    /// The passes' colour space and the registry table used.
+    pub colour: FrameColour,
+}
+
+/// The colour facts of one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameColour {
+    /// The passes' space and how it was known (the transmission pass's; the others agree).
+    pub space: PassSpace,
+    /// The registry table composited with.
+    pub table: ChosenTable,
+    /// Whether a PNG output was converted from the passes' space to linear Rec.709 before the
+    /// `standard` view's sRGB transfer.
+    pub converted_for_display: bool,
 }
 
 impl FrameReport {
@@ -416,7 +436,7 @@ fn absolute_from(w: &PixelWindow, origin: &PixelWindow) -> PixelWindow {
 pub fn compose_frame(
     job: &ComposeJob,
     settings: &ComposeSettings,
-    lut: &GlassLut,
+    luts: &RegistryLuts,
 ) -> Result<FrameReport, ComposeError> {
     if job.refl.is_empty() {
         return Err(ComposeError::NoReflectionPass);
@@ -435,11 +455,13 @@ pub fn compose_frame(
     let t0 = Instant::now();
     let DecodedInputs {
         mut trans,
-        frame,
+        mut frame,
         refl,
         mask,
     } = decode_inputs(job, settings)?;
     let decode = t0.elapsed();
+    let space = passes_space(job, settings, &trans, &refl)?;
+    let (table, lut) = luts.for_space(&space, &job.trans, &settings.registry_label)?;
 
     let t1 = Instant::now();
     let data = trans.windows.data;
@@ -527,6 +549,21 @@ pub fn compose_frame(
     let compose = t1.elapsed();
 
     let t2 = Instant::now();
+    if space.source != SpaceSource::Untagged {
+        frame.tag_space = Some(space.space);
+    }
+    let converted_for_display = io::output_format(&job.output)? == io::OutputFormat::Png
+        && matches!(
+            settings.output.view,
+            None | Some(view::ViewTransform::Standard)
+        )
+        && space.space != glassdb_colour::RgbSpace::Srgb;
+    if converted_for_display {
+        trans.image.convert_rgb(glassdb_colour::rgb_to_rgb(
+            space.space,
+            glassdb_colour::RgbSpace::Srgb,
+        ));
+    }
     let output = io::write_output_in_frame(
         &job.output,
         trans.image,
@@ -551,7 +588,35 @@ pub fn compose_frame(
         counts,
         planes: job.refl.len(),
         outside_pixels: outside.values().map(|(n, _)| n).sum(),
+        colour: FrameColour {
+            space,
+            table,
+            converted_for_display,
+        },
     })
+}
+
+/// The one colour space of the frame's passes ([`colour::frame_space`]).
+fn passes_space(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    trans: &Pass,
+    refl: &[Pass],
+) -> Result<PassSpace, ComposeError> {
+    let declared = settings.input_space;
+    let trans_space = colour::pass_space(&job.trans, &trans.colour, declared)?;
+    let refl_spaces = job
+        .refl
+        .iter()
+        .zip(refl)
+        .map(|(path, pass)| {
+            Ok((
+                path.clone(),
+                colour::pass_space(path, &pass.colour, declared)?,
+            ))
+        })
+        .collect::<Result<Vec<_>, ComposeError>>()?;
+    colour::frame_space((&job.trans, trans_space), &refl_spaces)
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 //! - normal incidence from `r0`, `t0` (`r0_back` for the back side) for binary masks.
 
 use glassdb_mask::CosCode;
-use glassdb_registry::{Registry, Side};
+use glassdb_registry::{RegistryTable, Side};
 
 /// Intervals of the fine table over cos θ ∈ [0, 1].
 pub const FINE_STEPS: usize = 4096;
@@ -145,8 +145,8 @@ impl GlassLut {
         }
     }
 
-    /// Builds the tables for every glass of the registry (its `eval` and normal values).
-    pub fn from_registry(registry: &Registry) -> GlassLut {
+    /// Builds the tables for every glass of a registry table (its `eval` and normal values).
+    pub fn from_table(registry: &RegistryTable) -> GlassLut {
         let ids: Vec<u16> = registry.glasses.iter().map(|g| g.id).collect();
         GlassLut::from_fn(
             &ids,
@@ -217,8 +217,9 @@ mod tests {
     fn code8_entries_are_the_registry_at_the_codes_cos_theta() {
         // The 8-bit entries equal the registry's eval at the code's cos θ, in f32, bit for bit.
         let reg = glassdb_registry::default_registry().unwrap();
-        let lut = GlassLut::from_registry(&reg);
-        let g = &reg.glasses[0];
+        let table = reg.default_table();
+        let lut = GlassLut::from_table(table);
+        let g = &table.glasses[0];
         for side in [Side::Front, Side::Back] {
             let s = lut.side(g.id, side).unwrap();
             for code in [0u8, 1, 77, 128, 254, 255] {

@@ -28,6 +28,18 @@ pub struct LinearImage {
 }
 
 impl LinearImage {
+    /// Applies a 3×3 matrix (row-major, as nalgebra indexes it) to every pixel's RGB: a change
+    /// of linear RGB space. Alpha is unchanged (a linear map commutes with premultiplication).
+    pub fn convert_rgb(&mut self, m: glassdb_colour::Matrix3<f64>) {
+        let m: [[f32; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)] as f32));
+        let [r, g, b] = &mut self.rgb;
+        for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
+            let v = [*r, *g, *b];
+            let row = |k: usize| m[k][0] * v[0] + m[k][1] * v[1] + m[k][2] * v[2];
+            (*r, *g, *b) = (row(0), row(1), row(2));
+        }
+    }
+
     /// Number of pixels.
     pub fn pixel_count(&self) -> usize {
         self.width as usize * self.height as usize

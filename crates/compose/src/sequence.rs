@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use crate::lut::GlassLut;
+use crate::colour::RegistryLuts;
 use crate::{ComposeError, ComposeJob, ComposeSettings, FrameReport, compose_frame};
 
 /// Whether `pattern` contains a `#` run (`glassdb_io::frames`, shared with `glassdb mask`).
@@ -63,7 +63,7 @@ pub fn compose_sequence(
     pattern: &ComposeJob,
     frames: &[u32],
     settings: &ComposeSettings,
-    lut: &GlassLut,
+    luts: &RegistryLuts,
     on_done: &(dyn Fn(&FrameOutcome) + Sync),
 ) -> Result<Vec<FrameOutcome>, ComposeError> {
     if !is_pattern(&pattern.output) && frames.len() > 1 {
@@ -80,7 +80,7 @@ pub fn compose_sequence(
                     let k = next.fetch_add(1, Ordering::Relaxed);
                     let Some(&frame) = frames.get(k) else { break };
                     let result = frame_job(pattern, frame)
-                        .and_then(|job| compose_frame(&job, settings, lut));
+                        .and_then(|job| compose_frame(&job, settings, luts));
                     let outcome = FrameOutcome { frame, result };
                     on_done(&outcome);
                     if let Ok(mut r) = results.lock() {

@@ -6,6 +6,7 @@ use glassdb_mask::{CosTheta, MaskImage};
 use proptest::prelude::*;
 
 use super::*;
+use crate::colour::RegistryLuts;
 use crate::kernel::{KernelShapeError, compose_in_place};
 use crate::lut::GlassLut;
 
@@ -294,7 +295,8 @@ proptest! {
         write(&r_path, &refl);
         glassdb_mask::write_mask(&m_path, &m, glassdb_mask::MaskFormat::Png8).unwrap();
         let job = ComposeJob { refl: vec![r_path], trans: t_path, mask: m_path, output: dir.path().join("o.exr") };
-        compose_frame(&job, &ComposeSettings::default(), &lut).unwrap();
+        let luts = RegistryLuts::single(glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb), lut);
+        compose_frame(&job, &ComposeSettings::default(), &luts).unwrap();
         let out = io::read_pass(&job.output, &PassReadOptions::default()).unwrap();
         let got: Vec<u32> = out.image.rgb.iter().flatten().map(|v| v.to_bits()).collect();
         let want: Vec<u32> = trans.iter().map(|v| v.to_bits()).collect();

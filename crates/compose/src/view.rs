@@ -57,7 +57,7 @@ impl ViewTransform {
     /// A name for reports: `standard` or the LUT's file.
     pub fn describe(&self) -> String {
         match self {
-            ViewTransform::Standard => "sRGB".to_string(),
+            ViewTransform::Standard => "standard view: sRGB transfer, clipped".to_string(),
             ViewTransform::Lut(lut) => format!("view {}", lut.path.display()),
         }
     }

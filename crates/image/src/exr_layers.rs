@@ -337,6 +337,7 @@ mod tests {
                 .collect(),
             compression: exr::compression::Compression::ZIP16,
             deep: false,
+            colour: crate::ExrColourTag::default(),
             view: None,
             multi_view: Vec::new(),
             multi_resolution: false,

@@ -9,7 +9,7 @@ use exr::block::UncompressedBlock;
 use exr::block::chunk::Chunk;
 use exr::math::Vec2;
 use exr::meta::BlockDescription;
-use exr::meta::attribute::SampleType;
+use exr::meta::attribute::{SampleType, Text};
 use exr::meta::header::{Header, ImageAttributes, LayerAttributes};
 use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
 use rayon::prelude::*;
@@ -73,6 +73,53 @@ pub struct ExrPart {
     /// Whether the file has several parts: only then does a part's name qualify its channel
     /// names (a single-part file's channel names are complete, even when it has a `name`).
     pub multi_part: bool,
+    /// What the header says of the colour of the part's RGB.
+    pub colour: ExrColourTag,
+}
+
+/// The colour attributes of an EXR part, as stored (interpreted by the compositor).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ExrColourTag {
+    /// OpenEXR's `chromaticities`: red, green, blue and white CIE xy (absent: OpenEXR's
+    /// default, Rec.709 primaries and D65).
+    pub chromaticities: Option<[f32; 8]>,
+    /// The Color Interop Forum id of the part's colour space (`colorInteropID`, written per
+    /// part by Blender 5: `lin_rec709_scene`, `lin_ap1_scene`, `data`, …).
+    pub interop_id: Option<String>,
+}
+
+/// The part's colour attributes: `chromaticities` (shared or the part's own) and a text
+/// `colorInteropID` (the part's own, else shared).
+fn colour_tag(h: &Header) -> ExrColourTag {
+    let text = |name: &str| {
+        [&h.own_attributes.other, &h.shared_attributes.other]
+            .into_iter()
+            .find_map(|map| match map.get(&Text::from(name)) {
+                Some(exr::meta::attribute::AttributeValue::Text(t)) => Some(t.to_string()),
+                _ => None,
+            })
+    };
+    let chromaticities = h.shared_attributes.chromaticities.or_else(|| {
+        match h.own_attributes.other.get(&Text::from("chromaticities")) {
+            Some(exr::meta::attribute::AttributeValue::Chromaticities(c)) => Some(*c),
+            _ => None,
+        }
+    });
+    ExrColourTag {
+        chromaticities: chromaticities.map(|c| {
+            [
+                c.red.x(),
+                c.red.y(),
+                c.green.x(),
+                c.green.y(),
+                c.blue.x(),
+                c.blue.y(),
+                c.white.x(),
+                c.white.y(),
+            ]
+        }),
+        interop_id: text("colorInteropID"),
+    }
 }
 
 impl ExrPart {
@@ -127,6 +174,7 @@ fn part_from_header(h: &Header) -> ExrPart {
             BlockDescription::Tiles(t) => t.level_mode != exr::meta::attribute::LevelMode::Singular,
             BlockDescription::ScanLines => false,
         },
+        colour: colour_tag(h),
     }
 }
 

@@ -27,7 +27,7 @@ pub use exr_layers::{
     rgb_layers,
 };
 pub use exr_read::{
-    ExactExr, ExactPart, ExrChannelInfo, ExrPart, ExrSampleType, read_exr_attributes,
+    ExactExr, ExactPart, ExrChannelInfo, ExrColourTag, ExrPart, ExrSampleType, read_exr_attributes,
     read_exr_channels, read_exr_exact, read_exr_headers, read_exr_text_attributes,
 };
 pub use exr_write::{

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use glassdb_fit::{Basis, CosPolynomial, FitSummary};
 use glassdb_mask::{CosTheta, MaskImage};
-use glassdb_registry::{AngleCurve, GlassRecord, Registry};
+use glassdb_registry::{AngleCurve, GlassRecord, Registry, RegistryTable};
 use glassdb_spectral::{IntegrationSettings, Method};
 
 use crate::chart::{Line, Panel, clipped_runs, format_axis_tick, format_tick};
@@ -170,8 +170,7 @@ fn curve(powers: Vec<u32>, coefficients: Vec<f64>) -> AngleCurve {
 fn linear_registry() -> Registry {
     let lin = curve(vec![1], vec![1.0]);
     let one = curve(vec![0], vec![1.0]);
-    Registry {
-        schema: glassdb_registry::SCHEMA_VERSION,
+    Registry::single(RegistryTable {
         spectral: IntegrationSettings {
             method: Method::Luminous,
             extrapolate: false,
@@ -183,7 +182,7 @@ fn linear_registry() -> Registry {
             [[0.1, 0.2, 0.3], [0.5, 0.6, 0.7], [0.4, 0.4, 0.4]],
             [&lin, &one, &one],
         )],
-    }
+    })
 }
 
 #[test]

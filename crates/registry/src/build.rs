@@ -14,7 +14,7 @@ use crate::catalog::{GlassSpec, parse_catalog, resolve};
 use crate::curves::fit_glass_curves;
 use crate::normal::{normal_values, read_spectral_source};
 use crate::{
-    AngleModelRecord, FileRef, GlassRecord, Provenance, Registry, RegistryError, SCHEMA_VERSION,
+    AngleModelRecord, FileRef, GlassRecord, Provenance, Registry, RegistryError, RegistryTable,
 };
 
 /// Where the angle model is applied.
@@ -48,8 +48,9 @@ pub struct MaskIds {
 /// How to build a registry.
 #[derive(Debug, Clone)]
 pub struct BuildOptions {
-    /// Spectral method for the whole build (recorded in the registry).
-    pub spectral: IntegrationSettings,
+    /// The spectral method of each table to build, the default table first (one per colour
+    /// basis: e.g. colorimetric in linear Rec.709 and in ACEScg).
+    pub tables: Vec<IntegrationSettings>,
     /// With the ids of a scene's masks, only those glasses are built.
     pub mask_ids: Option<MaskIds>,
     /// Fit tolerance on r and t (absolute).
@@ -63,7 +64,7 @@ pub struct BuildOptions {
 impl Default for BuildOptions {
     fn default() -> Self {
         BuildOptions {
-            spectral: IntegrationSettings::default(),
+            tables: vec![IntegrationSettings::default()],
             mask_ids: None,
             fit_tol: glassdb_fit::DEFAULT_TOL,
             max_degree: 12,
@@ -111,30 +112,33 @@ pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Regist
     })?;
     let specs = parse_catalog(&text, catalog_path)?;
     let wanted = wanted_ids(&specs, catalog_path, opts.mask_ids.as_ref())?;
-    let integrator =
-        Integrator::new(&opts.spectral).map_err(|e| RegistryError::SpectralMethod(Box::new(e)))?;
     let catalog_ref = FileRef {
         path: catalog_path.display().to_string(),
         sha256: catalog_sha,
     };
     let files = CatalogFiles { catalog_path };
-    let mut glasses = Vec::new();
-    for spec in &specs {
-        if let Some(w) = &wanted
-            && !w.contains(&spec.id)
-        {
-            continue;
+    let mut tables = Vec::with_capacity(opts.tables.len());
+    for settings in &opts.tables {
+        let integrator =
+            Integrator::new(settings).map_err(|e| RegistryError::SpectralMethod(Box::new(e)))?;
+        let mut glasses = Vec::new();
+        for spec in &specs {
+            if let Some(w) = &wanted
+                && !w.contains(&spec.id)
+            {
+                continue;
+            }
+            let mut g = build_glass(spec, &files, &integrator, opts)?;
+            g.provenance.catalog = Some(catalog_ref.clone());
+            glasses.push(g);
         }
-        let mut g = build_glass(spec, &files, &integrator, opts)?;
-        g.provenance.catalog = Some(catalog_ref.clone());
-        glasses.push(g);
+        glasses.sort_by_key(|g| g.id);
+        tables.push(RegistryTable {
+            spectral: *settings,
+            glasses,
+        });
     }
-    glasses.sort_by_key(|g| g.id);
-    let registry = Registry {
-        schema: SCHEMA_VERSION,
-        spectral: opts.spectral,
-        glasses,
-    };
+    let registry = Registry::from_tables_unchecked(tables);
     registry.validate_named(&format!("registry built from {}", catalog_path.display()))?;
     Ok(registry)
 }
@@ -297,7 +301,7 @@ mod tests {
             ),
         );
         let reg = build_registry(&catalog, &BuildOptions::default()).unwrap();
-        let g = reg.glass(1).unwrap();
+        let g = reg.default_table().glass(1).unwrap();
         assert_eq!(g.angle_model.kind, "measured");
         assert_eq!(g.angle_model.measured_max_angle_deg, Some(60.0));
         assert_eq!(g.angle_model.continued_by.as_deref(), Some("uncoated"));
@@ -359,7 +363,14 @@ mod tests {
             ..BuildOptions::default()
         };
         let reg = build_registry(&catalog, &only(&[(2, 10)], false)).unwrap();
-        assert_eq!(reg.glasses.iter().map(|g| g.id).collect::<Vec<_>>(), [2]);
+        assert_eq!(
+            reg.default_table()
+                .glasses
+                .iter()
+                .map(|g| g.id)
+                .collect::<Vec<_>>(),
+            [2]
+        );
         let err = build_registry(&catalog, &only(&[(2, 10), (7, 3)], false)).unwrap_err();
         assert!(
             matches!(&err, RegistryError::IdsNotInCatalog { ids, .. } if ids == &[(7, 3)]),
@@ -383,7 +394,7 @@ mod tests {
             "[[glass]]\nid = 12\nname = \"metal\"\nmodel = \"opaque\"\nior = [[1.5, 7.8], [1.0, 6.7], [0.6, 5.5]]\n",
         );
         let reg = build_registry(&catalog, &BuildOptions::default()).unwrap();
-        let g = reg.glass(12).unwrap();
+        let g = reg.default_table().glass(12).unwrap();
         let f0 = |n: f64, k: f64| ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
         assert!((g.r0[0] - f0(1.5, 7.8)).abs() < 1e-12);
         assert!((g.r0[2] - f0(0.6, 5.5)).abs() < 1e-12);

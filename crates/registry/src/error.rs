@@ -22,12 +22,45 @@ pub enum RegistryError {
 
     /// The registry was written by a different, incompatible schema version.
     #[error(
-        "{source_name}: registry schema {found} is not supported (this build reads schema {expected}); rebuild it from its catalog"
+        "{source_name}: registry schema {found} is not supported (this build reads schemas 2 and {expected}); rebuild it from its catalog"
     )]
     SchemaVersion {
         source_name: String,
         found: u32,
         expected: u32,
+    },
+
+    /// A registry with no table.
+    #[error("{source_name}: the registry has no table (schema 3 needs at least one in `tables`)")]
+    NoTables { source_name: String },
+
+    /// The registry holds no table in the colour basis asked for.
+    #[error("{source_name} has no table in {wanted} (it holds: {})", have.join(", "))]
+    NoSuchTable {
+        source_name: String,
+        wanted: String,
+        have: Vec<String>,
+    },
+
+    /// Two tables in one colour basis: a compositor could not tell which to use.
+    #[error("{source_name}: two tables in {basis}: {first} and {second}; keep one table per space")]
+    DuplicateTable {
+        source_name: String,
+        basis: String,
+        first: String,
+        second: String,
+    },
+
+    /// The tables of one registry hold different glasses.
+    #[error(
+        "{source_name}: the {other} table holds other glasses than the {first} table ({other_glasses:?} against {first_glasses:?}); build every table from one catalog"
+    )]
+    TablesDiffer {
+        source_name: String,
+        first: String,
+        other: String,
+        first_glasses: Vec<String>,
+        other_glasses: Vec<String>,
     },
 
     /// Id 0 is reserved for "no glass" in every mask.

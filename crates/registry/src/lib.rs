@@ -24,6 +24,7 @@ pub use build::{Application, BuildOptions, MaskIds, build_registry};
 pub use bundled::{DEFAULT_REGISTRY_JSON, DEFAULT_REGISTRY_NAME, default_registry};
 pub use error::RegistryError;
 pub use record::{
-    AngleCurve, AngleModelRecord, CHANNELS, FileRef, GlassRecord, LuminousRecord, ProductRecord,
-    Provenance, Registry, SCHEMA_VERSION, Side, UnknownSide,
+    AngleCurve, AngleModelRecord, CHANNELS, ColourBasis, FileRef, GlassRecord, LuminousRecord,
+    ProductRecord, Provenance, Registry, RegistryTable, SCHEMA_VERSION, SCHEMA_VERSION_ONE_TABLE,
+    Side, UnknownSide,
 };

@@ -6,28 +6,99 @@ use std::path::Path;
 use std::str::FromStr;
 
 use glassdb_fit::{CosPolynomial, FitSummary};
-use glassdb_spectral::IntegrationSettings;
+use glassdb_spectral::{IntegrationSettings, Method, RgbSpace};
 use serde::{Deserialize, Serialize};
 
 use crate::RegistryError;
 
-/// The registry schema version this crate reads and writes. Schema 2: curves are the fit
+/// The registry schema version this crate writes. Schema 3: one table per colour basis
+/// (`tables`, each with its spectral method and its glasses); schema 2 (one table, `spectral`
+/// and `glasses` at the top) is still read, as a registry of one table. Curves are the fit
 /// crate's [`CosPolynomial`] (basis `paper` or `full`, strictly ascending powers) and
 /// [`FitSummary`]; the spectral method is [`IntegrationSettings`].
-pub const SCHEMA_VERSION: u32 = 2;
+pub const SCHEMA_VERSION: u32 = 3;
+
+/// The older schema still read (one table).
+pub const SCHEMA_VERSION_ONE_TABLE: u32 = 2;
 
 /// Channel names, in the order of every `[_; 3]` array in the registry.
 pub const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
-/// The id-indexed table of glasses a scene uses.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// The id-indexed glass tables of a scene: the same glasses, integrated once per colour basis
+/// (an RGB working space such as linear Rec.709 or ACEScg, the paper's CIE RGB, or luminous
+/// grey), so that passes rendered in any of those spaces find their numbers. Never empty; the
+/// first table is the default one.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Registry {
-    /// Schema version ([`SCHEMA_VERSION`]).
-    pub schema: u32,
-    /// The spectral method that turned spectra into per-channel values (one for the whole build).
+    tables: Vec<RegistryTable>,
+}
+
+/// The glasses of a registry integrated with one spectral method (one colour basis).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RegistryTable {
+    /// The spectral method that turned spectra into per-channel values.
     pub spectral: IntegrationSettings,
     /// The glasses, sorted by id.
     pub glasses: Vec<GlassRecord>,
+}
+
+/// What a table's three channels are: the colour basis its numbers are in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ColourBasis {
+    /// A linear RGB working space (the colorimetric method).
+    Space(RgbSpace),
+    /// The paper's CIE 1931 RGB colour-matching functions (eqs. 15–20): no renderer's space.
+    PaperRgb,
+    /// The luminous value in all three channels: a grey, the same in every space.
+    Luminous,
+}
+
+impl fmt::Display for ColourBasis {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ColourBasis::Space(s) => write!(f, "{s}"),
+            ColourBasis::PaperRgb => f.write_str("paper-rgb"),
+            ColourBasis::Luminous => f.write_str("luminous"),
+        }
+    }
+}
+
+impl FromStr for ColourBasis {
+    type Err = String;
+    /// An RGB space's name (`srgb`/`rec709`, `rec2020`, `acescg`, …), `paper-rgb` or
+    /// `luminous`, any case.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let s = s.trim();
+        if s.eq_ignore_ascii_case("paper-rgb") || s.eq_ignore_ascii_case("paper") {
+            return Ok(ColourBasis::PaperRgb);
+        }
+        if s.eq_ignore_ascii_case("luminous") {
+            return Ok(ColourBasis::Luminous);
+        }
+        s.parse::<RgbSpace>().map(ColourBasis::Space).map_err(|_| {
+            let names: Vec<&str> = RgbSpace::ALL.iter().map(|r| r.name()).collect();
+            format!(
+                "unknown colour basis `{s}`; expected one of: {}, rec709, paper-rgb, luminous",
+                names.join(", ")
+            )
+        })
+    }
+}
+
+impl RegistryTable {
+    /// The colour basis of this table's channels.
+    pub fn basis(&self) -> ColourBasis {
+        match self.spectral.method {
+            Method::Colorimetric { space, .. } => ColourBasis::Space(space),
+            Method::Paper(_) => ColourBasis::PaperRgb,
+            Method::Luminous => ColourBasis::Luminous,
+        }
+    }
+
+    /// The glass with this registration id.
+    pub fn glass(&self, id: u16) -> Option<&GlassRecord> {
+        self.glasses.iter().find(|g| g.id == id)
+    }
 }
 
 /// One glass product: normal-incidence values per channel and its angle curves.
@@ -296,7 +367,91 @@ impl GlassRecord {
     }
 }
 
+/// The JSON form of schema 3.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RegistryJson {
+    #[allow(dead_code)] // checked before (`VersionOnly`)
+    schema: u32,
+    tables: Vec<RegistryTable>,
+}
+
+/// The JSON form of schema 2: one table at the top level.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OneTableJson {
+    #[allow(dead_code)] // checked before (`VersionOnly`)
+    schema: u32,
+    spectral: IntegrationSettings,
+    glasses: Vec<GlassRecord>,
+}
+
 impl Registry {
+    /// A registry of one table.
+    pub fn single(table: RegistryTable) -> Registry {
+        Registry {
+            tables: vec![table],
+        }
+    }
+
+    /// A registry of several tables, the first the default; validated
+    /// ([`Registry::validate`]): at least one table, one per colour basis, the same glasses
+    /// (ids and names) in each.
+    pub fn new(tables: Vec<RegistryTable>) -> Result<Registry, RegistryError> {
+        let registry = Registry { tables };
+        registry.validate()?;
+        Ok(registry)
+    }
+
+    /// Tables not yet validated (the builder validates them with its own name for messages).
+    pub(crate) fn from_tables_unchecked(tables: Vec<RegistryTable>) -> Registry {
+        Registry { tables }
+    }
+
+    /// Every table, the default first.
+    pub fn tables(&self) -> &[RegistryTable] {
+        &self.tables
+    }
+
+    /// The default (first) table: what commands show and plot unless asked for another basis.
+    pub fn default_table(&self) -> &RegistryTable {
+        // `tables` is never empty: every constructor and the loader check it.
+        &self.tables[0]
+    }
+
+    /// Mutable tables, for tools and tests that edit a registry before writing it (validate
+    /// again before use; [`Registry::write_json`] does).
+    pub fn tables_mut(&mut self) -> &mut Vec<RegistryTable> {
+        &mut self.tables
+    }
+
+    /// The table in this colour basis, if the registry holds one.
+    pub fn table(&self, basis: ColourBasis) -> Option<&RegistryTable> {
+        self.tables.iter().find(|t| t.basis() == basis)
+    }
+
+    /// The table in `basis`, or the default table for `None`; an error naming the registry
+    /// and the bases it holds when it has no such table.
+    pub fn table_or_error(
+        &self,
+        basis: Option<ColourBasis>,
+        source_name: &str,
+    ) -> Result<&RegistryTable, RegistryError> {
+        let Some(basis) = basis else {
+            return Ok(self.default_table());
+        };
+        self.table(basis).ok_or_else(|| RegistryError::NoSuchTable {
+            source_name: source_name.to_string(),
+            wanted: basis.to_string(),
+            have: self.bases().iter().map(ToString::to_string).collect(),
+        })
+    }
+
+    /// The colour bases held, in table order.
+    pub fn bases(&self) -> Vec<ColourBasis> {
+        self.tables.iter().map(RegistryTable::basis).collect()
+    }
+
     /// Reads and validates a registry JSON file.
     pub fn from_json_file(path: &Path) -> Result<Registry, RegistryError> {
         let text = std::fs::read_to_string(path).map_err(|source| RegistryError::Read {
@@ -306,7 +461,8 @@ impl Registry {
         Registry::from_json_str(&text, &path.display().to_string())
     }
 
-    /// Parses and validates a registry JSON text; `source_name` names it in errors.
+    /// Parses and validates a registry JSON text (schema 3, or schema 2 as one table);
+    /// `source_name` names it in errors.
     pub fn from_json_str(json: &str, source_name: &str) -> Result<Registry, RegistryError> {
         // Check the version first, so an old or future file gets a version message rather than
         // a missing-key one.
@@ -314,30 +470,35 @@ impl Registry {
         struct VersionOnly {
             schema: u32,
         }
-        let version: VersionOnly =
-            serde_json::from_str(json).map_err(|source| RegistryError::Json {
-                source_name: source_name.to_string(),
-                source,
-            })?;
-        if version.schema != SCHEMA_VERSION {
-            return Err(RegistryError::SchemaVersion {
-                source_name: source_name.to_string(),
-                found: version.schema,
-                expected: SCHEMA_VERSION,
-            });
-        }
-        let registry: Registry =
-            serde_json::from_str(json).map_err(|source| RegistryError::Json {
-                source_name: source_name.to_string(),
-                source,
-            })?;
+        let json_err = |source| RegistryError::Json {
+            source_name: source_name.to_string(),
+            source,
+        };
+        let version: VersionOnly = serde_json::from_str(json).map_err(json_err)?;
+        let tables = match version.schema {
+            SCHEMA_VERSION => {
+                serde_json::from_str::<RegistryJson>(json)
+                    .map_err(json_err)?
+                    .tables
+            }
+            SCHEMA_VERSION_ONE_TABLE => {
+                let one: OneTableJson = serde_json::from_str(json).map_err(json_err)?;
+                vec![RegistryTable {
+                    spectral: one.spectral,
+                    glasses: one.glasses,
+                }]
+            }
+            found => {
+                return Err(RegistryError::SchemaVersion {
+                    source_name: source_name.to_string(),
+                    found,
+                    expected: SCHEMA_VERSION,
+                });
+            }
+        };
+        let registry = Registry { tables };
         registry.validate_named(source_name)?;
         Ok(registry)
-    }
-
-    /// The glass with this registration id.
-    pub fn glass(&self, id: u16) -> Option<&GlassRecord> {
-        self.glasses.iter().find(|g| g.id == id)
     }
 
     /// SHA-256 (hex) of the registry's canonical JSON ([`Registry::to_json_string`]): names
@@ -346,9 +507,18 @@ impl Registry {
         Ok(crate::build::sha256_hex(self.to_json_string()?.as_bytes()))
     }
 
-    /// The registry as pretty JSON text.
+    /// The registry as pretty JSON text (schema 3).
     pub fn to_json_string(&self) -> Result<String, RegistryError> {
-        let mut s = serde_json::to_string_pretty(self).map_err(RegistryError::Serialize)?;
+        #[derive(Serialize)]
+        struct RegistryJsonOut<'a> {
+            schema: u32,
+            tables: &'a [RegistryTable],
+        }
+        let json = RegistryJsonOut {
+            schema: SCHEMA_VERSION,
+            tables: &self.tables,
+        };
+        let mut s = serde_json::to_string_pretty(&json).map_err(RegistryError::Serialize)?;
         s.push('\n');
         Ok(s)
     }
@@ -387,8 +557,7 @@ mod tests {
     fn sample() -> Registry {
         let cr = curve(vec![0, 1, 2], vec![10.0, -18.0, 9.0]);
         let ct = curve(vec![1], vec![1.0]);
-        Registry {
-            schema: SCHEMA_VERSION,
+        Registry::single(RegistryTable {
             spectral: IntegrationSettings::default(),
             glasses: vec![GlassRecord::with_shared_curves(
                 4,
@@ -397,15 +566,15 @@ mod tests {
                 [[0.1; 3], [0.8, 0.7, 0.6], [0.05; 3]],
                 [&cr, &ct, &cr],
             )],
-        }
+        })
     }
 
     #[test]
     fn eval_and_tables_agree_with_hand_values() {
         let reg = sample();
         reg.validate().unwrap();
-        let g = reg.glass(4).unwrap();
-        assert!(reg.glass(5).is_none());
+        let g = reg.default_table().glass(4).unwrap();
+        assert!(reg.default_table().glass(5).is_none());
         // cos θ = 0.5: C_r = 10 − 9 + 2.25 = 3.25 → r = 0.325; t = 0.8·0.5 = 0.4.
         let (r, t) = g.eval(Side::Front, 0.5);
         assert!((r[0] - 0.325).abs() < 1e-15 && (t[0] - 0.4).abs() < 1e-15);
@@ -424,8 +593,8 @@ mod tests {
         let mut reg = sample();
         // t0 = 0.95 with r0 = 0.1: at normal incidence r + t = 1.05 (invalid, but eval must
         // still give a physical pair).
-        reg.glasses[0].t0 = [0.95; 3];
-        let (r, t) = reg.glasses[0].eval(Side::Front, 1.0);
+        reg.tables[0].glasses[0].t0 = [0.95; 3];
+        let (r, t) = reg.tables[0].glasses[0].eval(Side::Front, 1.0);
         assert!((r[0] - 0.1).abs() < 1e-15 && (t[0] - 0.9).abs() < 1e-15);
         let err = reg.validate().unwrap_err().to_string();
         assert!(err.contains("at 0°") && err.contains("r + t"), "{err}");
@@ -437,12 +606,12 @@ mod tests {
         // Back reflectance curve too steep in channel B only: r_back = 0.05·(30 − 29c) and
         // t = 0.6·c give r + t = 1.5 − 0.85c > 1 + 0.004 where c < 0.58353 → θ > 54.30°; the
         // first angle of the 0.25° grid beyond is 54.5°.
-        reg.glasses[0].c_r_back[2] = curve(vec![0, 1], vec![30.0, -29.0]);
+        reg.tables[0].glasses[0].c_r_back[2] = curve(vec![0, 1], vec![30.0, -29.0]);
         let err = reg.validate().unwrap_err().to_string();
         assert!(err.contains("id 4 (\"hand-made\")"), "{err}");
         assert!(err.contains("back side, channel B, at 54.5°"), "{err}");
         let mut reg = sample();
-        reg.glasses[0].c_t[1].polynomial.coefficients[0] = f64::NAN;
+        reg.tables[0].glasses[0].c_t[1].polynomial.coefficients[0] = f64::NAN;
         assert!(
             reg.validate()
                 .unwrap_err()
@@ -450,7 +619,8 @@ mod tests {
                 .contains("c_t[1] (G).coefficients[0]")
         );
         let mut reg = sample();
-        reg.glasses.push(reg.glasses[0].clone());
+        let copy = reg.tables[0].glasses[0].clone();
+        reg.tables[0].glasses.push(copy);
         assert!(matches!(
             reg.validate(),
             Err(RegistryError::DuplicateId { id: 4, .. })
@@ -471,15 +641,15 @@ mod tests {
     #[test]
     fn powers_must_ascend_and_the_paper_basis_has_no_constant() {
         let mut reg = sample();
-        reg.glasses[0].c_r[0] = curve(vec![0, 2, 1], vec![10.0, 9.0, -18.0]);
+        reg.tables[0].glasses[0].c_r[0] = curve(vec![0, 2, 1], vec![10.0, 9.0, -18.0]);
         let e = glassdb_io::ErrorChain(&reg.validate().unwrap_err()).to_string();
         assert!(
             e.contains("c_r[0] (R)") && e.contains("ascend strictly"),
             "{e}"
         );
         let mut reg = sample();
-        reg.glasses[0].c_t[0].polynomial.powers = vec![0];
-        reg.glasses[0].c_t[0].polynomial.basis = glassdb_fit::Basis::Paper;
+        reg.tables[0].glasses[0].c_t[0].polynomial.powers = vec![0];
+        reg.tables[0].glasses[0].c_t[0].polynomial.basis = glassdb_fit::Basis::Paper;
         let e = glassdb_io::ErrorChain(&reg.validate().unwrap_err()).to_string();
         assert!(e.contains("no constant term"), "{e}");
     }
@@ -497,7 +667,7 @@ mod tests {
         assert_eq!(Registry::from_json_file(&p).unwrap(), reg);
         // An invalid registry is never written.
         let mut bad = reg.clone();
-        bad.glasses[0].id = 0;
+        bad.tables[0].glasses[0].id = 0;
         let q = dir.path().join("bad.json");
         assert!(bad.write_json(&q).is_err());
         assert!(!q.exists());
@@ -512,10 +682,10 @@ mod tests {
             e.starts_with("x.json:") && e.matches("line 1").count() == 1,
             "{e}"
         );
-        let e = Registry::from_json_str("{\"schema\": 3}", "y.json")
+        let e = Registry::from_json_str("{\"schema\": 4}", "y.json")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("schema 3 is not supported"), "{e}");
+        assert!(e.contains("schema 4 is not supported"), "{e}");
         // A schema-1 file says what to do, without naming command-line flags (the binary adds
         // the exact command).
         let err =
@@ -525,7 +695,7 @@ mod tests {
                 err,
                 RegistryError::SchemaVersion {
                     found: 1,
-                    expected: 2,
+                    expected: 3,
                     ..
                 }
             ),
@@ -541,5 +711,78 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("z.json:"), "{e}");
+    }
+
+    fn in_space(reg: &Registry, space: RgbSpace) -> RegistryTable {
+        let mut t = reg.default_table().clone();
+        t.spectral = IntegrationSettings {
+            method: Method::Colorimetric {
+                observer: glassdb_spectral::Observer::Cie1931,
+                illuminant: glassdb_spectral::Illuminant::D65,
+                space,
+            },
+            extrapolate: false,
+        };
+        t
+    }
+
+    #[test]
+    fn several_tables_one_per_basis_with_the_same_glasses() {
+        let reg = sample();
+        let acescg = in_space(&reg, RgbSpace::AcesCg);
+        let two = Registry::new(vec![reg.default_table().clone(), acescg.clone()]).unwrap();
+        assert_eq!(
+            two.bases(),
+            [
+                ColourBasis::Space(RgbSpace::Srgb),
+                ColourBasis::Space(RgbSpace::AcesCg)
+            ]
+        );
+        assert_eq!(
+            two.table(ColourBasis::Space(RgbSpace::AcesCg)),
+            Some(&acescg)
+        );
+        assert_eq!(two.table(ColourBasis::Luminous), None);
+        let text = two.to_json_string().unwrap();
+        assert!(text.contains("\"schema\": 3"), "{text}");
+        assert_eq!(Registry::from_json_str(&text, "two.json").unwrap(), two);
+
+        let e = Registry::new(vec![acescg.clone(), acescg.clone()]).unwrap_err();
+        assert!(matches!(e, RegistryError::DuplicateTable { .. }), "{e}");
+        let mut other = acescg.clone();
+        other.glasses[0].id = 7;
+        let e = Registry::new(vec![reg.default_table().clone(), other]).unwrap_err();
+        assert!(
+            e.to_string().contains("acescg table holds other glasses"),
+            "{e}"
+        );
+        assert!(matches!(
+            Registry::new(Vec::new()),
+            Err(RegistryError::NoTables { .. })
+        ));
+        // A per-glass error in a table names the table.
+        let mut bad = acescg;
+        bad.glasses[0].t0 = [0.95; 3];
+        let e = Registry::new(vec![reg.default_table().clone(), bad])
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("registry (table 2: acescg)"), "{e}");
+    }
+
+    #[test]
+    fn schema_2_files_read_as_one_table() {
+        let reg = sample();
+        let table = serde_json::to_value(reg.default_table()).unwrap();
+        let v2 = serde_json::json!({
+            "schema": 2,
+            "spectral": table["spectral"],
+            "glasses": table["glasses"],
+        });
+        let back = Registry::from_json_str(&v2.to_string(), "v2.json").unwrap();
+        assert_eq!(back, reg);
+        // Unknown keys stay errors in both schemas.
+        let mut typo = v2.clone();
+        typo["glases"] = serde_json::json!([]);
+        assert!(Registry::from_json_str(&typo.to_string(), "v2.json").is_err());
     }
 }

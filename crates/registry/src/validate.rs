@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use crate::RegistryError;
-use crate::record::{CHANNELS, GlassRecord, Registry, SCHEMA_VERSION, Side};
+use crate::record::{CHANNELS, GlassRecord, Registry, RegistryTable, Side};
 
 /// Angle step of the validation grid (degrees): 0, 0.25, …, 90.
 const VALIDATION_STEP_DEG: f64 = 0.25;
@@ -14,22 +14,64 @@ const VALIDATION_STEP_DEG: f64 = 0.25;
 const VALIDATION_EPS: f64 = 1e-9;
 
 impl Registry {
-    /// Validates: schema version, ids unique and non-zero, every number finite, normal values
-    /// in [0, 1] with r0 + t0 ≤ 1, well-formed curves, and on a dense 0–90° grid per side and
-    /// channel 0 ≤ r, t ≤ 1 and r + t ≤ 1, each within the tolerance recorded for the curve.
+    /// Validates every table ([`RegistryTable::validate_named`]) and how they fit together:
+    /// at least one table, one table per colour basis, and the same glasses (ids and names,
+    /// in order) in each.
     pub fn validate(&self) -> Result<(), RegistryError> {
         self.validate_named("registry")
     }
 
     /// [`Registry::validate`] with a name for the messages.
     pub fn validate_named(&self, source_name: &str) -> Result<(), RegistryError> {
-        if self.schema != SCHEMA_VERSION {
-            return Err(RegistryError::SchemaVersion {
+        let tables = self.tables();
+        let Some(first) = tables.first() else {
+            return Err(RegistryError::NoTables {
                 source_name: source_name.to_string(),
-                found: self.schema,
-                expected: SCHEMA_VERSION,
             });
+        };
+        let several = tables.len() > 1;
+        let ids = |t: &RegistryTable| -> Vec<(u16, String)> {
+            t.glasses.iter().map(|g| (g.id, g.name.clone())).collect()
+        };
+        let first_ids = ids(first);
+        for (k, t) in tables.iter().enumerate() {
+            let name = if several {
+                format!("{source_name} (table {}: {})", k + 1, t.basis())
+            } else {
+                source_name.to_string()
+            };
+            t.validate_named(&name)?;
+            if let Some(earlier) = tables[..k].iter().find(|e| e.basis() == t.basis()) {
+                return Err(RegistryError::DuplicateTable {
+                    source_name: source_name.to_string(),
+                    basis: t.basis().to_string(),
+                    first: earlier.spectral.method.to_string(),
+                    second: t.spectral.method.to_string(),
+                });
+            }
+            if k > 0 && ids(t) != first_ids {
+                return Err(RegistryError::TablesDiffer {
+                    source_name: source_name.to_string(),
+                    first: first.basis().to_string(),
+                    other: t.basis().to_string(),
+                    first_glasses: first_ids.iter().map(label).collect(),
+                    other_glasses: ids(t).iter().map(label).collect(),
+                });
+            }
         }
+        Ok(())
+    }
+}
+
+fn label((id, name): &(u16, String)) -> String {
+    format!("{id} \"{name}\"")
+}
+
+impl RegistryTable {
+    /// Validates one table: ids unique and non-zero, every number finite, normal values in
+    /// [0, 1] with r0 + t0 ≤ 1, well-formed curves, and on a dense 0–90° grid per side and
+    /// channel 0 ≤ r, t ≤ 1 and r + t ≤ 1, each within the tolerance recorded for the curve.
+    pub fn validate_named(&self, source_name: &str) -> Result<(), RegistryError> {
         let mut seen: BTreeMap<u16, &str> = BTreeMap::new();
         for g in &self.glasses {
             if g.id == 0 {

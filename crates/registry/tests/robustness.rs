@@ -4,7 +4,7 @@ use std::path::Path;
 
 use glassdb_fit::{Basis, CosPolynomial, FitSummary};
 use glassdb_registry::{
-    AngleCurve, GlassRecord, Registry, SCHEMA_VERSION, Side, catalog::parse_catalog,
+    AngleCurve, GlassRecord, Registry, RegistryTable, Side, catalog::parse_catalog,
 };
 use glassdb_spectral::{IntegrationSettings, Method};
 use proptest::prelude::*;
@@ -66,11 +66,10 @@ proptest! {
             }
         }
         // Validation either accepts or gives an error; it never panics.
-        let reg = Registry {
-            schema: SCHEMA_VERSION,
+        let reg = Registry::single(RegistryTable {
             spectral: IntegrationSettings { method: Method::Luminous, extrapolate: false },
             glasses: vec![g],
-        };
+        });
         let _ = reg.validate();
     }
 }

@@ -107,7 +107,7 @@ fn evaluation_cost(md: &mut String, refs: &[Reference], inputs: &[f64]) {
 fn pixel_cost(md: &mut String, inputs: &[f64]) {
     match glassdb_registry::default_registry() {
         Ok(reg) => {
-            for g in reg.glasses.iter().take(4) {
+            for g in reg.default_table().glasses.iter().take(4) {
                 let degrees: Vec<String> = g
                     .c_r
                     .iter()

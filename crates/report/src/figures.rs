@@ -179,12 +179,15 @@ fn registry_figure(
     let catalog = shown(&opts.root, &opts.catalog);
     let ids: Vec<u16> = [2u16, 4, 6, 8]
         .into_iter()
-        .filter(|id| reg.glass(*id).is_some())
+        .filter(|id| reg.default_table().glass(*id).is_some())
         .collect();
     let fig = registry_figure_of(
         &reg,
         &format!("default registry ({catalog})"),
-        &RegistryPlotOptions { ids: ids.clone() },
+        &RegistryPlotOptions {
+            ids: ids.clone(),
+            basis: None,
+        },
     )?;
     let id_args: Vec<String> = ids.iter().map(|i| format!("--id {i}")).collect();
     sink.add(

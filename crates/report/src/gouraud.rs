@@ -84,7 +84,12 @@ pub(crate) fn section_gouraud(
     let pane_scene = build_mask_scene(&scene, &mappings, &source, true)?;
     let registry = build_registry(&g.catalog, &BuildOptions::default())?;
     let lum = |v: [f64; 3]| 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
-    let r_of = |id: u16, c: f64| registry.glass(id).map(|gl| lum(gl.eval(Side::Front, c).0));
+    let r_of = |id: u16, c: f64| {
+        registry
+            .default_table()
+            .glass(id)
+            .map(|gl| lum(gl.eval(Side::Front, c).0))
+    };
 
     let name = file_name(&g.obj);
     let _ = writeln!(

@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::SpectralError;
 use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, validate};
 use crate::tables::{Table, tables};
+use glassdb_colour::{D65_XY, RgbSpace, cat02, xyz_to_rgb};
 
 /// The RGB colour-matching functions of the paper's method (eqs. 15–20).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -54,33 +55,6 @@ pub enum Illuminant {
     A,
     /// Equal energy.
     E,
-}
-
-/// Linear RGB working space of the renderer (colorimetric method). Each space's XYZ→RGB matrix
-/// is colour-science 0.4.7's `RGB_COLOURSPACES[...].matrix_XYZ_to_RGB`; XYZ integrated under an
-/// illuminant whose white differs from the space's white is first adapted with CAT02, as
-/// colour's `XYZ_to_RGB` does by default (see [`rgb_matrix`] and docs/spectral.md).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum RgbSpace {
-    /// Linear ITU-R BT.709 / sRGB primaries, D65 white (IEC 61966-2-1 matrix, as colour's
-    /// `sRGB` holds it). `rec709` is accepted as an alias on input; it is written `srgb`.
-    #[serde(rename = "srgb", alias = "rec709")]
-    Srgb,
-    /// ITU-R BT.2020 primaries, D65 white.
-    #[serde(rename = "rec2020")]
-    Rec2020,
-    /// ACEScg (AP1 primaries, ACES white ≈ D60).
-    #[serde(rename = "acescg")]
-    AcesCg,
-    /// ACES2065-1 (AP0 primaries, ACES white ≈ D60; the SMPTE ST 2065-1 matrix).
-    #[serde(rename = "aces2065-1")]
-    Aces2065_1,
-    /// Display P3 (P3 primaries, D65 white).
-    #[serde(rename = "display-p3")]
-    DisplayP3,
-    /// CIE XYZ itself (the identity; no white point, no adaptation).
-    #[serde(rename = "xyz")]
-    Xyz,
 }
 
 /// How a spectrum becomes three numbers.
@@ -524,60 +498,6 @@ fn luminous_weights(grid: LuminousGrid) -> Result<(Vec<f64>, Vec<f64>), Spectral
     Ok((grid, xyz.iter().map(|w| w[1] / total).collect()))
 }
 
-/// XYZ → linear RGB matrix of a working space, as colour-science 0.4.7 holds it
-/// (`RGB_COLOURSPACES[...].matrix_XYZ_to_RGB`; the identity for [`RgbSpace::Xyz`]).
-/// It expects XYZ relative to the space's own white ([`RgbSpace::whitepoint_xy`]).
-pub fn xyz_to_rgb(space: RgbSpace) -> Matrix3<f64> {
-    match space {
-        // colour uses the IEC 61966-2-1 published (rounded) matrix for sRGB.
-        RgbSpace::Srgb => Matrix3::new(
-            3.2406, -1.5372, -0.4986, -0.9689, 1.8758, 0.0415, 0.0557, -0.2040, 1.0570,
-        ),
-        RgbSpace::Rec2020 => invert(normalised_primary_matrix(
-            [0.708, 0.292, 0.170, 0.797, 0.131, 0.046],
-            D65_XY,
-        )),
-        RgbSpace::AcesCg => invert(normalised_primary_matrix(
-            [0.713, 0.293, 0.165, 0.830, 0.128, 0.044],
-            ACES_XY,
-        )),
-        // colour uses the published (10-decimal) XYZ→AP0 matrix of SMPTE ST 2065-1 / ACES
-        // TB-2014-004, not the one derived from the primaries (they differ by 4e-11).
-        RgbSpace::Aces2065_1 => Matrix3::new(
-            1.0498110175,
-            0.0,
-            -0.0000974845,
-            -0.4959030231,
-            1.3733130458,
-            0.0982400361,
-            0.0,
-            0.0,
-            0.9912520182,
-        ),
-        RgbSpace::DisplayP3 => invert(normalised_primary_matrix(
-            [0.680, 0.320, 0.265, 0.690, 0.150, 0.060],
-            D65_XY,
-        )),
-        RgbSpace::Xyz => Matrix3::identity(),
-    }
-}
-
-/// CIE 1931 xy of D65 as colour holds it (the white of sRGB, BT.2020 and Display P3).
-const D65_XY: [f64; 2] = [0.3127, 0.3290];
-/// CIE 1931 xy of the ACES white (≈ D60; ACES TB-2014-004).
-const ACES_XY: [f64; 2] = [0.32168, 0.33767];
-
-impl RgbSpace {
-    /// The space's white point as CIE xy, as colour holds it; `None` for [`RgbSpace::Xyz`].
-    pub fn whitepoint_xy(self) -> Option<[f64; 2]> {
-        match self {
-            RgbSpace::Srgb | RgbSpace::Rec2020 | RgbSpace::DisplayP3 => Some(D65_XY),
-            RgbSpace::AcesCg | RgbSpace::Aces2065_1 => Some(ACES_XY),
-            RgbSpace::Xyz => None,
-        }
-    }
-}
-
 impl Illuminant {
     /// The illuminant's white as CIE xy for `observer`, as colour's `CCS_ILLUMINANTS` holds it.
     pub fn white_xy(self, observer: Observer) -> [f64; 2] {
@@ -605,45 +525,6 @@ pub fn rgb_matrix(observer: Observer, illuminant: Illuminant, space: RgbSpace) -
         }
         _ => m,
     }
-}
-
-/// Von Kries adaptation matrix in the CAT02 space from white `from_xy` to white `to_xy` (colour's
-/// `matrix_chromatic_adaptation_VonKries(..., transform="CAT02")`, whites at Y = 1).
-fn cat02(from_xy: [f64; 2], to_xy: [f64; 2]) -> Matrix3<f64> {
-    let m = Matrix3::new(
-        0.7328, 0.4296, -0.1624, -0.7036, 1.6975, 0.0061, 0.0030, 0.0136, 0.9834,
-    );
-    let xyz = |xy: [f64; 2]| Vector3::new(xy[0] / xy[1], 1.0, (1.0 - xy[0] - xy[1]) / xy[1]);
-    let (from, to) = (m * xyz(from_xy), m * xyz(to_xy));
-    invert(m) * Matrix3::from_diagonal(&to.component_div(&from)) * m
-}
-
-fn invert(m: Matrix3<f64>) -> Matrix3<f64> {
-    // The primaries are constants with a well-conditioned matrix; identity is unreachable.
-    m.try_inverse().unwrap_or_else(Matrix3::identity)
-}
-
-/// RGB → XYZ matrix from primaries' and white's chromaticities (colour's
-/// `normalised_primary_matrix`, SMPTE RP 177).
-fn normalised_primary_matrix(xy: [f64; 6], white: [f64; 2]) -> Matrix3<f64> {
-    let p = Matrix3::new(
-        xy[0],
-        xy[2],
-        xy[4],
-        xy[1],
-        xy[3],
-        xy[5],
-        1.0 - xy[0] - xy[1],
-        1.0 - xy[2] - xy[3],
-        1.0 - xy[4] - xy[5],
-    );
-    let w = Vector3::new(
-        white[0] / white[1],
-        1.0,
-        (1.0 - white[0] - white[1]) / white[1],
-    );
-    let c = invert(p) * w;
-    p * Matrix3::from_diagonal(&c)
 }
 
 /// Visible (luminous) transmittance or reflectance per ISO 9050 / EN 410: `Σ v·D65·V / Σ D65·V`
@@ -739,18 +620,11 @@ names!(RgbCmf { WrightGuild1931 => "wright-guild-1931", StilesBurch1955 => "stil
 names!(Observer { Cie1931 => "cie1931", Cie1964 => "cie1964" });
 names!(Illuminant { D65 => "D65", A => "A", E => "E" });
 names!(MethodKind { Colorimetric => "colorimetric", Paper => "paper", Luminous => "luminous" });
-names!(RgbSpace {
-    Srgb => "srgb" | "rec709",
-    Rec2020 => "rec2020",
-    AcesCg => "acescg",
-    Aces2065_1 => "aces2065-1",
-    DisplayP3 => "display-p3",
-    Xyz => "xyz",
-});
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glassdb_colour::{ACES_XY, normalised_primary_matrix};
 
     fn flat(v: f64) -> (Vec<f64>, Vec<f64>) {
         let wl: Vec<f64> = (0..=53).map(|i| 300.0 + 10.0 * i as f64).collect();

@@ -20,9 +20,10 @@ mod read;
 mod tables;
 
 pub use error::SpectralError;
+pub use glassdb_colour::{CHROMATICITIES_TOLERANCE, RgbSpace, rgb_to_rgb, xyz_to_rgb};
 pub use integrate::{
     Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind, Observer,
-    RgbCmf, RgbSpace, luminous, luminous_iso9050, rgb_matrix, xyz_to_rgb,
+    RgbCmf, luminous, luminous_iso9050, rgb_matrix,
 };
 pub use interp::resample;
 pub use read::{

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use glassdb_mask::{MaskImage, MaskReadOptions, read_mask};
-use glassdb_registry::{GlassRecord, Registry, Side};
+use glassdb_registry::{ColourBasis, GlassRecord, Registry, Side};
 
 use crate::PlotError;
 use crate::heatmap::HeatMapFigure;
@@ -36,6 +36,8 @@ pub struct MaskPlotOptions {
     pub back_planes: Vec<u16>,
     /// How to read the mask (EXR channel names, binary glass id, pixel cap).
     pub read: MaskReadOptions,
+    /// The registry table to evaluate (`None`: its default table).
+    pub basis: Option<ColourBasis>,
 }
 
 impl Default for MaskPlotOptions {
@@ -45,6 +47,7 @@ impl Default for MaskPlotOptions {
             channel: MaskChannel::Luminance,
             back_planes: Vec::new(),
             read: MaskReadOptions::default(),
+            basis: None,
         }
     }
 }
@@ -81,7 +84,7 @@ pub fn mask_values(
     }
     let mut unknown: BTreeMap<u16, usize> = BTreeMap::new();
     let mut lookup: BTreeMap<u16, &GlassRecord> = BTreeMap::new();
-    for g in &reg.glasses {
+    for g in &reg.table_or_error(opts.basis, "the registry")?.glasses {
         lookup.insert(g.id, g);
     }
     let mut out = Vec::with_capacity(n);

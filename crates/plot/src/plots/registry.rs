@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use glassdb_registry::{GlassRecord, Registry, Side};
+use glassdb_registry::{ColourBasis, GlassRecord, Registry, Side};
 
 use super::{ANGLE_AXIS, curve_points};
 use crate::PlotError;
@@ -17,6 +17,8 @@ const CHANNEL_NAMES: [&str; 3] = ["R", "G", "B"];
 pub struct RegistryPlotOptions {
     /// Only these ids (empty: every glass).
     pub ids: Vec<u16>,
+    /// The table to draw (`None`: the registry's default table).
+    pub basis: Option<ColourBasis>,
 }
 
 fn glass_cell(g: &GlassRecord) -> Cell {
@@ -69,16 +71,17 @@ pub fn registry_figure_of(
     source: &str,
     opts: &RegistryPlotOptions,
 ) -> Result<GridFigure, PlotError> {
-    let mut glasses: Vec<&GlassRecord> = reg.glasses.iter().collect();
+    let table = reg.table_or_error(opts.basis, source)?;
+    let mut glasses: Vec<&GlassRecord> = table.glasses.iter().collect();
     if !opts.ids.is_empty() {
         let missing: Vec<u16> = opts
             .ids
             .iter()
             .copied()
-            .filter(|id| reg.glass(*id).is_none())
+            .filter(|id| table.glass(*id).is_none())
             .collect();
         if !missing.is_empty() {
-            let have: Vec<String> = reg.glasses.iter().map(|g| g.id.to_string()).collect();
+            let have: Vec<String> = table.glasses.iter().map(|g| g.id.to_string()).collect();
             return Err(PlotError::Input {
                 path: source.into(),
                 message: format!("no glass with id {missing:?} (ids: {})", have.join(", ")),
@@ -98,11 +101,12 @@ pub fn registry_figure_of(
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let method = reg.spectral.method.kind();
+    let method = table.spectral.method.kind();
+    let basis = table.basis();
     Ok(GridFigure {
         title: format!("Glass registry: {name}"),
         subtitle: Some(format!(
-            "per channel R, G, B (spectral method: {method}); r solid, t dashed, back-face r thin"
+            "per channel R, G, B in {basis} (spectral method: {method}); r solid, t dashed, back-face r thin"
         )),
         cells,
         columns,
