@@ -1,5 +1,6 @@
 //! The one error type of the crate: one variant per failure a user can act on.
 
+use std::fmt;
 use std::path::PathBuf;
 
 /// Everything that can go wrong reading or integrating spectral data.
@@ -53,6 +54,14 @@ pub enum SpectralError {
         "{source_name}: read as percent, but no value exceeds 1: the file looks like fractions"
     )]
     FractionsReadAsPercent { source_name: String },
+
+    /// The file is a kind of optical data glassdb does not read (a shading product, a BSDF, diffuse
+    /// data, a binary file); [`UnsupportedKind`] names it.
+    #[error("{source_name}: {kind}")]
+    Unsupported {
+        source_name: String,
+        kind: UnsupportedKind,
+    },
 
     /// The file as a whole is unusable (no data rows, unknown format, no quantity columns).
     #[error("{source_name}: {message}")]
@@ -155,6 +164,94 @@ impl SpectralError {
         SpectralError::Format {
             source_name: source_name.to_owned(),
             message: message.into(),
+        }
+    }
+}
+
+/// What an unsupported file is, as far as its content tells: [`SpectralError::Unsupported`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum UnsupportedKind {
+    /// An IGSDB shading layer (venetian blind, woven shade, perforated screen, …). `subtype` and
+    /// `name` as written in the file.
+    ShadingProduct {
+        subtype: Option<String>,
+        name: Option<String>,
+    },
+    /// An IGSDB shade material (`"type": "material"`): the slat paint or fabric of a shading
+    /// layer, not a glazing.
+    ShadeMaterial { name: Option<String> },
+    /// An IGSDB product whose optical data are not (only) specular: `is_specular` is false or
+    /// its wavelength data carry non-zero `diffuse` values.
+    DiffuseIgsdb { name: Option<String> },
+    /// An LBNL Optics file whose rows hold 9 numbers (λ, then direct and diffuse Tf, Tb, Rf, Rb)
+    /// with non-zero diffuse values; `line` is the first such row.
+    DiffuseOptics { line: usize },
+    /// A BSDF XML file (WINDOW's `WindowElement`, angle-resolved scattering matrices).
+    BsdfXml,
+    /// Other markup (XML or HTML, e.g. a THERM `.thmx` or a saved web page); `root` is its first
+    /// element's name.
+    Markup { root: String },
+    /// Binary data; `what` names the container when its signature is known.
+    Binary { what: Option<&'static str> },
+}
+
+/// An IGSDB subtype as words: `VENETIAN_BLIND` / `venetian` → "venetian blind".
+fn subtype_words(subtype: &str) -> String {
+    let words = subtype.trim().replace(['_', '-'], " ").to_lowercase();
+    match words.as_str() {
+        "venetian" => "venetian blind".to_owned(),
+        "woven" => "woven shade".to_owned(),
+        "vertical" | "louver" | "vertical louvre" => "vertical louver".to_owned(),
+        _ => words,
+    }
+}
+
+/// `(a, "b")` from the present parts, or "" when none is.
+fn parenthesised(parts: &[Option<String>]) -> String {
+    let parts: Vec<&str> = parts.iter().flatten().map(String::as_str).collect();
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", parts.join(", "))
+    }
+}
+
+impl fmt::Display for UnsupportedKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        const GLAZING_ONLY: &str = "glassdb reads glazing (specular) products only";
+        let quoted = |n: &Option<String>| n.as_ref().map(|n| format!("\"{n}\""));
+        match self {
+            UnsupportedKind::ShadingProduct { subtype, name } => write!(
+                f,
+                "is an IGSDB shading product{}; {GLAZING_ONLY}",
+                parenthesised(&[subtype.as_deref().map(subtype_words), quoted(name)])
+            ),
+            UnsupportedKind::ShadeMaterial { name } => write!(
+                f,
+                "is an IGSDB shade material{}, the slat or fabric material of a shading layer; {GLAZING_ONLY}",
+                parenthesised(&[quoted(name)])
+            ),
+            UnsupportedKind::DiffuseIgsdb { name } => write!(
+                f,
+                "is an IGSDB product{} with diffuse (scattering) optical data; glassdb reads specular spectral data only",
+                parenthesised(&[quoted(name)])
+            ),
+            UnsupportedKind::DiffuseOptics { line } => write!(
+                f,
+                "is an Optics file with diffuse columns (9 numbers per row: λ, then direct and diffuse Tf, Tb, Rf, Rb; line {line} has non-zero diffuse values); glassdb reads specular data (λ T Rf Rb)"
+            ),
+            UnsupportedKind::BsdfXml => write!(
+                f,
+                "is a BSDF XML file (WINDOW's WindowElement: angle-resolved scattering matrices, not a spectrum); glassdb reads specular spectral data"
+            ),
+            UnsupportedKind::Markup { root } => write!(
+                f,
+                "is markup (XML or HTML, first element <{root}>), not spectral data"
+            ),
+            UnsupportedKind::Binary { what } => match what {
+                Some(what) => write!(f, "is binary data ({what}), not a text spectral file"),
+                None => write!(f, "is binary data, not a text spectral file"),
+            },
         }
     }
 }

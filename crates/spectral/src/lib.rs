@@ -2,8 +2,10 @@
 //! them into the per-channel factors the compositor multiplies by (docs/method.md "Colour",
 //! eqs. 15–20) and into the luminous values glass makers publish (ISO 9050 / EN 410).
 //!
-//! - [`read_spectral_file`] / [`read_spectral_bytes`]: our CSV, LBNL Optics/IGDB text files and
-//!   IGSDB JSON, always returned as nm and fractions, validated with file:line errors.
+//! - [`read_spectral_file`] / [`read_spectral_bytes`]: our CSV and instrument exports, LBNL
+//!   Optics/IGDB text files and IGSDB JSON (schema v1 and v2), always returned as nm and
+//!   fractions, validated with file:line errors; shading products, BSDF XML, diffuse data and
+//!   binary files are refused by name ([`UnsupportedKind`]).
 //! - [`Integrator`]: built once from [`IntegrationSettings`], then cheap per spectrum
 //!   ([`Integrator::channels`]).
 //! - [`luminous_iso9050`]: visible transmittance/reflectance, D65 × V(λ), 380–780 nm at 10 nm.
@@ -17,9 +19,12 @@ mod error;
 mod integrate;
 mod interp;
 mod read;
+mod read_csv;
+mod read_igsdb;
+mod sniff;
 mod tables;
 
-pub use error::SpectralError;
+pub use error::{SpectralError, UnsupportedKind};
 pub use glassdb_colour::{CHROMATICITIES_TOLERANCE, RgbSpace, rgb_to_rgb, xyz_to_rgb};
 pub use integrate::{
     Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind, Observer,
