@@ -17,7 +17,7 @@ Prints one JSON object keyed by the file path as given. For every quantity prese
 - `luminous_1nm`: the same at 1 nm (D65 linearly interpolated by colour).
 
 The file readers here are independent of the Rust ones (written from the format notes in
-fixtures/glazing/README.md). Wavelengths in um become nm as round(um * 1000, 6), as the Rust
+fixtures/glazing/README.md; IGSDB v2 JSON from the schema of LBNL's py_igsdb_base_data). Wavelengths in um become nm as round(um * 1000, 6), as the Rust
 reader does, so that both sides see bit-identical inputs. With `--extrapolate`, a spectrum that
 does not cover a grid is extended by colour's constant extrapolation (only used on spectra whose
 ends lie on the integer grid, where colour is right).
@@ -103,12 +103,27 @@ def read_optics(path):
 
 def read_json(path):
     d = json.load(open(path, encoding="utf-8"))
+    if "spectral_data" not in d:
+        return read_json_v2(d)
     sd = d["spectral_data"]
     rows = sd["spectral_data"] if isinstance(sd, dict) else sd
     out = {"wl": um_to_nm([r["wavelength"] for r in rows])}
     for key, q in (("T", "transmittance"), ("Rf", "reflectance"), ("Rb", "reflectance_back")):
         if any(r.get(key) is not None for r in rows):
             out[q] = np.array([r[key] for r in rows], dtype=float)
+    return out
+
+
+def read_json_v2(d):
+    """IGSDB v2: the specular tf, rf, rb of the angle block at incidence angle 0 (values may be
+    decimal strings; w in um)."""
+    blocks = d["physical_properties"]["optical_properties"]["optical_data"]["angle_blocks"]
+    (normal,) = [b for b in blocks if float(b["incidence_angle"]) == 0.0]
+    rows = normal["wavelength_data"]
+    out = {"wl": um_to_nm([float(r["w"]) for r in rows])}
+    for key, q in (("tf", "transmittance"), ("rf", "reflectance"), ("rb", "reflectance_back")):
+        if any(r["specular"].get(key) is not None for r in rows):
+            out[q] = np.array([float(r["specular"][key]) for r in rows])
     return out
 
 

@@ -13,6 +13,7 @@ mod plot;
 mod registry;
 mod scene;
 mod spectral;
+mod spectral_formats;
 mod util;
 mod validation;
 mod view;

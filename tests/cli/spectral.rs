@@ -25,6 +25,8 @@ const FIXTURES: &[&str] = &[
     "nfrc_9962.json",
     "igsdb_product_10693.json",
     "nfrc_9223.json",
+    "igsdb_v2_clear_3.json",
+    "CLEAR_3.csv",
 ];
 
 fn fixture(name: &str) -> PathBuf {
