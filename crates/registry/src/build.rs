@@ -79,10 +79,15 @@ pub(crate) struct CatalogFiles<'a> {
 }
 
 impl CatalogFiles<'_> {
-    /// The full path and bytes of the file `rel` that `glass` names.
-    pub(crate) fn read(&self, rel: &str, glass: &str) -> Result<(PathBuf, Vec<u8>), RegistryError> {
+    /// The full path and bytes of the file `rel` that `glass` names, of at most `limit`.
+    pub(crate) fn read(
+        &self,
+        rel: &str,
+        glass: &str,
+        limit: glassdb_io::InputLimit,
+    ) -> Result<(PathBuf, Vec<u8>), RegistryError> {
         let path = resolve(self.catalog_path, rel);
-        match std::fs::read(&path) {
+        match glassdb_io::read_input(&path, limit) {
             Ok(bytes) => Ok((path, bytes)),
             Err(source) => Err(RegistryError::InputFile {
                 glass: glass.to_string(),
@@ -98,19 +103,31 @@ pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Builds a registry from a catalog file (paths in it are relative to the catalog; the
-/// catalog's provenance records `catalog_path` as given).
-pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Registry, RegistryError> {
-    let bytes = std::fs::read(catalog_path).map_err(|source| RegistryError::Read {
-        path: catalog_path.to_path_buf(),
-        source,
-    })?;
+/// The bytes of a catalog file, of at most [`glassdb_io::limits::CATALOG`].
+fn read_catalog(catalog_path: &Path) -> Result<Vec<u8>, RegistryError> {
+    glassdb_io::read_input(catalog_path, glassdb_io::limits::CATALOG).map_err(|source| {
+        RegistryError::Read {
+            path: catalog_path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+/// Parses a catalog file.
+fn load_catalog(catalog_path: &Path) -> Result<(Vec<GlassSpec>, String), RegistryError> {
+    let bytes = read_catalog(catalog_path)?;
     let catalog_sha = sha256_hex(&bytes);
     let text = String::from_utf8(bytes).map_err(|e| RegistryError::CatalogSyntax {
         path: catalog_path.to_path_buf(),
         message: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
     })?;
-    let specs = parse_catalog(&text, catalog_path)?;
+    Ok((parse_catalog(&text, catalog_path)?, catalog_sha))
+}
+
+/// Builds a registry from a catalog file (paths in it are relative to the catalog; the
+/// catalog's provenance records `catalog_path` as given).
+pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Registry, RegistryError> {
+    let (specs, catalog_sha) = load_catalog(catalog_path)?;
     let wanted = wanted_ids(&specs, catalog_path, opts.mask_ids.as_ref())?;
     let catalog_ref = FileRef {
         path: catalog_path.display().to_string(),

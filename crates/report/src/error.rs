@@ -9,7 +9,7 @@ pub enum ReportError {
     #[error("cannot read {path}")]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        source: glassdb_io::InputError,
     },
     /// The figures directory could not be created.
     #[error("cannot create the figures directory {path}")]

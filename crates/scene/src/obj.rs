@@ -179,9 +179,9 @@ fn syntax(path: &Path, line: usize, message: impl Into<String>) -> SceneError {
     }
 }
 
-/// Reads a text file, turning invalid UTF-8 into an error naming the line.
-fn read_text(path: &Path) -> Result<String, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+/// Reads a text file of at most `limit`, turning invalid UTF-8 into an error naming the line.
+fn read_text(path: &Path, limit: glassdb_io::InputLimit) -> Result<String, SceneError> {
+    let bytes = glassdb_io::read_input(path, limit).map_err(|source| SceneError::Read {
         path: path.to_path_buf(),
         source,
     })?;
@@ -567,7 +567,7 @@ fn scan_mtl(text: &str, path: &Path) -> Result<Vec<String>, SceneError> {
 /// Reads, validates and triangulates an OBJ scene. Polygons are ear-clipped in their plane;
 /// one that cannot be (non-planar, self-intersecting) is fanned with a warning.
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
-    let text = read_text(path)?;
+    let text = read_text(path, glassdb_io::limits::OBJ)?;
     let scan = scan_obj(&text, path)?;
     if scan.face_lines.is_empty() {
         return Err(SceneError::EmptyScene {
@@ -587,7 +587,7 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
             });
             continue;
         }
-        let mtl_text = read_text(&mtl_path)?;
+        let mtl_text = read_text(&mtl_path, glassdb_io::limits::MTL)?;
         defined.extend(scan_mtl(&mtl_text, &mtl_path)?);
     }
     if !scan.mtllibs.is_empty() {
