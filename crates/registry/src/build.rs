@@ -10,7 +10,7 @@ use glassdb_spectral::{IntegrationSettings, Integrator};
 use sha2::{Digest, Sha256};
 
 use crate::angle_model::{ModelTables, Physical, choose_model, read_measured_table};
-use crate::catalog::{GlassSpec, parse_catalog, resolve};
+use crate::catalog::{GlassSpec, NormalSource, parse_catalog, resolve};
 use crate::curves::fit_glass_curves;
 use crate::normal::{normal_values, read_spectral_source};
 use crate::{
@@ -122,6 +122,24 @@ fn load_catalog(catalog_path: &Path) -> Result<(Vec<GlassSpec>, String), Registr
         message: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
     })?;
     Ok((parse_catalog(&text, catalog_path)?, catalog_sha))
+}
+
+/// Every file a build from `catalog_path` reads: the catalog itself and each spectral file and
+/// angle table it names (resolved against the catalog's directory), so that an output can be
+/// refused before building when it is one of them.
+pub fn catalog_inputs(catalog_path: &Path) -> Result<Vec<PathBuf>, RegistryError> {
+    let (specs, _) = load_catalog(catalog_path)?;
+    let mut files = vec![catalog_path.to_path_buf()];
+    for spec in &specs {
+        if let NormalSource::Spectral { path, .. } = &spec.normal {
+            files.push(resolve(catalog_path, path));
+        }
+        if let Some((path, _)) = &spec.angles {
+            files.push(resolve(catalog_path, path));
+        }
+    }
+    files.dedup();
+    Ok(files)
 }
 
 /// Builds a registry from a catalog file (paths in it are relative to the catalog; the
