@@ -7,7 +7,7 @@
 //! place under it, so a stop that takes the lock sees every temporary file there is and lets
 //! no output land after it.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fs::{File, Metadata, Permissions};
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard, PoisonError};
@@ -19,7 +19,7 @@ pub const TEMP_PREFIX: &str = ".glassdb-tmp-";
 
 /// What identifies a file: its device and inode where it exists (so that hard links, symbolic
 /// links and spellings such as `./a/../a` match), else its canonical directory and name.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum FileId {
     Inode { dev: u64, ino: u64 },
     Path(PathBuf),
@@ -66,15 +66,15 @@ pub(crate) struct State {
     temporaries: BTreeSet<PathBuf>,
     /// Whether the files read are recorded (see [`protect_inputs`]).
     protect_inputs: bool,
-    /// The files read, as named and by identity.
-    inputs: Vec<(PathBuf, FileId)>,
+    /// The files read, by identity, with the name each was first read by.
+    inputs: BTreeMap<FileId, PathBuf>,
 }
 
 static STATE: Mutex<State> = Mutex::new(State {
     stopping: false,
     temporaries: BTreeSet::new(),
     protect_inputs: false,
-    inputs: Vec::new(),
+    inputs: BTreeMap::new(),
 });
 
 /// The lock (a panic elsewhere does not make the records unusable).
@@ -95,19 +95,13 @@ pub(crate) fn record_input(path: &Path, meta: &Metadata) {
     let mut s = state();
     if s.protect_inputs {
         let id = FileId::of_meta(meta, path);
-        if !s.inputs.iter().any(|(_, known)| *known == id) {
-            s.inputs.push((path.to_path_buf(), id));
-        }
+        s.inputs.entry(id).or_insert_with(|| path.to_path_buf());
     }
 }
 
 /// The file read before whose identity is `id`, if any.
 pub(crate) fn input_matching(id: &FileId) -> Option<PathBuf> {
-    state()
-        .inputs
-        .iter()
-        .find(|(_, known)| known == id)
-        .map(|(p, _)| p.clone())
+    state().inputs.get(id).cloned()
 }
 
 fn stopping_error() -> std::io::Error {
