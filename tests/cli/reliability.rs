@@ -400,6 +400,22 @@ fn devices_and_fifos_named_as_inputs_are_refused_at_once() {
     let (out, stderr) = run_within(&mut c, quick);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert_names(&stderr, &["/dev/urandom", "a character device"]);
+    // Images: compose's passes and mask, a registry build's mask.
+    let mut c = compose();
+    c.arg("--refl")
+        .arg(&fifo)
+        .args(["--trans", "/dev/zero", "--mask", "/dev/zero", "-o"])
+        .arg(d.join("c.exr"));
+    let (out, stderr) = run_within(&mut c, quick);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_names(&stderr, &["/dev/zero", "a character device"]);
+    let catalog = catalog_with_files(d);
+    let (out, stderr) = run_within(
+        registry_build(&catalog, &d.join("r.json")).args(["--mask", "/dev/zero"]),
+        quick,
+    );
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_names(&stderr, &["/dev/zero", "a character device"]);
     assert!(is_fifo(&fifo));
 }
 
