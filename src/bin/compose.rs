@@ -17,5 +17,7 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
-    cmd::finish(cmd::compose::run(Cli::parse().args))
+    let cli = Cli::parse();
+    cmd::init_process();
+    cmd::finish(cmd::compose::run(cli.args))
 }

@@ -40,6 +40,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    cmd::init_process();
     let result = match cli.command {
         Command::Fit(a) => cmd::fit::run_fit(a),
         Command::Eval(a) => cmd::fit::run_eval(a),

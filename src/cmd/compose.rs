@@ -456,7 +456,20 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)>
         },
         output,
         registry_label: label,
-        protected: args.registry.iter().chain(&args.planes).cloned().collect(),
+        // Every input besides the passes and the mask: no output may replace one.
+        protected: args
+            .registry
+            .iter()
+            .chain(&args.planes)
+            .chain(&args.camera)
+            .cloned()
+            .chain(
+                args.view
+                    .as_deref()
+                    .filter(|v| *v != "standard")
+                    .map(PathBuf::from),
+            )
+            .collect(),
         input_space: args.input_space,
     };
     Ok((settings, luts))

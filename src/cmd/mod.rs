@@ -14,6 +14,67 @@ use std::process::ExitCode;
 /// Exit code for a run that failed on its input or output (clap uses 2 for usage errors).
 pub const EXIT_FAILURE: u8 = 1;
 
+/// What every binary does first (docs/reliability.md): protect each file it reads from its
+/// outputs, and on SIGINT, SIGTERM or SIGHUP remove the unfinished outputs' temporary files
+/// and exit with 128 + the signal's number (130, 143, 129).
+pub fn init_process() {
+    glassdb_io::protect_inputs();
+    install_signal_cleanup();
+}
+
+/// The signals this process was started with set to be ignored (`nohup` ignores SIGHUP, a
+/// shell's background job SIGINT), from the `SigIgn` mask of `/proc/self/status`: such a
+/// signal keeps being ignored rather than handled.
+#[cfg(unix)]
+fn ignored_at_start(signal: i32) -> bool {
+    let Ok(status) = std::fs::read_to_string("/proc/self/status") else {
+        return false;
+    };
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("SigIgn:"))
+        .and_then(|mask| u64::from_str_radix(mask.trim(), 16).ok())
+        .is_some_and(|mask| (1..=64).contains(&signal) && mask & (1 << (signal - 1)) != 0)
+}
+
+#[cfg(unix)]
+fn install_signal_cleanup() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let warn = |e: std::io::Error| {
+        eprintln!(
+            "warning: cannot handle SIGINT and SIGTERM ({e}): a stopped run may leave {}* files",
+            glassdb_io::TEMP_PREFIX
+        );
+    };
+    let handled: Vec<i32> = [SIGINT, SIGTERM, SIGHUP]
+        .into_iter()
+        .filter(|&s| !ignored_at_start(s))
+        .collect();
+    let mut signals = match signal_hook::iterator::Signals::new(handled) {
+        Ok(s) => s,
+        Err(e) => return warn(e),
+    };
+    let spawned = std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                let name = match signal {
+                    SIGINT => "SIGINT",
+                    SIGTERM => "SIGTERM",
+                    _ => "SIGHUP",
+                };
+                eprintln!("stopped by {name}: unfinished outputs removed");
+                glassdb_io::exit_removing_temporaries(128 + signal);
+            }
+        });
+    if let Err(e) = spawned {
+        warn(e);
+    }
+}
+
+#[cfg(not(unix))]
+fn install_signal_cleanup() {}
+
 /// Turns a subcommand's result into the process exit code, printing the whole error chain and
 /// the hints that say which flag or command fixes it.
 pub fn finish(result: anyhow::Result<ExitCode>) -> ExitCode {

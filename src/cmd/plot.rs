@@ -171,13 +171,14 @@ fn write<F: Figure>(fig: &F, output: &Path, inputs: &[&Path]) -> anyhow::Result<
 
 /// True when the file looks like JSON (first non-blank byte `{`).
 fn looks_like_json(path: &Path) -> anyhow::Result<bool> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let bytes = glassdb_io::read_input(path, glassdb_io::limits::ANGLE_TABLE)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     Ok(bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{'))
 }
 
 /// True when a JSON file is a registry (it has the top-level `schema` key).
 fn is_registry_json(path: &Path) -> bool {
-    std::fs::read(path)
+    glassdb_io::read_input(path, glassdb_io::limits::JSON)
         .ok()
         .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
         .is_some_and(|v| v.get("schema").is_some())

@@ -154,9 +154,10 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     if a.max_degree == 0 || a.max_degree > 20 {
         anyhow::bail!("--max-degree must be 1–20, got {}", a.max_degree);
     }
-    let mut inputs: Vec<&std::path::Path> = vec![a.catalog.as_path()];
-    inputs.extend(a.masks.iter().map(|m| m.as_path()));
-    glassdb_io::refuse_input_as_output(&a.output, inputs)?;
+    // The catalog, every spectral file and angle table it names, and the masks.
+    let mut inputs = glassdb_registry::catalog_inputs(&a.catalog).map_err(anyhow::Error::new)?;
+    inputs.extend(a.masks.iter().cloned());
+    glassdb_io::refuse_input_as_output(&a.output, inputs.iter().map(PathBuf::as_path))?;
     let opts = BuildOptions {
         tables: table_settings(&a)?,
         mask_ids: mask_ids(&a.masks)?,

@@ -88,9 +88,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
     }
     let report = generate(&opts)?;
-    glassdb_io::write_bytes_atomic(&args.output, report.markdown.as_bytes())
+    let figures = report.figures.clone();
+    report
+        .write(&args.output)
         .with_context(|| format!("cannot write the report to {}", args.output.display()))?;
-    for f in &report.figures {
+    for f in &figures {
         eprintln!("wrote {}", f.display());
     }
     eprintln!("wrote {}", args.output.display());

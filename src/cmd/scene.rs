@@ -298,16 +298,30 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         ),
         _ => {}
     }
-    if frames.is_none() {
+    // Every file the mask is made from: the OBJ, its material libraries, the planes file and
+    // the camera (of each frame). No output may replace one.
+    let mut inputs: Vec<PathBuf> = vec![args.scene.clone()];
+    inputs.extend(args.planes.iter().cloned());
+    let refuse_inputs = |output: &Path, camera: &Path, inputs: &[PathBuf]| {
         glassdb_io::refuse_input_as_output(
-            &args.output,
-            [args.scene.as_path(), args.camera.as_path()],
-        )?;
+            output,
+            inputs
+                .iter()
+                .map(PathBuf::as_path)
+                .chain(std::iter::once(camera)),
+        )
+    };
+    if frames.is_none() {
+        refuse_inputs(&args.output, &args.camera, &inputs)?;
     }
 
     let t0 = Instant::now();
     let scene = load_obj(&args.scene)?;
     print_warnings(&scene.warnings);
+    inputs.extend(scene.input_files());
+    if frames.is_none() {
+        refuse_inputs(&args.output, &args.camera, &inputs)?;
+    }
     let source_planes = match &args.planes {
         Some(p) => {
             let file = PlanesFile::load(p)?;
@@ -398,10 +412,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
                 args.output.clone()
             };
             let camera_path = source.path(Some(frame));
-            glassdb_io::refuse_input_as_output(
-                &output,
-                [args.scene.as_path(), camera_path.as_path()],
-            )?;
+            refuse_inputs(&output, &camera_path, &inputs)?;
             let camera = source.camera(Some(frame))?;
             let mask = job.render(&camera, &output)?;
             Ok((output, mask))

@@ -11,6 +11,7 @@ mod masks;
 mod passes;
 mod plot;
 mod registry;
+mod reliability;
 mod scene;
 mod spectral;
 mod spectral_formats;

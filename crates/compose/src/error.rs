@@ -10,7 +10,7 @@ pub enum ComposeError {
     Read {
         path: PathBuf,
         #[source]
-        cause: std::io::Error,
+        cause: glassdb_io::InputError,
     },
     /// A pass that is not a PNG or EXR this reader can decode (the source's class says whether
     /// it is corrupt, unsupported or too large).

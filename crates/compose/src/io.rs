@@ -73,9 +73,9 @@ pub fn read_pass(path: &Path, opts: &PassReadOptions) -> Result<Pass, ComposeErr
     read_pass_bytes(&bytes, path, opts)
 }
 
-/// The bytes of an input file.
+/// The bytes of an input image, of at most [`glassdb_io::limits::IMAGE`].
 pub fn read_file(path: &Path) -> Result<Vec<u8>, ComposeError> {
-    std::fs::read(path).map_err(|cause| ComposeError::Read {
+    glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|cause| ComposeError::Read {
         path: path.to_path_buf(),
         cause,
     })

@@ -21,7 +21,6 @@
 //! tetrahedral only for `INTERP_TETRAHEDRAL`/`INTERP_BEST`). Arithmetic is `f32`, as OCIO's
 //! CPU path is.
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -32,7 +31,7 @@ pub const MAX_CUBE_3D_SIZE: usize = 129;
 /// Largest 1D table (OCIO's own limit).
 pub const MAX_CUBE_1D_SIZE: usize = 300_000;
 /// Largest `.cube` file read (a 129³ table at 6 decimals is about 60 MB).
-pub const MAX_CUBE_FILE_BYTES: u64 = 256 << 20;
+pub const MAX_CUBE_FILE_BYTES: u64 = glassdb_io::limits::CUBE_LUT.bytes;
 
 /// How the composite becomes the display-encoded values of a PNG.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -136,26 +135,17 @@ impl CubeLut {
             path: path.to_path_buf(),
             cause,
         };
-        let file = std::fs::File::open(path).map_err(read_err)?;
-        let len = file.metadata().map_err(read_err)?.len();
-        if len > MAX_CUBE_FILE_BYTES {
-            return Err(ComposeError::CubeTooLarge {
-                path: path.to_path_buf(),
-                bytes: len,
-                max: MAX_CUBE_FILE_BYTES,
-            });
-        }
-        let mut text = String::new();
-        file.take(MAX_CUBE_FILE_BYTES + 1)
-            .read_to_string(&mut text)
-            .map_err(read_err)?;
-        if text.len() as u64 > MAX_CUBE_FILE_BYTES {
-            return Err(ComposeError::CubeTooLarge {
-                path: path.to_path_buf(),
-                bytes: text.len() as u64,
-                max: MAX_CUBE_FILE_BYTES,
-            });
-        }
+        let text =
+            glassdb_io::read_input_string(path, glassdb_io::limits::CUBE_LUT).map_err(|cause| {
+                match cause {
+                    glassdb_io::InputError::TooLarge { size, .. } => ComposeError::CubeTooLarge {
+                        path: path.to_path_buf(),
+                        bytes: size.unwrap_or(MAX_CUBE_FILE_BYTES + 1),
+                        max: MAX_CUBE_FILE_BYTES,
+                    },
+                    cause => read_err(cause),
+                }
+            })?;
         CubeLut::parse(&text, path)
     }
 

@@ -6,18 +6,13 @@ use std::path::PathBuf;
 /// Table errors name the file, and the line and column where the problem is.
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
-    /// The file could not be opened or read.
+    /// The file could not be read: missing, not a regular file, or larger than any angle
+    /// table or fit file can reasonably be ([`crate::MAX_TABLE_BYTES`],
+    /// [`glassdb_io::limits::JSON`]).
     #[error("cannot read {path}")]
     Io {
         path: PathBuf,
-        source: std::io::Error,
-    },
-    /// The file is larger than any angle table can reasonably be.
-    #[error("{path}: file is {bytes} bytes, more than the {limit}-byte limit for an angle table")]
-    TooLarge {
-        path: PathBuf,
-        bytes: u64,
-        limit: u64,
+        source: glassdb_io::InputError,
     },
     /// The file has no header line (or nothing at all).
     #[error("{path}: the file is empty (expected a header line such as `angle_deg,R,T`)")]

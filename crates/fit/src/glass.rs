@@ -67,10 +67,11 @@ impl FitFile {
 
 /// Reads and validates a fit file (see [`parse_fit_json`]).
 pub fn read_fit_file(path: &Path) -> Result<FitFile, FitError> {
-    let text = std::fs::read(path).map_err(|source| FitError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        glassdb_io::read_input(path, glassdb_io::limits::JSON).map_err(|source| FitError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
     parse_fit_json(&text, path)
 }
 

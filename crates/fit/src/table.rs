@@ -11,7 +11,7 @@ use crate::error::FitError;
 use crate::model::AngleSamples;
 
 /// Largest angle table read (bytes): far above any real table, small enough to never exhaust memory.
-pub const MAX_TABLE_BYTES: u64 = 64 << 20;
+pub const MAX_TABLE_BYTES: u64 = glassdb_io::limits::ANGLE_TABLE.bytes;
 
 /// An angle that appeared on more than one row of a glass: the values were averaged.
 #[derive(Clone, Debug, PartialEq)]
@@ -68,15 +68,7 @@ pub fn read_angle_table(path: &Path, percent: bool) -> Result<Vec<GlassAngleTabl
         path: path.to_path_buf(),
         source,
     };
-    let meta = std::fs::metadata(path).map_err(io_err)?;
-    if meta.len() > MAX_TABLE_BYTES {
-        return Err(FitError::TooLarge {
-            path: path.to_path_buf(),
-            bytes: meta.len(),
-            limit: MAX_TABLE_BYTES,
-        });
-    }
-    let bytes = std::fs::read(path).map_err(io_err)?;
+    let bytes = glassdb_io::read_input(path, glassdb_io::limits::ANGLE_TABLE).map_err(io_err)?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

@@ -17,9 +17,6 @@ use glassdb_image::ExrFile;
 use crate::read::{PixelError, decode_channels, locate_channel};
 use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
 
-/// A manifest side file larger than this is refused (a manifest is a list of names).
-const MAX_MANIFEST_BYTES: u64 = 64 << 20;
-
 /// How an AOV relates to the glass it describes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum AovWeighting {
@@ -155,16 +152,7 @@ fn read_side_manifest(image: &Path, file: &str) -> Result<String, MaskError> {
         path: side.clone(),
         source,
     };
-    let meta = std::fs::metadata(&side).map_err(read_err)?;
-    if !meta.is_file() || meta.len() > MAX_MANIFEST_BYTES {
-        return Err(layout(
-            &side,
-            format!(
-                "a manifest side file must be a regular file of at most {MAX_MANIFEST_BYTES} bytes"
-            ),
-        ));
-    }
-    std::fs::read_to_string(&side).map_err(read_err)
+    glassdb_io::read_input_string(&side, glassdb_io::limits::MANIFEST).map_err(read_err)
 }
 
 /// `{"name": "hex"}` → name → hash.

@@ -11,7 +11,7 @@ pub enum MaskError {
     Read {
         path: PathBuf,
         #[source]
-        source: std::io::Error,
+        source: glassdb_io::InputError,
     },
     /// The file is not a PNG or EXR this reader can decode (its class says whether it is
     /// corrupt, unsupported or too large).

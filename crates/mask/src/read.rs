@@ -18,9 +18,11 @@ pub fn read_mask(path: &Path, opts: &MaskReadOptions) -> Result<MaskImage, MaskE
 
 /// Reads a mask file with its windows and whether it stores planes.
 pub fn read_placed_mask(path: &Path, opts: &MaskReadOptions) -> Result<PlacedMask, MaskError> {
-    let bytes = std::fs::read(path).map_err(|source| MaskError::Read {
-        path: path.to_path_buf(),
-        source,
+    let bytes = glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|source| {
+        MaskError::Read {
+            path: path.to_path_buf(),
+            source,
+        }
     })?;
     read_placed_mask_bytes(&bytes, path, opts)
 }

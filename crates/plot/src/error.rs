@@ -37,7 +37,7 @@ pub enum PlotError {
     #[error("cannot read {path}")]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        source: glassdb_io::InputError,
     },
     /// An input file parsed but does not hold what this plot needs.
     #[error("{path}: {message}")]

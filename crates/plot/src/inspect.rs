@@ -23,9 +23,11 @@ pub struct PngSummary {
 /// Decodes the PNG at `path` (grey, RGB or RGBA; 16-bit samples as their high byte) and
 /// summarises it.
 pub fn summarize_png(path: &Path) -> Result<PngSummary, PlotError> {
-    let bytes = std::fs::read(path).map_err(|source| PlotError::Read {
-        path: path.into(),
-        source,
+    let bytes = glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|source| {
+        PlotError::Read {
+            path: path.into(),
+            source,
+        }
     })?;
     let png =
         glassdb_image::decode_png(&bytes, glassdb_image::DEFAULT_MAX_PIXELS).map_err(|source| {

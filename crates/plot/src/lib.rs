@@ -16,7 +16,7 @@ pub mod inspect;
 pub mod render;
 
 pub use error::PlotError;
-pub use render::{Figure, ImageFormat, save};
+pub use render::{Figure, ImageFormat, render_for, save};
 pub mod plots;
 
 #[cfg(test)]

@@ -121,13 +121,19 @@ pub fn render_svg<F: Figure>(fig: &F) -> Result<String, PlotError> {
     Ok(svg)
 }
 
-/// Draws `fig` and writes it to `path` atomically, in the format its extension names.
-pub fn save<F: Figure>(fig: &F, path: &Path) -> Result<ImageFormat, PlotError> {
+/// Draws `fig` in the format the extension of `path` names; returns the file's bytes.
+pub fn render_for<F: Figure>(fig: &F, path: &Path) -> Result<(Vec<u8>, ImageFormat), PlotError> {
     let format = ImageFormat::from_path(path)?;
     let bytes = match format {
         ImageFormat::Png => render_png(fig)?,
         ImageFormat::Svg => render_svg(fig)?.into_bytes(),
     };
+    Ok((bytes, format))
+}
+
+/// Draws `fig` and writes it to `path` atomically, in the format its extension names.
+pub fn save<F: Figure>(fig: &F, path: &Path) -> Result<ImageFormat, PlotError> {
+    let (bytes, format) = render_for(fig, path)?;
     glassdb_io::write_bytes_atomic(path, &bytes)?;
     Ok(format)
 }

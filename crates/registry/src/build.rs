@@ -10,7 +10,7 @@ use glassdb_spectral::{IntegrationSettings, Integrator};
 use sha2::{Digest, Sha256};
 
 use crate::angle_model::{ModelTables, Physical, choose_model, read_measured_table};
-use crate::catalog::{GlassSpec, parse_catalog, resolve};
+use crate::catalog::{GlassSpec, NormalSource, parse_catalog, resolve};
 use crate::curves::fit_glass_curves;
 use crate::normal::{normal_values, read_spectral_source};
 use crate::{
@@ -79,10 +79,15 @@ pub(crate) struct CatalogFiles<'a> {
 }
 
 impl CatalogFiles<'_> {
-    /// The full path and bytes of the file `rel` that `glass` names.
-    pub(crate) fn read(&self, rel: &str, glass: &str) -> Result<(PathBuf, Vec<u8>), RegistryError> {
+    /// The full path and bytes of the file `rel` that `glass` names, of at most `limit`.
+    pub(crate) fn read(
+        &self,
+        rel: &str,
+        glass: &str,
+        limit: glassdb_io::InputLimit,
+    ) -> Result<(PathBuf, Vec<u8>), RegistryError> {
         let path = resolve(self.catalog_path, rel);
-        match std::fs::read(&path) {
+        match glassdb_io::read_input(&path, limit) {
             Ok(bytes) => Ok((path, bytes)),
             Err(source) => Err(RegistryError::InputFile {
                 glass: glass.to_string(),
@@ -98,19 +103,49 @@ pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Builds a registry from a catalog file (paths in it are relative to the catalog; the
-/// catalog's provenance records `catalog_path` as given).
-pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Registry, RegistryError> {
-    let bytes = std::fs::read(catalog_path).map_err(|source| RegistryError::Read {
-        path: catalog_path.to_path_buf(),
-        source,
-    })?;
+/// The bytes of a catalog file, of at most [`glassdb_io::limits::CATALOG`].
+fn read_catalog(catalog_path: &Path) -> Result<Vec<u8>, RegistryError> {
+    glassdb_io::read_input(catalog_path, glassdb_io::limits::CATALOG).map_err(|source| {
+        RegistryError::Read {
+            path: catalog_path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+/// Parses a catalog file.
+fn load_catalog(catalog_path: &Path) -> Result<(Vec<GlassSpec>, String), RegistryError> {
+    let bytes = read_catalog(catalog_path)?;
     let catalog_sha = sha256_hex(&bytes);
     let text = String::from_utf8(bytes).map_err(|e| RegistryError::CatalogSyntax {
         path: catalog_path.to_path_buf(),
         message: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
     })?;
-    let specs = parse_catalog(&text, catalog_path)?;
+    Ok((parse_catalog(&text, catalog_path)?, catalog_sha))
+}
+
+/// Every file a build from `catalog_path` reads: the catalog itself and each spectral file and
+/// angle table it names (resolved against the catalog's directory), so that an output can be
+/// refused before building when it is one of them.
+pub fn catalog_inputs(catalog_path: &Path) -> Result<Vec<PathBuf>, RegistryError> {
+    let (specs, _) = load_catalog(catalog_path)?;
+    let mut files = vec![catalog_path.to_path_buf()];
+    for spec in &specs {
+        if let NormalSource::Spectral { path, .. } = &spec.normal {
+            files.push(resolve(catalog_path, path));
+        }
+        if let Some((path, _)) = &spec.angles {
+            files.push(resolve(catalog_path, path));
+        }
+    }
+    files.dedup();
+    Ok(files)
+}
+
+/// Builds a registry from a catalog file (paths in it are relative to the catalog; the
+/// catalog's provenance records `catalog_path` as given).
+pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Registry, RegistryError> {
+    let (specs, catalog_sha) = load_catalog(catalog_path)?;
     let wanted = wanted_ids(&specs, catalog_path, opts.mask_ids.as_ref())?;
     let catalog_ref = FileRef {
         path: catalog_path.display().to_string(),

@@ -10,7 +10,7 @@ pub enum RegistryError {
     #[error("cannot read {path}")]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        source: glassdb_io::InputError,
     },
 
     /// The registry JSON is malformed or does not follow the schema (serde names line and column).
@@ -161,7 +161,7 @@ pub enum RegistryError {
     InputFile {
         glass: String,
         path: PathBuf,
-        source: std::io::Error,
+        source: glassdb_io::InputError,
     },
 
     /// A spectral file named by the catalog could not be parsed.

@@ -20,7 +20,7 @@ pub mod physics;
 mod record;
 mod validate;
 
-pub use build::{Application, BuildOptions, MaskIds, build_registry};
+pub use build::{Application, BuildOptions, MaskIds, build_registry, catalog_inputs};
 pub use bundled::{DEFAULT_REGISTRY_JSON, DEFAULT_REGISTRY_NAME, default_registry};
 pub use error::RegistryError;
 pub use record::{

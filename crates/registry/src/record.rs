@@ -454,10 +454,13 @@ impl Registry {
 
     /// Reads and validates a registry JSON file.
     pub fn from_json_file(path: &Path) -> Result<Registry, RegistryError> {
-        let text = std::fs::read_to_string(path).map_err(|source| RegistryError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            glassdb_io::read_input_string(path, glassdb_io::limits::JSON).map_err(|source| {
+                RegistryError::Read {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
         Registry::from_json_str(&text, &path.display().to_string())
     }
 

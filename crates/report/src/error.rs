@@ -9,7 +9,7 @@ pub enum ReportError {
     #[error("cannot read {path}")]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        source: glassdb_io::InputError,
     },
     /// The figures directory could not be created.
     #[error("cannot create the figures directory {path}")]
@@ -17,6 +17,9 @@ pub enum ReportError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// Writing the page or a figure failed (nothing was written).
+    #[error(transparent)]
+    Output(#[from] glassdb_io::OutputError),
     /// Drawing or saving a figure failed.
     #[error(transparent)]
     Plot(#[from] glassdb_plot::PlotError),

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use glassdb_fit::cos_deg;
+use glassdb_io::StagedOutput;
 use glassdb_mask::CosCode;
 use glassdb_plot::chart::{LegendCorner, Line, Panel, palette};
 use glassdb_plot::figure::{Cell, GridFigure};
@@ -24,16 +25,18 @@ use crate::spectral::spectral_methods;
 use crate::text::shown;
 use crate::{ReportError, ReportOptions, SpectrumFigure};
 
-/// Where the figures go and what has been written.
+/// Where the figures go and what has been staged.
 struct FigureSink<'a> {
     dir: &'a Path,
     /// How the page links the directory.
     link: &'a str,
     written: Vec<PathBuf>,
+    /// The figures, each in its temporary file until the report is written.
+    staged: &'a mut StagedOutput,
 }
 
 impl FigureSink<'_> {
-    /// Saves a figure into the figures directory and links it from the page.
+    /// Stages a figure for the figures directory and links it from the page.
     fn add<F: Figure>(
         &mut self,
         md: &mut String,
@@ -42,10 +45,9 @@ impl FigureSink<'_> {
         fig: &F,
     ) -> Result<(), ReportError> {
         let path = self.dir.join(file);
-        glassdb_plot::save(fig, &path)?;
-        let kb = std::fs::metadata(&path)
-            .map(|m| m.len() / 1024)
-            .unwrap_or(0);
+        let (bytes, _) = glassdb_plot::render_for(fig, &path)?;
+        self.staged.write_bytes(&path, &bytes)?;
+        let kb = bytes.len() / 1024;
         let _ = writeln!(
             md,
             "![{caption}]({}/{file})\n\n*{caption}* ({kb} KB)\n",
@@ -56,13 +58,14 @@ impl FigureSink<'_> {
     }
 }
 
-/// Writes the section and the figures into `dir`; returns the files written.
+/// Writes the section and stages the figures for `dir` in `staged`; returns their paths.
 pub(crate) fn section_figures(
     md: &mut String,
     opts: &ReportOptions,
     dir: &Path,
     refs: &[Reference],
     scene_mask: Option<&SceneMask>,
+    staged: &mut StagedOutput,
 ) -> Result<Vec<PathBuf>, ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateDir {
         path: dir.into(),
@@ -72,6 +75,7 @@ pub(crate) fn section_figures(
         dir,
         link: &opts.figures_link,
         written: Vec::new(),
+        staged,
     };
     let _ = writeln!(md, "## Figures\n");
     let _ = writeln!(

@@ -19,7 +19,7 @@ mod tables;
 mod text;
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub use error::ReportError;
 
@@ -62,11 +62,24 @@ pub struct GouraudScene {
     pub catalog: PathBuf,
 }
 
-/// The generated page and the figures written for it.
-#[derive(Debug, Clone)]
+/// The generated page and its figures, which [`Report::write`] writes together.
+#[derive(Debug)]
 pub struct Report {
     pub markdown: String,
+    /// Where the figures go (written by [`Report::write`]).
     pub figures: Vec<PathBuf>,
+    /// The figures, each drawn into its temporary file beside its target.
+    staged: glassdb_io::StagedOutput,
+}
+
+impl Report {
+    /// Writes the page to `page` and every figure: all of them land, or (on any failure) none
+    /// (`glassdb_io::StagedOutput`).
+    pub fn write(mut self, page: &Path) -> Result<(), ReportError> {
+        self.staged.write_bytes(page, self.markdown.as_bytes())?;
+        self.staged.commit()?;
+        Ok(())
+    }
 }
 
 /// Generates the page (and the figures when `figures_dir` is set). A section whose inputs
@@ -93,13 +106,17 @@ pub fn generate(opts: &ReportOptions) -> Result<Report, ReportError> {
         },
         None => None,
     };
+    let mut staged = glassdb_io::StagedOutput::new();
     let figures = match &opts.figures_dir {
-        Some(dir) => figures::section_figures(&mut md, opts, dir, &refs, scene_mask.as_ref())?,
+        Some(dir) => {
+            figures::section_figures(&mut md, opts, dir, &refs, scene_mask.as_ref(), &mut staged)?
+        }
         None => Vec::new(),
     };
     Ok(Report {
         markdown: md,
         figures,
+        staged,
     })
 }
 

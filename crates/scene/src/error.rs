@@ -9,7 +9,7 @@ pub enum SceneError {
     #[error("cannot read {path}")]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        source: glassdb_io::InputError,
     },
     /// A line of an OBJ or MTL file is malformed.
     #[error("{path}:{line}: {message}")]

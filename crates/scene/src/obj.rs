@@ -19,7 +19,6 @@
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::error::SceneError;
@@ -82,6 +81,15 @@ impl Mesh {
 }
 
 impl Scene {
+    /// The files the scene was read from: the OBJ and each material library it names
+    /// (resolved against the OBJ's directory, whether or not it exists). No output may be one.
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        let dir = self.source.parent().unwrap_or(Path::new(""));
+        std::iter::once(self.source.clone())
+            .chain(self.mtllibs.iter().map(|lib| dir.join(lib)))
+            .collect()
+    }
+
     /// Number of triangles over all meshes.
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(|m| m.triangles.len()).sum()
@@ -179,9 +187,9 @@ fn syntax(path: &Path, line: usize, message: impl Into<String>) -> SceneError {
     }
 }
 
-/// Reads a text file, turning invalid UTF-8 into an error naming the line.
-fn read_text(path: &Path) -> Result<String, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Read {
+/// Reads a text file of at most `limit`, turning invalid UTF-8 into an error naming the line.
+fn read_text(path: &Path, limit: glassdb_io::InputLimit) -> Result<String, SceneError> {
+    let bytes = glassdb_io::read_input(path, limit).map_err(|source| SceneError::Read {
         path: path.to_path_buf(),
         source,
     })?;
@@ -567,7 +575,7 @@ fn scan_mtl(text: &str, path: &Path) -> Result<Vec<String>, SceneError> {
 /// Reads, validates and triangulates an OBJ scene. Polygons are ear-clipped in their plane;
 /// one that cannot be (non-planar, self-intersecting) is fanned with a warning.
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
-    let text = read_text(path)?;
+    let text = read_text(path, glassdb_io::limits::OBJ)?;
     let scan = scan_obj(&text, path)?;
     if scan.face_lines.is_empty() {
         return Err(SceneError::EmptyScene {
@@ -587,7 +595,7 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
             });
             continue;
         }
-        let mtl_text = read_text(&mtl_path)?;
+        let mtl_text = read_text(&mtl_path, glassdb_io::limits::MTL)?;
         defined.extend(scan_mtl(&mtl_text, &mtl_path)?);
     }
     if !scan.mtllibs.is_empty() {
@@ -780,66 +788,90 @@ pub fn write_obj(
     meshes: &[Mesh],
 ) -> Result<(), SceneError> {
     glassdb_io::write_atomic(path, |w| {
-        for h in header {
-            writeln!(w, "# {h}")?;
-        }
-        for lib in mtllibs {
-            writeln!(w, "mtllib {}", mtllib_argument(lib))?;
-        }
-        let (mut ov, mut ot, mut on) = (1u64, 1u64, 1u64);
-        for m in meshes {
-            if m.triangles.is_empty() {
-                continue;
-            }
-            writeln!(w, "g {}", m.group)?;
-            if let Some(name) = m.material.and_then(|i| materials.get(i)) {
-                writeln!(w, "usemtl {name}")?;
-            }
-            for p in &m.positions {
-                writeln!(w, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
-            }
-            let has_t = !m.tex_triangles.is_empty();
-            let has_n = !m.normal_triangles.is_empty();
-            if has_t {
-                for t in &m.texcoords {
-                    writeln!(w, "vt {:?} {:?}", t[0], t[1])?;
-                }
-            }
-            if has_n {
-                for n in &m.normals {
-                    writeln!(w, "vn {:?} {:?} {:?}", n[0], n[1], n[2])?;
-                }
-            }
-            for (k, tri) in m.triangles.iter().enumerate() {
-                w.write_all(b"f")?;
-                for (c, &corner) in tri.iter().enumerate() {
-                    let v = ov + corner as u64;
-                    match (has_t, has_n) {
-                        (false, false) => write!(w, " {v}")?,
-                        (true, false) => write!(w, " {v}/{}", ot + m.tex_triangles[k][c] as u64)?,
-                        (false, true) => {
-                            write!(w, " {v}//{}", on + m.normal_triangles[k][c] as u64)?
-                        }
-                        (true, true) => write!(
-                            w,
-                            " {v}/{}/{}",
-                            ot + m.tex_triangles[k][c] as u64,
-                            on + m.normal_triangles[k][c] as u64
-                        )?,
-                    }
-                }
-                w.write_all(b"\n")?;
-            }
-            ov += m.positions.len() as u64;
-            if has_t {
-                ot += m.texcoords.len() as u64;
-            }
-            if has_n {
-                on += m.normals.len() as u64;
-            }
-        }
-        Ok(())
+        write_obj_text(w, header, mtllibs, materials, meshes)
     })?;
+    Ok(())
+}
+
+/// [`write_obj`] into a set of outputs that land together.
+pub fn stage_obj(
+    staged: &mut glassdb_io::StagedOutput,
+    path: &Path,
+    header: &[String],
+    mtllibs: &[String],
+    materials: &[String],
+    meshes: &[Mesh],
+) -> Result<(), SceneError> {
+    staged.write(path, |w| {
+        write_obj_text(w, header, mtllibs, materials, meshes)
+    })?;
+    Ok(())
+}
+
+/// The text of the OBJ [`write_obj`] writes.
+fn write_obj_text<W: std::io::Write>(
+    w: &mut W,
+    header: &[String],
+    mtllibs: &[String],
+    materials: &[String],
+    meshes: &[Mesh],
+) -> std::io::Result<()> {
+    for h in header {
+        writeln!(w, "# {h}")?;
+    }
+    for lib in mtllibs {
+        writeln!(w, "mtllib {}", mtllib_argument(lib))?;
+    }
+    let (mut ov, mut ot, mut on) = (1u64, 1u64, 1u64);
+    for m in meshes {
+        if m.triangles.is_empty() {
+            continue;
+        }
+        writeln!(w, "g {}", m.group)?;
+        if let Some(name) = m.material.and_then(|i| materials.get(i)) {
+            writeln!(w, "usemtl {name}")?;
+        }
+        for p in &m.positions {
+            writeln!(w, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
+        }
+        let has_t = !m.tex_triangles.is_empty();
+        let has_n = !m.normal_triangles.is_empty();
+        if has_t {
+            for t in &m.texcoords {
+                writeln!(w, "vt {:?} {:?}", t[0], t[1])?;
+            }
+        }
+        if has_n {
+            for n in &m.normals {
+                writeln!(w, "vn {:?} {:?} {:?}", n[0], n[1], n[2])?;
+            }
+        }
+        for (k, tri) in m.triangles.iter().enumerate() {
+            w.write_all(b"f")?;
+            for (c, &corner) in tri.iter().enumerate() {
+                let v = ov + corner as u64;
+                match (has_t, has_n) {
+                    (false, false) => write!(w, " {v}")?,
+                    (true, false) => write!(w, " {v}/{}", ot + m.tex_triangles[k][c] as u64)?,
+                    (false, true) => write!(w, " {v}//{}", on + m.normal_triangles[k][c] as u64)?,
+                    (true, true) => write!(
+                        w,
+                        " {v}/{}/{}",
+                        ot + m.tex_triangles[k][c] as u64,
+                        on + m.normal_triangles[k][c] as u64
+                    )?,
+                }
+            }
+            w.write_all(b"\n")?;
+        }
+        ov += m.positions.len() as u64;
+        if has_t {
+            ot += m.texcoords.len() as u64;
+        }
+        if has_n {
+            on += m.normals.len() as u64;
+        }
+    }
     Ok(())
 }
 

@@ -62,10 +62,13 @@ impl PlanesFile {
             path: path.to_path_buf(),
             message,
         };
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            glassdb_io::read_input_string(path, glassdb_io::limits::JSON).map_err(|source| {
+                SceneError::Read {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
         let file: PlanesFile =
             serde_json::from_str(&text).map_err(|source| SceneError::PlanesJson {
                 path: path.to_path_buf(),

@@ -7,7 +7,7 @@ use std::path::{Component, Path, PathBuf};
 use crate::error::SceneError;
 use crate::math::Vec3;
 use crate::mirror::{MirrorStats, mirror_scene};
-use crate::obj::{Mesh, Scene, write_obj};
+use crate::obj::{Mesh, Scene, stage_obj};
 use crate::planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_planes};
 use crate::planes_file::{PLANES_FORMAT, PlaneEntry, PlanesFile, ToleranceJson};
 
@@ -62,7 +62,18 @@ fn relative_to(target: &Path, base: &Path) -> String {
 /// Finds the planes (or takes the explicit one), writes `plane_<k>.obj` for each and
 /// `planes.json` into `out_dir` (created if missing). All glass faces are dropped from every
 /// virtual scene: reflection passes, like the transmission pass, are rendered without glass.
+/// The files land together or not at all (`glassdb_io::StagedOutput`): on any failure none is
+/// written, and an `out_dir` this call created is removed again.
 pub fn write_virtual_scenes(req: &MirrorRequest<'_>) -> Result<MirrorReport, SceneError> {
+    let created = !req.out_dir.exists();
+    let result = write_virtual_scenes_staged(req);
+    if result.is_err() && created {
+        let _ = std::fs::remove_dir(req.out_dir); // only when still empty
+    }
+    result
+}
+
+fn write_virtual_scenes_staged(req: &MirrorRequest<'_>) -> Result<MirrorReport, SceneError> {
     let scene = req.scene;
     req.tolerance.validate()?;
     let glass_table = if req.glass_patterns.is_empty() {
@@ -80,6 +91,7 @@ pub fn write_virtual_scenes(req: &MirrorRequest<'_>) -> Result<MirrorReport, Sce
         source,
     })?;
     let mtllibs = mtllibs_from(scene, req.out_dir);
+    let mut staged = glassdb_io::StagedOutput::new();
     let mut entries = Vec::with_capacity(planes.len());
     let mut all_stats = Vec::with_capacity(planes.len());
     for gp in &planes {
@@ -87,7 +99,15 @@ pub fn write_virtual_scenes(req: &MirrorRequest<'_>) -> Result<MirrorReport, Sce
         let (meshes, stats) = mirror_scene(scene, &kept, req.tolerance.distance, |m, _| {
             is_glass(scene.meshes[m].material)
         });
-        let file = write_plane_scene(scene, gp, eye_side, &mtllibs, &meshes, req.out_dir)?;
+        let file = write_plane_scene(
+            &mut staged,
+            scene,
+            gp,
+            eye_side,
+            &mtllibs,
+            &meshes,
+            req.out_dir,
+        )?;
         entries.push(PlaneEntry {
             index: gp.index,
             equation: gp.plane.equation(),
@@ -112,7 +132,8 @@ pub fn write_virtual_scenes(req: &MirrorRequest<'_>) -> Result<MirrorReport, Sce
         },
         planes: entries,
     };
-    let planes_path = write_planes_file(&file, scene, req.out_dir)?;
+    let planes_path = write_planes_file(&mut staged, &file, scene, req.out_dir)?;
+    staged.commit()?;
     Ok(MirrorReport {
         planes_path,
         planes: file,
@@ -230,8 +251,9 @@ fn kept_side(
     })
 }
 
-/// Writes plane `gp`'s virtual scene into `out_dir`; returns its file name.
+/// Stages plane `gp`'s virtual scene for `out_dir`; returns its file name.
 fn write_plane_scene(
+    staged: &mut glassdb_io::StagedOutput,
     scene: &Scene,
     gp: &GlassPlane,
     eye_side: Side,
@@ -241,7 +263,8 @@ fn write_plane_scene(
 ) -> Result<String, SceneError> {
     let name = virtual_scene_name(gp.index);
     let path = out_dir.join(&name);
-    glassdb_io::refuse_input_as_output(&path, [scene.source.as_path()])?;
+    let inputs = scene.input_files();
+    glassdb_io::refuse_input_as_output(&path, inputs.iter().map(PathBuf::as_path))?;
     let header = vec![
         format!(
             "virtual scene of {} (glassdb mirror)",
@@ -255,22 +278,24 @@ fn write_plane_scene(
         "geometry behind the plane removed, faces crossing it clipped, glass faces dropped"
             .to_string(),
     ];
-    write_obj(&path, &header, mtllibs, &scene.materials, meshes)?;
+    stage_obj(staged, &path, &header, mtllibs, &scene.materials, meshes)?;
     Ok(name)
 }
 
-/// Writes `planes.json` into `out_dir`; returns its path.
+/// Stages `planes.json` for `out_dir`; returns its path.
 fn write_planes_file(
+    staged: &mut glassdb_io::StagedOutput,
     file: &PlanesFile,
     scene: &Scene,
     out_dir: &Path,
 ) -> Result<PathBuf, SceneError> {
     let planes_path = out_dir.join("planes.json");
-    glassdb_io::refuse_input_as_output(&planes_path, [scene.source.as_path()])?;
+    let inputs = scene.input_files();
+    glassdb_io::refuse_input_as_output(&planes_path, inputs.iter().map(PathBuf::as_path))?;
     let json = serde_json::to_string_pretty(file).map_err(|source| SceneError::EncodePlanes {
         path: planes_path.clone(),
         source,
     })?;
-    glassdb_io::write_bytes_atomic(&planes_path, format!("{json}\n").as_bytes())?;
+    staged.write_bytes(&planes_path, format!("{json}\n").as_bytes())?;
     Ok(planes_path)
 }

@@ -9,12 +9,13 @@ use std::path::PathBuf;
 /// column); integration errors describe the spectrum and say what would make it acceptable.
 #[derive(Debug, thiserror::Error)]
 pub enum SpectralError {
-    /// The file could not be opened or read.
+    /// The file could not be read: missing, not a regular file, or over
+    /// [`glassdb_io::limits::SPECTRAL`].
     #[error("{path}: cannot read")]
     Io {
         path: PathBuf,
         #[source]
-        source: std::io::Error,
+        source: glassdb_io::InputError,
     },
 
     /// A syntax or content error at a known place in the file.

@@ -90,9 +90,11 @@ pub struct ReadOptions {
 
 /// Reads a spectral file; the format comes from the extension, then from the content.
 pub fn read_spectral_file(path: &Path, opts: &ReadOptions) -> Result<SpectralData, SpectralError> {
-    let bytes = std::fs::read(path).map_err(|source| SpectralError::Io {
-        path: path.to_path_buf(),
-        source,
+    let bytes = glassdb_io::read_input(path, glassdb_io::limits::SPECTRAL).map_err(|source| {
+        SpectralError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
     })?;
     read_spectral_bytes(&bytes, &path.display().to_string(), opts)
 }

@@ -5,7 +5,6 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use serde::de::{Deserializer, MapAccess, Visitor};
@@ -17,7 +16,7 @@ use crate::error::SceneError;
 
 /// Largest camera file read (a camera is a few hundred bytes; an animation file of ten
 /// thousand frames a few megabytes).
-pub const MAX_CAMERA_FILE_BYTES: u64 = 16 << 20;
+pub const MAX_CAMERA_FILE_BYTES: u64 = glassdb_io::limits::CAMERA.bytes;
 
 /// Where the camera of each frame comes from.
 #[derive(Debug, Clone, PartialEq)]
@@ -143,8 +142,11 @@ enum CameraJson {
 /// Reads a camera file of at most [`MAX_CAMERA_FILE_BYTES`]; a per-frame file that does not
 /// exist is a missing frame.
 fn read_camera_text(path: &Path, frame: Option<u32>) -> Result<String, SceneError> {
-    let read_err = |source: std::io::Error| match frame {
-        Some(f) if source.kind() == std::io::ErrorKind::NotFound => {
+    let read_err = |source: glassdb_io::InputError| match frame {
+        Some(f)
+            if matches!(&source, glassdb_io::InputError::Io(e)
+                if e.kind() == std::io::ErrorKind::NotFound) =>
+        {
             SceneError::MissingCameraFrame {
                 path: path.to_path_buf(),
                 frame: f,
@@ -156,22 +158,7 @@ fn read_camera_text(path: &Path, frame: Option<u32>) -> Result<String, SceneErro
             source,
         },
     };
-    let file = std::fs::File::open(path).map_err(read_err)?;
-    let mut text = String::new();
-    file.take(MAX_CAMERA_FILE_BYTES + 1)
-        .read_to_string(&mut text)
-        .map_err(read_err)?;
-    if text.len() as u64 > MAX_CAMERA_FILE_BYTES {
-        return Err(SceneError::BadCamera {
-            path: path.to_path_buf(),
-            frame,
-            message: format!(
-                "the file is larger than {} MiB, the most a camera file may be",
-                MAX_CAMERA_FILE_BYTES >> 20
-            ),
-        });
-    }
-    Ok(text)
+    glassdb_io::read_input_string(path, glassdb_io::limits::CAMERA).map_err(read_err)
 }
 
 /// Parses a camera file: an object with a `frames` key is an animation, anything else one

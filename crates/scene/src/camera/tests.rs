@@ -642,8 +642,9 @@ fn oversized_camera_files_are_refused_before_parsing() {
     let path = dir.path().join("big.json");
     let f = std::fs::File::create(&path).unwrap();
     f.set_len(MAX_CAMERA_FILE_BYTES + 10).unwrap();
-    let e = CameraSource::open(&path).unwrap_err().to_string();
-    assert!(e.contains("big.json") && e.contains("MiB"), "{e}");
+    let e = CameraSource::open(&path).unwrap_err();
+    let e = glassdb_io::ErrorChain(&e).to_string();
+    assert!(e.contains("big.json") && e.contains("16 MiB"), "{e}");
 }
 
 #[test]

@@ -1,0 +1,312 @@
+//! Bounded input: every file a glassdb tool reads goes through [`read_input`], which refuses
+//! what is not a regular file (a directory, a device such as `/dev/zero`, a FIFO, a socket)
+//! and a file over the limit of its kind ([`limits`]), checking the file's metadata before
+//! reading a byte and bounding the read itself too, so that no input is read without end.
+//!
+//! [`InputError`] says what is wrong without repeating the path: each library wraps it in its
+//! own error variant, which names the file (`cannot read cat.toml: it is a FIFO …`).
+
+use std::fs::{File, Metadata};
+use std::io::Read;
+use std::path::Path;
+
+use crate::kind::FileKind;
+use crate::registry;
+
+/// The most bytes one kind of input may have, and what that kind is called in messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct InputLimit {
+    /// The most bytes a file of this kind may have.
+    pub bytes: u64,
+    /// The kind, as a message names it: `a catalog`, `an OBJ scene`.
+    pub what: &'static str,
+}
+
+/// The limit of every kind of input (the table in docs/reliability.md).
+pub mod limits {
+    use super::InputLimit;
+
+    const MIB: u64 = 1 << 20;
+    const GIB: u64 = 1 << 30;
+
+    /// A registry catalog (`catalog.toml`).
+    pub const CATALOG: InputLimit = InputLimit {
+        bytes: 16 * MIB,
+        what: "a catalog",
+    };
+    /// A JSON document: a registry, a fit file, a `planes.json`.
+    pub const JSON: InputLimit = InputLimit {
+        bytes: 64 * MIB,
+        what: "a JSON file",
+    };
+    /// A camera file (JSON, one camera or an animation's frames).
+    pub const CAMERA: InputLimit = InputLimit {
+        bytes: 16 * MIB,
+        what: "a camera file",
+    };
+    /// A measured angle table (CSV).
+    pub const ANGLE_TABLE: InputLimit = InputLimit {
+        bytes: 64 * MIB,
+        what: "an angle table",
+    };
+    /// A spectral data file (CSV, LBNL Optics text or IGSDB JSON).
+    pub const SPECTRAL: InputLimit = InputLimit {
+        bytes: 64 * MIB,
+        what: "a spectral data file",
+    };
+    /// An OBJ scene.
+    pub const OBJ: InputLimit = InputLimit {
+        bytes: 2 * GIB,
+        what: "an OBJ scene",
+    };
+    /// An MTL material library named by an OBJ's `mtllib`.
+    pub const MTL: InputLimit = InputLimit {
+        bytes: 64 * MIB,
+        what: "an MTL file",
+    };
+    /// An image: a pass or a mask, PNG or EXR (its pixel count is limited from its header
+    /// before decoding).
+    pub const IMAGE: InputLimit = InputLimit {
+        bytes: 8 * GIB,
+        what: "an image",
+    };
+    /// A `.cube` view-transform LUT.
+    pub const CUBE_LUT: InputLimit = InputLimit {
+        bytes: 256 * MIB,
+        what: "a .cube LUT",
+    };
+    /// A Cryptomatte manifest side file (JSON).
+    pub const MANIFEST: InputLimit = InputLimit {
+        bytes: 64 * MIB,
+        what: "a Cryptomatte manifest",
+    };
+
+    /// Every limit, for the documentation table and its test.
+    pub const ALL: [InputLimit; 10] = [
+        CATALOG,
+        JSON,
+        CAMERA,
+        ANGLE_TABLE,
+        SPECTRAL,
+        OBJ,
+        MTL,
+        IMAGE,
+        CUBE_LUT,
+        MANIFEST,
+    ];
+}
+
+/// `n` bytes as people write them: `16 MiB`, `2 GiB`, `1500 bytes`.
+pub fn byte_size_text(n: u64) -> String {
+    const MIB: u64 = 1 << 20;
+    const GIB: u64 = 1 << 30;
+    if n >= GIB && n.is_multiple_of(GIB) {
+        format!("{} GiB", n / GIB)
+    } else if n >= MIB && n.is_multiple_of(MIB) {
+        format!("{} MiB", n / MIB)
+    } else {
+        format!("{n} bytes")
+    }
+}
+
+fn size_text(size: &Option<u64>) -> String {
+    match size {
+        Some(n) => format!("it has {n} bytes,"),
+        None => "it grew while being read, to".to_string(),
+    }
+}
+
+/// Why an input could not be read. The messages do not repeat the path: the error that wraps
+/// this one names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum InputError {
+    /// Opening or reading failed (no such file, permission denied, an I/O error).
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// The path names something that is not a regular file and would be read without end or
+    /// not at all (a directory, `/dev/zero`, a FIFO, a socket).
+    #[error("it is {kind}, not a regular file")]
+    NotAFile { kind: FileKind },
+    /// The file is over the limit of its kind (see [`limits`]); nothing was read.
+    #[error(
+        "{} more than the {} {} may have",
+        size_text(size),
+        byte_size_text(limit.bytes),
+        limit.what
+    )]
+    TooLarge {
+        /// Its size from its metadata (`None` when it grew past the limit while being read).
+        size: Option<u64>,
+        limit: InputLimit,
+    },
+    /// The file was read as text but is not UTF-8.
+    #[error("it is not UTF-8 text (byte {valid_up_to} is not)")]
+    NotUtf8 { valid_up_to: usize },
+}
+
+/// Refuses what is not a regular file, or one over `limit`.
+fn check(meta: &Metadata, limit: InputLimit) -> Result<(), InputError> {
+    let kind = FileKind::of(&meta.file_type());
+    if kind != FileKind::Regular {
+        return Err(InputError::NotAFile { kind });
+    }
+    if meta.len() > limit.bytes {
+        return Err(InputError::TooLarge {
+            size: Some(meta.len()),
+            limit,
+        });
+    }
+    Ok(())
+}
+
+/// Opens `path` for reading without blocking on a FIFO that appeared since it was checked.
+fn open(path: &Path) -> std::io::Result<File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    options.open(path)
+}
+
+/// Reads the whole of the regular file `path`, of at most `limit.bytes` bytes. Refuses a path
+/// that is not a regular file (following symbolic links) and a file over the limit from its
+/// metadata before opening it, checks the opened file again, and reads at most
+/// `limit.bytes + 1` bytes whatever the metadata said. With [`crate::protect_inputs`], the file
+/// is recorded as an input that no output of this process may replace.
+pub fn read_input(path: &Path, limit: InputLimit) -> Result<Vec<u8>, InputError> {
+    check(&std::fs::metadata(path)?, limit)?;
+    let file = open(path)?;
+    let meta = file.metadata()?;
+    check(&meta, limit)?;
+    registry::record_input(path, &meta);
+    let mut bytes = Vec::new();
+    let expected = usize::try_from(meta.len()).unwrap_or(usize::MAX);
+    bytes.try_reserve_exact(expected).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::OutOfMemory,
+            format!("cannot allocate {} bytes to read it", meta.len()),
+        )
+    })?;
+    file.take(limit.bytes + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit.bytes {
+        return Err(InputError::TooLarge { size: None, limit });
+    }
+    Ok(bytes)
+}
+
+/// [`read_input`] of a text file: its bytes must be UTF-8.
+pub fn read_input_string(path: &Path, limit: InputLimit) -> Result<String, InputError> {
+    let bytes = read_input(path, limit)?;
+    String::from_utf8(bytes).map_err(|e| InputError::NotUtf8 {
+        valid_up_to: e.utf8_error().valid_up_to(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SMALL: InputLimit = InputLimit {
+        bytes: 10,
+        what: "a test file",
+    };
+
+    #[test]
+    fn regular_files_within_the_limit_are_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.txt");
+        std::fs::write(&p, b"0123456789").unwrap();
+        assert_eq!(read_input(&p, SMALL).unwrap(), b"0123456789");
+        assert_eq!(read_input_string(&p, SMALL).unwrap(), "0123456789");
+    }
+
+    #[test]
+    fn files_over_the_limit_are_refused_from_their_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("big.txt");
+        let f = File::create(&p).unwrap();
+        f.set_len(1 << 40).unwrap(); // sparse: a terabyte that is never read
+        let e = read_input(&p, SMALL).unwrap_err();
+        assert!(
+            matches!(e, InputError::TooLarge { size: Some(n), .. } if n == 1 << 40),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "it has 1099511627776 bytes, more than the 10 bytes a test file may have"
+        );
+        assert_eq!(
+            InputError::TooLarge {
+                size: Some(20 << 20),
+                limit: limits::CATALOG
+            }
+            .to_string(),
+            "it has 20971520 bytes, more than the 16 MiB a catalog may have"
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_directories_and_fifos_are_refused_without_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = read_input(dir.path(), SMALL).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                InputError::NotAFile {
+                    kind: FileKind::Directory
+                }
+            ),
+            "{e:?}"
+        );
+        let e = read_input(Path::new("/dev/zero"), SMALL).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "it is a character device, not a regular file"
+        );
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            // Opening a FIFO for reading would wait for a writer: it must be refused first.
+            let e = read_input(&fifo, SMALL).unwrap_err();
+            assert!(e.to_string().contains("a FIFO"), "{e}");
+        }
+        // A symbolic link is followed: to a regular file it reads, to a device it is refused.
+        let link = dir.path().join("zero");
+        std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
+        assert!(matches!(
+            read_input(&link, SMALL),
+            Err(InputError::NotAFile {
+                kind: FileKind::CharDevice
+            })
+        ));
+    }
+
+    #[test]
+    fn missing_files_keep_the_os_error() {
+        let e = read_input(Path::new("/nonexistent-glassdb/x"), SMALL).unwrap_err();
+        let InputError::Io(io) = &e else {
+            panic!("{e:?}")
+        };
+        assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
+    }
+
+    #[test]
+    fn invalid_utf8_is_named_by_its_byte() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.txt");
+        std::fs::write(&p, b"ab\xffcd").unwrap();
+        let e = read_input_string(&p, SMALL).unwrap_err();
+        assert!(matches!(e, InputError::NotUtf8 { valid_up_to: 2 }), "{e:?}");
+    }
+
+    #[test]
+    fn limits_read_as_sizes() {
+        assert_eq!(byte_size_text(limits::OBJ.bytes), "2 GiB");
+        assert_eq!(byte_size_text(limits::CATALOG.bytes), "16 MiB");
+        assert_eq!(byte_size_text(1500), "1500 bytes");
+    }
+}

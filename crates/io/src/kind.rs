@@ -1,0 +1,67 @@
+//! What a path names, for messages that refuse an input or output that is not a regular file.
+
+use std::fs::FileType;
+
+/// The kind of a file system entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileKind {
+    Regular,
+    Directory,
+    CharDevice,
+    BlockDevice,
+    Fifo,
+    Socket,
+    Symlink,
+    /// A link to an open file descriptor (`/dev/stdout`, `/dev/fd/N`, `/proc/self/fd/N`): it
+    /// names whatever the descriptor is (a terminal, a pipe), not a file to replace.
+    DescriptorLink,
+    Other,
+}
+
+impl FileKind {
+    /// The kind of `t` (not following a symbolic link: `t` says what it is).
+    pub fn of(t: &FileType) -> FileKind {
+        if t.is_file() {
+            return FileKind::Regular;
+        }
+        if t.is_dir() {
+            return FileKind::Directory;
+        }
+        if t.is_symlink() {
+            return FileKind::Symlink;
+        }
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::FileTypeExt;
+            if t.is_char_device() {
+                return FileKind::CharDevice;
+            }
+            if t.is_block_device() {
+                return FileKind::BlockDevice;
+            }
+            if t.is_fifo() {
+                return FileKind::Fifo;
+            }
+            if t.is_socket() {
+                return FileKind::Socket;
+            }
+        }
+        FileKind::Other
+    }
+}
+
+impl std::fmt::Display for FileKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            FileKind::Regular => "a regular file",
+            FileKind::Directory => "a directory",
+            FileKind::CharDevice => "a character device",
+            FileKind::BlockDevice => "a block device",
+            FileKind::Fifo => "a FIFO (named pipe)",
+            FileKind::Socket => "a socket",
+            FileKind::Symlink => "a symbolic link",
+            FileKind::DescriptorLink => "a link to an open file descriptor (such as /dev/stdout)",
+            FileKind::Other => "not a file",
+        })
+    }
+}

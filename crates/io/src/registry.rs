@@ -1,0 +1,201 @@
+//! The process-wide records behind [`crate::write_atomic`] and [`crate::read_input`]: the
+//! temporary files being written, which [`exit_removing_temporaries`] removes when the process
+//! is stopped by a signal, and (after [`protect_inputs`]) the files read, which no output of the
+//! process may replace.
+//!
+//! One lock guards both. A temporary file is created and recorded under it, and renamed into
+//! place under it, so a stop that takes the lock sees every temporary file there is and lets
+//! no output land after it.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fs::{File, Metadata, Permissions};
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
+use tempfile::TempPath;
+
+/// The prefix of every temporary file (`.glassdb-tmp-XXXXXX` beside its target).
+pub const TEMP_PREFIX: &str = ".glassdb-tmp-";
+
+/// What identifies a file: its device and inode where it exists (so that hard links, symbolic
+/// links and spellings such as `./a/../a` match), else its canonical directory and name.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum FileId {
+    Inode { dev: u64, ino: u64 },
+    Path(PathBuf),
+}
+
+impl FileId {
+    /// The identity of the file whose metadata (links followed) is `meta`.
+    #[cfg_attr(unix, allow(unused_variables))]
+    pub(crate) fn of_meta(meta: &Metadata, path: &Path) -> FileId {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            FileId::Inode {
+                dev: meta.dev(),
+                ino: meta.ino(),
+            }
+        }
+        #[cfg(not(unix))]
+        {
+            FileId::Path(path.canonicalize().unwrap_or_else(|_| path.to_path_buf()))
+        }
+    }
+
+    /// The identity of `path`: of the file it names (links followed), or, where nothing is
+    /// there yet, its canonical directory joined with its name (`None` when even the directory
+    /// cannot be resolved).
+    pub(crate) fn of_path(path: &Path) -> Option<FileId> {
+        if let Ok(meta) = std::fs::metadata(path) {
+            return Some(FileId::of_meta(&meta, path));
+        }
+        let name = path.file_name()?;
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        Some(FileId::Path(dir.canonicalize().ok()?.join(name)))
+    }
+}
+
+pub(crate) struct State {
+    /// A stop is under way: no temporary file may be created or renamed into place.
+    stopping: bool,
+    /// The temporary files that exist now (absolute paths).
+    temporaries: BTreeSet<PathBuf>,
+    /// Whether the files read are recorded (see [`protect_inputs`]).
+    protect_inputs: bool,
+    /// The files read, by identity, with the name each was first read by.
+    inputs: BTreeMap<FileId, PathBuf>,
+}
+
+static STATE: Mutex<State> = Mutex::new(State {
+    stopping: false,
+    temporaries: BTreeSet::new(),
+    protect_inputs: false,
+    inputs: BTreeMap::new(),
+});
+
+/// The lock (a panic elsewhere does not make the records unusable).
+pub(crate) fn state() -> MutexGuard<'static, State> {
+    STATE.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// From now on, every file read through [`crate::read_input`] is an input that no output of
+/// this process may replace: [`crate::write_atomic`] and [`crate::refuse_input_as_output`]
+/// refuse an output that is (by device and inode) a file read before. The binaries call this
+/// first thing; a library never does, so that library users and tests are not affected.
+pub fn protect_inputs() {
+    state().protect_inputs = true;
+}
+
+/// Records a file read (when [`protect_inputs`] was called).
+pub(crate) fn record_input(path: &Path, meta: &Metadata) {
+    let mut s = state();
+    if s.protect_inputs {
+        let id = FileId::of_meta(meta, path);
+        s.inputs.entry(id).or_insert_with(|| path.to_path_buf());
+    }
+}
+
+/// The file read before whose identity is `id`, if any.
+pub(crate) fn input_matching(id: &FileId) -> Option<PathBuf> {
+    state().inputs.get(id).cloned()
+}
+
+fn stopping_error() -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::Interrupted,
+        "the process is being stopped",
+    )
+}
+
+/// A temporary file beside an output, recorded while it exists; dropping it removes it.
+#[derive(Debug)]
+pub(crate) struct LiveTemp {
+    path: Option<TempPath>,
+}
+
+impl LiveTemp {
+    /// Creates a new temporary file in `dir` with `permissions`, recorded before anyone can
+    /// see it; fails once a stop is under way.
+    pub(crate) fn create(dir: &Path, permissions: Permissions) -> std::io::Result<(File, Self)> {
+        let tmp = tempfile::Builder::new()
+            .prefix(TEMP_PREFIX)
+            .make_in(dir, |path| {
+                let mut s = state();
+                if s.stopping {
+                    return Err(stopping_error());
+                }
+                let mut options = std::fs::OpenOptions::new();
+                options.read(true).write(true).create_new(true);
+                #[cfg(unix)]
+                {
+                    use std::os::unix::fs::{OpenOptionsExt, PermissionsExt};
+                    options.mode(permissions.mode());
+                }
+                let file = options.open(path)?;
+                s.temporaries.insert(path.to_path_buf());
+                Ok(file)
+            })?;
+        let (file, path) = tmp.into_parts();
+        #[cfg(not(unix))]
+        {
+            let _ = file.set_permissions(permissions);
+        }
+        Ok((file, LiveTemp { path: Some(path) }))
+    }
+
+    /// Renames it over `target` (taking the lock).
+    pub(crate) fn persist(mut self, target: &Path) -> std::io::Result<()> {
+        let mut s = state();
+        self.persist_locked(target, &mut s)
+    }
+
+    /// Renames it over `target` with the lock held by the caller. On failure it is removed.
+    pub(crate) fn persist_locked(&mut self, target: &Path, s: &mut State) -> std::io::Result<()> {
+        let Some(path) = self.path.take() else {
+            return Err(std::io::Error::other("the temporary file is gone"));
+        };
+        let key = path.to_path_buf();
+        if s.stopping {
+            drop(path);
+            s.temporaries.remove(&key);
+            return Err(stopping_error());
+        }
+        let result = path.persist(target).map_err(|e| e.error);
+        // Renamed, or removed by the failed persist's TempPath drop: no longer there either way.
+        s.temporaries.remove(&key);
+        result
+    }
+}
+
+impl Drop for LiveTemp {
+    fn drop(&mut self) {
+        if let Some(path) = self.path.take() {
+            let mut s = state();
+            let key = path.to_path_buf();
+            drop(path); // removes the file
+            s.temporaries.remove(&key);
+        }
+    }
+}
+
+/// Removes every temporary file this process is writing and exits with `code` (128 + the
+/// signal number, by convention: 130 for SIGINT, 143 for SIGTERM). The lock stays held, so no
+/// other thread creates a temporary file or renames one into place after this point: the
+/// outputs that were finished before stay, the unfinished leave nothing behind.
+pub fn exit_removing_temporaries(code: i32) -> ! {
+    let mut s = state();
+    s.stopping = true;
+    for path in std::mem::take(&mut s.temporaries) {
+        let _ = std::fs::remove_file(path);
+    }
+    std::process::exit(code)
+}
+
+/// The temporary files that exist now (for tests).
+pub fn live_temporaries() -> Vec<PathBuf> {
+    state().temporaries.iter().cloned().collect()
+}
