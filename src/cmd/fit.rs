@@ -94,6 +94,9 @@ pub fn run_fit(args: FitArgs) -> anyhow::Result<ExitCode> {
             .with_context(|| args.table.display().to_string())?;
         file.glasses.push(fit);
     }
+    // What every reader of fit files refuses is not written: a curve beyond the physical range
+    // by more than its tolerance (smaller violations are warnings, errors with --strict).
+    file.validate(&args.table)?;
     if let Some(out) = &args.output {
         glassdb_io::refuse_input_as_output(out, [args.table.as_path()])?;
         glassdb_io::write_bytes_atomic(out, file.to_json().as_bytes())?;

@@ -15,4 +15,5 @@ mod scene;
 mod spectral;
 mod util;
 mod validation;
+mod values;
 mod view;

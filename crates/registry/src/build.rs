@@ -53,7 +53,8 @@ pub struct BuildOptions {
     pub tables: Vec<IntegrationSettings>,
     /// With the ids of a scene's masks, only those glasses are built.
     pub mask_ids: Option<MaskIds>,
-    /// Fit tolerance on r and t (absolute).
+    /// Fit tolerance on r and t (absolute), in (0, [`glassdb_fit::MAX_CURVE_TOLERANCE`]]: it
+    /// becomes each curve's recorded validation tolerance.
     pub fit_tol: f64,
     /// Highest polynomial degree tried.
     pub max_degree: u32,
@@ -101,6 +102,13 @@ pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
 /// Builds a registry from a catalog file (paths in it are relative to the catalog; the
 /// catalog's provenance records `catalog_path` as given).
 pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Registry, RegistryError> {
+    let max = glassdb_fit::MAX_CURVE_TOLERANCE;
+    if !(opts.fit_tol > 0.0 && opts.fit_tol <= max) {
+        return Err(RegistryError::FitTolerance {
+            tol: opts.fit_tol,
+            max,
+        });
+    }
     let bytes = std::fs::read(catalog_path).map_err(|source| RegistryError::Read {
         path: catalog_path.to_path_buf(),
         source,
