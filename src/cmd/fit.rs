@@ -107,9 +107,9 @@ pub fn run_fit(args: FitArgs) -> anyhow::Result<ExitCode> {
         }
     }
     if args.json {
-        print!("{}", file.to_json());
+        out!("{}", file.to_json());
     } else {
-        print!("{}", fit_report(&file, &args));
+        out!("{}", fit_report(&file, &args));
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -366,7 +366,7 @@ pub fn run_eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
             })
             .collect();
         let doc = serde_json::json!({ "glasses": out });
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
         let mut s = String::new();
         for g in &glasses {
@@ -382,7 +382,7 @@ pub fn run_eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
                 let _ = writeln!(s, "  {:>9} {r:>10} {t:>10}", trim_num(a));
             }
         }
-        print!("{s}");
+        out!("{s}");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -165,7 +165,7 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
         out_dir: &args.out_dir,
     })
     .map_err(anyhow::Error::new)?;
-    println!(
+    outln!(
         "{} glass plane{} in {} ({} triangles; tolerance {}°, {:e} units)",
         report.planes.planes.len(),
         if report.planes.planes.len() == 1 {
@@ -180,7 +180,7 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
     );
     for (p, stats) in report.planes.planes.iter().zip(&report.stats) {
         let [a, b, c, d] = p.equation;
-        println!(
+        outln!(
             "plane {}: {a:.6}x {:+.6}y {:+.6}z {:+.6} = 0  area {:.6}  {} glass triangles  materials [{}]  eye sees the {}  -> {} ({} triangles, {} clipped, {} behind)",
             p.index,
             b,
@@ -196,7 +196,7 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
             stats.behind,
         );
     }
-    println!("wrote {}", report.planes_path.display());
+    outln!("wrote {}", report.planes_path.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -351,7 +351,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         let t1 = Instant::now();
         let mask = job.render(&camera, &args.output)?;
         let t_raster = t1.elapsed();
-        println!(
+        outln!(
             "{}x{} mask of {} ({} triangles, {} glass on {} plane{}; {} in view) -> {}",
             mask.width,
             mask.height,
@@ -364,12 +364,12 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             args.output.display()
         );
         if mask.id_pixels.is_empty() {
-            println!("no glass is visible from this camera");
+            outln!("no glass is visible from this camera");
         }
         for (id, n) in &mask.id_pixels {
-            println!("id {id}: {n} pixels");
+            outln!("id {id}: {n} pixels");
         }
-        println!(
+        outln!(
             "load {:.3} s, rasterise {:.3} s",
             t_load.as_secs_f64(),
             t_raster.as_secs_f64()
@@ -379,7 +379,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
 
     // An animation: the scene is labelled once; each frame has its own camera and output. A
     // frame that fails is reported and the others go on.
-    println!(
+    outln!(
         "{} ({} triangles, {} glass on {} plane{}), {} frame(s)",
         args.scene.display(),
         scene.triangle_count(),
@@ -409,7 +409,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         match result {
             Ok((output, mask)) => {
                 let glass: u64 = mask.id_pixels.values().sum();
-                println!(
+                outln!(
                     "frame {frame}: {}x{}, {glass} glass pixels -> {}",
                     mask.width,
                     mask.height,
@@ -425,7 +425,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             }
         }
     }
-    println!(
+    outln!(
         "load {:.3} s, rasterise and write {:.3} s",
         t_load.as_secs_f64(),
         t1.elapsed().as_secs_f64()

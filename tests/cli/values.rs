@@ -1,7 +1,11 @@
-//! Values that must not pass unchecked: registry tolerances above the cap, fit files with
-//! unphysical normal values, spectra whose integrated values create light (refused by
-//! `glassdb spectral` with the registry build's own message), the wrong kind of file for
-//! `glassdb eval`.
+//! Values that must not pass unchecked, and the command line's behaviour on a closed pipe:
+//! registry tolerances above the cap, fit files with unphysical normal values, spectra whose
+//! integrated values create light (refused by `glassdb spectral` with the registry build's own
+//! message), the wrong kind of file for `glassdb eval`, and `… | head`.
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Command, ExitStatus, Stdio};
 
 use crate::util::{assert_names, compose, fails, fails_naming, glassdb, ok, repo_path, write_file};
 
@@ -195,4 +199,68 @@ fn spectral_refuses_a_gapped_spectrum_with_the_registry_builds_message() {
     let message = message_after(&spectral, "at 550 nm");
     assert!(message.contains("more light out than in"), "{message}");
     assert!(fails(&mut build).contains(message), "{message}");
+}
+
+/// Runs `cmd` with its stdout a pipe whose reader goes away at once, before the command
+/// writes anything; returns its exit status and stderr.
+fn with_closed_stdout(cmd: &mut Command) -> (ExitStatus, String) {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("wait");
+    (
+        out.status,
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn assert_quiet_exit(what: &str, (status, stderr): (ExitStatus, String)) {
+    assert!(
+        status.success() && stderr.is_empty(),
+        "{what}: {status:?}, stderr:\n{stderr}"
+    );
+}
+
+#[test]
+fn a_closed_pipe_ends_every_binary_quietly() {
+    let registry = repo_path("data/registry.json");
+    let mut show = glassdb();
+    show.args(["registry", "show"]).arg(&registry);
+    assert_quiet_exit("registry show", with_closed_stdout(&mut show));
+    // `head -1`: the reader takes one line of a long output (far more than a pipe buffers)
+    // and goes away while the command is still writing.
+    let dir = tempfile::tempdir().unwrap();
+    let fits = write_file(dir.path(), "f.json", fit_file("0.1", 0.0).as_bytes());
+    let mut child = glassdb()
+        .arg("eval")
+        .arg(&fits)
+        .args(["--angles", "0:90:0.001"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    let stdout = child.stdout.take().unwrap();
+    BufReader::new(stdout).read_line(&mut first).unwrap();
+    assert_eq!(first, "glass g\n");
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_quiet_exit("eval | head -1", (out.status, stderr));
+    // The compose binary: the output is written, then the report meets the closed pipe.
+    let example = repo_path("fixtures/example");
+    let output = dir.path().join("o.png");
+    let mut c = compose();
+    for (flag, file) in [
+        ("--refl", "refl.exr"),
+        ("--trans", "trans.exr"),
+        ("--mask", "mask.png"),
+    ] {
+        c.arg(flag).arg(example.join(file));
+    }
+    c.arg("-o").arg(&output).arg("--stats");
+    assert_quiet_exit("compose", with_closed_stdout(&mut c));
+    assert!(Path::new(&output).exists());
 }
