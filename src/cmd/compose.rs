@@ -1,6 +1,7 @@
 //! `compose` / `glassdb compose`: reflection and transmission passes through an id + cos θ mask
 //! (docs/compose.md). All logic lives in `glassdb_compose`; this module parses arguments,
-//! prints the report and drives the progress bar.
+//! prints the report and drives the progress display (stages of one frame, or a bar over the
+//! frames of a sequence).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -13,7 +14,8 @@ use glassdb_compose::pixels::{InputTransfer, PngBits};
 use glassdb_compose::sequence::{self, FrameOutcome};
 use glassdb_compose::view::ViewTransform;
 use glassdb_compose::{
-    ComposeJob, ComposeSettings, FrameReport, InputLayers, OutsidePolicy, UnknownIds, compose_frame,
+    ComposeJob, ComposeSettings, FrameReport, InputLayers, OutsidePolicy, UnknownIds,
+    compose_frame_with_progress,
 };
 use glassdb_mask::{
     AovWeighting, CosSource, CryptomatteOptions, ExrMaskChannels, GlassMapping, GlassNames,
@@ -21,6 +23,8 @@ use glassdb_mask::{
 };
 use glassdb_registry::{ColourBasis, Registry, Side};
 use glassdb_spectral::RgbSpace;
+
+use crate::cmd::progress::Spinner;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -582,7 +586,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
 
     let Some(frames_spec) = &args.frames else {
-        let report = compose_frame(&job, &settings, &luts)?;
+        let spinner = Spinner::on_terminal("compose");
+        let report = compose_frame_with_progress(&job, &settings, &luts, &spinner)?;
+        spinner.finish();
         report_nonfinite(&report, "");
         if args.stats {
             print_stats(&report, &luts);

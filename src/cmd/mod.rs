@@ -24,6 +24,7 @@ pub mod fit;
 pub mod hints;
 pub mod out;
 pub mod plot;
+pub mod progress;
 pub mod registry;
 pub mod report;
 pub mod scene;

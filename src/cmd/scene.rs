@@ -7,12 +7,15 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
+use glassdb_io::Progress;
 use glassdb_mask::{MaskFormat, write_mask};
 use glassdb_scene::{
     Camera, CameraSource, CosEncoding, CosMode, GlassMapping, MaskScene, MirrorRequest,
     PlaneSource, PlaneTolerance, PlanesFile, RasterOptions, SceneWarning, build_mask_scene,
     load_obj, rasterize, to_mask_image, write_virtual_scenes,
 };
+
+use crate::cmd::progress::Spinner;
 
 #[derive(Debug, clap::Args)]
 pub struct MirrorArgs {
@@ -305,9 +308,11 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         )?;
     }
 
+    let spinner = Spinner::on_terminal("mask");
+    spinner.stage("load scene");
     let t0 = Instant::now();
     let scene = load_obj(&args.scene)?;
-    print_warnings(&scene.warnings);
+    spinner.suspend(|| print_warnings(&scene.warnings));
     let source_planes = match &args.planes {
         Some(p) => {
             let file = PlanesFile::load(p)?;
@@ -330,15 +335,18 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             PlaneSource::Detect(tolerance)
         }
     };
+    spinner.stage("label glass planes");
     let labelled = build_mask_scene(
         &scene,
         &mappings,
         &source_planes,
         matches!(cos, CosMode::Gouraud { .. }),
     )?;
-    for p in &labelled.unmatched_patterns {
-        eprintln!("warning: --glass {p} matches no material with faces");
-    }
+    spinner.suspend(|| {
+        for p in &labelled.unmatched_patterns {
+            eprintln!("warning: --glass {p} matches no material with faces");
+        }
+    });
     let t_load = t0.elapsed();
     let job = MaskJob {
         labelled: &labelled,
@@ -349,8 +357,9 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
     let Some(frames) = frames else {
         let camera = source.camera(None)?;
         let t1 = Instant::now();
-        let mask = job.render(&camera, &args.output)?;
+        let mask = job.render(&camera, &args.output, &spinner)?;
         let t_raster = t1.elapsed();
+        spinner.finish();
         outln!(
             "{}x{} mask of {} ({} triangles, {} glass on {} plane{}; {} in view) -> {}",
             mask.width,
@@ -379,18 +388,22 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
 
     // An animation: the scene is labelled once; each frame has its own camera and output. A
     // frame that fails is reported and the others go on.
-    outln!(
-        "{} ({} triangles, {} glass on {} plane{}), {} frame(s)",
-        args.scene.display(),
-        scene.triangle_count(),
-        labelled.glass_triangles,
-        labelled.planes.len(),
-        if labelled.planes.len() == 1 { "" } else { "s" },
-        frames.len()
-    );
+    let frame_count = frames.len() as u64;
+    spinner.suspend(|| {
+        outln!(
+            "{} ({} triangles, {} glass on {} plane{}), {} frame(s)",
+            args.scene.display(),
+            scene.triangle_count(),
+            labelled.glass_triangles,
+            labelled.planes.len(),
+            if labelled.planes.len() == 1 { "" } else { "s" },
+            frames.len()
+        )
+    });
     let t1 = Instant::now();
     let mut failed: Vec<u32> = Vec::new();
-    for &frame in &frames {
+    for (k, &frame) in frames.iter().enumerate() {
+        spinner.step(k as u64, frame_count);
         let result = (|| -> anyhow::Result<(PathBuf, FrameMask)> {
             let output = if glassdb_io::is_frame_pattern(&args.output) {
                 glassdb_io::expand_frame_pattern(&args.output, frame)?
@@ -403,28 +416,33 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
                 [args.scene.as_path(), camera_path.as_path()],
             )?;
             let camera = source.camera(Some(frame))?;
-            let mask = job.render(&camera, &output)?;
+            let mask = job.render(&camera, &output, &spinner)?;
             Ok((output, mask))
         })();
         match result {
             Ok((output, mask)) => {
                 let glass: u64 = mask.id_pixels.values().sum();
-                outln!(
-                    "frame {frame}: {}x{}, {glass} glass pixels -> {}",
-                    mask.width,
-                    mask.height,
-                    output.display()
-                );
+                spinner.suspend(|| {
+                    outln!(
+                        "frame {frame}: {}x{}, {glass} glass pixels -> {}",
+                        mask.width,
+                        mask.height,
+                        output.display()
+                    )
+                });
             }
             Err(e) => {
-                eprintln!(
-                    "frame {frame}: error: {}",
-                    crate::cmd::hints::with_hints(&e)
-                );
+                spinner.suspend(|| {
+                    eprintln!(
+                        "frame {frame}: error: {}",
+                        crate::cmd::hints::with_hints(&e)
+                    )
+                });
                 failed.push(frame);
             }
         }
     }
+    spinner.finish();
     outln!(
         "load {:.3} s, rasterise and write {:.3} s",
         t_load.as_secs_f64(),
@@ -449,8 +467,15 @@ struct FrameMask {
 }
 
 impl MaskJob<'_> {
-    /// Rasterises the scene from `camera` and writes the mask to `output`.
-    fn render(&self, camera: &Camera, output: &Path) -> anyhow::Result<FrameMask> {
+    /// Rasterises the scene from `camera` and writes the mask to `output`, telling `progress`
+    /// of each stage.
+    fn render(
+        &self,
+        camera: &Camera,
+        output: &Path,
+        progress: &dyn Progress,
+    ) -> anyhow::Result<FrameMask> {
+        progress.stage("rasterise");
         let out = rasterize(&self.labelled.raster, camera, self.options)?;
         let drawn = out.triangles_drawn;
         let encoding = match self.format {
@@ -458,6 +483,7 @@ impl MaskJob<'_> {
             MaskFormat::Png16 => CosEncoding::Quantized16,
             MaskFormat::Exr => CosEncoding::Float,
         };
+        progress.stage("write");
         let mask = to_mask_image(out, encoding);
         write_mask(output, &mask, self.format)?;
         Ok(FrameMask {

@@ -1,6 +1,7 @@
 //! Atomic output for every glassdb tool: a file is written to a temporary file in the target's
 //! own directory and renamed over the target only when complete, so a failed run never leaves a
 //! half-written or lost output. [`frames`]: frame patterns and frame lists of animations.
+//! [`progress`]: the observer through which libraries report the progress of long work.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -8,6 +9,8 @@ use std::path::{Path, PathBuf};
 
 pub mod frames;
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
+pub mod progress;
+pub use progress::{NoProgress, Progress, StageLog};
 
 /// Failures of [`write_atomic`] and [`refuse_input_as_output`], each naming the path involved.
 #[derive(Debug, thiserror::Error)]
