@@ -1,6 +1,7 @@
 //! `compose` / `glassdb compose`: reflection and transmission passes through an id + cos θ mask
 //! (docs/compose.md). All logic lives in `glassdb_compose`; this module parses arguments,
-//! prints the report and drives the progress bar.
+//! prints the report and drives the progress display (stages of one frame, or a bar over the
+//! frames of a sequence).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -13,7 +14,8 @@ use glassdb_compose::pixels::{InputTransfer, PngBits};
 use glassdb_compose::sequence::{self, FrameOutcome};
 use glassdb_compose::view::ViewTransform;
 use glassdb_compose::{
-    ComposeJob, ComposeSettings, FrameReport, InputLayers, OutsidePolicy, UnknownIds, compose_frame,
+    ComposeJob, ComposeSettings, FrameReport, InputLayers, OutsidePolicy, UnknownIds,
+    compose_frame_with_progress,
 };
 use glassdb_mask::{
     AovWeighting, CosSource, CryptomatteOptions, ExrMaskChannels, GlassMapping, GlassNames,
@@ -21,6 +23,8 @@ use glassdb_mask::{
 };
 use glassdb_registry::{ColourBasis, Registry, Side};
 use glassdb_spectral::RgbSpace;
+
+use crate::cmd::progress::Spinner;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -482,7 +486,7 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts) {
     };
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let t = &r.timings;
-    println!(
+    outln!(
         "image        {}×{} ({:.2} Mpixel), {} reflection pass(es)",
         r.width,
         r.height,
@@ -490,13 +494,14 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts) {
         r.planes
     );
     if r.windows.data != r.windows.display {
-        println!(
+        outln!(
             "windows      data {} in display {}",
-            r.windows.data, r.windows.display
+            r.windows.data,
+            r.windows.display
         );
     }
     if r.output.kept_channels > 0 {
-        println!(
+        outln!(
             "kept         {} other channel(s) of the transmission file",
             r.output.kept_channels
         );
@@ -506,51 +511,52 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts) {
         ColourBasis::PaperRgb => " (the paper's CIE 1931 RGB, not a renderer's space)",
         ColourBasis::Space(_) => "",
     };
-    println!(
+    outln!(
         "colour       passes in {}; registry table {}{table_note}",
-        colour.space, colour.table.basis
+        colour.space,
+        colour.table.basis
     );
     if colour.converted_for_display {
-        println!(
+        outln!(
             "             PNG converted from {} to linear Rec.709 (CAT02) for the standard view",
             glassdb_compose::colour::space_label(colour.space.space)
         );
     }
-    println!(
+    outln!(
         "decode       {:9.1} ms  (all inputs, in parallel)",
         ms(t.decode)
     );
-    println!("compose      {:9.1} ms", ms(t.compose));
-    println!(
+    outln!("compose      {:9.1} ms", ms(t.compose));
+    outln!(
         "encode       {:9.1} ms  ({}, {} bytes)",
         ms(t.encode),
         r.output.encoding,
         r.output.bytes
     );
-    println!(
+    outln!(
         "total        {:9.1} ms  ({:.1} Mpixel/s)",
         ms(t.total()),
         r.megapixels_per_second()
     );
     let glass: u64 = r.id_counts.values().sum();
-    println!("glass pixels {glass}");
+    outln!("glass pixels {glass}");
     for (id, n) in &r.id_counts {
         let known = if lut.contains(*id) {
             ""
         } else {
             "  (not in registry: passed through)"
         };
-        println!("  id {id:5}   {n} pixels{known}");
+        outln!("  id {id:5}   {n} pixels{known}");
     }
     match r.cos_range {
-        Some((lo, hi)) => println!(
+        Some((lo, hi)) => outln!(
             "cos θ        {lo:.4} – {hi:.4}  (θ {:.1}° – {:.1}°)",
             hi.clamp(-1.0, 1.0).acos().to_degrees(),
             lo.clamp(-1.0, 1.0).acos().to_degrees()
         ),
-        None => println!("cos θ        (no glass pixels)"),
+        None => outln!("cos θ        (no glass pixels)"),
     }
-    println!(
+    outln!(
         "fine-table interpolation error (16-bit/float masks): {:.2e}",
         lut.fine_table_error
     );
@@ -593,12 +599,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
 
     let Some(frames_spec) = &args.frames else {
-        let report = compose_frame(&job, &settings, &luts)?;
+        let spinner = Spinner::on_terminal("compose");
+        let report = compose_frame_with_progress(&job, &settings, &luts, &spinner)?;
+        spinner.finish();
         report_nonfinite(&report, "");
         if args.stats {
             print_stats(&report, &luts);
         }
-        println!(
+        outln!(
             "wrote {} ({}×{}, {})",
             report.output.path.display(),
             report.width,
@@ -657,13 +665,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.stats {
         for o in &outcomes {
             if let Ok(r) = &o.result {
-                println!("--- frame {}", o.frame);
+                outln!("--- frame {}", o.frame);
                 print_stats(r, &luts);
             }
         }
     }
     if let (Some(first), Some(last)) = (done.first(), done.last()) {
-        println!(
+        outln!(
             "wrote {} frame(s): {} … {}",
             done.len(),
             first.output.path.display(),

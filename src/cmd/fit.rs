@@ -94,6 +94,9 @@ pub fn run_fit(args: FitArgs) -> anyhow::Result<ExitCode> {
             .with_context(|| args.table.display().to_string())?;
         file.glasses.push(fit);
     }
+    // What every reader of fit files refuses is not written: a curve beyond the physical range
+    // by more than its tolerance (smaller violations are warnings, errors with --strict).
+    file.validate(&args.table)?;
     if let Some(out) = &args.output {
         glassdb_io::refuse_input_as_output(out, [args.table.as_path()])?;
         glassdb_io::write_bytes_atomic(out, file.to_json().as_bytes())?;
@@ -104,9 +107,9 @@ pub fn run_fit(args: FitArgs) -> anyhow::Result<ExitCode> {
         }
     }
     if args.json {
-        print!("{}", file.to_json());
+        out!("{}", file.to_json());
     } else {
-        print!("{}", fit_report(&file, &args));
+        out!("{}", fit_report(&file, &args));
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -363,7 +366,7 @@ pub fn run_eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
             })
             .collect();
         let doc = serde_json::json!({ "glasses": out });
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
         let mut s = String::new();
         for g in &glasses {
@@ -379,7 +382,7 @@ pub fn run_eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
                 let _ = writeln!(s, "  {:>9} {r:>10} {t:>10}", trim_num(a));
             }
         }
-        print!("{s}");
+        out!("{s}");
     }
     Ok(ExitCode::SUCCESS)
 }

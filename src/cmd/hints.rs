@@ -3,7 +3,7 @@
 //! error variants that one flag or command answers; [`super::finish`] prints each as `hint:`.
 
 use glassdb_compose::ComposeError;
-use glassdb_fit::FitError;
+use glassdb_fit::{FitError, OtherJson};
 use glassdb_mask::MaskError;
 use glassdb_plot::PlotError;
 use glassdb_registry::RegistryError;
@@ -77,10 +77,25 @@ fn plot_hint(e: &PlotError) -> Option<String> {
 }
 
 fn fit_hint(e: &FitError) -> Option<String> {
+    const FIT_FILES: &str = "`glassdb eval` reads the fit files that `glassdb fit -o` writes";
     match e {
         FitError::AboveOneInFractions { .. } => {
             Some("if the table is in percent, pass --percent".into())
         }
+        FitError::OtherFile {
+            kind: OtherJson::Registry,
+            ..
+        } => Some(format!(
+            "a registry is read by `glassdb registry show`, `glassdb registry check`, \
+             `glassdb plot registry` and `glassdb compose --registry`; {FIT_FILES}"
+        )),
+        FitError::OtherFile {
+            kind: OtherJson::Planes,
+            ..
+        } => Some(format!(
+            "a planes file is read by `glassdb compose --planes` and `glassdb mask --planes`; \
+             {FIT_FILES}"
+        )),
         _ => None,
     }
 }
@@ -100,6 +115,12 @@ fn spectral_hint(e: &SpectralError) -> Option<String> {
 
 fn registry_hint(e: &RegistryError) -> Option<String> {
     match e {
+        RegistryError::FitTolerance { max, .. } => {
+            Some(format!("give --tol a value above 0 and at most {max}"))
+        }
+        RegistryError::ToleranceTooLarge { source_name, .. } => Some(format!(
+            "rebuild it from its catalog: glassdb registry build CATALOG.toml -o {source_name}"
+        )),
         RegistryError::SchemaVersion { source_name, .. } => Some(format!(
             "rebuild it: glassdb registry build CATALOG.toml -o {source_name}"
         )),

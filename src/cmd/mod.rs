@@ -1,9 +1,30 @@
 //! One module per subcommand. Each exposes clap `Args` and `run(args) -> anyhow::Result<ExitCode>`.
+//! Command output goes through `outln!` / `out!` ([`out`]: a closed pipe ends the process
+//! quietly instead of panicking).
+
+/// `println!` for command output, through [`out::write`].
+macro_rules! outln {
+    () => {
+        $crate::cmd::out::write(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        $crate::cmd::out::write(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// `print!` for command output, through [`out::write`].
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::cmd::out::write(format_args!($($arg)*))
+    };
+}
 
 pub mod compose;
 pub mod fit;
 pub mod hints;
+pub mod out;
 pub mod plot;
+pub mod progress;
 pub mod registry;
 pub mod report;
 pub mod scene;

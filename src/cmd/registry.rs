@@ -221,24 +221,24 @@ fn show(a: ShowArgs) -> anyhow::Result<ExitCode> {
     let table = registry
         .table_or_error(a.space, &a.registry.display().to_string())
         .map_err(anyhow::Error::new)?;
-    println!(
+    outln!(
         "{}: schema {SCHEMA_VERSION}, {}, {} glasses",
         a.registry.display(),
         tables_text(&registry),
         table.glasses.len()
     );
-    println!(
+    outln!(
         "showing the {} table (spectral method {}); values per channel in it",
         table.basis(),
         method_text(&table.spectral)
     );
     if a.back {
-        println!("reflectance: back side (r0_back, c_r_back)");
+        outln!("reflectance: back side (r0_back, c_r_back)");
     }
-    println!();
+    outln!();
     for g in &table.glasses {
         print_glass(g, side);
-        println!();
+        outln!();
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -276,7 +276,7 @@ fn print_glass(g: &GlassRecord, side: Side) {
         Side::Front => (&g.r0, &g.c_r),
         Side::Back => (&g.r0_back, &g.c_r_back),
     };
-    println!("id {:>5}  {}", g.id, g.name);
+    outln!("id {:>5}  {}", g.id, g.name);
     let lum = match &g.luminous {
         Some(l) => format!(
             "τv {:.4}  ρv {:.4}  ρv back {:.4}",
@@ -284,7 +284,7 @@ fn print_glass(g: &GlassRecord, side: Side) {
         ),
         None => "τv –  ρv – (no spectrum)".to_string(),
     };
-    println!("  r0 (R G B) {}   t0 {}   {lum}", rgb(r0), rgb(&g.t0));
+    outln!("  r0 (R G B) {}   t0 {}   {lum}", rgb(r0), rgb(&g.t0));
     let m = &g.angle_model;
     let mut model = format!("{} ({})", m.kind, m.applied);
     if let Some(max) = m.measured_max_angle_deg {
@@ -296,7 +296,7 @@ fn print_glass(g: &GlassRecord, side: Side) {
     if !m.chosen_by.is_empty() {
         model.push_str(&format!("; chosen by {}", m.chosen_by));
     }
-    println!("  angle model: {model}");
+    outln!("  angle model: {model}");
     let fit_line = |label: &str, curves: &[AngleCurve; 3]| {
         let parts: Vec<String> = curves
             .iter()
@@ -307,7 +307,7 @@ fn print_glass(g: &GlassRecord, side: Side) {
                 )
             })
             .collect();
-        println!("  {label}: {}", parts.join(" | "));
+        outln!("  {label}: {}", parts.join(" | "));
     };
     fit_line(
         if side == Side::Back {
@@ -318,10 +318,10 @@ fn print_glass(g: &GlassRecord, side: Side) {
         c_r,
     );
     fit_line("C_t", &g.c_t);
-    println!("  {:>6}  {:>22}  {:>22}", "angle", "r (R G B)", "t (R G B)");
+    outln!("  {:>6}  {:>22}  {:>22}", "angle", "r (R G B)", "t (R G B)");
     for deg in [0.0f64, 45.0, 60.0, 75.0] {
         let (r, t) = g.eval(side, deg.to_radians().cos());
-        println!("  {:>5}°  {:>22}  {:>22}", deg, rgb(&r), rgb(&t));
+        outln!("  {:>5}°  {:>22}  {:>22}", deg, rgb(&r), rgb(&t));
     }
 }
 
@@ -329,7 +329,7 @@ fn check(a: CheckArgs) -> anyhow::Result<ExitCode> {
     let mut failed = 0usize;
     for path in &a.registries {
         match Registry::from_json_file(path) {
-            Ok(r) => println!(
+            Ok(r) => outln!(
                 "{}: ok (schema {SCHEMA_VERSION}, {} glasses, {})",
                 path.display(),
                 r.default_table().glasses.len(),

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use glassdb_report::{GouraudScene, ReportOptions, SpectrumFigure, generate};
+use glassdb_report::{GouraudScene, ReportOptions, SpectrumFigure, generate_with_progress};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -87,7 +87,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "note: a debug build; the timings will not be representative (use cargo run --release -- report)"
         );
     }
-    let report = generate(&opts)?;
+    let spinner = crate::cmd::progress::Spinner::on_terminal("report");
+    let report = generate_with_progress(&opts, &spinner)?;
+    spinner.finish();
     let figures = report.figures.clone();
     report
         .write(&args.output)

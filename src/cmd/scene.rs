@@ -7,12 +7,15 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
+use glassdb_io::Progress;
 use glassdb_mask::{MaskFormat, write_mask};
 use glassdb_scene::{
     Camera, CameraSource, CosEncoding, CosMode, GlassMapping, MaskScene, MirrorRequest,
     PlaneSource, PlaneTolerance, PlanesFile, RasterOptions, SceneWarning, build_mask_scene,
     load_obj, rasterize, to_mask_image, write_virtual_scenes,
 };
+
+use crate::cmd::progress::Spinner;
 
 #[derive(Debug, clap::Args)]
 pub struct MirrorArgs {
@@ -165,7 +168,7 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
         out_dir: &args.out_dir,
     })
     .map_err(anyhow::Error::new)?;
-    println!(
+    outln!(
         "{} glass plane{} in {} ({} triangles; tolerance {}°, {:e} units)",
         report.planes.planes.len(),
         if report.planes.planes.len() == 1 {
@@ -180,7 +183,7 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
     );
     for (p, stats) in report.planes.planes.iter().zip(&report.stats) {
         let [a, b, c, d] = p.equation;
-        println!(
+        outln!(
             "plane {}: {a:.6}x {:+.6}y {:+.6}z {:+.6} = 0  area {:.6}  {} glass triangles  materials [{}]  eye sees the {}  -> {} ({} triangles, {} clipped, {} behind)",
             p.index,
             b,
@@ -196,7 +199,7 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
             stats.behind,
         );
     }
-    println!("wrote {}", report.planes_path.display());
+    outln!("wrote {}", report.planes_path.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -315,9 +318,11 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         refuse_inputs(&args.output, &args.camera, &inputs)?;
     }
 
+    let spinner = Spinner::on_terminal("mask");
+    spinner.stage("load scene");
     let t0 = Instant::now();
     let scene = load_obj(&args.scene)?;
-    print_warnings(&scene.warnings);
+    spinner.suspend(|| print_warnings(&scene.warnings));
     inputs.extend(scene.input_files());
     if frames.is_none() {
         refuse_inputs(&args.output, &args.camera, &inputs)?;
@@ -344,15 +349,18 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             PlaneSource::Detect(tolerance)
         }
     };
+    spinner.stage("label glass planes");
     let labelled = build_mask_scene(
         &scene,
         &mappings,
         &source_planes,
         matches!(cos, CosMode::Gouraud { .. }),
     )?;
-    for p in &labelled.unmatched_patterns {
-        eprintln!("warning: --glass {p} matches no material with faces");
-    }
+    spinner.suspend(|| {
+        for p in &labelled.unmatched_patterns {
+            eprintln!("warning: --glass {p} matches no material with faces");
+        }
+    });
     let t_load = t0.elapsed();
     let job = MaskJob {
         labelled: &labelled,
@@ -363,9 +371,10 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
     let Some(frames) = frames else {
         let camera = source.camera(None)?;
         let t1 = Instant::now();
-        let mask = job.render(&camera, &args.output)?;
+        let mask = job.render(&camera, &args.output, &spinner)?;
         let t_raster = t1.elapsed();
-        println!(
+        spinner.finish();
+        outln!(
             "{}x{} mask of {} ({} triangles, {} glass on {} plane{}; {} in view) -> {}",
             mask.width,
             mask.height,
@@ -378,12 +387,12 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             args.output.display()
         );
         if mask.id_pixels.is_empty() {
-            println!("no glass is visible from this camera");
+            outln!("no glass is visible from this camera");
         }
         for (id, n) in &mask.id_pixels {
-            println!("id {id}: {n} pixels");
+            outln!("id {id}: {n} pixels");
         }
-        println!(
+        outln!(
             "load {:.3} s, rasterise {:.3} s",
             t_load.as_secs_f64(),
             t_raster.as_secs_f64()
@@ -393,18 +402,22 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
 
     // An animation: the scene is labelled once; each frame has its own camera and output. A
     // frame that fails is reported and the others go on.
-    println!(
-        "{} ({} triangles, {} glass on {} plane{}), {} frame(s)",
-        args.scene.display(),
-        scene.triangle_count(),
-        labelled.glass_triangles,
-        labelled.planes.len(),
-        if labelled.planes.len() == 1 { "" } else { "s" },
-        frames.len()
-    );
+    let frame_count = frames.len() as u64;
+    spinner.suspend(|| {
+        outln!(
+            "{} ({} triangles, {} glass on {} plane{}), {} frame(s)",
+            args.scene.display(),
+            scene.triangle_count(),
+            labelled.glass_triangles,
+            labelled.planes.len(),
+            if labelled.planes.len() == 1 { "" } else { "s" },
+            frames.len()
+        )
+    });
     let t1 = Instant::now();
     let mut failed: Vec<u32> = Vec::new();
-    for &frame in &frames {
+    for (k, &frame) in frames.iter().enumerate() {
+        spinner.step(k as u64, frame_count);
         let result = (|| -> anyhow::Result<(PathBuf, FrameMask)> {
             let output = if glassdb_io::is_frame_pattern(&args.output) {
                 glassdb_io::expand_frame_pattern(&args.output, frame)?
@@ -414,29 +427,34 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             let camera_path = source.path(Some(frame));
             refuse_inputs(&output, &camera_path, &inputs)?;
             let camera = source.camera(Some(frame))?;
-            let mask = job.render(&camera, &output)?;
+            let mask = job.render(&camera, &output, &spinner)?;
             Ok((output, mask))
         })();
         match result {
             Ok((output, mask)) => {
                 let glass: u64 = mask.id_pixels.values().sum();
-                println!(
-                    "frame {frame}: {}x{}, {glass} glass pixels -> {}",
-                    mask.width,
-                    mask.height,
-                    output.display()
-                );
+                spinner.suspend(|| {
+                    outln!(
+                        "frame {frame}: {}x{}, {glass} glass pixels -> {}",
+                        mask.width,
+                        mask.height,
+                        output.display()
+                    )
+                });
             }
             Err(e) => {
-                eprintln!(
-                    "frame {frame}: error: {}",
-                    crate::cmd::hints::with_hints(&e)
-                );
+                spinner.suspend(|| {
+                    eprintln!(
+                        "frame {frame}: error: {}",
+                        crate::cmd::hints::with_hints(&e)
+                    )
+                });
                 failed.push(frame);
             }
         }
     }
-    println!(
+    spinner.finish();
+    outln!(
         "load {:.3} s, rasterise and write {:.3} s",
         t_load.as_secs_f64(),
         t1.elapsed().as_secs_f64()
@@ -460,8 +478,15 @@ struct FrameMask {
 }
 
 impl MaskJob<'_> {
-    /// Rasterises the scene from `camera` and writes the mask to `output`.
-    fn render(&self, camera: &Camera, output: &Path) -> anyhow::Result<FrameMask> {
+    /// Rasterises the scene from `camera` and writes the mask to `output`, telling `progress`
+    /// of each stage.
+    fn render(
+        &self,
+        camera: &Camera,
+        output: &Path,
+        progress: &dyn Progress,
+    ) -> anyhow::Result<FrameMask> {
+        progress.stage("rasterise");
         let out = rasterize(&self.labelled.raster, camera, self.options)?;
         let drawn = out.triangles_drawn;
         let encoding = match self.format {
@@ -469,6 +494,7 @@ impl MaskJob<'_> {
             MaskFormat::Png16 => CosEncoding::Quantized16,
             MaskFormat::Exr => CosEncoding::Float,
         };
+        progress.stage("write");
         let mask = to_mask_image(out, encoding);
         write_mask(output, &mask, self.format)?;
         Ok(FrameMask {

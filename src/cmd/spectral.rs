@@ -191,7 +191,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let data = read_spectral_file(&args.file, &args.settings.read_options())
         .map_err(anyhow::Error::new)?;
     let integrator = Integrator::new(&settings)?;
+    // the energy checks of the registry build, on the data and on the integrated channels
+    glassdb_spectral::check_spectrum_balance(
+        &data.wavelength_nm,
+        data.transmittance.as_deref(),
+        &[
+            data.reflectance_front.as_deref(),
+            data.reflectance_back.as_deref(),
+        ],
+    )
+    .with_context(|| data.source.clone())?;
     let results = integrate_all(&data, &integrator, settings.extrapolate)?;
+    check_channel_balance(&data, &results)?;
     let out = if args.json {
         let mut s = serde_json::to_string_pretty(&to_json(&data, &method, &results))?;
         s.push('\n');
@@ -199,7 +210,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         to_text(&data, &method, &results)
     };
-    print!("{out}");
+    out!("{out}");
     Ok(ExitCode::SUCCESS)
 }
 
@@ -245,6 +256,21 @@ fn integrate_all(
         });
     }
     Ok(results)
+}
+
+/// t + r ≤ 1 per channel for each side the file has, as the registry build checks it.
+fn check_channel_balance(data: &SpectralData, results: &[QuantityResult]) -> anyhow::Result<()> {
+    let rgb = |key: &str| results.iter().find(|r| r.key == key).map(|r| r.rgb);
+    let Some(t) = rgb("transmittance") else {
+        return Ok(());
+    };
+    for (key, side) in [("reflectance", "front"), ("reflectance_back", "back")] {
+        if let Some(r) = rgb(key) {
+            glassdb_spectral::check_channel_balance(t, r, side, &data.wavelength_nm)
+                .with_context(|| data.source.clone())?;
+        }
+    }
+    Ok(())
 }
 
 fn to_json(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> Value {

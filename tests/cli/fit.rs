@@ -402,12 +402,35 @@ fn bad_tables_fail_with_a_clear_message() {
 #[test]
 fn strict_mode_fails_on_a_physical_violation() {
     let dir = tempfile::tempdir().unwrap();
-    let p = write_file(dir.path(), "sum.csv", r_plus_t_above_one_csv().as_bytes());
+    // R + T = 1.001: within the fit file's tolerance (0.002 per curve), so a warning, and an
+    // error only with --strict.
+    let rows: String = (0..=9)
+        .map(|i| {
+            format!(
+                "{},{},{}\n",
+                i * 10,
+                0.1 + 0.001 * i as f64,
+                0.901 - 0.001 * i as f64
+            )
+        })
+        .collect();
+    let p = write_file(
+        dir.path(),
+        "small.csv",
+        format!("angle_deg,R,T\n{rows}").as_bytes(),
+    );
     let (res, _, stderr) = run(glassdb().arg("fit").arg(&p));
-    assert!(res.status.success());
+    assert!(res.status.success(), "{stderr}");
     assert!(stderr.contains("r + t > 1"), "{stderr}");
     let e = fails(glassdb().arg("fit").arg(&p).arg("--strict"));
     assert!(e.contains("r + t > 1") && e.contains("worst at"), "{e}");
+    // R + T = 1.02: beyond the tolerance, so no fit file is written even without --strict
+    // (every reader of fit files would refuse it).
+    let p = write_file(dir.path(), "sum.csv", r_plus_t_above_one_csv().as_bytes());
+    let out = dir.path().join("sum.json");
+    let e = fails(glassdb().arg("fit").arg(&p).arg("-o").arg(&out));
+    assert_names(&e, &["sum.csv", "r + t > 1", "allowed tolerance 4.00e-3"]);
+    assert!(!out.exists());
 }
 
 #[test]

@@ -17,4 +17,5 @@ mod spectral;
 mod spectral_formats;
 mod util;
 mod validation;
+mod values;
 mod view;

@@ -9,7 +9,8 @@
 //! - [`colour`]: the passes' colour space and the registry table in it.
 //! - [`kernel`]: the per-pixel composite, in place, rayon over rows.
 //! - [`sequence`]: frame patterns (`r.####.exr`) and frames in parallel.
-//! - [`compose_frame`]: one image end to end, with per-stage timings for `--stats`.
+//! - [`compose_frame`]: one image end to end, with per-stage timings for `--stats`
+//!   ([`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`).
 
 pub mod colour;
 pub mod error;
@@ -430,6 +431,9 @@ fn absolute_from(w: &PixelWindow, origin: &PixelWindow) -> PixelWindow {
     }
 }
 
+/// The stages [`compose_frame_with_progress`] reports, in order.
+pub const FRAME_STAGES: [&str; 3] = ["decode", "composite", "encode"];
+
 /// Composites one image end to end: decode (all inputs in parallel), place every input in the
 /// transmission pass's frame by its pixel coordinates, check, composite in place, encode and
 /// write atomically. The output may not be one of the inputs.
@@ -438,6 +442,17 @@ pub fn compose_frame(
     settings: &ComposeSettings,
     luts: &RegistryLuts,
 ) -> Result<FrameReport, ComposeError> {
+    compose_frame_with_progress(job, settings, luts, &glassdb_io::NoProgress)
+}
+
+/// [`compose_frame`], telling `progress` as each of the [`FRAME_STAGES`] begins.
+pub fn compose_frame_with_progress(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    luts: &RegistryLuts,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<FrameReport, ComposeError> {
+    let [decode_stage, composite_stage, encode_stage] = FRAME_STAGES;
     if job.refl.is_empty() {
         return Err(ComposeError::NoReflectionPass);
     }
@@ -452,6 +467,7 @@ pub fn compose_frame(
             .chain(settings.protected.iter().map(PathBuf::as_path)),
     )?;
 
+    progress.stage(decode_stage);
     let t0 = Instant::now();
     let DecodedInputs {
         mut trans,
@@ -463,6 +479,7 @@ pub fn compose_frame(
     let space = passes_space(job, settings, &trans, &refl)?;
     let (table, lut) = luts.for_space(&space, &job.trans, &settings.registry_label)?;
 
+    progress.stage(composite_stage);
     let t1 = Instant::now();
     let data = trans.windows.data;
     let display = trans.windows.display;
@@ -548,6 +565,7 @@ pub fn compose_frame(
     drop(mask);
     let compose = t1.elapsed();
 
+    progress.stage(encode_stage);
     let t2 = Instant::now();
     if space.source != SpaceSource::Untagged {
         frame.tag_space = Some(space.space);

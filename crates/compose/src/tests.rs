@@ -332,3 +332,55 @@ fn unknown_ids_are_listed_up_to_ten_then_counted() {
     };
     assert!(err.to_string().contains("colour transform"), "{err}");
 }
+
+#[test]
+fn a_frame_reports_its_stages_in_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, v: f32| {
+        let path = dir.path().join(name);
+        let img = pixels::LinearImage {
+            width: 2,
+            height: 1,
+            rgb: [vec![v; 2], vec![v; 2], vec![v; 2]],
+            alpha: None,
+        };
+        let src = io::PassSource::Exr {
+            sample_type: glassdb_image::ExrSampleType::Float,
+            compression: exr::compression::Compression::ZIP16,
+            layer: String::new(),
+            part: 0,
+            channel_names: vec!["R".into(), "G".into(), "B".into()],
+        };
+        io::write_output(&path, img, &src, &OutputOptions::default()).unwrap();
+        path
+    };
+    let m = mask(
+        vec![1, 0],
+        CosTheta::Quantized8(vec![255, 0]),
+        vec![0; 2],
+        None,
+    );
+    let m_path = dir.path().join("m.png");
+    glassdb_mask::write_mask(&m_path, &m, glassdb_mask::MaskFormat::Png8).unwrap();
+    let job = ComposeJob {
+        refl: vec![write("r.exr", 0.25)],
+        trans: write("t.exr", 0.5),
+        mask: m_path,
+        output: dir.path().join("o.exr"),
+    };
+    let basis = glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb);
+    let luts = RegistryLuts::single(basis, test_lut());
+    let log = glassdb_io::StageLog::default();
+    compose_frame_with_progress(&job, &ComposeSettings::default(), &luts, &log).unwrap();
+    assert_eq!(log.stages(), FRAME_STAGES);
+    // a frame that fails before decoding reports no stage
+    let log = glassdb_io::StageLog::default();
+    let no_refl = ComposeJob {
+        refl: Vec::new(),
+        ..job
+    };
+    assert!(
+        compose_frame_with_progress(&no_refl, &ComposeSettings::default(), &luts, &log).is_err()
+    );
+    assert!(log.stages().is_empty());
+}

@@ -158,6 +158,32 @@ pub enum FitError {
     /// A fit file (JSON) is malformed or inconsistent.
     #[error("{path}: {message}")]
     FitFile { path: PathBuf, message: String },
+    /// The file is another glassdb JSON file (a registry, a planes file), not a fit file.
+    #[error("{path} is {kind}, not a fit file")]
+    OtherFile {
+        path: PathBuf,
+        kind: crate::OtherJson,
+    },
+    /// A curve's normal value r0 or t0 lies outside [0, 1] (beyond the curve's tolerance).
+    #[error(
+        "{path}: glass `{glass}`, {quantity}: the normal value {normal:?} is outside [0, 1] (allowed tolerance {tolerance:.2e})"
+    )]
+    NormalOutOfRange {
+        path: PathBuf,
+        glass: String,
+        quantity: &'static str,
+        normal: f64,
+        tolerance: f64,
+    },
+    /// A glass's curves leave the physical range (0 ≤ r, t ≤ 1, r + t ≤ 1) by more than their
+    /// tolerance ([`crate::CurveFit::validation_tolerance`]).
+    #[error("{path}: glass `{glass}`: {violation} (allowed tolerance {tolerance:.2e})")]
+    Unphysical {
+        path: PathBuf,
+        glass: String,
+        violation: crate::PhysicalViolation,
+        tolerance: f64,
+    },
     /// A curve of a fit file cannot be evaluated as written.
     #[error("{path}: glass `{glass}`, {quantity}")]
     CurveShape {

@@ -7,7 +7,9 @@
 //!   basis, exported in the power basis; degree by tolerance with a leave-one-out guard.
 //! - [`fit_glass`]: both curves of a glass plus the physical checks (0 ≤ r, t ≤ 1, r + t ≤ 1).
 //! - [`FitFile`] / [`read_fit_file`]: the JSON that `glassdb fit --json` writes
-//!   (`docs/fit-json.md`), and [`CurveFit::eval_angle_deg`] / [`CosPolynomial::eval`] to use it.
+//!   (`docs/fit-json.md`), validated on every read ([`FitFile::validate`]: physical ranges
+//!   within [`MAX_CURVE_TOLERANCE`] at most, as the registry checks its curves), and
+//!   [`CurveFit::eval_angle_deg`] / [`CosPolynomial::eval`] to use it.
 
 mod dd;
 mod error;
@@ -18,8 +20,8 @@ mod table;
 
 pub use error::FitError;
 pub use glass::{
-    CHECK_SLACK, CHECK_STEP_DEG, FitFile, GlassFit, PhysicalViolation, fit_glass, parse_fit_json,
-    physical_checks, read_fit_file,
+    CHECK_SLACK, CHECK_STEP_DEG, FitFile, GlassFit, MAX_CURVE_TOLERANCE, OtherJson,
+    PhysicalViolation, fit_glass, parse_fit_json, physical_checks, read_fit_file,
 };
 pub use model::{
     AngleSamples, Basis, CosPolynomial, CurveFit, DEFAULT_MAX_DEGREE, DEFAULT_TOL, FitDiagnostics,

@@ -9,6 +9,7 @@
 //!   every file read safe from the outputs and let a signal handler remove the unfinished
 //!   temporary files (docs/reliability.md).
 //! - [`frames`]: frame patterns and frame lists of animations.
+//! - [`progress`]: the observer through which libraries report the progress of long work.
 
 pub mod frames;
 pub mod input;
@@ -23,6 +24,8 @@ pub use output::{
     OutputError, StagedOutput, refuse_input_as_output, write_atomic, write_bytes_atomic,
 };
 pub use registry::{TEMP_PREFIX, exit_removing_temporaries, live_temporaries, protect_inputs};
+pub mod progress;
+pub use progress::{NoProgress, Progress, StageLog};
 
 /// Displays an error with its causes as `outer: cause: root`, as `anyhow`'s `{:#}` does, for
 /// messages that are printed or written without going through `anyhow`.

@@ -53,7 +53,8 @@ pub struct BuildOptions {
     pub tables: Vec<IntegrationSettings>,
     /// With the ids of a scene's masks, only those glasses are built.
     pub mask_ids: Option<MaskIds>,
-    /// Fit tolerance on r and t (absolute).
+    /// Fit tolerance on r and t (absolute), in (0, [`glassdb_fit::MAX_CURVE_TOLERANCE`]]: it
+    /// becomes each curve's recorded validation tolerance.
     pub fit_tol: f64,
     /// Highest polynomial degree tried.
     pub max_degree: u32,
@@ -145,6 +146,13 @@ pub fn catalog_inputs(catalog_path: &Path) -> Result<Vec<PathBuf>, RegistryError
 /// Builds a registry from a catalog file (paths in it are relative to the catalog; the
 /// catalog's provenance records `catalog_path` as given).
 pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Registry, RegistryError> {
+    let max = glassdb_fit::MAX_CURVE_TOLERANCE;
+    if !(opts.fit_tol > 0.0 && opts.fit_tol <= max) {
+        return Err(RegistryError::FitTolerance {
+            tol: opts.fit_tol,
+            max,
+        });
+    }
     let (specs, catalog_sha) = load_catalog(catalog_path)?;
     let wanted = wanted_ids(&specs, catalog_path, opts.mask_ids.as_ref())?;
     let catalog_ref = FileRef {

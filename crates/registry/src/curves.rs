@@ -18,7 +18,8 @@ pub(crate) struct GlassCurves {
 }
 
 /// Fits one curve; the validation tolerance recorded with it is the larger of the fit
-/// tolerance and the fit's own largest residual.
+/// tolerance and the fit's own largest residual, at most [`glassdb_fit::MAX_CURVE_TOLERANCE`]
+/// (a worse fit is still validated with that slack, on the curve itself).
 fn fit_curve(
     samples: &AngleSamples,
     quantity: Quantity,
@@ -38,7 +39,10 @@ fn fit_curve(
     Ok(AngleCurve {
         polynomial: fit.polynomial,
         fit: summary,
-        tolerance: opts.fit_tol.max(summary.max_abs_error),
+        tolerance: opts
+            .fit_tol
+            .max(summary.max_abs_error)
+            .min(glassdb_fit::MAX_CURVE_TOLERANCE),
     })
 }
 

@@ -113,6 +113,24 @@ pub enum RegistryError {
         tolerance: f64,
     },
 
+    /// A curve's recorded validation tolerance is above the cap every file is held to
+    /// ([`glassdb_fit::MAX_CURVE_TOLERANCE`]): it would let unphysical curves pass.
+    #[error(
+        "{source_name}: glass {glass}: curve {field}: tolerance {tolerance} is above the largest validation tolerance {max} (a file cannot widen validation)"
+    )]
+    ToleranceTooLarge {
+        source_name: String,
+        glass: String,
+        field: String,
+        tolerance: f64,
+        max: f64,
+    },
+
+    /// The fit tolerance of a build is not positive or is above the largest tolerance a curve
+    /// may record ([`glassdb_fit::MAX_CURVE_TOLERANCE`]).
+    #[error("fit tolerance {tol} is outside (0, {max}], the range a registry's curves may record")]
+    FitTolerance { tol: f64, max: f64 },
+
     /// The curves give an unphysical value at some angle (outside [0, 1] or r + t > 1) by more
     /// than the fit tolerance recorded for the curve.
     #[error(

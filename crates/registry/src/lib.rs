@@ -23,6 +23,8 @@ mod validate;
 pub use build::{Application, BuildOptions, MaskIds, build_registry, catalog_inputs};
 pub use bundled::{DEFAULT_REGISTRY_JSON, DEFAULT_REGISTRY_NAME, default_registry};
 pub use error::RegistryError;
+/// The cap on every curve's recorded validation tolerance (shared with fit files).
+pub use glassdb_fit::MAX_CURVE_TOLERANCE;
 pub use record::{
     AngleCurve, AngleModelRecord, CHANNELS, ColourBasis, FileRef, GlassRecord, LuminousRecord,
     ProductRecord, Provenance, Registry, RegistryTable, SCHEMA_VERSION, SCHEMA_VERSION_ONE_TABLE,

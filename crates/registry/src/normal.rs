@@ -11,6 +11,8 @@ use crate::{FileRef, LuminousRecord, ProductRecord, RegistryError};
 
 /// Spectra of one glass at normal incidence on the file's own wavelengths.
 pub(crate) struct Spectra {
+    /// The spectral file, for messages.
+    pub path: PathBuf,
     pub wavelength_nm: Vec<f64>,
     pub t: Vec<f64>,
     pub rf: Vec<f64>,
@@ -89,7 +91,8 @@ pub(crate) fn read_spectral_source(
 }
 
 /// The normal-incidence values: the catalog's explicit ones, or the spectra integrated per
-/// channel (clamped to [0, 1]) with their luminous values.
+/// channel (clamped to [0, 1]; t + r ≤ 1 per channel and side,
+/// [`glassdb_spectral::check_channel_balance`]) with their luminous values.
 pub(crate) fn normal_values(
     spec: &GlassSpec,
     spectra: Option<&Spectra>,
@@ -136,11 +139,22 @@ pub(crate) fn normal_values(
         t0: channels(&s.t, "transmittance")?,
         r0_back: channels(&s.rb, "back reflectance")?,
     };
+    // the check `glassdb spectral` applies to the same integrated values
+    for (r, side) in [(values.r0, "front"), (values.r0_back, "back")] {
+        glassdb_spectral::check_channel_balance(values.t0, r, side, &s.wavelength_nm).map_err(
+            |source| RegistryError::Spectral {
+                glass: glass.to_string(),
+                path: s.path.clone(),
+                source: Box::new(source),
+            },
+        )?;
+    }
     Ok((values, Some(luminous)))
 }
 
 /// The spectra of a parsed file, checked against the glass: T (zero for opaque glass), Rf, Rb
-/// (Rf when absent), equal lengths, and T + R ≤ 1 at every wavelength.
+/// (Rf when absent), equal lengths, and T + R ≤ 1 at every wavelength
+/// ([`glassdb_spectral::check_spectrum_balance`], as `glassdb spectral` checks it).
 fn spectra_of(
     data: SpectralData,
     spec: &GlassSpec,
@@ -174,16 +188,18 @@ fn spectra_of(
     if t.len() != n || rf.len() != n || rb.len() != n {
         return Err(err("columns of different lengths".into()));
     }
-    for k in 0..n {
-        if t[k] + rf[k] > 1.0 + 1e-6 || t[k] + rb[k] > 1.0 + 1e-6 {
-            return Err(err(format!(
-                "at {} nm, T + R = {:.4} > 1: more light out than in",
-                data.wavelength_nm[k],
-                t[k] + rf[k].max(rb[k])
-            )));
-        }
-    }
+    glassdb_spectral::check_spectrum_balance(
+        &data.wavelength_nm,
+        Some(&t),
+        &[Some(&rf), Some(&rb)],
+    )
+    .map_err(|source| RegistryError::Spectral {
+        glass: glass.to_string(),
+        path: path.to_path_buf(),
+        source: Box::new(source),
+    })?;
     Ok(Spectra {
+        path: path.to_path_buf(),
         wavelength_nm: data.wavelength_nm,
         t,
         rf,

@@ -137,8 +137,9 @@ pub struct AngleCurve {
     pub polynomial: CosPolynomial,
     #[serde(flatten)]
     pub fit: FitSummary,
-    /// Absolute tolerance on r (or t) that validation allows beyond the physical range
-    /// (at least the fit's own max residual).
+    /// Absolute tolerance on r (or t) that validation allows beyond the physical range (the
+    /// larger of the fit tolerance and the fit's own max residual). Validation refuses a value
+    /// above [`glassdb_fit::MAX_CURVE_TOLERANCE`].
     pub tolerance: f64,
 }
 

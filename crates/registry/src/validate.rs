@@ -3,6 +3,8 @@
 
 use std::collections::BTreeMap;
 
+use glassdb_fit::MAX_CURVE_TOLERANCE;
+
 use crate::RegistryError;
 use crate::record::{CHANNELS, GlassRecord, Registry, RegistryTable, Side};
 
@@ -71,6 +73,8 @@ impl RegistryTable {
     /// Validates one table: ids unique and non-zero, every number finite, normal values in
     /// [0, 1] with r0 + t0 ≤ 1, well-formed curves, and on a dense 0–90° grid per side and
     /// channel 0 ≤ r, t ≤ 1 and r + t ≤ 1, each within the tolerance recorded for the curve.
+    /// A recorded tolerance is refused above [`MAX_CURVE_TOLERANCE`]: the slack of validation
+    /// is not the file's to set.
     pub fn validate_named(&self, source_name: &str) -> Result<(), RegistryError> {
         let mut seen: BTreeMap<u16, &str> = BTreeMap::new();
         for g in &self.glasses {
@@ -159,6 +163,15 @@ fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryErro
                     glass: glass.clone(),
                     field: name.clone(),
                     tolerance: curve.tolerance,
+                });
+            }
+            if curve.tolerance > MAX_CURVE_TOLERANCE {
+                return Err(RegistryError::ToleranceTooLarge {
+                    source_name: source_name.to_string(),
+                    glass: glass.clone(),
+                    field: name.clone(),
+                    tolerance: curve.tolerance,
+                    max: MAX_CURVE_TOLERANCE,
                 });
             }
         }

@@ -82,20 +82,54 @@ impl Report {
     }
 }
 
+/// The sections [`generate_with_progress`] reports as stages, in order (the last only when
+/// figures are written).
+pub const SECTIONS: [&str; 6] = [
+    "degree and basis",
+    "cos θ storage",
+    "approximation tables",
+    "spectral methods",
+    "Gouraud cos θ",
+    "figures",
+];
+
 /// Generates the page (and the figures when `figures_dir` is set). A section whose inputs
 /// fail says so in the page ("Not computed") and the others still run; only the figures
 /// fail the report.
 pub fn generate(opts: &ReportOptions) -> Result<Report, ReportError> {
+    generate_with_progress(opts, &glassdb_io::NoProgress)
+}
+
+/// [`generate`], telling `progress` as each of the [`SECTIONS`] begins (a stage and its step
+/// among them).
+pub fn generate_with_progress(
+    opts: &ReportOptions,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<Report, ReportError> {
+    let total = if opts.figures_dir.is_some() {
+        SECTIONS.len()
+    } else {
+        SECTIONS.len() - 1
+    } as u64;
+    let section = |k: usize| {
+        progress.stage(SECTIONS[k]);
+        progress.step(k as u64, total);
+    };
     let mut md = String::new();
     let refs = reference::references();
     let inputs = measure::timing_inputs(opts.timing_values.max(1024));
     write_header(&mut md, &refs, inputs.len());
+    section(0);
     degree_basis::section_degree_basis(&mut md, &refs, &inputs);
+    section(1);
     cos_storage::section_quantisation(&mut md, &refs);
+    section(2);
     tables::section_tables(&mut md, &refs, &inputs);
+    section(3);
     if let Err(e) = spectral::section_spectral(&mut md, &opts.catalog) {
         not_computed(&mut md, "Spectral methods", &e);
     }
+    section(4);
     let scene_mask = match &opts.gouraud_scene {
         Some(g) => match gouraud::section_gouraud(&mut md, g, &opts.root) {
             Ok(m) => Some(m),
@@ -109,10 +143,12 @@ pub fn generate(opts: &ReportOptions) -> Result<Report, ReportError> {
     let mut staged = glassdb_io::StagedOutput::new();
     let figures = match &opts.figures_dir {
         Some(dir) => {
+            section(5);
             figures::section_figures(&mut md, opts, dir, &refs, scene_mask.as_ref(), &mut staged)?
         }
         None => Vec::new(),
     };
+    progress.step(total, total);
     Ok(Report {
         markdown: md,
         figures,
@@ -150,4 +186,31 @@ fn not_computed(md: &mut String, title: &str, e: &ReportError) {
         "## {title}\n\nNot computed: {}\n",
         glassdb_io::ErrorChain(e)
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sections_are_reported_in_order() {
+        let dir = std::env::temp_dir();
+        let opts = ReportOptions {
+            root: dir.clone(),
+            catalog: dir.join("no-such-catalog.toml"),
+            angle_tables: Vec::new(),
+            spectrum_figure: None,
+            gouraud_scene: None,
+            figures_dir: None,
+            figures_link: "figures".into(),
+            timing_values: 1024,
+        };
+        let log = glassdb_io::StageLog::default();
+        let report = generate_with_progress(&opts, &log).unwrap();
+        assert_eq!(log.stages(), SECTIONS[..5]);
+        assert!(
+            report.markdown.contains("Not computed"),
+            "the missing catalog"
+        );
+    }
 }

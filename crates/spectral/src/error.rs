@@ -122,6 +122,25 @@ pub enum SpectralError {
         need_end_nm: f64,
     },
 
+    /// More light leaves the glass than falls on it at one wavelength of the data.
+    #[error("at {wavelength_nm} nm, T + R = {sum:.4} > 1: more light out than in")]
+    SpectrumEnergy { wavelength_nm: f64, sum: f64 },
+
+    /// The integrated values of one channel transmit and reflect more than the light that
+    /// falls on the glass (usually interpolation overshooting across sparse samples).
+    #[error(
+        "channel {channel}: integrated transmittance + {side} reflectance = {transmittance:.6} + {reflectance:.6} = {:.6} > 1 (energy is not conserved{})",
+        transmittance + reflectance,
+        largest_gap_nm.map(|(a, b)| format!("; largest gap between samples in 380–780 nm: {} nm, {a}–{b} nm", b - a)).unwrap_or_default()
+    )]
+    ChannelEnergy {
+        side: &'static str,
+        channel: &'static str,
+        transmittance: f64,
+        reflectance: f64,
+        largest_gap_nm: Option<(f64, f64)>,
+    },
+
     /// The reference white of a method has a zero (or negative) channel, so no ratio exists.
     #[error(
         "the illuminant's {channel} channel in this colour space is {value}: no per-channel ratio exists"

@@ -9,12 +9,15 @@
 //! - [`Integrator`]: built once from [`IntegrationSettings`], then cheap per spectrum
 //!   ([`Integrator::channels`]).
 //! - [`luminous_iso9050`]: visible transmittance/reflectance, D65 × V(λ), 380–780 nm at 10 nm.
+//! - [`check_spectrum_balance`] / [`check_channel_balance`]: T + R ≤ 1 per wavelength and per
+//!   integrated channel, the checks every command applies to a glass's spectra.
 //!
 //! Interpolation and alignment follow colour-science 0.4.7 (Sprague for uniform spacing,
 //! not-a-knot cubic spline otherwise, end values held constant outside the data), so the numbers
 //! agree with it to 1e-9 relative; the differences where colour is wrong are in
 //! `docs/spectral.md`.
 
+mod balance;
 mod error;
 mod integrate;
 mod interp;
@@ -24,6 +27,10 @@ mod read_igsdb;
 mod sniff;
 mod tables;
 
+pub use balance::{
+    CHANNEL_BALANCE_SLACK, SPECTRUM_BALANCE_SLACK, check_channel_balance, check_spectrum_balance,
+    largest_visible_gap,
+};
 pub use error::{SpectralError, UnsupportedKind};
 pub use glassdb_colour::{CHROMATICITIES_TOLERANCE, RgbSpace, rgb_to_rgb, xyz_to_rgb};
 pub use integrate::{
