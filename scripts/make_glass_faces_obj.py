@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
 """A facade of many glass panes for timing `glassdb mask` (docs/performance.md).
 
-Writes DIR/facade.obj, DIR/facade.mtl and DIR/camera.json: FACES glass quads (material
-Glass, each its own face with its own four corners, so each is a pane) in a square grid on
-PLANES parallel planes (z = 0, -0.5, -1, ...; the grid's rows go round-robin to the planes),
-in front of an opaque wall, and a 1920x1080 camera looking at the whole facade. Every pane
-covers a few pixels: with 100 000 panes the glass fills most of the frame.
+Writes DIR/facade.obj, DIR/facade.mtl and DIR/camera.json: FACES glass panes (material
+Glass, each its own face with its own corners, so each is a pane) in a square grid on PLANES
+parallel planes (z = 0, -0.5, -1, ...; the grid's rows go round-robin to the planes), in
+front of an opaque wall, and a 1920x1080 camera looking at the whole facade. With the default
+--size 0.8 every pane covers a few pixels; with --size above 1 the panes are large and
+overlap, each set back by a small depth of its own (1e-3 times its index modulo 997), so most
+of each is hidden behind others (heavy overdraw). --sides N makes round (or, with --star,
+star-shaped) panes of N corners instead of squares.
 
-    python3 scripts/make_glass_faces_obj.py DIR [--faces 100000] [--planes 1]
+    python3 scripts/make_glass_faces_obj.py DIR [--faces 100000] [--size 55] [--planes 1]
 """
 
 import argparse

@@ -272,7 +272,7 @@ fn max_memory_refuses_a_frame_naming_the_estimate_the_limit_and_the_largest_inpu
 #[test]
 fn frames_of_a_sequence_share_the_limit_and_one_over_it_fails_alone() {
     let f = Frame::new();
-    // Frame 1 is 64×48; frames 2 and 3 are 640×480 (about 100 times the memory each).
+    // Frame 1 is 64×48; frames 2 and 3 are 640×480 (100 times the pixels each).
     for (frame, (w, h)) in [(1, (64, 48)), (2, (640, 480)), (3, (640, 480))] {
         std::fs::write(f.path(&format!("t.{frame:04}.png")), grey_png(w, h, 100)).unwrap();
         std::fs::write(f.path(&format!("r.{frame:04}.png")), grey_png(w, h, 50)).unwrap();
@@ -284,19 +284,20 @@ fn frames_of_a_sequence_share_the_limit_and_one_over_it_fails_alone() {
         c
     };
     let err = fails_naming(
-        &mut run("2M"),
+        &mut run("40M"),
         &[
             "frame 2",
             "t.0002.png",
             "frame 3",
-            "over the memory limit of 2 MiB",
+            "over the memory limit of 40 MiB",
             "2 of 3 frame(s) failed",
         ],
     );
     assert!(!err.contains("frame 1"), "{err}");
     assert!(f.path("o.0001.exr").exists() && !f.path("o.0002.exr").exists());
-    // Frames 2 and 3 each fit alone but not together: they run one after the other.
-    let stdout = ok(run("16M").arg("--stats"));
+    // Frames 2 and 3 (about 46 MiB each, with the program's own 32 MiB) each fit alone but
+    // not together: they run one after the other.
+    let stdout = ok(run("80M").arg("--stats"));
     assert!(f.path("o.0002.exr").exists() && f.path("o.0003.exr").exists());
     let estimates: Vec<&str> = stdout.lines().filter(|l| l.starts_with("memory")).collect();
     assert_eq!(estimates.len(), 3, "{stdout}");

@@ -260,18 +260,29 @@ fn decode_inputs(
         )?;
         Ok((pass, frame))
     };
+    // The reflection passes a few at a time (as many as there are threads): each holds its
+    // file and compressed blocks only while it is decoded, so that many planes do not hold
+    // every file at once (`memory` counts it so).
+    let read_refl = || -> Result<Vec<Pass>, ComposeError> {
+        let at_once = memory::decoding_at_once();
+        let mut passes = Vec::with_capacity(job.refl.len());
+        for (c, chunk) in job.refl.chunks(at_once).enumerate() {
+            let decoded = chunk
+                .par_iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let k = c * at_once + i;
+                    io::read_pass(p, &settings.pass_options(settings.layers.refl.get(k)))
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            passes.extend(decoded);
+        }
+        Ok(passes)
+    };
     let (trans, (mask, refl)) = rayon::join(read_trans, || {
         rayon::join(
             || glassdb_mask::read_placed_mask(&job.mask, &settings.mask),
-            || {
-                job.refl
-                    .par_iter()
-                    .enumerate()
-                    .map(|(k, p)| {
-                        io::read_pass(p, &settings.pass_options(settings.layers.refl.get(k)))
-                    })
-                    .collect::<Result<Vec<_>, _>>()
-            },
+            read_refl,
         )
     });
     let (trans, frame) = trans?;

@@ -4,20 +4,44 @@
 //! shared budget, so frames in flight together never add up to more than the limit.
 //!
 //! What is counted, per frame (docs/compose.md, "Memory"):
-//! - decoding, all inputs at once (they are decoded in parallel): each input's file (read
-//!   whole), an EXR's compressed blocks copied out of it, a PNG's decoding buffer, and what the
-//!   read keeps (passes as `f32` planes, the mask as ids, planes, cos θ and coverage); the
-//!   transmission file's other channels in their own sample types when they are carried over;
+//! - decoding: what every input's read keeps (passes as `f32` planes, the mask as ids,
+//!   planes, cos θ and coverage), and what a read holds only while it runs (the file, read
+//!   whole; an EXR's compressed blocks copied out of it; a PNG's decoding buffer) for the
+//!   transmission pass, the mask and as many reflection passes as are decoded at once
+//!   ([`decoding_at_once`], the largest counted); the transmission file's other channels in
+//!   their own sample types when they are carried over;
 //! - compositing: the decoded inputs, and the mask placed in the frame when its data window
 //!   differs from the transmission pass's;
 //! - encoding: the composite and the carried channels, a half-float copy of one plane (half
 //!   EXR), the compressor's batch of blocks, or the PNG samples and file.
 //!
-//! The frame's estimate is the largest of the three stages. Allocator overhead, thread stacks
-//! and the registry's tables (a few MB) are not counted.
+//! The frame's estimate is the largest of the three stages, plus an eighth for what the
+//! allocator keeps and [`PROCESS_OVERHEAD`] for the program itself ([`with_overhead`]).
 
 use std::path::Path;
 use std::sync::{Condvar, Mutex};
+
+/// What the program holds besides the frame: its code and libraries, the threads' stacks and
+/// the registry's tables (7 MiB in all for a tiny frame), with room to spare.
+pub const PROCESS_OVERHEAD: u64 = 32 << 20;
+
+/// What the allocator keeps besides the frame's buffers, as a share of them (1/8): freed
+/// blocks it has not given back (glibc's malloc, raising its mmap threshold after large frees,
+/// serves later blocks from its heap and keeps them; a 4K half-float frame peaked 11 % above
+/// its counted buffers, 1 % with a fixed threshold; docs/performance.md).
+pub const ALLOCATOR_SHARE: u64 = 8;
+
+/// The estimate of a frame whose largest stage holds `buffers` bytes.
+pub fn with_overhead(buffers: u64) -> u64 {
+    buffers
+        .saturating_add(buffers / ALLOCATOR_SHARE)
+        .saturating_add(PROCESS_OVERHEAD)
+}
+
+/// How many reflection passes are decoded at once: one per thread of the pool (at least 1).
+pub fn decoding_at_once() -> usize {
+    rayon::current_num_threads().max(1)
+}
 
 /// The default limit of the library, 8 GiB (the `compose` binary lowers it to half the
 /// machine's memory where that is less).
@@ -54,11 +78,12 @@ pub fn format_bytes(bytes: u64) -> String {
         value /= 1024.0;
         unit += 1;
     }
-    if value >= 100.0 || value.fract() == 0.0 {
-        format!("{value:.0} {}", UNITS[unit])
+    let text = if value >= 100.0 {
+        format!("{value:.0}")
     } else {
-        format!("{value:.1} {}", UNITS[unit])
-    }
+        format!("{value:.1}")
+    };
+    format!("{} {}", text.trim_end_matches(".0"), UNITS[unit])
 }
 
 /// `path`'s file name (the whole path when it has none), for short messages.
@@ -139,6 +164,8 @@ mod tests {
         assert_eq!(format_bytes(512 << 20), "512 MiB");
         assert_eq!(format_bytes(3 << 29), "1.5 GiB");
         assert_eq!(format_bytes(8 << 30), "8 GiB");
+        assert_eq!(format_bytes((32 << 20) + 5), "32 MiB");
+        assert_eq!(format_bytes(100 << 20), "100 MiB");
     }
 
     #[test]

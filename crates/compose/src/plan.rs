@@ -139,22 +139,30 @@ fn estimate(
         }
     };
 
-    let inputs = std::iter::once(&trans.memory)
+    let kept = std::iter::once(&trans.memory)
         .chain(refl.iter().map(|p| &p.memory))
-        .chain(std::iter::once(&mask.memory));
-    let sum = |f: &dyn Fn(&glassdb_image::ReadMemory) -> u64| {
-        inputs.clone().map(f).fold(0, u64::saturating_add)
-    };
-    let decoding = sum(&|m| m.peak()).saturating_add(carried);
-    let compositing = sum(&|m| m.kept)
-        .saturating_add(carried)
-        .saturating_add(placed_mask);
+        .chain(std::iter::once(&mask.memory))
+        .map(|m| m.kept)
+        .fold(0, u64::saturating_add);
+    // The reflection passes are decoded a few at a time (`decode_inputs`): the largest few
+    // transients at once, beside the transmission pass's and the mask's.
+    let mut refl_transient: Vec<u64> = refl.iter().map(|p| p.memory.transient).collect();
+    refl_transient.sort_unstable_by(|a, b| b.cmp(a));
+    let transient = refl_transient
+        .iter()
+        .take(crate::memory::decoding_at_once())
+        .fold(0u64, |a, &b| a.saturating_add(b))
+        .saturating_add(trans.memory.transient)
+        .saturating_add(mask.memory.transient);
+    let decoding = kept.saturating_add(transient).saturating_add(carried);
+    let compositing = kept.saturating_add(carried).saturating_add(placed_mask);
     let encoding = trans
         .memory
         .kept
         .saturating_add(carried)
         .saturating_add(output);
-    let total = decoding.max(compositing).max(encoding);
+    let largest_stage = decoding.max(compositing).max(encoding);
+    let total = crate::memory::with_overhead(largest_stage);
 
     let mut items = vec![MemoryItem {
         what: file_label(&job.trans),
@@ -177,6 +185,10 @@ fn estimate(
     items.push(MemoryItem {
         what: format!("encoding {}", file_label(&job.output)),
         bytes: output,
+    });
+    items.push(MemoryItem {
+        what: "the program and what the allocator keeps".into(),
+        bytes: total - largest_stage,
     });
     items.sort_by(|a, b| b.bytes.cmp(&a.bytes).then_with(|| a.what.cmp(&b.what)));
     Ok(MemoryEstimate {
