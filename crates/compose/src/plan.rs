@@ -145,13 +145,23 @@ fn estimate(
         .map(|m| m.kept)
         .fold(0, u64::saturating_add);
     // The reflection passes are decoded a few at a time (`decode_inputs`): the largest few
-    // transients at once, beside the transmission pass's and the mask's.
-    let mut refl_transient: Vec<u64> = refl.iter().map(|p| p.memory.transient).collect();
-    refl_transient.sort_unstable_by(|a, b| b.cmp(a));
-    let transient = refl_transient
+    // transients at once (those passes' shares count them), beside the transmission pass's
+    // and the mask's.
+    let mut by_transient: Vec<usize> = (0..refl.len()).collect();
+    by_transient.sort_by_key(|&k| std::cmp::Reverse(refl[k].memory.transient));
+    by_transient.truncate(crate::memory::decoding_at_once());
+    let refl_share = |k: usize| {
+        let m = &refl[k].memory;
+        if by_transient.contains(&k) {
+            m.peak()
+        } else {
+            m.kept
+        }
+    };
+    let transient = by_transient
         .iter()
-        .take(crate::memory::decoding_at_once())
-        .fold(0u64, |a, &b| a.saturating_add(b))
+        .map(|&k| refl[k].memory.transient)
+        .fold(0u64, u64::saturating_add)
         .saturating_add(trans.memory.transient)
         .saturating_add(mask.memory.transient);
     let decoding = kept.saturating_add(transient).saturating_add(carried);
@@ -168,9 +178,9 @@ fn estimate(
         what: file_label(&job.trans),
         bytes: trans.memory.peak(),
     }];
-    items.extend(job.refl.iter().zip(refl).map(|(path, p)| MemoryItem {
+    items.extend(job.refl.iter().enumerate().map(|(k, path)| MemoryItem {
         what: file_label(path),
-        bytes: p.memory.peak(),
+        bytes: refl_share(k),
     }));
     items.push(MemoryItem {
         what: format!("{} (the mask)", file_label(&job.mask)),
