@@ -156,6 +156,72 @@ pub struct Args {
     /// Refuse inputs with more pixels than this (checked before decoding).
     #[arg(long, value_name = "N", default_value_t = glassdb_mask::DEFAULT_MAX_PIXELS)]
     pub max_pixels: u64,
+    /// Refuse a frame that would hold more memory than SIZE, estimated from the inputs'
+    /// headers before anything is decoded (e.g. 8G, 512M; K, M, G, T are powers of 1024);
+    /// frames of --frames in flight together share it [default: 8G, or half the machine's
+    /// memory if that is less].
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub max_memory: Option<u64>,
+}
+
+/// `--max-memory`: a number of bytes with an optional unit K, M, G or T (powers of 1024; `KiB`,
+/// `MB`, `g` … are read the same), e.g. `8G`, `512M`, `1.5G`, `1048576`.
+fn parse_size(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let unit = unit.trim().to_ascii_uppercase();
+    let unit = unit
+        .strip_suffix("IB")
+        .or_else(|| unit.strip_suffix('B'))
+        .unwrap_or(&unit);
+    let shift = match unit {
+        "" => 0,
+        "K" => 10,
+        "M" => 20,
+        "G" => 30,
+        "T" => 40,
+        _ => {
+            return Err(format!(
+                "{text:?}: the unit must be K, M, G or T (e.g. 8G, 512M)"
+            ));
+        }
+    };
+    let value: f64 = number
+        .parse()
+        .map_err(|_| format!("{text:?} is not a size (e.g. 8G, 512M)"))?;
+    let bytes = value * (1u64 << shift) as f64;
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64) {
+        return Err(format!("{text:?} is not a size of at least one byte"));
+    }
+    Ok(bytes as u64)
+}
+
+/// The default memory limit: 8 GiB, or half the machine's memory (or of the control group's
+/// limit) where that is less, leaving the rest to the system and to other work.
+fn default_max_memory() -> u64 {
+    let half = machine_memory().map_or(u64::MAX, |m| m / 2);
+    glassdb_compose::memory::DEFAULT_MAX_MEMORY.min(half)
+}
+
+/// The memory this process may use: the machine's (Linux `/proc/meminfo`), or the control
+/// group's limit (`/sys/fs/cgroup/memory.max`) when lower; `None` where neither is known.
+fn machine_memory() -> Option<u64> {
+    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        m.lines()
+            .find_map(|l| l.strip_prefix("MemTotal:"))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+            .map(|kib| kib.saturating_mul(1024))
+    });
+    let cgroup = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok());
+    match (total, cgroup) {
+        (Some(t), Some(c)) => Some(t.min(c)),
+        (t, c) => t.or(c),
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -475,11 +541,12 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)>
             )
             .collect(),
         input_space: args.input_space,
+        max_memory: args.max_memory.unwrap_or_else(default_max_memory),
     };
     Ok((settings, luts))
 }
 
-fn print_stats(r: &FrameReport, luts: &RegistryLuts) {
+fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
     let colour = &r.colour;
     let Some(lut) = luts.get(colour.table.basis) else {
         return;
@@ -500,6 +567,11 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts) {
             r.windows.display
         );
     }
+    outln!(
+        "memory       about {} at once, estimated from the headers (limit {})",
+        glassdb_compose::memory::format_bytes(r.memory.total),
+        glassdb_compose::memory::format_bytes(limit)
+    );
     if r.output.kept_channels > 0 {
         outln!(
             "kept         {} other channel(s) of the transmission file",
@@ -604,7 +676,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         spinner.finish();
         report_nonfinite(&report, "");
         if args.stats {
-            print_stats(&report, &luts);
+            print_stats(&report, &luts, settings.max_memory);
         }
         outln!(
             "wrote {} ({}×{}, {})",
@@ -666,7 +738,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         for o in &outcomes {
             if let Ok(r) = &o.result {
                 outln!("--- frame {}", o.frame);
-                print_stats(r, &luts);
+                print_stats(r, &luts, settings.max_memory);
             }
         }
     }
@@ -712,6 +784,21 @@ mod tests {
         for plain in ["r.exr", "a:b/r.exr", "mask.png:x", "r.exr:", "r.exr:a/b"] {
             assert_eq!(split(plain), (PathBuf::from(plain), None), "{plain}");
         }
+    }
+
+    #[test]
+    fn sizes_parse_in_powers_of_1024() {
+        assert_eq!(parse_size("8G"), Ok(8 << 30));
+        assert_eq!(parse_size("512M"), Ok(512 << 20));
+        assert_eq!(parse_size("512MiB"), Ok(512 << 20));
+        assert_eq!(parse_size("1.5g"), Ok(3 << 29));
+        assert_eq!(parse_size("2 TB"), Ok(2 << 40));
+        assert_eq!(parse_size("4096"), Ok(4096));
+        assert!(parse_size("8X").is_err());
+        assert!(parse_size("G").is_err());
+        assert!(parse_size("0").is_err());
+        assert!(parse_size("-1G").is_err());
+        assert!(default_max_memory() <= glassdb_compose::memory::DEFAULT_MAX_MEMORY);
     }
 
     #[test]

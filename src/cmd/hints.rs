@@ -225,6 +225,21 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
              srgb,{space_name} -o REGISTRY.json (docs/colour.md); if the passes' tag is wrong, \
              --input-space declares their space"
         )),
+        ComposeError::MemoryLimit {
+            estimate, carried, ..
+        } => {
+            // Worth saying when the carried channels are a large share.
+            let carried = *carried > estimate / 4;
+            Some(format!(
+                "if the machine has the memory, raise the limit with --max-memory SIZE (e.g. \
+                 --max-memory 16G){}",
+                if carried {
+                    "; --keep-channels none leaves the other channels out"
+                } else {
+                    ""
+                }
+            ))
+        }
         ComposeError::ZipLevelNotApplicable { .. } | ComposeError::ZipLevelOutOfRange { .. } => {
             Some("--zip-level sets it".into())
         }

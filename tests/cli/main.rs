@@ -7,6 +7,7 @@ mod colour;
 mod compose;
 mod fit;
 mod fixtures;
+mod limits;
 mod masks;
 mod passes;
 mod plot;

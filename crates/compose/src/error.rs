@@ -225,6 +225,22 @@ pub enum ComposeError {
         "{path} is {bytes} bytes; a .cube file of at most {max} bytes is read (LUT_3D_SIZE ≤ 129)"
     )]
     CubeTooLarge { path: PathBuf, bytes: u64, max: u64 },
+    /// A frame whose estimated memory (from the inputs' headers) is over the limit.
+    #[error(
+        "compositing {trans} would hold about {} at once, over the memory limit of {}; the largest shares: {}",
+        crate::memory::format_bytes(*estimate),
+        crate::memory::format_bytes(*limit),
+        list_items(items)
+    )]
+    MemoryLimit {
+        trans: PathBuf,
+        estimate: u64,
+        limit: u64,
+        /// The shares, largest first.
+        items: Vec<crate::memory::MemoryItem>,
+        /// Bytes of the transmission file's other channels carried over.
+        carried: u64,
+    },
     /// A view transform asked of an EXR output, which stays scene-linear.
     #[error(
         "a view transform applies to PNG output only, but {path} is EXR, which stays scene-linear"
@@ -274,6 +290,29 @@ fn list_counts(ids: &[(u16, u64)]) -> String {
         let rest = &ids[LISTED_IDS..];
         let pixels: u64 = rest.iter().map(|(_, n)| n).sum();
         listed.push(format!("and {} more id(s) ({pixels} pixels)", rest.len()));
+    }
+    listed.join(", ")
+}
+
+/// Memory shares listed in full in the memory-limit message; the rest are counted.
+const LISTED_ITEMS: usize = 3;
+
+fn list_items(items: &[crate::memory::MemoryItem]) -> String {
+    let mut listed: Vec<String> = items
+        .iter()
+        .take(LISTED_ITEMS)
+        .map(|i| format!("{} {}", i.what, crate::memory::format_bytes(i.bytes)))
+        .collect();
+    if items.len() > LISTED_ITEMS {
+        let rest: u64 = items[LISTED_ITEMS..]
+            .iter()
+            .map(|i| i.bytes)
+            .fold(0, u64::saturating_add);
+        listed.push(format!(
+            "and {} more ({})",
+            items.len() - LISTED_ITEMS,
+            crate::memory::format_bytes(rest)
+        ));
     }
     listed.join(", ")
 }

@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 
 use glassdb_image::{
     ExactExr, ExactPart, ExrColourTag, ExrFile, ExrImageAttributes, ExrImageOut,
-    ExrLayerAttributes, ExrPartOut, ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions,
-    ExrWriteReport, ImageError, ImageFile, ImageWindows, LayerChoiceError, PlaneSamples, PngColor,
-    PngCompression, PngEncodeOptions, PngPixels, PngSampleSlice, PngSamples,
+    ExrLayerAttributes, ExrPart, ExrPartOut, ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions,
+    ExrWriteReport, ImageError, ImageFile, ImageHeader, ImageWindows, LayerChoiceError,
+    PlaneSamples, PngColor, PngCompression, PngEncodeOptions, PngPixels, PngSampleSlice,
+    PngSamples, ReadMemory,
 };
 
 use exr::meta::attribute::{AttributeValue, Text};
@@ -65,6 +66,121 @@ pub struct Pass {
     pub source: PassSource,
     /// The colour attributes of the layer's part (none for a PNG).
     pub colour: ExrColourTag,
+}
+
+/// What a pass's header says, read and checked before any pixel is decoded
+/// ([`read_pass_header`]).
+#[derive(Debug, Clone)]
+pub struct PassHeader {
+    /// The pass's own windows (a PNG: its size at the origin).
+    pub windows: ImageWindows,
+    /// How it is stored (as [`Pass::source`] will say).
+    pub source: PassSource,
+    /// The colour attributes of the layer's part (none for a PNG).
+    pub colour: ExrColourTag,
+    /// An EXR's parts (none for a PNG).
+    pub parts: Vec<ExrPart>,
+    /// Reading it: the file and the decoder's buffers while reading, the linear planes after.
+    pub memory: ReadMemory,
+}
+
+impl PassHeader {
+    /// Whether the pass states its pixels' coordinates (an EXR; a PNG does not).
+    pub fn has_coordinates(&self) -> bool {
+        !matches!(self.source, PassSource::Png { .. })
+    }
+}
+
+/// Reads a pass's header only (a PNG's chunks up to the pixel data, an EXR's headers; no pixel
+/// is decompressed) and checks what [`read_pass`] would refuse from it: an unknown format, a
+/// missing or ambiguous layer, too many pixels, deep data, subsampled channels.
+pub fn read_pass_header(path: &Path, opts: &PassReadOptions) -> Result<PassHeader, ComposeError> {
+    let read_err = |cause| ComposeError::Read {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let (file, file_len) =
+        glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(read_err)?;
+    let header = glassdb_image::read_image_header(std::io::BufReader::new(file), opts.max_pixels)
+        .map_err(|source| decode_err(path, source))?;
+    match header {
+        ImageHeader::Png(h) => {
+            let planes = 3 + u64::from(h.channels == 2 || h.channels == 4);
+            Ok(PassHeader {
+                windows: ImageWindows::full_frame(h.width as usize, h.height as usize),
+                source: PassSource::Png {
+                    bits: if h.sixteen_bit {
+                        PngBits::Sixteen
+                    } else {
+                        PngBits::Eight
+                    },
+                },
+                colour: ExrColourTag::default(),
+                parts: Vec::new(),
+                memory: ReadMemory::png(file_len, &h)
+                    .keeping(h.pixel_count().saturating_mul(4 * planes)),
+            })
+        }
+        ImageHeader::Exr(headers) => {
+            let parts = headers.parts;
+            let chosen = choose_layer(&parts, opts.layer.as_deref(), path)?;
+            let mut channels = chosen.rgb.to_vec();
+            channels.extend(chosen.alpha);
+            let info = parts.get(chosen.part).ok_or_else(|| {
+                decode_err(
+                    path,
+                    ImageError::Unsupported {
+                        feature: format!("part {} (the file has {})", chosen.part, parts.len()),
+                    },
+                )
+            })?;
+            glassdb_image::check_exr_readable(info, &channels, opts.max_pixels)
+                .map_err(|source| decode_err(path, source))?;
+            let source = PassSource::Exr {
+                sample_type: info
+                    .channels
+                    .get(chosen.rgb[0])
+                    .map_or(ExrSampleType::Float, |c| c.sample_type),
+                compression: info.compression,
+                layer: chosen.name.clone(),
+                part: chosen.part,
+                channel_names: channels
+                    .iter()
+                    .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))
+                    .collect(),
+            };
+            Ok(PassHeader {
+                windows: info.windows(),
+                colour: info.colour.clone(),
+                memory: ReadMemory::exr_planes(file_len, info.pixel_count(), channels.len()),
+                source,
+                parts,
+            })
+        }
+    }
+}
+
+/// The RGB layer `wanted` names (or the default one), as compose's errors.
+fn choose_layer(
+    parts: &[ExrPart],
+    wanted: Option<&str>,
+    path: &Path,
+) -> Result<glassdb_image::RgbLayer, ComposeError> {
+    glassdb_image::choose_rgb_layer(parts, wanted).map_err(|e| {
+        let path = path.to_path_buf();
+        match e {
+            LayerChoiceError::NoRgb { available } => ComposeError::NoRgb { path, available },
+            LayerChoiceError::NotFound { wanted, layers } => ComposeError::LayerNotFound {
+                path,
+                layer: wanted,
+                candidates: layers,
+            },
+            LayerChoiceError::Ambiguous { layers, .. } => ComposeError::AmbiguousLayer {
+                path,
+                candidates: layers,
+            },
+        }
+    })
 }
 
 /// Reads a pass file (format from its bytes).
@@ -135,21 +251,7 @@ fn read_exr_pass(
     opts: &PassReadOptions,
 ) -> Result<Pass, ComposeError> {
     let parts = exr.parts();
-    let chosen = glassdb_image::choose_rgb_layer(parts, opts.layer.as_deref()).map_err(|e| {
-        let path = path.to_path_buf();
-        match e {
-            LayerChoiceError::NoRgb { available } => ComposeError::NoRgb { path, available },
-            LayerChoiceError::NotFound { wanted, layers } => ComposeError::LayerNotFound {
-                path,
-                layer: wanted,
-                candidates: layers,
-            },
-            LayerChoiceError::Ambiguous { layers, .. } => ComposeError::AmbiguousLayer {
-                path,
-                candidates: layers,
-            },
-        }
-    })?;
+    let chosen = choose_layer(parts, opts.layer.as_deref(), path)?;
     let mut channels = chosen.rgb.to_vec();
     channels.extend(chosen.alpha);
     let (info, mut buffers) = exr
@@ -373,7 +475,7 @@ impl OutputFrame {
             && parts
                 .first()
                 .is_some_and(|p| p.channels.len() == channel_names.len());
-        let exr = if keep_channels && (beside || !only_the_layer) {
+        let exr = if carries_whole_file(&parts, channel_names, (keep_channels, beside)) {
             let file = glassdb_image::read_exr_exact(bytes, max_pixels).map_err(|source| {
                 ComposeError::KeepChannels {
                     path: path.to_path_buf(),
@@ -444,19 +546,7 @@ pub fn write_output_in_frame(
     let mut kept_channels = 0;
     let (bytes_written, encoding) = match format {
         OutputFormat::Exr => {
-            let data_type = opts.exr_data_type.unwrap_or(match source {
-                PassSource::Exr {
-                    sample_type: ExrSampleType::Half,
-                    ..
-                } => ExrDataType::Half,
-                PassSource::Exr { .. } => ExrDataType::Float,
-                PassSource::Png {
-                    bits: PngBits::Eight,
-                } => ExrDataType::Half,
-                PassSource::Png {
-                    bits: PngBits::Sixteen,
-                } => ExrDataType::Float,
-            });
+            let data_type = output_data_type(source, opts);
             let compression = opts.exr_compression.unwrap_or(DEFAULT_EXR_COMPRESSION);
             let zip_level = match (
                 glassdb_image::zip_block_lines(compression),
@@ -498,10 +588,7 @@ pub fn write_output_in_frame(
             (n, encoding)
         }
         OutputFormat::Png => {
-            let bits = opts.png_bits.unwrap_or(match source {
-                PassSource::Png { bits } => *bits,
-                PassSource::Exr { .. } => PngBits::Eight,
-            });
+            let bits = output_png_bits(source, opts);
             image.unpremultiply();
             let view = opts.view.clone().unwrap_or_default();
             let encoded = image.to_encoded_view(bits, opts.dither, &view);
@@ -525,6 +612,47 @@ pub fn write_output_in_frame(
         half_overflow,
         kept_channels,
     })
+}
+
+/// The EXR output's sample type: as asked, else the transmission pass's (half for 8-bit PNG
+/// input, float for 16-bit).
+pub fn output_data_type(source: &PassSource, opts: &OutputOptions) -> ExrDataType {
+    opts.exr_data_type.unwrap_or(match source {
+        PassSource::Exr {
+            sample_type: ExrSampleType::Half,
+            ..
+        } => ExrDataType::Half,
+        PassSource::Exr { .. } => ExrDataType::Float,
+        PassSource::Png {
+            bits: PngBits::Eight,
+        } => ExrDataType::Half,
+        PassSource::Png {
+            bits: PngBits::Sixteen,
+        } => ExrDataType::Float,
+    })
+}
+
+/// The PNG output's bits per sample: as asked, else the transmission pass's (8 for EXR input).
+pub fn output_png_bits(source: &PassSource, opts: &OutputOptions) -> PngBits {
+    opts.png_bits.unwrap_or(match source {
+        PassSource::Png { bits } => *bits,
+        PassSource::Exr { .. } => PngBits::Eight,
+    })
+}
+
+/// Whether the output carries every part and channel of the transmission file (`parts`, its
+/// chosen layer's channels `channel_names`): when they are kept and the file holds more than
+/// the layer, or the composite goes beside the original layer.
+pub fn carries_whole_file(
+    parts: &[ExrPart],
+    channel_names: &[String],
+    (keep_channels, beside): (bool, bool),
+) -> bool {
+    let only_the_layer = parts.len() == 1
+        && parts
+            .first()
+            .is_some_and(|p| p.channels.len() == channel_names.len());
+    keep_channels && (beside || !only_the_layer)
 }
 
 /// Refuses a view transform for an EXR output (scene-linear) before any work is done.

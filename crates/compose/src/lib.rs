@@ -9,15 +9,19 @@
 //! - [`colour`]: the passes' colour space and the registry table in it.
 //! - [`kernel`]: the per-pixel composite, in place, rayon over rows.
 //! - [`sequence`]: frame patterns (`r.####.exr`) and frames in parallel.
-//! - [`compose_frame`]: one image end to end, with per-stage timings for `--stats`
-//!   ([`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`).
+//! - [`memory`]: the frame's memory, estimated from the headers, and its limit.
+//! - [`compose_frame`]: one image end to end — every input's header read and compared first
+//!   (`plan`), then decoded — with per-stage timings for `--stats`.
+//!   [`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`.
 
 pub mod colour;
 pub mod error;
 pub mod io;
 pub mod kernel;
 pub mod lut;
+pub mod memory;
 pub mod pixels;
+mod plan;
 pub mod sequence;
 pub mod view;
 
@@ -29,6 +33,7 @@ pub use error::ComposeError;
 use glassdb_image::{ImageWindows, PixelWindow};
 use glassdb_mask::{MaskImage, MaskReadOptions, PlacedMask};
 pub use glassdb_registry::Side;
+use memory::{MemoryBudget, MemoryEstimate};
 use rayon::prelude::*;
 
 use crate::colour::{ChosenTable, PassSpace, RegistryLuts, SpaceSource};
@@ -108,6 +113,9 @@ pub struct ComposeSettings {
     pub protected: Vec<PathBuf>,
     /// The passes' linear RGB space, over what their headers say (`--input-space`).
     pub input_space: Option<glassdb_colour::RgbSpace>,
+    /// Bytes a frame may hold (estimated from the headers, [`memory`]); the frames of a
+    /// sequence in flight together share it.
+    pub max_memory: u64,
 }
 
 impl Default for ComposeSettings {
@@ -123,6 +131,7 @@ impl Default for ComposeSettings {
             registry_label: "the registry".into(),
             protected: Vec::new(),
             input_space: None,
+            max_memory: memory::DEFAULT_MAX_MEMORY,
         }
     }
 }
@@ -166,6 +175,8 @@ pub struct FrameReport {
     pub outside_pixels: u64,
     /// The passes' colour space and the registry table used.
     pub colour: FrameColour,
+    /// The memory estimated from the headers (held within [`ComposeSettings::max_memory`]).
+    pub memory: MemoryEstimate,
 }
 
 /// The colour facts of one frame.
@@ -250,18 +261,29 @@ fn decode_inputs(
         )?;
         Ok((pass, frame))
     };
+    // The reflection passes a few at a time (as many as there are threads): each holds its
+    // file and compressed blocks only while it is decoded, so that many planes do not hold
+    // every file at once (`memory` counts it so).
+    let read_refl = || -> Result<Vec<Pass>, ComposeError> {
+        let at_once = memory::decoding_at_once();
+        let mut passes = Vec::with_capacity(job.refl.len());
+        for (c, chunk) in job.refl.chunks(at_once).enumerate() {
+            let decoded = chunk
+                .par_iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let k = c * at_once + i;
+                    io::read_pass(p, &settings.pass_options(settings.layers.refl.get(k)))
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            passes.extend(decoded);
+        }
+        Ok(passes)
+    };
     let (trans, (mask, refl)) = rayon::join(read_trans, || {
         rayon::join(
             || glassdb_mask::read_placed_mask(&job.mask, &settings.mask),
-            || {
-                job.refl
-                    .par_iter()
-                    .enumerate()
-                    .map(|(k, p)| {
-                        io::read_pass(p, &settings.pass_options(settings.layers.refl.get(k)))
-                    })
-                    .collect::<Result<Vec<_>, _>>()
-            },
+            read_refl,
         )
     });
     let (trans, frame) = trans?;
@@ -305,14 +327,14 @@ fn check_frames(
     Ok(())
 }
 
-/// Checks ids and planes of the mask (placed in the frame) before compositing.
+/// Checks ids and planes of the mask (placed in the frame) before compositing (that a mask
+/// without planes is not given several passes is checked from its header, `plan`).
 fn check_inputs(
     job: &ComposeJob,
     settings: &ComposeSettings,
     lut: &GlassLut,
     refl_count: usize,
     mask: &MaskImage,
-    stores_planes: bool,
     id_counts: &BTreeMap<u16, u64>,
 ) -> Result<(), ComposeError> {
     let unknown: Vec<(u16, u64)> = id_counts
@@ -326,12 +348,6 @@ fn check_inputs(
             registry: settings.registry_label.clone(),
             none_known: unknown.len() == id_counts.len(),
             ids: unknown,
-        });
-    }
-    if refl_count > 1 && !stores_planes {
-        return Err(ComposeError::MaskWithoutPlanes {
-            mask: job.mask.clone(),
-            passes: refl_count,
         });
     }
     if mask.max_plane() as usize >= refl_count {
@@ -434,7 +450,9 @@ fn absolute_from(w: &PixelWindow, origin: &PixelWindow) -> PixelWindow {
 /// The stages [`compose_frame_with_progress`] reports, in order.
 pub const FRAME_STAGES: [&str; 3] = ["decode", "composite", "encode"];
 
-/// Composites one image end to end: decode (all inputs in parallel), place every input in the
+/// Composites one image end to end: read every input's header and check the frame from them
+/// (sizes and windows, layers, channels, colour space, memory within
+/// [`ComposeSettings::max_memory`]), decode (all inputs in parallel), place every input in the
 /// transmission pass's frame by its pixel coordinates, check, composite in place, encode and
 /// write atomically. The output may not be one of the inputs.
 pub fn compose_frame(
@@ -450,6 +468,19 @@ pub fn compose_frame_with_progress(
     job: &ComposeJob,
     settings: &ComposeSettings,
     luts: &RegistryLuts,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<FrameReport, ComposeError> {
+    let budget = MemoryBudget::new(settings.max_memory);
+    compose_frame_within(job, settings, luts, &budget, progress)
+}
+
+/// [`compose_frame_with_progress`] holding its memory estimate from `budget` (shared by the
+/// frames of a sequence) while it decodes, composites and encodes.
+pub(crate) fn compose_frame_within(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    luts: &RegistryLuts,
+    budget: &MemoryBudget,
     progress: &dyn glassdb_io::Progress,
 ) -> Result<FrameReport, ComposeError> {
     let [decode_stage, composite_stage, encode_stage] = FRAME_STAGES;
@@ -469,6 +500,18 @@ pub fn compose_frame_with_progress(
 
     progress.stage(decode_stage);
     let t0 = Instant::now();
+    let plan::FramePlan { space, memory } = plan::plan_frame(job, settings)?;
+    let (table, lut) = luts.for_space(&space, &job.trans, &settings.registry_label)?;
+    if memory.total > budget.limit() {
+        return Err(ComposeError::MemoryLimit {
+            trans: job.trans.clone(),
+            estimate: memory.total,
+            limit: budget.limit(),
+            items: memory.items,
+            carried: memory.carried,
+        });
+    }
+    let _reserved = budget.reserve(memory.total);
     let DecodedInputs {
         mut trans,
         mut frame,
@@ -476,8 +519,6 @@ pub fn compose_frame_with_progress(
         mask,
     } = decode_inputs(job, settings)?;
     let decode = t0.elapsed();
-    let space = passes_space(job, settings, &trans, &refl)?;
-    let (table, lut) = luts.for_space(&space, &job.trans, &settings.registry_label)?;
 
     progress.stage(composite_stage);
     let t1 = Instant::now();
@@ -502,26 +543,16 @@ pub fn compose_frame_with_progress(
             .zip(refl_windows.iter().copied()),
     );
     check_frames(job, &trans.windows, &others)?;
-    let PlacedMask {
-        image: mask,
-        stores_planes,
-        ..
-    } = mask;
+    let PlacedMask { image: mask, .. } = mask;
     let mask = if mask_windows.data == data {
         mask
     } else {
-        mask.placed(&mask_windows.data, &data)
+        let placed = mask.placed(&mask_windows.data, &data);
+        drop(mask);
+        placed
     };
     let id_counts = mask.id_pixel_counts();
-    check_inputs(
-        job,
-        settings,
-        lut,
-        refl.len(),
-        &mask,
-        stores_planes,
-        &id_counts,
-    )?;
+    check_inputs(job, settings, lut, refl.len(), &mask, &id_counts)?;
     let windows: Vec<PixelWindow> = refl_windows
         .iter()
         .map(|w| relative_to(&w.data, &data))
@@ -611,30 +642,8 @@ pub fn compose_frame_with_progress(
             table,
             converted_for_display,
         },
+        memory,
     })
-}
-
-/// The one colour space of the frame's passes ([`colour::frame_space`]).
-fn passes_space(
-    job: &ComposeJob,
-    settings: &ComposeSettings,
-    trans: &Pass,
-    refl: &[Pass],
-) -> Result<PassSpace, ComposeError> {
-    let declared = settings.input_space;
-    let trans_space = colour::pass_space(&job.trans, &trans.colour, declared)?;
-    let refl_spaces = job
-        .refl
-        .iter()
-        .zip(refl)
-        .map(|(path, pass)| {
-            Ok((
-                path.clone(),
-                colour::pass_space(path, &pass.colour, declared)?,
-            ))
-        })
-        .collect::<Result<Vec<_>, ComposeError>>()?;
-    colour::frame_space((&job.trans, trans_space), &refl_spaces)
 }
 
 #[cfg(test)]

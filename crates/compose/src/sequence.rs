@@ -1,14 +1,16 @@
 //! Animations: file patterns with a `#` run for the frame number (`r.####.exr` → `r.0007.exr`),
 //! frame lists (`1-240`, `1,5,10-20`) (both from `glassdb_io::frames`), and every frame composed with two frames in flight at
-//! a time (so one frame's decoding overlaps another's encoding); a frame with missing or bad
-//! inputs is reported and the others go on.
+//! a time (so one frame's decoding overlaps another's encoding) as long as their memory
+//! estimates fit the limit together; a frame with missing or bad inputs is reported and the
+//! others go on.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::colour::RegistryLuts;
-use crate::{ComposeError, ComposeJob, ComposeSettings, FrameReport, compose_frame};
+use crate::memory::MemoryBudget;
+use crate::{ComposeError, ComposeJob, ComposeSettings, FrameReport, compose_frame_within};
 
 /// Whether `pattern` contains a `#` run (`glassdb_io::frames`, shared with `glassdb mask`).
 pub fn is_pattern(pattern: &Path) -> bool {
@@ -58,7 +60,9 @@ pub struct FrameOutcome {
 pub const FRAMES_IN_FLIGHT: usize = 2;
 
 /// Composes every frame; `on_done` is called as each finishes (from worker threads, in
-/// completion order). Returns the outcomes in frame order.
+/// completion order). Returns the outcomes in frame order. The frames in flight share
+/// `settings.max_memory`: a frame whose estimate does not fit beside the other's waits for it
+/// (so two large frames run one after the other), and a frame over the whole limit fails.
 pub fn compose_sequence(
     pattern: &ComposeJob,
     frames: &[u32],
@@ -72,6 +76,7 @@ pub fn compose_sequence(
         });
     }
     let next = AtomicUsize::new(0);
+    let budget = MemoryBudget::new(settings.max_memory);
     let results: Mutex<Vec<FrameOutcome>> = Mutex::new(Vec::with_capacity(frames.len()));
     std::thread::scope(|scope| {
         for _ in 0..FRAMES_IN_FLIGHT.min(frames.len()) {
@@ -79,8 +84,9 @@ pub fn compose_sequence(
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed);
                     let Some(&frame) = frames.get(k) else { break };
-                    let result = frame_job(pattern, frame)
-                        .and_then(|job| compose_frame(&job, settings, luts));
+                    let result = frame_job(pattern, frame).and_then(|job| {
+                        compose_frame_within(&job, settings, luts, &budget, &glassdb_io::NoProgress)
+                    });
                     let outcome = FrameOutcome { frame, result };
                     on_done(&outcome);
                     if let Ok(mut r) = results.lock() {

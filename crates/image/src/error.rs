@@ -62,6 +62,9 @@ pub enum ImageError {
     /// A codec panicked (a bug in it, reached by these bytes); the panic is caught, not renamed.
     #[error("the {codec} codec failed internally (it panicked: {message})")]
     CodecPanic { codec: Codec, message: String },
+    /// Reading the file's header from its stream failed.
+    #[error("cannot read the image header")]
+    Read(#[source] std::io::Error),
     /// The sample buffer handed to an encoder does not match the image size.
     #[error("{samples} samples given for a {width}×{height} image of {channels} channel(s)")]
     SampleCount {
@@ -103,6 +106,7 @@ impl ImageError {
                 ImageErrorKind::Invalid
             }
             ImageError::TooLarge { .. } => ImageErrorKind::Limits,
+            ImageError::Read(io) => io_kind(io),
             ImageError::CodecPanic { .. } => ImageErrorKind::Internal,
         }
     }

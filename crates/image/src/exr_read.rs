@@ -178,18 +178,57 @@ fn part_from_header(h: &Header) -> ExrPart {
     }
 }
 
+impl ExrPart {
+    /// Number of pixels of the data window.
+    pub fn pixel_count(&self) -> u64 {
+        self.data_window.pixel_count()
+    }
+
+    /// Bytes of every channel's samples as stored (half 2, float and uint 4 per sample): what
+    /// [`read_exr_exact`] holds of this part.
+    pub fn stored_bytes(&self) -> u64 {
+        let per_pixel: u64 = self
+            .channels
+            .iter()
+            .map(|c| match c.sample_type {
+                ExrSampleType::Half => 2,
+                ExrSampleType::Float | ExrSampleType::Uint => 4,
+            })
+            .sum();
+        self.pixel_count().saturating_mul(per_pixel)
+    }
+}
+
 /// Reads only the headers of an EXR held in memory (no pixel data is touched or allocated).
 pub fn read_exr_headers(bytes: &[u8]) -> Result<Vec<ExrPart>, ImageError> {
-    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false))?;
+    read_exr_header_info(Cursor::new(bytes)).map(|h| h.parts)
+}
+
+/// What an EXR's headers say: its parts, and every text attribute as (part, name, value).
+#[derive(Debug, Clone)]
+pub struct ExrHeaders {
+    pub parts: Vec<ExrPart>,
+    /// Every text attribute, from the attributes shared by the parts and each part's own, as
+    /// (part, name, value), sorted, without repeats (see [`read_exr_text_attributes`]).
+    pub text_attributes: Vec<(usize, String, String)>,
+}
+
+/// Reads the headers of an EXR from `reader`, which is read only as far as the headers go: no
+/// offset table or pixel data is read (a file need not be loaded to be checked).
+pub fn read_exr_header_info(reader: impl std::io::Read) -> Result<ExrHeaders, ImageError> {
+    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(reader, false))?;
     let multi_part = meta.headers.len() > 1;
-    Ok(meta
-        .headers
-        .iter()
-        .map(|h| ExrPart {
-            multi_part,
-            ..part_from_header(h)
-        })
-        .collect())
+    Ok(ExrHeaders {
+        parts: meta
+            .headers
+            .iter()
+            .map(|h| ExrPart {
+                multi_part,
+                ..part_from_header(h)
+            })
+            .collect(),
+        text_attributes: text_attributes(&meta),
+    })
 }
 
 /// Runs an `exr` call that sees file bytes: a panic becomes `CodecPanic`, an error `ExrDecode`.
@@ -220,7 +259,7 @@ pub fn read_exr_channels(
         .get(part)
         .cloned()
         .ok_or_else(|| unsupported(format!("part {part} (the file has {})", parts.len())))?;
-    check_readable(&info, channels, max_pixels)?;
+    check_exr_readable(&info, channels, max_pixels)?;
 
     let reader = guarded(|| exr::block::read(Cursor::new(bytes), false))?;
     let meta = reader.meta_data().clone();
@@ -267,9 +306,13 @@ pub fn read_exr_channels(
     Ok((info, outputs))
 }
 
-/// Refuses what this reader cannot decode, from the header alone: too many pixels, no pixels,
-/// deep data, a missing or subsampled channel.
-fn check_readable(info: &ExrPart, channels: &[usize], max_pixels: u64) -> Result<(), ImageError> {
+/// Refuses what [`read_exr_channels`] cannot decode, from the header alone: too many pixels,
+/// no pixels, deep data, a missing or subsampled channel.
+pub fn check_exr_readable(
+    info: &ExrPart,
+    channels: &[usize],
+    max_pixels: u64,
+) -> Result<(), ImageError> {
     let (width, height) = (info.width as u64, info.height as u64);
     let pixels = width.saturating_mul(height);
     if pixels > max_pixels {
@@ -581,7 +624,10 @@ pub fn read_exr_exact(bytes: &[u8], max_pixels: u64) -> Result<ExactExr, ImageEr
 /// each part's own, as (part, name, value); no pixel data is touched. Renderers keep metadata
 /// here (Cryptomatte's `cryptomatte/<key>/manifest`, Blender's `colorInteropID`).
 pub fn read_exr_text_attributes(bytes: &[u8]) -> Result<Vec<(usize, String, String)>, ImageError> {
-    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false))?;
+    read_exr_header_info(Cursor::new(bytes)).map(|h| h.text_attributes)
+}
+
+fn text_attributes(meta: &exr::meta::MetaData) -> Vec<(usize, String, String)> {
     let mut out = Vec::new();
     for (k, header) in meta.headers.iter().enumerate() {
         for map in [
@@ -597,5 +643,5 @@ pub fn read_exr_text_attributes(bytes: &[u8]) -> Result<Vec<(usize, String, Stri
     }
     out.sort();
     out.dedup();
-    Ok(out)
+    out
 }

@@ -12,9 +12,12 @@ pub mod exr_read;
 mod exr_write;
 mod exr_zip;
 mod guard;
+mod memory;
 pub mod png_read;
 mod png_write;
 mod window;
+
+use std::io::Read as _;
 
 pub use error::{Codec, ImageError, ImageErrorKind};
 /// The `exr` crate's attribute and sample types that cross this crate's API.
@@ -27,15 +30,17 @@ pub use exr_layers::{
     rgb_layers,
 };
 pub use exr_read::{
-    ExactExr, ExactPart, ExrChannelInfo, ExrColourTag, ExrPart, ExrSampleType, read_exr_attributes,
-    read_exr_channels, read_exr_exact, read_exr_headers, read_exr_text_attributes,
+    ExactExr, ExactPart, ExrChannelInfo, ExrColourTag, ExrHeaders, ExrPart, ExrSampleType,
+    check_exr_readable, read_exr_attributes, read_exr_channels, read_exr_exact,
+    read_exr_header_info, read_exr_headers, read_exr_text_attributes,
 };
 pub use exr_write::{
     ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport, PlaneSamples,
     encode_exr_f32, write_exr_image, write_exr_planes,
 };
 pub use exr_zip::{DEFAULT_ZIP_LEVEL, zip_block_lines};
-pub use png_read::{PngPixels, PngSamples, decode_png};
+pub use memory::ReadMemory;
+pub use png_read::{PngHeader, PngPixels, PngSamples, decode_png, read_png_header};
 pub use png_write::{PngColor, PngCompression, PngEncodeOptions, PngSampleSlice, encode_png};
 pub use window::{ImageWindows, PixelWindow, place_plane};
 
@@ -57,6 +62,37 @@ pub fn sniff_image_kind(bytes: &[u8]) -> Option<ImageFileKind> {
         Some(ImageFileKind::Exr)
     } else {
         None
+    }
+}
+
+/// What an image file's header says, read before any pixel is decoded
+/// ([`read_image_header`]).
+#[derive(Debug, Clone)]
+pub enum ImageHeader {
+    Png(PngHeader),
+    Exr(ExrHeaders),
+}
+
+/// Reads the header of a PNG (its chunks up to the pixel data; refused above `max_pixels`) or
+/// an OpenEXR (its headers), detected from the magic number, reading `reader` only that far.
+/// No pixel is decompressed: a file whose pixel data is corrupt or truncated is not noticed.
+pub fn read_image_header<R: std::io::BufRead + std::io::Seek>(
+    mut reader: R,
+    max_pixels: u64,
+) -> Result<ImageHeader, ImageError> {
+    let start = reader.stream_position().map_err(ImageError::Read)?;
+    let mut magic = Vec::with_capacity(8);
+    (&mut reader)
+        .take(8)
+        .read_to_end(&mut magic)
+        .map_err(ImageError::Read)?;
+    reader
+        .seek(std::io::SeekFrom::Start(start))
+        .map_err(ImageError::Read)?;
+    match sniff_image_kind(&magic) {
+        Some(ImageFileKind::Png) => read_png_header(reader, max_pixels).map(ImageHeader::Png),
+        Some(ImageFileKind::Exr) => read_exr_header_info(reader).map(ImageHeader::Exr),
+        None => Err(ImageError::UnknownFormat { start: magic }),
     }
 }
 
@@ -87,6 +123,11 @@ impl ExrFile<'_> {
         self.bytes
     }
 
+    /// The pixel limit its parts are decoded under.
+    pub fn max_pixels(&self) -> u64 {
+        self.max_pixels
+    }
+
     /// Decodes channels `channels` of part `part`, one `f32` plane each (see
     /// [`read_exr_channels`]).
     pub fn read_channels(
@@ -98,16 +139,22 @@ impl ExrFile<'_> {
     }
 }
 
+/// Opens an OpenEXR held in memory: its headers are read, its channels decoded on request
+/// (refusing parts of more than `max_pixels` pixels before allocating them).
+pub fn open_exr(bytes: &[u8], max_pixels: u64) -> Result<ExrFile<'_>, ImageError> {
+    Ok(ExrFile {
+        bytes,
+        parts: read_exr_headers(bytes)?,
+        max_pixels,
+    })
+}
+
 /// The one sniff-and-dispatch reader: detects PNG or OpenEXR from the bytes and opens it,
 /// refusing images of more than `max_pixels` pixels before allocating their pixels.
 pub fn open_image(bytes: &[u8], max_pixels: u64) -> Result<ImageFile<'_>, ImageError> {
     match sniff_image_kind(bytes) {
         Some(ImageFileKind::Png) => decode_png(bytes, max_pixels).map(ImageFile::Png),
-        Some(ImageFileKind::Exr) => Ok(ImageFile::Exr(ExrFile {
-            bytes,
-            parts: read_exr_headers(bytes)?,
-            max_pixels,
-        })),
+        Some(ImageFileKind::Exr) => open_exr(bytes, max_pixels).map(ImageFile::Exr),
         None => Err(ImageError::UnknownFormat {
             start: bytes.iter().take(8).copied().collect(),
         }),

@@ -43,6 +43,75 @@ impl PngPixels {
     }
 }
 
+/// What a PNG's chunks before its pixel data say, in the terms of [`decode_png`]'s output:
+/// the size, and the samples per pixel and bits per sample after expansion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PngHeader {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel after expansion: 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA.
+    pub channels: usize,
+    /// 16-bit samples (else 8-bit, after expansion).
+    pub sixteen_bit: bool,
+}
+
+impl PngHeader {
+    /// Number of pixels.
+    pub fn pixel_count(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+
+    /// Bytes of the samples [`decode_png`] returns.
+    pub fn sample_bytes(&self) -> u64 {
+        let per_sample = if self.sixteen_bit { 2 } else { 1 };
+        self.pixel_count()
+            .saturating_mul(self.channels as u64 * per_sample)
+    }
+
+    /// Bytes [`decode_png`] holds at its peak: its decoding buffer, and for 16-bit samples the
+    /// `u16` copy beside it.
+    pub fn decode_bytes(&self) -> u64 {
+        let copies = if self.sixteen_bit { 2 } else { 1 };
+        self.sample_bytes().saturating_mul(copies)
+    }
+}
+
+/// Refuses an image of more than `max_pixels` pixels.
+fn check_pixel_limit(width: u32, height: u32, max_pixels: u64) -> Result<(), ImageError> {
+    if u64::from(width) * u64::from(height) > max_pixels {
+        return Err(ImageError::TooLarge {
+            width: width.into(),
+            height: height.into(),
+            max_pixels,
+        });
+    }
+    Ok(())
+}
+
+/// Reads a PNG's chunks up to its first pixel data (IDAT), without decompressing any pixel:
+/// the size (refused above `max_pixels`), and the samples [`decode_png`] would return. A
+/// corrupt or truncated image after the header is not noticed here.
+pub fn read_png_header<R: std::io::BufRead + std::io::Seek>(
+    reader: R,
+    max_pixels: u64,
+) -> Result<PngHeader, ImageError> {
+    catch_codec_panic(Codec::Png, || {
+        let mut decoder = png::Decoder::new(reader);
+        decoder.set_transformations(png::Transformations::EXPAND);
+        let header = decoder.read_header_info().map_err(ImageError::PngDecode)?;
+        check_pixel_limit(header.width, header.height, max_pixels)?;
+        let reader = decoder.read_info().map_err(ImageError::PngDecode)?;
+        let (color, depth) = reader.output_color_type();
+        let info = reader.info();
+        Ok(PngHeader {
+            width: info.width,
+            height: info.height,
+            channels: color.samples(),
+            sixteen_bit: depth == png::BitDepth::Sixteen,
+        })
+    })?
+}
+
 /// Decodes a PNG held in memory. Palette images become RGB(A), grey images below 8 bits
 /// become 8-bit grey, 16-bit samples are returned as `u16`.
 pub fn decode_png(bytes: &[u8], max_pixels: u64) -> Result<PngPixels, ImageError> {
@@ -55,13 +124,7 @@ fn decode_png_inner(bytes: &[u8], max_pixels: u64) -> Result<PngPixels, ImageErr
     decoder.set_transformations(png::Transformations::EXPAND);
     let header = decoder.read_header_info().map_err(err)?;
     let (width, height) = (header.width, header.height);
-    if u64::from(width) * u64::from(height) > max_pixels {
-        return Err(ImageError::TooLarge {
-            width: width.into(),
-            height: height.into(),
-            max_pixels,
-        });
-    }
+    check_pixel_limit(width, height, max_pixels)?;
     let mut reader = decoder.read_info().map_err(err)?;
     let (color, depth) = reader.output_color_type();
     let channels = color.samples();

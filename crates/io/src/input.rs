@@ -197,6 +197,22 @@ pub fn read_input(path: &Path, limit: InputLimit) -> Result<Vec<u8>, InputError>
     Ok(bytes)
 }
 
+/// Opens the regular file `path` to read part of it (an image's header), with the checks of
+/// [`read_input`]: not a directory, device or FIFO, within `limit`; the reader returned stops
+/// after `limit.bytes`. Returns it with the file's size. Recorded as an input as by
+/// [`read_input`].
+pub fn open_input(
+    path: &Path,
+    limit: InputLimit,
+) -> Result<(std::io::Take<File>, u64), InputError> {
+    check(&std::fs::metadata(path)?, limit)?;
+    let file = open(path)?;
+    let meta = file.metadata()?;
+    check(&meta, limit)?;
+    registry::record_input(path, &meta);
+    Ok((file.take(limit.bytes), meta.len()))
+}
+
 /// [`read_input`] of a text file: its bytes must be UTF-8.
 pub fn read_input_string(path: &Path, limit: InputLimit) -> Result<String, InputError> {
     let bytes = read_input(path, limit)?;

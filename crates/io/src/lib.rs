@@ -18,7 +18,9 @@ pub mod output;
 mod registry;
 
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
-pub use input::{InputError, InputLimit, byte_size_text, limits, read_input, read_input_string};
+pub use input::{
+    InputError, InputLimit, byte_size_text, limits, open_input, read_input, read_input_string,
+};
 pub use kind::FileKind;
 pub use output::{
     OutputError, StagedOutput, refuse_input_as_output, write_atomic, write_bytes_atomic,

@@ -12,9 +12,9 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
-use glassdb_image::ExrFile;
+use glassdb_image::{ExrFile, ExrHeaders, ExrPart, ImageWindows, ReadMemory};
 
-use crate::read::{PixelError, decode_channels, locate_channel};
+use crate::read::{MaskHeader, PixelError, decode_channels, locate_channel, plan_channels};
 use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
 
 /// How an AOV relates to the glass it describes.
@@ -219,8 +219,7 @@ fn choose_layer<'a>(
 
 /// The (part, channel) of each rank channel of `layer`: `NAME00.r`, `.g`, `.b`, `.a`, `NAME01.r`,
 /// … (any case), in rank order, as long as a level exists.
-fn rank_channels(exr: &ExrFile<'_>, layer: &str) -> Vec<[(usize, usize); 4]> {
-    let parts = exr.parts();
+fn rank_channels(parts: &[ExrPart], layer: &str) -> Vec<[(usize, usize); 4]> {
     let find = |name: &str| {
         parts.iter().enumerate().find_map(|(p, part)| {
             (0..part.channels.len()).find_map(|c| {
@@ -245,24 +244,24 @@ fn rank_channels(exr: &ExrFile<'_>, layer: &str) -> Vec<[(usize, usize); 4]> {
 }
 
 /// A required channel by the name a user gives.
-fn locate(exr: &ExrFile<'_>, name: &str, path: &Path) -> Result<(usize, usize), MaskError> {
-    locate_channel(exr.parts(), name, None, true, path)?.ok_or_else(|| MaskError::MissingChannel {
+fn locate(parts: &[ExrPart], name: &str, path: &Path) -> Result<(usize, usize), MaskError> {
+    locate_channel(parts, name, None, true, path)?.ok_or_else(|| MaskError::MissingChannel {
         path: path.to_path_buf(),
         channel: name.to_string(),
-        available: glassdb_image::all_channel_names(exr.parts()),
+        available: glassdb_image::all_channel_names(parts),
     })
 }
 
 /// The three channels of a vector pass: `NAME.X/.Y/.Z` or `NAME.R/.G/.B`.
 fn locate_vector(
-    exr: &ExrFile<'_>,
+    parts: &[ExrPart],
     name: &str,
     path: &Path,
 ) -> Result<[(usize, usize); 3], MaskError> {
     for letters in [["X", "Y", "Z"], ["R", "G", "B"], ["x", "y", "z"]] {
         let found: Result<Vec<_>, _> = letters
             .iter()
-            .map(|l| locate(exr, &format!("{name}.{l}"), path))
+            .map(|l| locate(parts, &format!("{name}.{l}"), path))
             .collect();
         if let Ok(f) = found {
             return Ok([f[0], f[1], f[2]]);
@@ -271,25 +270,33 @@ fn locate_vector(
     Err(MaskError::MissingChannel {
         path: path.to_path_buf(),
         channel: format!("{name}.X/.Y/.Z"),
-        available: glassdb_image::all_channel_names(exr.parts()),
+        available: glassdb_image::all_channel_names(parts),
     })
 }
 
-/// Builds a mask from the Cryptomatte layer of an EXR render (see the module docs): per pixel
-/// the glass id with the largest coverage among the ranks whose manifest name is glass, its
-/// coverage, cos θ from the chosen source, and the plane from the plane AOV.
-pub fn mask_from_cryptomatte(
-    exr: &ExrFile<'_>,
+/// What the header decided for a Cryptomatte mask: the glass ids of the manifest's hashes and
+/// the channels to decode (the ranks', then cos θ's, then the planes').
+pub(crate) struct CryptomattePlan {
+    /// hash → glass id, for the glass names only.
+    glass_of: HashMap<u32, u16>,
+    wanted: Vec<(usize, usize)>,
+    rank_count: usize,
+    windows: ImageWindows,
+    stores_planes: bool,
+}
+
+/// Checks a Cryptomatte mask from the file's headers alone: the layer and its manifest (header
+/// or side file), that the glass patterns name something in it, that the rank channels and the
+/// cos θ and plane channels exist, and that they can be decoded (`max_pixels`, one data
+/// window).
+pub(crate) fn plan_cryptomatte(
+    headers: &ExrHeaders,
     path: &Path,
     opts: &CryptomatteOptions,
-) -> Result<PlacedMask, MaskError> {
-    let attributes = glassdb_image::read_exr_text_attributes(exr.bytes()).map_err(|source| {
-        MaskError::Decode {
-            path: path.to_path_buf(),
-            source,
-        }
-    })?;
-    let layers = cryptomatte_layers(&attributes, path)?;
+    max_pixels: u64,
+) -> Result<CryptomattePlan, MaskError> {
+    let parts = headers.parts.as_slice();
+    let layers = cryptomatte_layers(&headers.text_attributes, path)?;
     let layer = choose_layer(&layers, opts.layer.as_deref(), path)?;
     let unmatched = opts
         .glass
@@ -302,41 +309,111 @@ pub fn mask_from_cryptomatte(
             names: layer.manifest.keys().cloned().collect(),
         });
     }
-    // hash → glass id, for the glass names only.
     let glass_of: HashMap<u32, u16> = layer
         .manifest
         .iter()
         .filter_map(|(name, &hash)| opts.glass.id_of(name).map(|id| (hash, id)))
         .collect();
-    let ranks = rank_channels(exr, &layer.name);
+    let ranks = rank_channels(parts, &layer.name);
     if ranks.is_empty() {
         return Err(MaskError::MissingChannel {
             path: path.to_path_buf(),
             channel: format!("{}00.r", layer.name),
-            available: glassdb_image::all_channel_names(exr.parts()),
+            available: glassdb_image::all_channel_names(parts),
         });
     }
     let mut wanted: Vec<(usize, usize)> = ranks.iter().flatten().copied().collect();
     let rank_count = wanted.len();
     match &opts.cos {
-        CosSource::Aov { channel } => wanted.push(locate(exr, channel, path)?),
+        CosSource::Aov { channel } => wanted.push(locate(parts, channel, path)?),
         CosSource::Geometry {
             normal, position, ..
         } => {
-            wanted.extend(locate_vector(exr, normal, path)?);
-            wanted.extend(locate_vector(exr, position, path)?);
+            wanted.extend(locate_vector(parts, normal, path)?);
+            wanted.extend(locate_vector(parts, position, path)?);
         }
     }
     match &opts.planes {
         PlaneSource::Single => {}
-        PlaneSource::Aov(plane) => wanted.push(locate(exr, plane, path)?),
+        PlaneSource::Aov(plane) => wanted.push(locate(parts, plane, path)?),
         PlaneSource::Geometry {
             normal, position, ..
         } => {
-            wanted.extend(locate_vector(exr, normal, path)?);
-            wanted.extend(locate_vector(exr, position, path)?);
+            wanted.extend(locate_vector(parts, normal, path)?);
+            wanted.extend(locate_vector(parts, position, path)?);
         }
     }
+    let windows = plan_channels(parts, &wanted, path, max_pixels)?;
+    Ok(CryptomattePlan {
+        glass_of,
+        wanted,
+        rank_count,
+        windows,
+        stores_planes: opts.planes != PlaneSource::Single,
+    })
+}
+
+impl CryptomattePlan {
+    /// The header's facts and the memory reading costs, for a file of `file_len` bytes: every
+    /// wanted channel as f32 and the dominant glass's id, coverage and total coverage while
+    /// reading; id, plane (u16), cos θ and coverage (f32) after.
+    pub(crate) fn header(&self, file_len: u64) -> MaskHeader {
+        let pixels = self.windows.data.pixel_count();
+        let per_pixel = 2 + 2 + 4 + 4;
+        let planes = ReadMemory::exr_planes(file_len, pixels, self.wanted.len());
+        MaskHeader {
+            windows: self.windows,
+            stores_planes: self.stores_planes,
+            has_coordinates: true,
+            bytes_per_pixel: per_pixel,
+            memory: ReadMemory {
+                transient: planes.transient.saturating_add(planes.kept),
+                kept: 0,
+            }
+            // The dominant glass's total coverage, dropped at the end.
+            .with_transient(pixels.saturating_mul(4))
+            .keeping(pixels.saturating_mul(per_pixel)),
+        }
+    }
+}
+
+/// Builds a mask from the Cryptomatte layer of an EXR render (see the module docs): per pixel
+/// the glass id with the largest coverage among the ranks whose manifest name is glass, its
+/// coverage, cos θ from the chosen source, and the plane from the plane AOV.
+pub fn mask_from_cryptomatte(
+    exr: &ExrFile<'_>,
+    path: &Path,
+    opts: &CryptomatteOptions,
+) -> Result<PlacedMask, MaskError> {
+    let text_attributes =
+        glassdb_image::read_exr_text_attributes(exr.bytes()).map_err(|source| {
+            MaskError::Decode {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
+    let headers = ExrHeaders {
+        parts: exr.parts().to_vec(),
+        text_attributes,
+    };
+    let plan = plan_cryptomatte(&headers, path, opts, exr.max_pixels())?;
+    decode_cryptomatte(exr, path, opts, plan)
+}
+
+/// Decodes the channels `plan` chose and builds the mask.
+pub(crate) fn decode_cryptomatte(
+    exr: &ExrFile<'_>,
+    path: &Path,
+    opts: &CryptomatteOptions,
+    plan: CryptomattePlan,
+) -> Result<PlacedMask, MaskError> {
+    let CryptomattePlan {
+        glass_of,
+        wanted,
+        rank_count,
+        stores_planes,
+        ..
+    } = plan;
     let (windows, planes) = decode_channels(exr, &wanted, path)?;
     let (ranks_data, rest) = planes.split_at(rank_count);
     let glass = dominant_glass(ranks_data, &glass_of);
@@ -382,7 +459,7 @@ pub fn mask_from_cryptomatte(
             coverage: partial.then_some(glass.coverage),
         },
         windows,
-        stores_planes: opts.planes != PlaneSource::Single,
+        stores_planes,
         has_coordinates: true,
     })
 }

@@ -30,7 +30,10 @@ pub use error::MaskError;
 pub use glass_names::{GlassMapping, GlassNames};
 pub use glassdb_image::DEFAULT_MAX_PIXELS;
 use glassdb_image::PixelWindow;
-pub use read::{read_mask, read_mask_bytes, read_placed_mask, read_placed_mask_bytes};
+pub use read::{
+    MaskHeader, read_mask, read_mask_bytes, read_mask_header, read_placed_mask,
+    read_placed_mask_bytes,
+};
 pub use write::{MaskFormat, write_mask, write_mask_bytes};
 
 /// A decoded mask, row-major, row 0 at the top. All per-pixel vectors have `width * height`

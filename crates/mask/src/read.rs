@@ -1,13 +1,50 @@
-//! Reading masks: the one image reader of glassdb-image decodes the file, and each mask
-//! format's layout (packed PNG, binary PNG, EXR channels) becomes a [`MaskImage`].
+//! Reading masks: the header first (glassdb-image reads a PNG's chunks up to its pixel data,
+//! an EXR's headers), from which the format's layout is checked and the channels to decode are
+//! chosen ([`MaskPlan`]); then the one image reader of glassdb-image decodes only those, and
+//! each mask format's layout (packed PNG, binary PNG, EXR channels, Cryptomatte) becomes a
+//! [`MaskImage`].
 
+use std::io::{BufReader, Cursor};
 use std::path::Path;
 
 use glassdb_image::{
-    ChannelMatch, ExrFile, ExrPart, ImageFile, ImageWindows, PngPixels, PngSamples,
+    ChannelMatch, ExrFile, ExrPart, ImageHeader, ImageWindows, PngHeader, PngPixels, PngSamples,
+    ReadMemory,
 };
 
+use crate::cryptomatte::{CryptomattePlan, decode_cryptomatte, plan_cryptomatte};
 use crate::{CosTheta, MaskError, MaskImage, MaskReadOptions, PlacedMask};
+
+/// What a mask file's header says, checked as the reader checks it before decoding any pixel:
+/// where its pixels lie, whether it stores planes, and what reading it costs in memory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MaskHeader {
+    pub windows: ImageWindows,
+    pub stores_planes: bool,
+    /// Whether the file states its pixels' coordinates (EXR); see [`PlacedMask`].
+    pub has_coordinates: bool,
+    /// Bytes per pixel of the decoded [`MaskImage`] (id, plane, cos θ, coverage).
+    pub bytes_per_pixel: u64,
+    /// Reading it: the file and the decoder's buffers while reading, the mask after.
+    pub memory: ReadMemory,
+}
+
+/// Reads a mask file's header only (a PNG's chunks up to its pixel data, an EXR's headers; no
+/// pixel is decompressed) and checks the layout `opts` asks for: a packed PNG is RGB, a binary
+/// mask is a PNG, the EXR channels (or the Cryptomatte layer, its manifest and the cos θ and
+/// plane channels) are present, the parts read are within the pixel limit. A file whose pixel
+/// data is corrupt passes; [`read_placed_mask`] finds that.
+pub fn read_mask_header(path: &Path, opts: &MaskReadOptions) -> Result<MaskHeader, MaskError> {
+    let read_err = |source| MaskError::Read {
+        path: path.to_path_buf(),
+        source,
+    };
+    let (file, file_len) =
+        glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(read_err)?;
+    let header = glassdb_image::read_image_header(BufReader::new(file), opts.max_pixels)
+        .map_err(|source| decode_err(path, source))?;
+    Ok(MaskPlan::new(&header, path, opts)?.header(file_len))
+}
 
 /// Reads a mask file (PNG or EXR, detected from its bytes); see the crate docs for the formats.
 /// The pixels are those the file stores (an EXR's data window); [`read_placed_mask`] also says
@@ -36,44 +73,46 @@ pub fn read_mask_bytes(
     read_placed_mask_bytes(bytes, path, opts).map(|m| m.image)
 }
 
+fn decode_err(path: &Path, source: glassdb_image::ImageError) -> MaskError {
+    MaskError::Decode {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
 /// Reads a mask from bytes in memory with its windows; `path` is only used in error messages.
+/// The header is read and checked first ([`read_mask_header`]'s checks), then only what the
+/// layout needs is decoded.
 pub fn read_placed_mask_bytes(
     bytes: &[u8],
     path: &Path,
     opts: &MaskReadOptions,
 ) -> Result<PlacedMask, MaskError> {
-    let decode_err = |source| MaskError::Decode {
-        path: path.to_path_buf(),
-        source,
-    };
-    let placed = match glassdb_image::open_image(bytes, opts.max_pixels).map_err(decode_err)? {
-        ImageFile::Png(png) => {
-            let windows = ImageWindows::full_frame(png.width as usize, png.height as usize);
-            match opts.binary_glass_id {
-                Some(id) => PlacedMask {
-                    image: binary_from_png(&png, id, path)?,
-                    windows,
-                    stores_planes: false,
-                    has_coordinates: false,
-                },
-                None => PlacedMask {
-                    image: packed_from_png(&png, path)?,
-                    windows,
-                    stores_planes: true,
-                    has_coordinates: false,
-                },
-            }
-        }
-        ImageFile::Exr(exr) => {
-            if opts.binary_glass_id.is_some() {
-                return Err(MaskError::BinaryMaskNotPng {
-                    path: path.to_path_buf(),
-                });
-            }
-            match &opts.cryptomatte {
-                Some(crypto) => crate::mask_from_cryptomatte(&exr, path, crypto)?,
-                None => mask_from_exr(&exr, path, opts)?,
-            }
+    let header = glassdb_image::read_image_header(Cursor::new(bytes), opts.max_pixels)
+        .map_err(|source| decode_err(path, source))?;
+    let plan = MaskPlan::new(&header, path, opts)?;
+    let png = || glassdb_image::decode_png(bytes, opts.max_pixels).map_err(|s| decode_err(path, s));
+    let exr = || glassdb_image::open_exr(bytes, opts.max_pixels).map_err(|s| decode_err(path, s));
+    let placed = match plan {
+        MaskPlan::Packed(h) => PlacedMask {
+            image: packed_from_png(&png()?, path)?,
+            windows: ImageWindows::full_frame(h.width as usize, h.height as usize),
+            stores_planes: true,
+            has_coordinates: false,
+        },
+        MaskPlan::Binary(h, id) => PlacedMask {
+            image: binary_from_png(&png()?, id),
+            windows: ImageWindows::full_frame(h.width as usize, h.height as usize),
+            stores_planes: false,
+            has_coordinates: false,
+        },
+        MaskPlan::Exr(p) => mask_from_exr(&exr()?, path, opts, &p)?,
+        MaskPlan::Cryptomatte(p) => {
+            let crypto = opts.cryptomatte.as_ref().ok_or_else(|| MaskError::Layout {
+                path: path.to_path_buf(),
+                detail: "no Cryptomatte options".into(),
+            })?;
+            decode_cryptomatte(&exr()?, path, crypto, p)?
         }
     };
     placed
@@ -81,6 +120,166 @@ pub fn read_placed_mask_bytes(
         .check_consistent()
         .map_err(MaskError::Inconsistent)?;
     Ok(placed)
+}
+
+/// What the header decided: the layout and, for an EXR, the channels to decode.
+pub(crate) enum MaskPlan {
+    /// The packed RGB formats (8- or 16-bit).
+    Packed(PngHeader),
+    /// The paper's binary mask, every glass pixel getting the id.
+    Binary(PngHeader, u16),
+    Exr(ExrChannelsPlan),
+    Cryptomatte(CryptomattePlan),
+}
+
+/// The (part, channel) of the id, cos θ, plane and coverage channels of an EXR mask (the last
+/// two optional), and where they lie.
+pub(crate) struct ExrChannelsPlan {
+    wanted: [Option<(usize, usize)>; 4],
+    windows: ImageWindows,
+}
+
+impl MaskPlan {
+    /// Checks the layout `opts` asks for against the header.
+    pub(crate) fn new(
+        header: &ImageHeader,
+        path: &Path,
+        opts: &MaskReadOptions,
+    ) -> Result<MaskPlan, MaskError> {
+        match header {
+            ImageHeader::Png(h) => match opts.binary_glass_id {
+                Some(0) => Err(MaskError::Layout {
+                    path: path.to_path_buf(),
+                    detail: "glass id 0 means \"no glass\"; a binary mask needs an id from 1"
+                        .into(),
+                }),
+                Some(id) => Ok(MaskPlan::Binary(*h, id)),
+                None if h.channels < 3 => Err(MaskError::GreyPngWithoutGlassId {
+                    path: path.to_path_buf(),
+                }),
+                None => Ok(MaskPlan::Packed(*h)),
+            },
+            ImageHeader::Exr(exr) => {
+                if opts.binary_glass_id.is_some() {
+                    return Err(MaskError::BinaryMaskNotPng {
+                        path: path.to_path_buf(),
+                    });
+                }
+                match &opts.cryptomatte {
+                    Some(crypto) => plan_cryptomatte(exr, path, crypto, opts.max_pixels)
+                        .map(MaskPlan::Cryptomatte),
+                    None => plan_exr_channels(&exr.parts, path, opts).map(MaskPlan::Exr),
+                }
+            }
+        }
+    }
+
+    /// The header's facts and the memory reading costs, for a file of `file_len` bytes.
+    pub(crate) fn header(&self, file_len: u64) -> MaskHeader {
+        let png = |h: &PngHeader, per_pixel: u64| MaskHeader {
+            windows: ImageWindows::full_frame(h.width as usize, h.height as usize),
+            stores_planes: false,
+            has_coordinates: false,
+            bytes_per_pixel: per_pixel,
+            memory: ReadMemory::png(file_len, h).keeping(h.pixel_count().saturating_mul(per_pixel)),
+        };
+        match self {
+            // id and plane u16, cos θ a code of the PNG's depth.
+            MaskPlan::Packed(h) => MaskHeader {
+                stores_planes: true,
+                ..png(h, 4 + if h.sixteen_bit { 2 } else { 1 })
+            },
+            // id and plane u16, coverage f32.
+            MaskPlan::Binary(h, _) => png(h, 8),
+            MaskPlan::Exr(p) => {
+                let pixels = p.windows.data.pixel_count();
+                let [_, _, plane, coverage] = p.wanted;
+                // id, plane u16; cos θ f32 (the decoded plane); coverage f32 (likewise).
+                let per_pixel = 8 + if coverage.is_some() { 4 } else { 0 };
+                let channels = p.wanted.iter().flatten().count();
+                // The id and plane channels are decoded as f32 and converted.
+                let decoded_id_plane = 4 * (1 + u64::from(plane.is_some()));
+                MaskHeader {
+                    windows: p.windows,
+                    stores_planes: plane.is_some(),
+                    has_coordinates: true,
+                    bytes_per_pixel: per_pixel,
+                    memory: ReadMemory {
+                        transient: ReadMemory::exr_planes(file_len, pixels, channels).transient,
+                        kept: 0,
+                    }
+                    .with_transient(pixels.saturating_mul(decoded_id_plane))
+                    .keeping(pixels.saturating_mul(per_pixel)),
+                }
+            }
+            MaskPlan::Cryptomatte(p) => p.header(file_len),
+        }
+    }
+}
+
+/// Locates the EXR mask's channels (id and cos θ required) and checks that their parts can be
+/// read and share one data window.
+fn plan_exr_channels(
+    parts: &[ExrPart],
+    path: &Path,
+    opts: &MaskReadOptions,
+) -> Result<ExrChannelsPlan, MaskError> {
+    let names = &opts.exr_channels;
+    let layer = opts.layer.as_deref();
+    let wanted = [
+        locate_channel(parts, &names.id, layer, true, path)?,
+        locate_channel(parts, &names.cos_theta, layer, true, path)?,
+        locate_channel(parts, &names.plane, layer, false, path)?,
+        locate_channel(parts, &names.coverage, layer, false, path)?,
+    ];
+    let present: Vec<(usize, usize)> = wanted.iter().flatten().copied().collect();
+    let windows = plan_channels(parts, &present, path, opts.max_pixels)?;
+    Ok(ExrChannelsPlan { wanted, windows })
+}
+
+/// Checks, from the headers, that channels `wanted` (part, channel) can be decoded (within
+/// `max_pixels`, not deep, not subsampled) and that their parts share one data window, which
+/// is returned with the display window.
+pub(crate) fn plan_channels(
+    parts: &[ExrPart],
+    wanted: &[(usize, usize)],
+    path: &Path,
+    max_pixels: u64,
+) -> Result<ImageWindows, MaskError> {
+    let mut windows: Option<ImageWindows> = None;
+    let mut part_ids: Vec<usize> = wanted.iter().map(|w| w.0).collect();
+    part_ids.sort_unstable();
+    part_ids.dedup();
+    for p in part_ids {
+        let channels: Vec<usize> = wanted.iter().filter(|w| w.0 == p).map(|w| w.1).collect();
+        let info = parts.get(p).ok_or_else(|| MaskError::Layout {
+            path: path.to_path_buf(),
+            detail: format!("no part {p}"),
+        })?;
+        glassdb_image::check_exr_readable(info, &channels, max_pixels)
+            .map_err(|source| decode_err(path, source))?;
+        match windows {
+            None => windows = Some(info.windows()),
+            Some(w) if w.data != info.data_window => {
+                return Err(different_windows(path, &w, info));
+            }
+            Some(_) => {}
+        }
+    }
+    windows.ok_or_else(|| MaskError::Layout {
+        path: path.to_path_buf(),
+        detail: "no mask channels".into(),
+    })
+}
+
+fn different_windows(path: &Path, w: &ImageWindows, info: &ExrPart) -> MaskError {
+    MaskError::Layout {
+        path: path.to_path_buf(),
+        detail: format!(
+            "the mask channels lie in parts with different data windows ({} and {})",
+            w.data, info.data_window
+        ),
+    }
 }
 
 /// The packed formats: R = plane, G = id, B = cos θ code (8- or 16-bit). Alpha is ignored.
@@ -128,13 +327,8 @@ fn packed_from_png(png: &PngPixels, path: &Path) -> Result<MaskImage, MaskError>
 
 /// The paper's binary mask: black = no glass; any other value = glass `glass_id`, with coverage
 /// = the largest colour sample / maximum (1 for white). Alpha is ignored.
-fn binary_from_png(png: &PngPixels, glass_id: u16, path: &Path) -> Result<MaskImage, MaskError> {
-    if glass_id == 0 {
-        return Err(MaskError::Layout {
-            path: path.to_path_buf(),
-            detail: "glass id 0 means \"no glass\"; a binary mask needs an id from 1".into(),
-        });
-    }
+/// The glass id is checked (not 0) by [`MaskPlan::new`].
+fn binary_from_png(png: &PngPixels, glass_id: u16) -> MaskImage {
     let n = png.width as usize * png.height as usize;
     let colour_channels = if png.channels >= 3 { 3 } else { 1 };
     let max = png.max_value();
@@ -150,30 +344,26 @@ fn binary_from_png(png: &PngPixels, glass_id: u16, path: &Path) -> Result<MaskIm
         partial |= v != 0 && v != max;
         coverage.push(v as f32 / max as f32);
     }
-    Ok(MaskImage {
+    MaskImage {
         width: png.width,
         height: png.height,
         id,
         cos_theta: CosTheta::Normal,
         plane: vec![0; n],
         coverage: partial.then_some(coverage),
-    })
+    }
 }
 
-/// EXR masks: float (or uint) channels for id, cos θ and optionally plane and coverage.
+/// EXR masks: float (or uint) channels for id, cos θ and optionally plane and coverage, as
+/// planned from the header.
 fn mask_from_exr(
     exr: &ExrFile<'_>,
     path: &Path,
     opts: &MaskReadOptions,
+    plan: &ExrChannelsPlan,
 ) -> Result<PlacedMask, MaskError> {
     let names = &opts.exr_channels;
-    let layer = opts.layer.as_deref();
-    let wanted = [
-        locate_channel(exr.parts(), &names.id, layer, true, path)?,
-        locate_channel(exr.parts(), &names.cos_theta, layer, true, path)?,
-        locate_channel(exr.parts(), &names.plane, layer, false, path)?,
-        locate_channel(exr.parts(), &names.coverage, layer, false, path)?,
-    ];
+    let wanted = plan.wanted;
     let stores_planes = wanted[2].is_some();
     let present: Vec<(usize, usize)> = wanted.iter().flatten().copied().collect();
     let (windows, mut decoded) = decode_channels(exr, &present, path)?;
@@ -269,13 +459,7 @@ pub(crate) fn decode_channels(
         match windows {
             None => windows = Some(info.windows()),
             Some(w) if w.data != info.data_window => {
-                return Err(MaskError::Layout {
-                    path: path.to_path_buf(),
-                    detail: format!(
-                        "the mask channels lie in parts with different data windows ({} and {})",
-                        w.data, info.data_window
-                    ),
-                });
+                return Err(different_windows(path, &w, &info));
             }
             Some(_) => {}
         }

@@ -430,3 +430,74 @@ proptest! {
         let _ = read_mask_bytes(&bad, Path::new("p"), &o);
     }
 }
+
+#[test]
+fn the_header_says_where_the_mask_lies_and_what_reading_it_costs_without_decoding() {
+    let dir = tempfile::tempdir().unwrap();
+    for (format, stores_planes, has_coordinates, per_pixel) in [
+        (MaskFormat::Png8, true, false, 5),
+        (MaskFormat::Png16, true, false, 6),
+        (MaskFormat::Exr, true, true, 8),
+    ] {
+        let p = dir.path().join(format!("m{format:?}"));
+        write_mask(&p, &packed8(), format).unwrap();
+        let h = read_mask_header(&p, &opts()).unwrap();
+        let placed = read_placed_mask(&p, &opts()).unwrap();
+        assert_eq!(h.windows, placed.windows, "{format:?}");
+        assert_eq!(
+            (h.stores_planes, h.has_coordinates),
+            (stores_planes, has_coordinates)
+        );
+        assert_eq!(
+            (placed.stores_planes, placed.has_coordinates),
+            (stores_planes, has_coordinates)
+        );
+        assert_eq!(h.bytes_per_pixel, per_pixel, "{format:?}");
+        assert_eq!(h.memory.kept, 6 * per_pixel, "{format:?}");
+        // The file is held while reading.
+        let len = std::fs::metadata(&p).unwrap().len();
+        assert!(h.memory.transient >= len, "{format:?}");
+    }
+    // Only the header is read: cut after it, the file passes the header and fails decoding.
+    let bytes = write_mask_bytes(Path::new("x.png"), &packed8(), MaskFormat::Png8).unwrap();
+    let idat = bytes.windows(4).position(|w| w == b"IDAT").unwrap();
+    let cut = dir.path().join("cut.png");
+    std::fs::write(&cut, &bytes[..idat + 8]).unwrap();
+    let h = read_mask_header(&cut, &opts()).unwrap();
+    assert_eq!((h.windows.display.width, h.windows.display.height), (3, 2));
+    assert!(read_mask(&cut, &opts()).is_err());
+    // The header's checks are the reader's: a grey PNG is no packed mask, a binary mask must
+    // be a PNG, glass id 0 is no glass, channels must exist.
+    let grey = dir.path().join("grey.png");
+    std::fs::write(
+        &grey,
+        encode_png(2, 1, PngColor::Grey, Depth::Eight, &[0, 255]),
+    )
+    .unwrap();
+    assert!(matches!(
+        read_mask_header(&grey, &opts()),
+        Err(MaskError::GreyPngWithoutGlassId { .. })
+    ));
+    let binary = MaskReadOptions {
+        binary_glass_id: Some(4),
+        ..opts()
+    };
+    let h = read_mask_header(&grey, &binary).unwrap();
+    assert!(!h.stores_planes && h.bytes_per_pixel == 8);
+    let zero = MaskReadOptions {
+        binary_glass_id: Some(0),
+        ..opts()
+    };
+    assert!(matches!(
+        read_mask_header(&grey, &zero),
+        Err(MaskError::Layout { .. })
+    ));
+    let exr = dir.path().join("m.exr");
+    std::fs::write(&exr, exr_bytes(2, 1, vec![("id", vec![1.0, 0.0])])).unwrap();
+    assert!(matches!(
+        read_mask_header(&exr, &binary),
+        Err(MaskError::BinaryMaskNotPng { .. })
+    ));
+    let err = chain(&read_mask_header(&exr, &opts()).unwrap_err());
+    assert!(err.contains("cos_theta") && err.contains("id"), "{err}");
+}
