@@ -1,7 +1,7 @@
 //! Standard output of every command. Rust starts programs with SIGPIPE ignored, so a write to
 //! a closed pipe (`glassdb registry show … | head -1`) fails with `BrokenPipe`, on which
 //! `println!` panics. Commands print through `outln!` and `out!` (defined in `cmd`) instead,
-//! which call [`write`] (the crate's `clippy::print_stdout` lint keeps `println!` out). When the
+//! which call [`write()`] (the crate's `clippy::print_stdout` lint keeps `println!` out). When the
 //! reader has gone, the process exits at once, quietly, with status 0, as ripgrep and other
 //! Rust tools do: what it printed was read as far as the reader wanted, and every file a
 //! command writes is complete before the command prints about it. Any other write error (a
