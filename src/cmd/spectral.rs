@@ -330,6 +330,18 @@ fn to_text(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> 
     if let (Some(first), Some(last)) = (wl.first(), wl.last()) {
         let _ = writeln!(s, "  {} samples, {first}–{last} nm", wl.len());
     }
+    if !p.other_incidence_angles_deg.is_empty() {
+        let angles: Vec<String> = p
+            .other_incidence_angles_deg
+            .iter()
+            .map(|a| format!("{a}°"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "  normal incidence read; the file also has {} (not read)",
+            angles.join(", ")
+        );
+    }
     let _ = writeln!(s, "method: {method}");
     let _ = writeln!(
         s,

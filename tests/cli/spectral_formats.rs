@@ -227,3 +227,33 @@ fn unsupported_kinds_get_messages_that_name_them() {
         &["blind", "is an IGSDB shading product (venetian blind"],
     );
 }
+
+#[test]
+fn igsdb_v2_other_incidence_angles_are_named_not_read() {
+    // The real v2 file with its 0° block copied as a 30° block: the numbers stay the 0° ones,
+    // and both outputs say which angles the file has beside it.
+    let dir = tempfile::tempdir().unwrap();
+    let mut v: Value =
+        serde_json::from_slice(&std::fs::read(fixture("igsdb_v2_clear_3.json")).unwrap()).unwrap();
+    let blocks = v["physical_properties"]["optical_properties"]["optical_data"]["angle_blocks"]
+        .as_array_mut()
+        .unwrap();
+    let mut oblique = blocks[0].clone();
+    oblique["incidence_angle"] = serde_json::json!(30);
+    blocks.push(oblique);
+    let file = write_file(dir.path(), "two_angles.json", v.to_string().as_bytes());
+    let text = ok(glassdb().arg("spectral").arg(&file));
+    assert!(
+        text.contains("normal incidence read; the file also has 30° (not read)"),
+        "{text}"
+    );
+    let json = spectral_json(&[], &file);
+    assert_eq!(
+        json["product"]["other_incidence_angles_deg"][0], 30.0,
+        "{json}"
+    );
+    assert_eq!(
+        numbers(&[], &file),
+        numbers(&[], &fixture("igsdb_v2_clear_3.json"))
+    );
+}
