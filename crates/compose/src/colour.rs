@@ -156,23 +156,19 @@ pub struct RegistryLuts {
     tables: Vec<(ColourBasis, LazyLut)>,
 }
 
-/// A lookup table, or the registry table to build it from.
+/// A lookup table given built, or a registry table and its lookup table once built.
 #[derive(Debug)]
-struct LazyLut {
-    table: Option<RegistryTable>,
-    lut: OnceLock<GlassLut>,
+enum LazyLut {
+    Built(GlassLut),
+    Table(RegistryTable, OnceLock<GlassLut>),
 }
 
 impl LazyLut {
     fn get(&self) -> &GlassLut {
-        self.lut.get_or_init(|| match &self.table {
-            Some(t) => GlassLut::from_table(t),
-            None => GlassLut::from_fn(
-                &[],
-                |_, _, _| ([0.0; 3], [0.0; 3]),
-                |_, _| ([0.0; 3], [0.0; 3]),
-            ),
-        })
+        match self {
+            LazyLut::Built(lut) => lut,
+            LazyLut::Table(table, lut) => lut.get_or_init(|| GlassLut::from_table(table)),
+        }
     }
 }
 
@@ -192,25 +188,15 @@ impl RegistryLuts {
             tables: registry
                 .tables()
                 .iter()
-                .map(|t| {
-                    let lazy = LazyLut {
-                        table: Some(t.clone()),
-                        lut: OnceLock::new(),
-                    };
-                    (t.basis(), lazy)
-                })
+                .map(|t| (t.basis(), LazyLut::Table(t.clone(), OnceLock::new())))
                 .collect(),
         }
     }
 
     /// One lookup table in one basis (tests, benchmarks).
     pub fn single(basis: ColourBasis, lut: GlassLut) -> RegistryLuts {
-        let lazy = LazyLut {
-            table: None,
-            lut: OnceLock::from(lut),
-        };
         RegistryLuts {
-            tables: vec![(basis, lazy)],
+            tables: vec![(basis, LazyLut::Built(lut))],
         }
     }
 

@@ -64,8 +64,6 @@ pub struct Pass {
     pub image: LinearImage,
     pub windows: ImageWindows,
     pub source: PassSource,
-    /// The colour attributes of the layer's part (none for a PNG).
-    pub colour: ExrColourTag,
 }
 
 /// What a pass's header says, read and checked before any pixel is decoded
@@ -241,7 +239,6 @@ fn pass_from_png(png: PngPixels, transfer: InputTransfer) -> Pass {
         image,
         windows,
         source: PassSource::Png { bits },
-        colour: ExrColourTag::default(),
     }
 }
 
@@ -291,10 +288,6 @@ fn read_exr_pass(
             part: chosen.part,
             channel_names,
         },
-        colour: parts
-            .get(chosen.part)
-            .map(|p| p.colour.clone())
-            .unwrap_or_default(),
     })
 }
 

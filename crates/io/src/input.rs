@@ -177,17 +177,13 @@ fn open(path: &Path) -> std::io::Result<File> {
 /// `limit.bytes + 1` bytes whatever the metadata said. With [`crate::protect_inputs`], the file
 /// is recorded as an input that no output of this process may replace.
 pub fn read_input(path: &Path, limit: InputLimit) -> Result<Vec<u8>, InputError> {
-    check(&std::fs::metadata(path)?, limit)?;
-    let file = open(path)?;
-    let meta = file.metadata()?;
-    check(&meta, limit)?;
-    registry::record_input(path, &meta);
+    let (file, len) = open_checked(path, limit)?;
     let mut bytes = Vec::new();
-    let expected = usize::try_from(meta.len()).unwrap_or(usize::MAX);
+    let expected = usize::try_from(len).unwrap_or(usize::MAX);
     bytes.try_reserve_exact(expected).map_err(|_| {
         std::io::Error::new(
             std::io::ErrorKind::OutOfMemory,
-            format!("cannot allocate {} bytes to read it", meta.len()),
+            format!("cannot allocate {len} bytes to read it"),
         )
     })?;
     file.take(limit.bytes + 1).read_to_end(&mut bytes)?;
@@ -205,12 +201,19 @@ pub fn open_input(
     path: &Path,
     limit: InputLimit,
 ) -> Result<(std::io::Take<File>, u64), InputError> {
+    let (file, len) = open_checked(path, limit)?;
+    Ok((file.take(limit.bytes), len))
+}
+
+/// The checks both readers make: `path` refused from its metadata, opened without blocking,
+/// checked again as opened, and recorded as an input. Returns the file and its size.
+fn open_checked(path: &Path, limit: InputLimit) -> Result<(File, u64), InputError> {
     check(&std::fs::metadata(path)?, limit)?;
     let file = open(path)?;
     let meta = file.metadata()?;
     check(&meta, limit)?;
     registry::record_input(path, &meta);
-    Ok((file.take(limit.bytes), meta.len()))
+    Ok((file, meta.len()))
 }
 
 /// [`read_input`] of a text file: its bytes must be UTF-8.
