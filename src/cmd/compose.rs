@@ -9,9 +9,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use glassdb_compose::colour::RegistryLuts;
+use glassdb_compose::frames_report::FramesReport;
 use glassdb_compose::io::{ExrDataType, OutputOptions, PassReadOptions, parse_exr_compression};
 use glassdb_compose::pixels::{InputTransfer, PngBits};
-use glassdb_compose::sequence::{self, FrameOutcome};
+use glassdb_compose::sequence::{self, FrameDone, FrameOutcome, SequenceOptions};
 use glassdb_compose::view::ViewTransform;
 use glassdb_compose::{
     ComposeJob, ComposeSettings, FrameReport, InputLayers, OutsidePolicy, UnknownIds,
@@ -150,6 +151,15 @@ pub struct Args {
     /// and -o is replaced by the zero-padded frame number.
     #[arg(long, value_name = "LIST")]
     pub frames: Option<String>,
+    /// With --frames: leave a frame whose output already exists and is complete (a regular
+    /// file that decodes whole), so that a rerun composites only what is missing
+    /// (docs/farm.md).
+    #[arg(long, requires = "frames")]
+    pub skip_existing: bool,
+    /// With --frames: write a JSON report of every frame (status, inputs, output, seconds,
+    /// error) to FILE, atomically, also when frames fail (docs/farm.md).
+    #[arg(long, value_name = "FILE.json", requires = "frames")]
+    pub report: Option<PathBuf>,
     /// Print per-stage timings, megapixels per second, per-id pixel counts and the cos θ range.
     #[arg(long)]
     pub stats: bool,
@@ -702,10 +712,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let on_done = |o: &FrameOutcome| {
         let line = match &o.result {
-            Ok(r) => {
-                report_nonfinite(r, &format!("frame {}: ", o.frame));
-                None
+            Ok(FrameDone::Composed { report, replaced }) => {
+                report_nonfinite(report, &format!("frame {}: ", o.frame));
+                replaced
+                    .as_ref()
+                    .map(|why| format!("frame {}: composited again: {why}", o.frame))
             }
+            Ok(FrameDone::Skipped) => None,
             Err(e) => Some(format!(
                 "frame {}: error: {}",
                 o.frame,
@@ -721,22 +734,40 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             b.inc(1);
         }
     };
-    let outcomes = sequence::compose_sequence(&job, &frames, &settings, &luts, &on_done)?;
+    if let Some(report) = &args.report {
+        // The report is an output like the frames: it may not replace an input.
+        glassdb_io::refuse_input_as_output(
+            report,
+            settings
+                .protected
+                .iter()
+                .map(PathBuf::as_path)
+                .chain(job.inputs()),
+        )?;
+    }
+    let options = SequenceOptions {
+        skip_existing: args.skip_existing,
+    };
+    let outcomes = sequence::compose_sequence(&job, &frames, &settings, &luts, options, &on_done)?;
     if let Some(b) = &bar {
         b.finish_and_clear();
+    }
+    if let Some(report) = &args.report {
+        FramesReport::from_outcomes(&outcomes).write(report)?;
     }
     let failed: Vec<u32> = outcomes
         .iter()
         .filter(|o| o.result.is_err())
         .map(|o| o.frame)
         .collect();
-    let done: Vec<&FrameReport> = outcomes
+    let done: Vec<&FrameReport> = outcomes.iter().filter_map(FrameOutcome::report).collect();
+    let skipped = outcomes
         .iter()
-        .filter_map(|o| o.result.as_ref().ok())
-        .collect();
+        .filter(|o| matches!(o.result, Ok(FrameDone::Skipped)))
+        .count();
     if args.stats {
         for o in &outcomes {
-            if let Ok(r) = &o.result {
+            if let Some(r) = o.report() {
                 outln!("--- frame {}", o.frame);
                 print_stats(r, &luts, settings.max_memory);
             }
@@ -749,6 +780,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             first.output.path.display(),
             last.output.path.display()
         );
+    }
+    if skipped > 0 {
+        outln!("skipped {skipped} frame(s) whose output is complete");
     }
     Ok(crate::cmd::frames_exit(&failed, frames.len()))
 }

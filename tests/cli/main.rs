@@ -5,6 +5,7 @@ mod architecture;
 mod cameras;
 mod colour;
 mod compose;
+mod farm;
 mod fit;
 mod fixtures;
 mod limits;

@@ -196,6 +196,13 @@ pub enum ComposeError {
     },
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),
+    /// The frames report could not be encoded as JSON.
+    #[error("cannot encode the frames report {path}")]
+    EncodeReport {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
     #[error(transparent)]
     Kernel(#[from] crate::kernel::KernelShapeError),
     /// A frame list that does not parse or is out of range.

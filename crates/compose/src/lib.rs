@@ -16,6 +16,7 @@
 
 pub mod colour;
 pub mod error;
+pub mod frames_report;
 pub mod io;
 pub mod kernel;
 pub mod lut;

@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
 use crate::colour::RegistryLuts;
 use crate::memory::MemoryBudget;
@@ -53,7 +54,69 @@ pub fn frame_job(pattern: &ComposeJob, frame: u32) -> Result<ComposeJob, Compose
 #[derive(Debug)]
 pub struct FrameOutcome {
     pub frame: u32,
-    pub result: Result<FrameReport, ComposeError>,
+    /// The frame's files (`None` when a pattern could not be expanded).
+    pub job: Option<ComposeJob>,
+    pub result: Result<FrameDone, ComposeError>,
+    /// Wall-clock time of the frame, including the check of an existing output.
+    pub wall: Duration,
+}
+
+/// What became of a frame that did not fail.
+#[derive(Debug)]
+pub enum FrameDone {
+    /// Composited and written; `replaced` says why an existing output was not kept (with
+    /// [`SequenceOptions::skip_existing`]: it was incomplete).
+    Composed {
+        report: Box<FrameReport>,
+        replaced: Option<String>,
+    },
+    /// Left alone: its output exists and is complete ([`output_is_complete`]).
+    Skipped,
+}
+
+impl FrameOutcome {
+    /// The frame's report when it was composited.
+    pub fn report(&self) -> Option<&FrameReport> {
+        match &self.result {
+            Ok(FrameDone::Composed { report, .. }) => Some(report),
+            _ => None,
+        }
+    }
+}
+
+/// How a sequence treats outputs that already exist.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SequenceOptions {
+    /// Skip a frame whose output exists and is complete, so that a rerun (a farm retrying a
+    /// chunk) only composites the frames still missing.
+    pub skip_existing: bool,
+}
+
+/// Checks that `path` is a complete image: a regular file that glassdb-image decodes whole
+/// (every pixel of a PNG; every part, channel and chunk of an EXR), within `max_pixels` per
+/// part. The error says what is wrong (missing, truncated, corrupt). It does not compare the
+/// file with the frame's inputs: after changing an input, rerun without skipping.
+pub fn output_is_complete(path: &Path, max_pixels: u64) -> Result<(), ComposeError> {
+    let bytes =
+        glassdb_io::read_previous_output(path, glassdb_io::limits::IMAGE).map_err(|cause| {
+            ComposeError::Read {
+                path: path.to_path_buf(),
+                cause,
+            }
+        })?;
+    let decode = |source| ComposeError::Decode {
+        path: path.to_path_buf(),
+        source,
+    };
+    match glassdb_image::sniff_image_kind(&bytes) {
+        Some(glassdb_image::ImageFileKind::Exr) => {
+            glassdb_image::read_exr_exact(&bytes, max_pixels).map_err(decode)?;
+        }
+        _ => {
+            glassdb_image::open_image(&bytes, max_pixels).map_err(decode)?;
+        }
+    }
+    Ok(())
 }
 
 /// Frames composed at once.
@@ -68,6 +131,7 @@ pub fn compose_sequence(
     frames: &[u32],
     settings: &ComposeSettings,
     luts: &RegistryLuts,
+    options: SequenceOptions,
     on_done: &(dyn Fn(&FrameOutcome) + Sync),
 ) -> Result<Vec<FrameOutcome>, ComposeError> {
     if !is_pattern(&pattern.output) && frames.len() > 1 {
@@ -84,10 +148,20 @@ pub fn compose_sequence(
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed);
                     let Some(&frame) = frames.get(k) else { break };
-                    let result = frame_job(pattern, frame).and_then(|job| {
-                        compose_frame_within(&job, settings, luts, &budget, &glassdb_io::NoProgress)
-                    });
-                    let outcome = FrameOutcome { frame, result };
+                    let start = Instant::now();
+                    let (job, result) = match frame_job(pattern, frame) {
+                        Ok(job) => {
+                            let result = compose_or_skip(&job, settings, luts, &budget, options);
+                            (Some(job), result)
+                        }
+                        Err(e) => (None, Err(e)),
+                    };
+                    let outcome = FrameOutcome {
+                        frame,
+                        job,
+                        result,
+                        wall: start.elapsed(),
+                    };
                     on_done(&outcome);
                     if let Ok(mut r) = results.lock() {
                         r.push(outcome);
@@ -99,6 +173,33 @@ pub fn compose_sequence(
     let mut out = results.into_inner().unwrap_or_else(|e| e.into_inner());
     out.sort_by_key(|o| o.frame);
     Ok(out)
+}
+
+/// One frame: skipped when asked and its output is complete, else composited.
+fn compose_or_skip(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    luts: &RegistryLuts,
+    budget: &MemoryBudget,
+    options: SequenceOptions,
+) -> Result<FrameDone, ComposeError> {
+    let mut replaced = None;
+    if options.skip_existing && job.output.exists() {
+        match output_is_complete(&job.output, settings.pass.max_pixels) {
+            Ok(()) => return Ok(FrameDone::Skipped),
+            Err(e) => {
+                replaced = Some(format!(
+                    "the existing output was incomplete: {}",
+                    glassdb_io::ErrorChain(&e)
+                ))
+            }
+        }
+    }
+    let report = compose_frame_within(job, settings, luts, budget, &glassdb_io::NoProgress)?;
+    Ok(FrameDone::Composed {
+        report: Box::new(report),
+        replaced,
+    })
 }
 
 #[cfg(test)]

@@ -178,6 +178,19 @@ fn open(path: &Path) -> std::io::Result<File> {
 /// is recorded as an input that no output of this process may replace.
 pub fn read_input(path: &Path, limit: InputLimit) -> Result<Vec<u8>, InputError> {
     let (file, len) = open_checked(path, limit)?;
+    read_all(file, len, limit)
+}
+
+/// Reads an earlier output of the command, with the checks of [`read_input`], to see whether
+/// it is complete (`compose --skip-existing`): it is **not** recorded as an input, so the
+/// command may still replace it.
+pub fn read_previous_output(path: &Path, limit: InputLimit) -> Result<Vec<u8>, InputError> {
+    let (file, meta) = open_unrecorded(path, limit)?;
+    read_all(file, meta.len(), limit)
+}
+
+/// Reads at most `limit.bytes` of `file` (of `len` bytes by its metadata), refusing more.
+fn read_all(file: File, len: u64, limit: InputLimit) -> Result<Vec<u8>, InputError> {
     let mut bytes = Vec::new();
     let expected = usize::try_from(len).unwrap_or(usize::MAX);
     bytes.try_reserve_exact(expected).map_err(|_| {
@@ -208,12 +221,19 @@ pub fn open_input(
 /// The checks both readers make: `path` refused from its metadata, opened without blocking,
 /// checked again as opened, and recorded as an input. Returns the file and its size.
 fn open_checked(path: &Path, limit: InputLimit) -> Result<(File, u64), InputError> {
+    let (file, meta) = open_unrecorded(path, limit)?;
+    registry::record_input(path, &meta);
+    Ok((file, meta.len()))
+}
+
+/// The checks of [`open_checked`] without recording the file as an input; returns the file
+/// and its metadata as opened.
+fn open_unrecorded(path: &Path, limit: InputLimit) -> Result<(File, Metadata), InputError> {
     check(&std::fs::metadata(path)?, limit)?;
     let file = open(path)?;
     let meta = file.metadata()?;
     check(&meta, limit)?;
-    registry::record_input(path, &meta);
-    Ok((file, meta.len()))
+    Ok((file, meta))
 }
 
 /// [`read_input`] of a text file: its bytes must be UTF-8.

@@ -20,6 +20,7 @@ mod registry;
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
 pub use input::{
     InputError, InputLimit, byte_size_text, limits, open_input, read_input, read_input_string,
+    read_previous_output,
 };
 pub use kind::FileKind;
 pub use output::{
