@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::util::{compose, fails, ok, read_exr_planes, repo_path, run};
+use crate::util::{compose, fails, ok, oracle_python, read_exr_planes, repo_path, run};
 
 /// The atrium's passes copied as frames `frames` of a sequence in `dir`
 /// (`refl_K.####.exr`, `trans.####.exr`, `mask.####.png`), as a renderer would write them.
@@ -171,4 +171,109 @@ fn reruns_skip_complete_frames_and_the_report_says_what_each_frame_did() {
     ]));
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("--frames"), "{stderr}");
+}
+
+/// `openjd run` of the bundled template with `params`, in the oracle venv (python_oracle's
+/// requirements pin openjd-cli). Returns the output and the run's log.
+fn openjd_run(params: &[(&str, String)]) -> (std::process::Output, String) {
+    let openjd = oracle_python().with_file_name("openjd");
+    let mut c = std::process::Command::new(&openjd);
+    c.arg("run")
+        .arg(repo_path("integrations/farm/openjd/glassdb-composite.yaml"))
+        .args(["--extensions", "TASK_CHUNKING"]);
+    for (k, v) in params {
+        c.arg("-p").arg(format!("{k}={v}"));
+    }
+    let (out, stdout, stderr) = run(&mut c);
+    (out, format!("{stdout}\n{stderr}"))
+}
+
+#[test]
+fn the_open_job_description_template_renders_then_composites_in_chunks() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let atrium = repo_path("fixtures/atrium");
+    // The render step's command: the atrium's fixture passes copied as the chunk's frames (a
+    // stand-in for a renderer such as `glassdb blender render`); frame 4 is never "rendered".
+    let render = format!(
+        "for f in $(seq $FRAME_START $FRAME_END); do [ $f = 4 ] && continue; n=$(printf %04d $f); \
+         for p in refl_0 refl_1 refl_2 trans; do cp {a}/$p.exr $p.$n.exr; done; \
+         cp {a}/mask.png mask.$n.png; done",
+        a = atrium.display()
+    );
+    let planes = atrium.join("virtual/planes.json");
+    let params = |frames: &str| {
+        vec![
+            ("Frames", frames.to_string()),
+            ("ChunkSize", "2".to_string()),
+            ("WorkDir", d.display().to_string()),
+            ("RenderCommand", render.clone()),
+            ("Glassdb", env!("CARGO_BIN_EXE_glassdb").to_string()),
+            (
+                "ComposeArgs",
+                format!(
+                    "--refl refl_0.####.exr --refl refl_1.####.exr --refl refl_2.####.exr \
+                     --trans trans.####.exr --mask mask.####.png --planes {}",
+                    planes.display()
+                ),
+            ),
+        ]
+    };
+    let (out, log) = openjd_run(&params("1-3"));
+    assert!(out.status.success(), "{log}");
+    assert!(
+        log.contains("Chunks run: 4"),
+        "2 render + 2 composite chunks: {log}"
+    );
+    // Each frame is what compose makes of the same passes by hand.
+    let by_hand = d.join("by_hand.exr");
+    ok(compose()
+        .arg("--refl")
+        .arg(atrium.join("refl_0.exr"))
+        .arg("--refl")
+        .arg(atrium.join("refl_1.exr"))
+        .arg("--refl")
+        .arg(atrium.join("refl_2.exr"))
+        .arg("--trans")
+        .arg(atrium.join("trans.exr"))
+        .arg("--mask")
+        .arg(atrium.join("mask.png"))
+        .arg("--planes")
+        .arg(&planes)
+        .arg("-o")
+        .arg(&by_hand));
+    let want = read_exr_planes(&by_hand).channels;
+    for f in 1..=3 {
+        let got = read_exr_planes(&d.join(format!("composite/out.{f:04}.exr")));
+        assert!(
+            got.channels == want,
+            "frame {f} differs from compose by hand"
+        );
+    }
+    let chunk = json(&d.join("reports/frames.1-2.json"));
+    assert_eq!(
+        statuses(&chunk),
+        vec![(1, "composed".to_string()), (2, "composed".to_string())]
+    );
+
+    // Frames 1-4: frame 4 has no passes, so its chunk fails (and with it the job); the
+    // chunk's report says that frame 3 was complete and kept, and why frame 4 failed.
+    let (out, log) = openjd_run(&params("1-4"));
+    assert!(!out.status.success(), "{log}");
+    let chunk = json(&d.join("reports/frames.3-4.json"));
+    assert_eq!(
+        statuses(&chunk),
+        vec![(3, "skipped".to_string()), (4, "failed".to_string())]
+    );
+    assert!(
+        chunk["frames"][1]["error"]
+            .as_str()
+            .unwrap()
+            .contains("0004"),
+        "{chunk}"
+    );
+    assert_eq!(
+        statuses(&json(&d.join("reports/frames.1-2.json"))),
+        vec![(1, "skipped".to_string()), (2, "skipped".to_string())]
+    );
 }
