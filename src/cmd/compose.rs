@@ -666,7 +666,41 @@ fn report_nonfinite(r: &FrameReport, label: &str) {
     }
 }
 
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+/// One `--refl FILE.exr` (no layer named) whose file holds the passes of several planes as
+/// layers or parts `plane0`, `plane1`, … becomes one `--refl FILE.exr:planeK` per plane. In a
+/// sequence the first frame whose file can be read decides (every frame of a shot has the same
+/// planes; a frame without a layer then fails naming it).
+fn expand_plane_layers(args: &mut Args) -> anyhow::Result<()> {
+    let [refl] = args.refl.as_slice() else {
+        return Ok(());
+    };
+    if split_layer(refl).1.is_some() || args.refl_layer.is_some() {
+        return Ok(());
+    }
+    let candidates: Vec<PathBuf> = match &args.frames {
+        Some(spec) if glassdb_io::is_frame_pattern(refl) => sequence::parse_frames(spec)?
+            .into_iter()
+            .filter_map(|f| sequence::expand(refl, f).ok())
+            .filter(|p| p.is_file())
+            .take(1)
+            .collect(),
+        _ => vec![refl.clone()],
+    };
+    let Some(first) = candidates.first() else {
+        return Ok(());
+    };
+    if let Some(layers) = glassdb_compose::io::plane_layers_of(first, args.max_pixels)? {
+        let file = refl.to_string_lossy().into_owned();
+        args.refl = layers
+            .iter()
+            .map(|l| PathBuf::from(format!("{file}:{l}")))
+            .collect();
+    }
+    Ok(())
+}
+
+pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
+    expand_plane_layers(&mut args)?;
     let (settings, luts) = settings_from(&args)?;
     let trans = split_layer(&args.trans).0;
     let output = args

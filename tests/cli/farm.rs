@@ -3,9 +3,9 @@
 //! `integrations/farm/` run by `openjd run` (its render step copies the atrium's fixture passes
 //! per frame, standing in for a renderer).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use crate::util::{compose, fails, ok, oracle_python, read_exr_planes, repo_path, run};
+use crate::util::{compose, fails, ok, oracle_python, read_exr_planes, repo_path, run, run_oracle};
 
 /// The atrium's passes copied as frames `frames` of a sequence in `dir`
 /// (`refl_K.####.exr`, `trans.####.exr`, `mask.####.png`), as a renderer would write them.
@@ -275,5 +275,91 @@ fn the_open_job_description_template_renders_then_composites_in_chunks() {
     assert_eq!(
         statuses(&json(&d.join("reports/frames.1-2.json"))),
         vec![(1, "skipped".to_string()), (2, "skipped".to_string())]
+    );
+}
+
+#[test]
+fn one_file_holds_every_planes_reflection_cropped_to_its_glass() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = repo_path("fixtures/atrium");
+    let refl: Vec<PathBuf> = (0..3).map(|k| a.join(format!("refl_{k}.exr"))).collect();
+    let oracle = |args: &[&std::ffi::OsStr]| {
+        run_oracle(
+            "plane_parts.py",
+            &args
+                .iter()
+                .copied()
+                .chain(refl.iter().map(|p| p.as_os_str()))
+                .collect::<Vec<_>>(),
+        )
+    };
+    // Written by OpenEXR itself: parts plane0..2, each cropped to its plane's glass; and one
+    // part with layers plane0..2 over the whole frame.
+    let parts = d.join("planes.exr");
+    let windows = oracle(&[
+        "parts".as_ref(),
+        "--mask".as_ref(),
+        a.join("mask.png").as_os_str(),
+        "--out".as_ref(),
+        parts.as_os_str(),
+    ]);
+    let windows: Vec<[i64; 4]> = serde_json::from_str(windows.trim()).unwrap();
+    let cropped: u64 = windows
+        .iter()
+        .map(|w| ((w[2] - w[0] + 1) * (w[3] - w[1] + 1)) as u64)
+        .sum();
+    assert!(
+        cropped < 3 * 320 * 240 / 2,
+        "the parts are crops: {windows:?}"
+    );
+    let layers = d.join("layers.exr");
+    oracle(&["layers".as_ref(), "--out".as_ref(), layers.as_os_str()]);
+
+    let composite = |refl_args: &[PathBuf], out: &str| {
+        let mut c = compose();
+        for r in refl_args {
+            c.arg("--refl").arg(r);
+        }
+        c.arg("--trans")
+            .arg(a.join("trans.exr"))
+            .arg("--mask")
+            .arg(a.join("mask.png"))
+            .arg("--planes")
+            .arg(a.join("virtual/planes.json"))
+            .arg("-o")
+            .arg(d.join(out));
+        c
+    };
+    ok(&mut composite(&refl, "separate.exr"));
+    let stdout = ok(composite(std::slice::from_ref(&parts), "out_parts.exr").arg("--stats"));
+    assert!(stdout.contains("3 reflection pass(es)"), "{stdout}");
+    ok(&mut composite(std::slice::from_ref(&layers), "out_layers.exr"));
+    let want = read_exr_planes(&d.join("separate.exr")).channels;
+    for out in ["out_parts.exr", "out_layers.exr"] {
+        assert!(
+            read_exr_planes(&d.join(out)).channels == want,
+            "{out} differs from the separate passes"
+        );
+    }
+
+    // Plane layers must count from 0: plane1 and plane2 alone name the missing plane 0.
+    let gap = d.join("gap.exr");
+    run_oracle(
+        "plane_parts.py",
+        &[
+            "layers".as_ref(),
+            "--first".as_ref(),
+            "1".as_ref(),
+            "--out".as_ref(),
+            gap.as_os_str(),
+            refl[1].as_os_str(),
+            refl[2].as_os_str(),
+        ],
+    );
+    let err = fails(&mut composite(std::slice::from_ref(&gap), "gap_out.exr"));
+    assert!(
+        err.contains("plane 0 is missing") && err.contains("gap.exr"),
+        "{err}"
     );
 }

@@ -166,6 +166,13 @@ pub enum ComposeError {
         pixels: u64,
         passes: usize,
     },
+    /// A reflection file with plane layers (`plane0`, `plane1`, …) that are not numbered 0…N−1.
+    #[error("{path}: {problem}; its plane layers: {}", layers.join(", "))]
+    PlaneLayers {
+        path: PathBuf,
+        problem: String,
+        layers: Vec<String>,
+    },
     /// A compose job without any reflection pass.
     #[error("at least one reflection pass is needed")]
     NoReflectionPass,

@@ -89,6 +89,45 @@ impl PassHeader {
     }
 }
 
+/// The plane layers of a reflection file holding several planes' passes (docs/compose.md,
+/// "Several planes in one file"): the layer names `plane0`, `plane1`, … in plane order, from
+/// the header alone; `None` for a PNG or an EXR without such layers. Planes must be numbered
+/// from 0 without gaps.
+pub fn plane_layers_of(path: &Path, max_pixels: u64) -> Result<Option<Vec<String>>, ComposeError> {
+    let (file, _) = glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(|cause| {
+        ComposeError::Read {
+            path: path.to_path_buf(),
+            cause,
+        }
+    })?;
+    let header = glassdb_image::read_image_header(std::io::BufReader::new(file), max_pixels)
+        .map_err(|source| decode_err(path, source))?;
+    let ImageHeader::Exr(headers) = header else {
+        return Ok(None);
+    };
+    let planes = glassdb_image::plane_layers(&headers.parts);
+    if planes.is_empty() {
+        return Ok(None);
+    }
+    for (expected, (k, _)) in planes.iter().enumerate() {
+        if *k as usize != expected {
+            return Err(ComposeError::PlaneLayers {
+                path: path.to_path_buf(),
+                problem: if (*k as usize) < expected {
+                    format!("two layers are plane {k}")
+                } else {
+                    format!(
+                        "plane {expected} is missing (the layers go to plane {})",
+                        planes.len() - 1
+                    )
+                },
+                layers: planes.iter().map(|(_, n)| n.clone()).collect(),
+            });
+        }
+    }
+    Ok(Some(planes.into_iter().map(|(_, n)| n).collect()))
+}
+
 /// Reads a pass's header only (a PNG's chunks up to the pixel data, an EXR's headers; no pixel
 /// is decompressed) and checks what [`read_pass`] would refuse from it: an unknown format, a
 /// missing or ambiguous layer, too many pixels, deep data, subsampled channels.

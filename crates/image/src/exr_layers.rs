@@ -222,6 +222,27 @@ pub fn rgb_layers(parts: &[ExrPart]) -> Vec<RgbLayer> {
     out
 }
 
+/// The reflection passes of several glass planes in one file: the RGB layers named `plane<K>`
+/// (a part or channel prefix `plane0`, `plane1`, …; Blender's `plane<K>.Combined` too), as
+/// (K, layer name) by increasing K. Empty when the file has no such layer.
+pub fn plane_layers(parts: &[ExrPart]) -> Vec<(u32, String)> {
+    let mut out: Vec<(u32, String)> = rgb_layers(parts)
+        .into_iter()
+        .filter_map(|l| {
+            let first = l.name.strip_suffix(".Combined").unwrap_or(&l.name);
+            let k = first.strip_prefix("plane")?;
+            (!k.is_empty()
+                && k.bytes().all(|b| b.is_ascii_digit())
+                && (k == "0" || !k.starts_with('0')))
+            .then(|| k.parse::<u32>().ok())
+            .flatten()
+            .map(|k| (k, l.name.clone()))
+        })
+        .collect();
+    out.sort();
+    out
+}
+
 /// Why no RGB layer could be chosen.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum LayerChoiceError {

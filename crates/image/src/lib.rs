@@ -27,7 +27,7 @@ pub use exr::meta::header::{
 pub use exr::prelude::FlatSamples;
 pub use exr_layers::{
     ChannelMatch, LayerChoiceError, RgbLayer, all_channel_names, choose_rgb_layer, find_channel,
-    rgb_layers,
+    plane_layers, rgb_layers,
 };
 pub use exr_read::{
     ExactExr, ExactPart, ExrChannelInfo, ExrColourTag, ExrHeaders, ExrPart, ExrSampleType,
