@@ -37,6 +37,32 @@ fn compose_frames(dir: &Path, frames: &str) -> std::process::Command {
     c
 }
 
+/// `compose` of the atrium's transmission pass and mask (with its planes.json) with the
+/// reflection passes `refl`, into `out`.
+fn atrium_compose(refl: &[PathBuf], out: &Path) -> std::process::Command {
+    let a = repo_path("fixtures/atrium");
+    let mut c = compose();
+    for r in refl {
+        c.arg("--refl").arg(r);
+    }
+    c.arg("--trans")
+        .arg(a.join("trans.exr"))
+        .arg("--mask")
+        .arg(a.join("mask.png"))
+        .arg("--planes")
+        .arg(a.join("virtual/planes.json"))
+        .arg("-o")
+        .arg(out);
+    c
+}
+
+/// The atrium's three reflection passes.
+fn atrium_refl() -> Vec<PathBuf> {
+    (0..3)
+        .map(|k| repo_path(&format!("fixtures/atrium/refl_{k}.exr")))
+        .collect()
+}
+
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap())
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -227,21 +253,7 @@ fn the_open_job_description_template_renders_then_composites_in_chunks() {
     );
     // Each frame is what compose makes of the same passes by hand.
     let by_hand = d.join("by_hand.exr");
-    ok(compose()
-        .arg("--refl")
-        .arg(atrium.join("refl_0.exr"))
-        .arg("--refl")
-        .arg(atrium.join("refl_1.exr"))
-        .arg("--refl")
-        .arg(atrium.join("refl_2.exr"))
-        .arg("--trans")
-        .arg(atrium.join("trans.exr"))
-        .arg("--mask")
-        .arg(atrium.join("mask.png"))
-        .arg("--planes")
-        .arg(&planes)
-        .arg("-o")
-        .arg(&by_hand));
+    ok(&mut atrium_compose(&atrium_refl(), &by_hand));
     let want = read_exr_planes(&by_hand).channels;
     for f in 1..=3 {
         let got = read_exr_planes(&d.join(format!("composite/out.{f:04}.exr")));
@@ -283,7 +295,7 @@ fn one_file_holds_every_planes_reflection_cropped_to_its_glass() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let a = repo_path("fixtures/atrium");
-    let refl: Vec<PathBuf> = (0..3).map(|k| a.join(format!("refl_{k}.exr"))).collect();
+    let refl = atrium_refl();
     let oracle = |args: &[&std::ffi::OsStr]| {
         run_oracle(
             "plane_parts.py",
@@ -316,25 +328,14 @@ fn one_file_holds_every_planes_reflection_cropped_to_its_glass() {
     let layers = d.join("layers.exr");
     oracle(&["layers".as_ref(), "--out".as_ref(), layers.as_os_str()]);
 
-    let composite = |refl_args: &[PathBuf], out: &str| {
-        let mut c = compose();
-        for r in refl_args {
-            c.arg("--refl").arg(r);
-        }
-        c.arg("--trans")
-            .arg(a.join("trans.exr"))
-            .arg("--mask")
-            .arg(a.join("mask.png"))
-            .arg("--planes")
-            .arg(a.join("virtual/planes.json"))
-            .arg("-o")
-            .arg(d.join(out));
-        c
-    };
+    let composite = |refl: &[PathBuf], out: &str| atrium_compose(refl, &d.join(out));
     ok(&mut composite(&refl, "separate.exr"));
     let stdout = ok(composite(std::slice::from_ref(&parts), "out_parts.exr").arg("--stats"));
     assert!(stdout.contains("3 reflection pass(es)"), "{stdout}");
-    ok(&mut composite(std::slice::from_ref(&layers), "out_layers.exr"));
+    ok(&mut composite(
+        std::slice::from_ref(&layers),
+        "out_layers.exr",
+    ));
     let want = read_exr_planes(&d.join("separate.exr")).channels;
     for out in ["out_parts.exr", "out_layers.exr"] {
         assert!(
