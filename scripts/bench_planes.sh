@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Cost follows the glass, not the planes (docs/performance.md, "Many planes, cropped passes"):
+# times `compose` on a frame with PLANES glass windows (one plane each) whose reflection passes
+# are full frames, cropped to each plane's window (EXR data windows, one file per plane), or
+# every crop in one multi-part file (parts plane0, plane1, …), against one plane carrying the
+# same glass with one full-frame pass, and against oiiotool doing the same composite (the crops
+# summed over the frame, `--add`, then the compositor's own tables as colormaps, as in
+# scripts/bench_compose_vs_oiiotool.sh).
+#
+# Paired whole-process runs: every repetition runs each command once, in a fixed order, so all
+# see the same machine state; medians of REPEATS, wall clock and peak RSS from /usr/bin/time -v.
+#   SIZES="1280x1024 3840x2160" TYPES="half float" PLANES=17 REPEATS=5 scripts/bench_planes.sh
+# Needs oiiotool (Debian: openimageio-tools) and GNU time. Prints a Markdown table.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+SIZES=${SIZES:-"1280x1024 3840x2160"}
+TYPES=${TYPES:-"half float"}
+PLANES=${PLANES:-17}
+REPEATS=${REPEATS:-5}
+THREADS=${THREADS:-$(nproc)}
+TARGET=${CARGO_TARGET_DIR:-target}
+
+cargo build --release --quiet --bin compose
+cargo build --release --quiet -p glassdb-compose --example make_plane_bench_inputs --example oiiotool_colormaps
+COMPOSE=$TARGET/release/compose
+EXAMPLES=$TARGET/release/examples
+
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/glassdb-planes.XXXXXX")
+trap 'rm -rf "$WORK"' EXIT
+eval "$("$EXAMPLES/oiiotool_colormaps" 6)"
+
+# Runs "$@"; prints "SECONDS MAX_RSS_MIB" from GNU time's verbose report.
+measure() {
+    /usr/bin/time -v -o "$WORK/time" "$@" >/dev/null 2>"$WORK/stderr" || {
+        cat "$WORK/stderr" "$WORK/time" >&2
+        return 1
+    }
+    awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, t, ":"); s = 0; for (i = 1; i <= n; i++) s = s * 60 + t[i] }
+                /Maximum resident set size/ { kb = $2 }
+                END { printf "%.3f %.0f\n", s, kb / 1024 }' "$WORK/time"
+}
+median() { sort -n | awk '{ v[NR] = $0 } END { print v[int((NR + 1) / 2)] }'; }
+
+echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), oiiotool $(oiiotool --version), threads $THREADS, $PLANES planes, ZIP, medians of $REPEATS paired runs; load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+echo
+echo "| size | samples | case | compose (s) | compose RSS (MiB) | oiiotool (s) | oiiotool RSS (MiB) | speed-up | max abs diff to oiiotool |"
+echo "|---|---|---|---|---|---|---|---|---|"
+for size in $SIZES; do
+    w=${size%x*}
+    h=${size#*x}
+    for type in $TYPES; do
+        d="$WORK/$size-$type"
+        mapfile -t rects < <("$EXAMPLES/make_plane_bench_inputs" "$d" "$w" "$h" "$type" zip "$PLANES")
+        full=() crop=() oiio_full=() oiio_crop=() parts=()
+        for r in "${rects[@]}"; do
+            read -r k x y cw ch <<<"$r"
+            oiiotool "$d/refl.exr" --crop "${cw}x${ch}+${x}+${y}" -d "$type" --compression zip -o "$d/crop_$k.exr"
+            full+=(--refl "$d/refl.exr")
+            crop+=(--refl "$d/crop_$k.exr")
+            parts+=("$d/crop_$k.exr" --attrib oiio:subimagename "plane$k")
+            oiio_full+=("$d/refl.exr" --crop "${cw}x${ch}+${x}+${y}")
+            oiio_crop+=("$d/crop_$k.exr")
+            [ "$k" = 0 ] || { oiio_full+=(--add); oiio_crop+=(--add); }
+        done
+        oiiotool "${parts[@]}" --siappendall -d "$type" --compression zip -o "$d/planes.exr"
+        composite=(--chsum:weight="$CHSUM_WEIGHTS" --dup --colormap "$R_KNOTS")
+        declare -A runs=()
+        for _ in $(seq "$REPEATS"); do
+            runs[one]+="$(measure "$COMPOSE" --refl "$d/refl.exr" --trans "$d/trans.exr" --mask "$d/mask_one.png" --compression zip -o "$d/c_one.exr")"$'\n'
+            runs[full]+="$(measure "$COMPOSE" "${full[@]}" --trans "$d/trans.exr" --mask "$d/mask_planes.png" --compression zip -o "$d/c_full.exr")"$'\n'
+            runs[crop]+="$(measure "$COMPOSE" "${crop[@]}" --trans "$d/trans.exr" --mask "$d/mask_planes.png" --compression zip -o "$d/c_crop.exr")"$'\n'
+            runs[parts]+="$(measure "$COMPOSE" --refl "$d/planes.exr" --trans "$d/trans.exr" --mask "$d/mask_planes.png" --compression zip -o "$d/c_parts.exr")"$'\n'
+            runs[o_one]+="$(measure oiiotool --threads "$THREADS" "$d/mask_one.png" "${composite[@]}" "$d/refl.exr" --mul --swap --colormap "$T_KNOTS" "$d/trans.exr" --mul --add -d "$type" --compression zip -o "$d/o_one.exr")"$'\n'
+            runs[o_full]+="$(measure oiiotool --threads "$THREADS" "$d/mask_planes.png" "${composite[@]}" "${oiio_full[@]}" --mul --swap --colormap "$T_KNOTS" "$d/trans.exr" --mul --add -d "$type" --compression zip -o "$d/o_full.exr")"$'\n'
+            runs[o_crop]+="$(measure oiiotool --threads "$THREADS" "$d/mask_planes.png" "${composite[@]}" "${oiio_crop[@]}" --mul --swap --colormap "$T_KNOTS" "$d/trans.exr" --mul --add -d "$type" --compression zip -o "$d/o_crop.exr")"$'\n'
+        done
+        med() { printf '%s' "${runs[$1]}" | awk 'NF' | cut -d' ' -f"$2" | median; }
+        diff() {
+            oiiotool "$1" "$2" --absdiff --mulc 1e6 --printstats |
+                awk '/Stats Max/ { m = 0; for (i = 3; i <= 5; i++) if ($i > m) m = $i; printf "%.2g", m / 1e6 }'
+        }
+        row() { # LABEL COMPOSE_KEY OIIO_KEY COMPOSE_OUT OIIO_OUT
+            local cs cr os or
+            cs=$(med "$2" 1) cr=$(med "$2" 2) os=$(med "$3" 1) or=$(med "$3" 2)
+            echo "| ${w}×${h} | $type | $1 | $cs | $cr | $os | $or | $(awk -v a="$os" -v b="$cs" 'BEGIN { printf "%.2f", a / b }')× | $(diff "$4" "$5") |"
+        }
+        row "1 plane, 1 full-frame pass (same glass)" one o_one "$d/c_one.exr" "$d/o_one.exr"
+        row "$PLANES planes, full-frame passes" full o_full "$d/c_full.exr" "$d/o_full.exr"
+        row "$PLANES planes, cropped passes" crop o_crop "$d/c_crop.exr" "$d/o_crop.exr"
+        row "$PLANES planes, one multi-part file of the crops" parts o_crop "$d/c_parts.exr" "$d/o_crop.exr"
+        echo "|  |  | cropped ÷ 1 plane: time $(awk -v a="$(med crop 1)" -v b="$(med one 1)" 'BEGIN { printf "%.2f", a / b }')×, memory $(awk -v a="$(med crop 2)" -v b="$(med one 2)" 'BEGIN { printf "%.2f", a / b }')×; multi-part ÷ 1 plane: time $(awk -v a="$(med parts 1)" -v b="$(med one 1)" 'BEGIN { printf "%.2f", a / b }')×, memory $(awk -v a="$(med parts 2)" -v b="$(med one 2)" 'BEGIN { printf "%.2f", a / b }')× |  |  |  |  |  |  |"
+        unset runs
+        rm -rf "$d"
+    done
+done
+echo
+echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
