@@ -689,14 +689,20 @@ fn expand_plane_layers(args: &mut Args) -> anyhow::Result<()> {
     let Some(first) = candidates.first() else {
         return Ok(());
     };
-    if let Some(layers) = glassdb_compose::io::plane_layers_of(first, args.max_pixels)? {
-        let file = refl.to_string_lossy().into_owned();
-        args.refl = layers
-            .iter()
-            .map(|l| PathBuf::from(format!("{file}:{l}")))
-            .collect();
+    // A file that cannot be read is reported by the frame that reads it, after the other
+    // inputs' checks; only misnumbered plane layers are this function's to report.
+    match glassdb_compose::io::plane_layers_of(first, args.max_pixels) {
+        Ok(Some(layers)) => {
+            let file = refl.to_string_lossy().into_owned();
+            args.refl = layers
+                .iter()
+                .map(|l| PathBuf::from(format!("{file}:{l}")))
+                .collect();
+            Ok(())
+        }
+        Err(e @ glassdb_compose::ComposeError::PlaneLayers { .. }) => Err(e.into()),
+        Ok(None) | Err(_) => Ok(()),
     }
-    Ok(())
 }
 
 pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {

@@ -65,8 +65,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let src = PassSource::Png {
         bits: PngBits::Eight,
     };
-    write_output(&out.join("trans.exr"), pass(1, [0.6, 0.5, 0.4]), &src, &opts)?;
-    write_output(&out.join("refl.exr"), pass(1 << 40, [0.9, 1.0, 1.2]), &src, &opts)?;
+    write_output(
+        &out.join("trans.exr"),
+        pass(1, [0.6, 0.5, 0.4]),
+        &src,
+        &opts,
+    )?;
+    write_output(
+        &out.join("refl.exr"),
+        pass(1 << 40, [0.9, 1.0, 1.2]),
+        &src,
+        &opts,
+    )?;
 
     // Windows on a grid of 6 columns, each inset by a tenth of its cell on every side.
     let cols = 6;
@@ -76,8 +86,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut plane = vec![0u16; n];
     for k in 0..planes {
         let (cx, cy) = (k % cols, k / cols);
-        let (x0, x1) = ((cx * 10 + 1) * w / (cols * 10), (cx * 10 + 9) * w / (cols * 10));
-        let (y0, y1) = ((cy * 10 + 1) * h / (rows * 10), (cy * 10 + 9) * h / (rows * 10));
+        let (x0, x1) = (
+            (cx * 10 + 1) * w / (cols * 10),
+            (cx * 10 + 9) * w / (cols * 10),
+        );
+        let (y0, y1) = (
+            (cy * 10 + 1) * h / (rows * 10),
+            (cy * 10 + 9) * h / (rows * 10),
+        );
         println!("{k} {x0} {y0} {} {}", x1 - x0, y1 - y0);
         for y in y0..y1 {
             for x in x0..x1 {
@@ -97,6 +113,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         coverage: None,
     };
     write_mask(&out.join("mask_planes.png"), &mask(plane), MaskFormat::Png8)?;
-    write_mask(&out.join("mask_one.png"), &mask(vec![0; n]), MaskFormat::Png8)?;
+    write_mask(
+        &out.join("mask_one.png"),
+        &mask(vec![0; n]),
+        MaskFormat::Png8,
+    )?;
     Ok(())
 }

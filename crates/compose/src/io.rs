@@ -226,6 +226,23 @@ pub fn read_pass(path: &Path, opts: &PassReadOptions) -> Result<Pass, ComposeErr
     read_pass_bytes(&bytes, path, opts)
 }
 
+/// [`read_pass`] of what rows `y_first..=y_last` (frame pixel coordinates) need: an EXR's
+/// blocks holding them only (a reflection pass decodes the rows of its plane's glass); a PNG
+/// whole.
+pub fn read_pass_rows(
+    path: &Path,
+    opts: &PassReadOptions,
+    rows: (i64, i64),
+) -> Result<Pass, ComposeError> {
+    let bytes = read_file(path)?;
+    let decoded = glassdb_image::open_image(&bytes, opts.max_pixels)
+        .map_err(|source| decode_err(path, source))?;
+    match decoded {
+        ImageFile::Png(png) => Ok(pass_from_png(png, opts.transfer)),
+        ImageFile::Exr(exr) => read_exr_pass(&exr, path, opts, Some(rows)),
+    }
+}
+
 /// The bytes of an input image, of at most [`glassdb_io::limits::IMAGE`].
 pub fn read_file(path: &Path) -> Result<Vec<u8>, ComposeError> {
     glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|cause| ComposeError::Read {
@@ -244,7 +261,7 @@ pub fn read_pass_bytes(
         .map_err(|source| decode_err(path, source))?;
     match decoded {
         ImageFile::Png(png) => Ok(pass_from_png(png, opts.transfer)),
-        ImageFile::Exr(exr) => read_exr_pass(&exr, path, opts),
+        ImageFile::Exr(exr) => read_exr_pass(&exr, path, opts, None),
     }
 }
 
@@ -285,14 +302,17 @@ fn read_exr_pass(
     exr: &ExrFile<'_>,
     path: &Path,
     opts: &PassReadOptions,
+    rows: Option<(i64, i64)>,
 ) -> Result<Pass, ComposeError> {
     let parts = exr.parts();
     let chosen = choose_layer(parts, opts.layer.as_deref(), path)?;
     let mut channels = chosen.rgb.to_vec();
     channels.extend(chosen.alpha);
-    let (info, mut buffers) = exr
-        .read_channels(chosen.part, &channels)
-        .map_err(|source| decode_err(path, source))?;
+    let (info, mut buffers) = match rows {
+        Some(rows) => exr.read_channel_rows(chosen.part, &channels, rows),
+        None => exr.read_channels(chosen.part, &channels),
+    }
+    .map_err(|source| decode_err(path, source))?;
     let channel_names = channels
         .iter()
         .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))

@@ -245,6 +245,7 @@ impl ComposeSettings {
 fn decode_inputs(
     job: &ComposeJob,
     settings: &ComposeSettings,
+    display: &PixelWindow,
 ) -> Result<DecodedInputs, ComposeError> {
     let read_trans = || -> Result<(Pass, OutputFrame), ComposeError> {
         let opts = settings.pass_options(Some(&settings.layers.trans));
@@ -264,8 +265,10 @@ fn decode_inputs(
     };
     // The reflection passes a few at a time (as many as there are threads): each holds its
     // file and compressed blocks only while it is decoded, so that many planes do not hold
-    // every file at once (`memory` counts it so).
-    let read_refl = || -> Result<Vec<Pass>, ComposeError> {
+    // every file at once (`memory` counts it so). Of each, only the rows of its plane's glass
+    // in the mask are decoded (`rows`, frame coordinates; a plane without glass decodes one
+    // block).
+    let read_refl = |rows: &BTreeMap<u16, (i64, i64)>| -> Result<Vec<Pass>, ComposeError> {
         let at_once = memory::decoding_at_once();
         let mut passes = Vec::with_capacity(job.refl.len());
         for (c, chunk) in job.refl.chunks(at_once).enumerate() {
@@ -274,25 +277,41 @@ fn decode_inputs(
                 .enumerate()
                 .map(|(i, p)| {
                     let k = c * at_once + i;
-                    io::read_pass(p, &settings.pass_options(settings.layers.refl.get(k)))
+                    let rows = u16::try_from(k)
+                        .ok()
+                        .and_then(|plane| rows.get(&plane))
+                        .copied()
+                        .unwrap_or((i64::MIN, i64::MIN));
+                    io::read_pass_rows(p, &settings.pass_options(settings.layers.refl.get(k)), rows)
                 })
                 .collect::<Result<Vec<_>, _>>()?;
             passes.extend(decoded);
         }
         Ok(passes)
     };
-    let (trans, (mask, refl)) = rayon::join(read_trans, || {
-        rayon::join(
-            || glassdb_mask::read_placed_mask(&job.mask, &settings.mask),
-            read_refl,
-        )
-    });
+    let mask_then_refl = || -> Result<(PlacedMask, Vec<Pass>), ComposeError> {
+        let mask = glassdb_mask::read_placed_mask(&job.mask, &settings.mask)?;
+        let at = in_frame(mask.windows, !mask.has_coordinates, display).data;
+        let rows = mask
+            .image
+            .plane_bounds()
+            .into_iter()
+            .map(|(plane, b)| {
+                let y = i64::from(at.y);
+                (plane, (y + i64::from(b.y_min), y + i64::from(b.y_max)))
+            })
+            .collect();
+        let refl = read_refl(&rows)?;
+        Ok((mask, refl))
+    };
+    let (trans, mask_refl) = rayon::join(read_trans, mask_then_refl);
     let (trans, frame) = trans?;
+    let (mask, refl) = mask_refl?;
     Ok(DecodedInputs {
         trans,
         frame,
-        refl: refl?,
-        mask: mask?,
+        refl,
+        mask,
     })
 }
 
@@ -501,7 +520,12 @@ pub(crate) fn compose_frame_within(
 
     progress.stage(decode_stage);
     let t0 = Instant::now();
-    let plan::FramePlan { space, memory } = plan::plan_frame(job, settings)?;
+    let plan::FramePlan {
+        space,
+        display,
+        refl_windows: stored_refl_windows,
+        memory,
+    } = plan::plan_frame(job, settings)?;
     let (table, lut) = luts.for_space(&space, &job.trans, &settings.registry_label)?;
     if memory.total > budget.limit() {
         return Err(ComposeError::MemoryLimit {
@@ -518,7 +542,7 @@ pub(crate) fn compose_frame_within(
         mut frame,
         refl,
         mask,
-    } = decode_inputs(job, settings)?;
+    } = decode_inputs(job, settings, &display)?;
     let decode = t0.elapsed();
 
     progress.stage(composite_stage);
@@ -566,7 +590,9 @@ pub(crate) fn compose_frame_within(
             plane,
             pass: job.refl[plane].clone(),
             pixels,
-            pass_window: refl_windows[plane].data,
+            pass_window: stored_refl_windows
+                .get(plane)
+                .map_or(refl_windows[plane].data, |w| w.data),
             bounds: absolute_from(&bounds, &data),
         });
     }

@@ -20,6 +20,11 @@ use crate::{ComposeError, ComposeJob, ComposeSettings, check_frames, in_frame};
 pub(crate) struct FramePlan {
     /// The passes' one colour space.
     pub(crate) space: PassSpace,
+    /// The frame's display window (the transmission pass's), where a PNG mask is placed.
+    pub(crate) display: glassdb_image::PixelWindow,
+    /// Each reflection pass's windows in the frame as its file stores them (decoding may keep
+    /// only the rows its plane's glass needs).
+    pub(crate) refl_windows: Vec<ImageWindows>,
     pub(crate) memory: MemoryEstimate,
 }
 
@@ -50,6 +55,7 @@ pub(crate) fn plan_frame(
         )
     }));
     check_frames(job, &trans.windows, &others)?;
+    let refl_windows = others.iter().skip(1).map(|(_, w)| *w).collect();
 
     let declared = settings.input_space;
     let trans_space = colour::pass_space(&job.trans, &trans.colour, declared)?;
@@ -74,7 +80,12 @@ pub(crate) fn plan_frame(
     }
 
     let memory = estimate(job, settings, &trans, &refl, &mask, &mask_windows)?;
-    Ok(FramePlan { space, memory })
+    Ok(FramePlan {
+        space,
+        display,
+        refl_windows,
+        memory,
+    })
 }
 
 /// The frame's memory from the headers (module docs of [`crate::memory`]).

@@ -253,9 +253,24 @@ pub fn read_exr_channels(
     channels: &[usize],
     max_pixels: u64,
 ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
+    read_exr_channel_rows(bytes, part, channels, max_pixels, None)
+}
+
+/// [`read_exr_channels`] of only the rows `rows` of the data window (absolute pixel
+/// coordinates, `y_first..=y_last`; `None`: every row): only the blocks holding them are
+/// decompressed. The part returned describes what was decoded: its data window is the whole
+/// blocks covering those rows (full width), so that it places the buffers in the frame. Rows
+/// outside the data window are ignored; none inside decodes the first block.
+pub fn read_exr_channel_rows(
+    bytes: &[u8],
+    part: usize,
+    channels: &[usize],
+    max_pixels: u64,
+    rows: Option<(i64, i64)>,
+) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
     // Headers first, so that the size limit is enforced before the offset tables are read.
     let parts = read_exr_headers(bytes)?;
-    let info = parts
+    let mut info = parts
         .get(part)
         .cloned()
         .ok_or_else(|| unsupported(format!("part {part} (the file has {})", parts.len())))?;
@@ -275,19 +290,46 @@ pub fn read_exr_channels(
     if band_height == 0 {
         return Err(unsupported("tile height 0".into()));
     }
+    let band_count = info.height.div_ceil(band_height);
+    // The bands (block rows) holding the rows asked for, relative to the data window.
+    let (first_band, end_band) = match rows {
+        None => (0, band_count),
+        Some((y_first, y_last)) => {
+            let top = i64::from(info.data_window.y);
+            let bottom = top + info.height as i64 - 1;
+            if y_last < top || y_first > bottom || y_first > y_last {
+                (0, 1)
+            } else {
+                let first = (y_first.max(top) - top) as usize;
+                let last = (y_last.min(bottom) - top) as usize;
+                (first / band_height, last / band_height + 1)
+            }
+        }
+    };
     let chunks = guarded(|| {
         reader
             .filter_chunks(false, |_, tile, block| {
-                block.layer == part && tile.level_index == Vec2(0, 0)
+                block.layer == part
+                    && tile.level_index == Vec2(0, 0)
+                    && (first_band..end_band).contains(&tile.tile_index.y())
             })?
             .collect::<exr::error::Result<Vec<Chunk>>>()
     })?;
-    let band_chunks = chunks_by_band(chunks, &header, info.height.div_ceil(band_height))?;
+    let band_chunks = chunks_by_band(chunks, &header, first_band, end_band)?;
     let layout = BandLayout {
         width: info.width,
         height: info.height,
         band_height,
+        first_band,
+        end_band,
     };
+    if (first_band, end_band) != (0, band_count) {
+        let y_start = first_band * band_height;
+        let decoded_rows = (end_band * band_height).min(info.height) - y_start;
+        info.data_window.y += y_start as i32;
+        info.data_window.height = decoded_rows;
+        info.height = decoded_rows;
+    }
     // A channel asked for twice is decoded once and copied.
     let mut unique: Vec<usize> = channels.to_vec();
     unique.sort_unstable();
@@ -349,15 +391,17 @@ pub fn check_exr_readable(
 fn chunks_by_band(
     chunks: Vec<Chunk>,
     header: &Header,
-    band_count: usize,
+    first_band: usize,
+    end_band: usize,
 ) -> Result<Vec<Vec<Chunk>>, ImageError> {
-    let mut bands: Vec<Vec<Chunk>> = (0..band_count).map(|_| Vec::new()).collect();
+    let mut bands: Vec<Vec<Chunk>> = (first_band..end_band).map(|_| Vec::new()).collect();
     for chunk in chunks {
         let tile = guarded(|| header.get_block_data_indices(&chunk.compressed_block))?;
         if tile.level_index != Vec2(0, 0) {
             continue;
         }
-        let band = bands.get_mut(tile.tile_index.y()).ok_or_else(|| {
+        let index = tile.tile_index.y().wrapping_sub(first_band);
+        let band = bands.get_mut(index).ok_or_else(|| {
             incomplete(format!(
                 "block row {} is outside the image",
                 tile.tile_index.y()
@@ -368,11 +412,14 @@ fn chunks_by_band(
     Ok(bands)
 }
 
-/// The image size and its division into bands of `band_height` rows.
+/// The image size, its division into bands of `band_height` rows, and the bands decoded
+/// (`first_band..end_band`).
 struct BandLayout {
     width: usize,
     height: usize,
     band_height: usize,
+    first_band: usize,
+    end_band: usize,
 }
 
 /// Decompresses every band in parallel straight into one output buffer per selected channel,
@@ -389,7 +436,11 @@ fn decode_bands(
         width,
         height,
         band_height,
+        first_band,
+        end_band,
     } = *layout;
+    let y_start = first_band * band_height;
+    let decoded_rows = (end_band * band_height).min(height).saturating_sub(y_start);
     // Which output buffer each channel of the part goes to.
     let mut target: Vec<Option<usize>> = vec![None; info.channels.len()];
     for (k, &c) in channels.iter().enumerate() {
@@ -401,7 +452,7 @@ fn decode_bands(
 
     let mut outputs: Vec<Vec<f32>> = channels
         .iter()
-        .map(|_| vec![0f32; width * height])
+        .map(|_| vec![0f32; width * decoded_rows])
         .collect();
     let mut band_slices: Vec<Vec<&mut [f32]>> = band_chunks
         .iter()
@@ -421,7 +472,7 @@ fn decode_bands(
         .zip(band_chunks.into_par_iter())
         .enumerate()
         .try_for_each(|(band, (mut slices, chunks))| -> Result<(), ImageError> {
-            let y0 = band * band_height;
+            let y0 = (first_band + band) * band_height;
             let rows = band_height.min(height - y0);
             let mut written = 0usize;
             for chunk in chunks {

@@ -31,8 +31,8 @@ pub use exr_layers::{
 };
 pub use exr_read::{
     ExactExr, ExactPart, ExrChannelInfo, ExrColourTag, ExrHeaders, ExrPart, ExrSampleType,
-    check_exr_readable, read_exr_attributes, read_exr_channels, read_exr_exact,
-    read_exr_header_info, read_exr_headers, read_exr_text_attributes,
+    check_exr_readable, read_exr_attributes, read_exr_channel_rows, read_exr_channels,
+    read_exr_exact, read_exr_header_info, read_exr_headers, read_exr_text_attributes,
 };
 pub use exr_write::{
     ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport, PlaneSamples,
@@ -136,6 +136,17 @@ impl ExrFile<'_> {
         channels: &[usize],
     ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
         read_exr_channels(self.bytes, part, channels, self.max_pixels)
+    }
+
+    /// [`Self::read_channels`] of rows `y_first..=y_last` only (absolute pixel coordinates;
+    /// see [`read_exr_channel_rows`]): the part returned has the decoded blocks' window.
+    pub fn read_channel_rows(
+        &self,
+        part: usize,
+        channels: &[usize],
+        rows: (i64, i64),
+    ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
+        read_exr_channel_rows(self.bytes, part, channels, self.max_pixels, Some(rows))
     }
 }
 

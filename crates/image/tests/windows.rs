@@ -96,3 +96,42 @@ fn an_exact_copy_keeps_windows_attributes_and_samples() {
     );
     assert_eq!(again.attributes.pixel_aspect, exact.attributes.pixel_aspect);
 }
+
+#[test]
+fn reading_some_rows_decodes_the_blocks_holding_them_and_places_them() {
+    // OpenEXR's t08.exr: data window (30, 40)–(429, 339), read whole and by rows.
+    let bytes = sample("t08.exr");
+    let ImageFile::Exr(exr) = open_image(&bytes, 1 << 24).unwrap() else {
+        panic!("not an EXR");
+    };
+    let full = rgb(&bytes);
+    let part = &exr.parts()[0];
+    let lines = part.compression.scan_lines_per_block();
+    let channels: Vec<usize> = ["R", "G", "B"]
+        .iter()
+        .map(|n| part.channels.iter().position(|c| c.name == *n).unwrap())
+        .collect();
+    for (first, last) in [(100, 100), (40, 60), (200, 500), (-10, 45), (339, 339)] {
+        let (info, planes) = exr.read_channel_rows(0, &channels, (first, last)).unwrap();
+        let w = info.data_window;
+        // Whole blocks of `lines` rows from the data window's top, covering the rows asked for.
+        assert_eq!((w.x, w.width), (30, 400));
+        assert_eq!((w.y - 40) % lines as i32, 0, "{first}-{last}: {w}");
+        assert!(
+            i64::from(w.y) <= first.max(40) && w.end_y() > last.min(339),
+            "{w}"
+        );
+        assert!(w.height <= (last.min(339) - first.max(40)) as usize + 2 * lines);
+        // The same samples as the whole read, where they are.
+        let rows = (w.y - 40) as usize..(w.y - 40) as usize + w.height;
+        for (got, all) in planes.iter().zip(&full) {
+            assert!(
+                got[..] == all[rows.start * 400..rows.end * 400],
+                "{first}-{last}: samples differ"
+            );
+        }
+    }
+    // Rows outside the data window decode the first block only.
+    let (info, _) = exr.read_channel_rows(0, &[0], (0, 10)).unwrap();
+    assert_eq!((info.data_window.y, info.data_window.height), (40, lines));
+}
