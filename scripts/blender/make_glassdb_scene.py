@@ -7,8 +7,10 @@
   (`Glass_clear`, pass index 1, in the plane y = 1; `Tinted_bronze`, pass index 5, in the plane
   x = 1.5), a floor, a wall and a box behind the glass, a red box on the camera's side (seen in
   the reflections), a sun and a grey-blue world; the camera moves over frames 1-2.
-- `example` (docs/blender.md): 320 × 240, a room with a glazed facade of 6 panes in two planes,
-  buildings outside, sun and sky, the camera moving over frames 1-3.
+- `example` (docs/blender.md): 320 × 240, 64 samples, a room (floor, ceiling with a luminous panel,
+  walls, a table and a cabinet) with a glazed facade (two `Glass_clear` panes either side of a
+  mullion, plane y = 2) and a `Tinted_bronze` side window (plane x = 3), buildings outside,
+  the sun shining in and a blue world; the camera moves and turns over frames 1-3.
 
 Every coordinate is a multiple of 1/8 (exact in float32 and in text). With `--index DIR` the
 saved scene is also rendered once per frame with 1 sample through each pixel centre
@@ -34,6 +36,7 @@ MATERIALS = {
     "Box_red": ((0.65, 0.10, 0.08), 0.6, 0),
     "Box_green": ((0.15, 0.50, 0.15), 0.7, 0),
     "Building": ((0.55, 0.52, 0.48), 0.9, 0),
+    "Lamp": ((1.0, 0.95, 0.85), 4.0, 0),  # emission colour and strength
     "Glass_clear": ((1.0, 1.0, 1.0), 0.0, 1),
     "Tinted_bronze": ((0.55, 0.40, 0.25), 0.0, 5),
 }
@@ -70,6 +73,11 @@ def example():
         ("Ceiling", "Wall", quad((-4.0, -4.0, 3.0), (-4.0, 2.0, 3.0), (3.0, 2.0, 3.0), (3.0, -4.0, 3.0))),
         ("BackWall", "Wall", quad((-4.0, -4.0, 0.0), (3.0, -4.0, 0.0), (3.0, -4.0, 3.0), (-4.0, -4.0, 3.0))),
         ("LeftWall", "Wall", quad((-4.0, -4.0, 0.0), (-4.0, -4.0, 3.0), (-4.0, 2.0, 3.0), (-4.0, 2.0, 0.0))),
+        ("RightWall", "Wall", quad((3.0, -4.0, 0.0), (3.0, -2.5, 0.0), (3.0, -2.5, 3.0), (3.0, -4.0, 3.0))),
+        ("SideSill", "Building", box(3.0, -2.5, 0.0, 3.125, 2.0, 0.375)),
+        # A luminous ceiling panel (an emissive mesh, which camera rays see too, unlike a
+        # Cycles lamp object), so that the room shows in the glass's reflections.
+        ("Lamp", "Lamp", quad((-1.75, -2.25, 2.875), (-0.25, -2.25, 2.875), (-0.25, -0.75, 2.875), (-1.75, -0.75, 2.875))),
         ("Table", "Box_red", box(-1.5, -1.5, 0.0, 0.0, -0.5, 0.75)),
         ("Cabinet", "Box_green", box(-3.75, -3.75, 0.0, -3.0, -2.0, 1.5)),
         # Facade mullions and sill (opaque), between the panes.
@@ -89,7 +97,7 @@ def example():
     cameras = {1: ((-2.5, -3.5, 1.5), (0.5, 2.0, 1.5)),
                2: ((-2.0, -3.5, 1.5), (1.25, 2.0, 1.5)),
                3: ((-1.5, -3.5, 1.5), (2.0, 2.0, 1.5))}
-    return objects, cameras, (320, 240), 64, (50.0, 0.0, 40.0)
+    return objects, cameras, (320, 240), 64, (50.0, 0.0, 200.0)
 
 
 def material(name):
@@ -97,7 +105,14 @@ def material(name):
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     mat.pass_index = index
-    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    nt = mat.node_tree
+    if name == "Lamp":
+        emit = nt.nodes.new("ShaderNodeEmission")
+        emit.inputs["Color"].default_value = rgb + (1.0,)
+        emit.inputs["Strength"].default_value = rough
+        nt.links.new(emit.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+        return mat
+    bsdf = nt.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = rgb + (1.0,)
     bsdf.inputs["Roughness"].default_value = rough
     if name in ("Glass_clear", "Tinted_bronze"):

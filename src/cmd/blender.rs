@@ -188,5 +188,12 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         },
         report.mask_s
     );
+    if let Some(cpu) = report.render_cpu_s {
+        out!("Blender CPU: passes {cpu:.2} s");
+        if let Some(r) = report.reference_cpu_s {
+            out!(", reference {r:.2} s");
+        }
+        outln!();
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -24,7 +24,7 @@ use crate::job::{
     ExportInfo, FrameRecord, PixelBounds, RECORD_FORMAT, RECORD_NAME, RunRecord, ScriptFrame,
     ScriptJob, ScriptPlane,
 };
-use crate::program::{Blender, BlenderRun, check_blend_file};
+use crate::program::{Blender, BlenderRun, check_blend_file, children_cpu_seconds};
 use crate::thin_pane::ThinPane;
 
 /// The Blender-side script, embedded so that the binary needs nothing else.
@@ -71,11 +71,16 @@ pub struct RenderReport {
     pub record: RunRecord,
     pub planes: usize,
     pub glass_materials: Vec<(String, u16)>,
-    /// Seconds spent in Blender (export, passes, reference) and in glassdb's own steps.
+    /// Wall seconds of each step: Blender's export, passes and reference; glassdb's planes
+    /// and masks.
     pub export_s: f64,
     pub render_s: f64,
     pub reference_s: f64,
     pub mask_s: f64,
+    /// CPU seconds (user + system) of Blender's passes and of its reference render
+    /// ([`children_cpu_seconds`]), where the system says.
+    pub render_cpu_s: Option<f64>,
+    pub reference_cpu_s: Option<f64>,
     pub compose: ComposeReport,
 }
 
@@ -261,6 +266,7 @@ pub fn render(
     // 3. Blender renders the transmission and reflection passes.
     progress.stage("render passes");
     let t = Instant::now();
+    let cpu = children_cpu_seconds();
     let job = ScriptJob {
         resolution: resolution.clone(),
         samples: request.samples,
@@ -285,6 +291,7 @@ pub fn render(
         }
     }
     let render_s = t.elapsed().as_secs_f64();
+    let render_cpu_s = cpu_since(cpu);
     let record = RunRecord {
         format: RECORD_FORMAT.into(),
         blend: request.blend.display().to_string(),
@@ -304,9 +311,11 @@ pub fn render(
 
     // The Cycles reference: the same shader seen by the camera, no passes.
     let mut reference_s = 0.0;
+    let mut reference_cpu_s = None;
     if request.reference {
         progress.stage("render reference");
         let t = Instant::now();
+        let cpu = children_cpu_seconds();
         let job = ScriptJob {
             reference: true,
             frames: record
@@ -325,6 +334,7 @@ pub fn render(
             rename(&f.trans, &dir.join(frame_name("reference", f.frame)))?;
         }
         reference_s = t.elapsed().as_secs_f64();
+        reference_cpu_s = cpu_since(cpu);
     }
 
     // 4. The composites.
@@ -340,8 +350,15 @@ pub fn render(
         render_s,
         reference_s,
         mask_s,
+        render_cpu_s,
+        reference_cpu_s,
         compose,
     })
+}
+
+/// Children's CPU seconds since `before`.
+fn cpu_since(before: Option<f64>) -> Option<f64> {
+    Some(children_cpu_seconds()? - before?)
 }
 
 /// Writes the job and has Blender render it.

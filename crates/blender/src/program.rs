@@ -204,6 +204,18 @@ impl Blender {
     }
 }
 
+/// CPU seconds (user + system) of the child processes this process has waited for so far
+/// (every Blender run), from `/proc/self/stat` (Linux; fields `cutime` and `cstime` in clock
+/// ticks of 1/100 s, Linux's USER_HZ); `None` where that file cannot be read.
+pub fn children_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // After the command name in parentheses: field 3 (state) onwards.
+    let fields: Vec<&str> = stat[stat.rfind(')')? + 1..].split_whitespace().collect();
+    let cutime: f64 = fields.get(13)?.parse().ok()?;
+    let cstime: f64 = fields.get(14)?.parse().ok()?;
+    Some((cutime + cstime) / 100.0)
+}
+
 /// "exit code 1" or "killed by signal 11 (a crash)".
 fn describe_status(status: ExitStatus) -> String {
     #[cfg(unix)]
@@ -282,6 +294,19 @@ mod tests {
         );
         assert_eq!(parse_version("bash: blender: not found"), None);
         assert!(parse_version("Blender 2.93.1").unwrap().1 < MINIMUM_VERSION);
+    }
+
+    #[test]
+    fn children_cpu_counts_a_waited_child() {
+        let before = children_cpu_seconds().expect("Linux /proc");
+        // A child that spins for a while on the CPU.
+        let status = Command::new("sh")
+            .args(["-c", "i=0; while [ $i -lt 200000 ]; do i=$((i+1)); done"])
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let after = children_cpu_seconds().unwrap();
+        assert!(after > before, "{before} -> {after}");
     }
 
     #[test]
