@@ -1,7 +1,7 @@
 """The numbers of docs/blender.md ("Validation against Cycles"), from two runs of
 `glassdb blender render … --reference` with seeds 0 and 1 (scripts/blender_validation.sh).
 
-    .venv/bin/python scripts/blender_validation.py DIR
+    .venv/bin/python scripts/blender_validation.py DIR [FIGURE.png]
 
 DIR holds seed0/ and seed1/ (each with composite.####.exr, reference.####.exr,
 mask.####.exr, glassdb-blender.json and the command's output in run.txt) and swap.txt (the
@@ -25,8 +25,15 @@ import os
 import re
 import sys
 
+from pathlib import Path
+
 import numpy as np
 import OpenEXR
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python_oracle"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from exr_oracle import write_png_rgb8  # noqa: E402
+from blender_example_figure import srgb8  # noqa: E402
 
 
 def read(path, names):
@@ -90,6 +97,17 @@ def time_v(path):
             "max_rss_kb": get("Maximum resident set size (kbytes)")}
 
 
+def figure(runs, frame, out):
+    """Frame `frame`: reference | composite | 4 × |error| (each the mean of its two seeds), sRGB
+    clipped, 2 × nearest."""
+    name = lambda run, stem: os.path.join(runs[run], "%s.%04d.exr" % (stem, frame))
+    ref = (rgb(name(0, "reference")) + rgb(name(1, "reference"))) / 2
+    comp = (rgb(name(0, "composite")) + rgb(name(1, "composite"))) / 2
+    panels = [srgb8(ref), srgb8(comp), srgb8(4 * np.abs(comp - ref))]
+    image = np.concatenate(panels, axis=1).repeat(2, axis=0).repeat(2, axis=1)
+    write_png_rgb8(out, image)
+
+
 def main():
     root = sys.argv[1]
     runs = [os.path.join(root, "seed%d" % s) for s in (0, 1)]
@@ -107,10 +125,20 @@ def main():
         edge = glass & edges(idm, plane)
         inner = glass & ~edge
         every = np.ones_like(glass)
+        # Interior glass pixels at high-contrast detail (the 3 × 3 range of the two-seed mean
+        # reference above 0.1 in some channel: edges of what is reflected or seen through).
+        mean_ref = (ref[0] + ref[1]) / 2
+        pad = np.pad(mean_ref, ((1, 1), (1, 1), (0, 0)), mode="edge")
+        stack = np.stack([pad[1 + dy:1 + dy + mean_ref.shape[0], 1 + dx:1 + dx + mean_ref.shape[1]]
+                          for dy in (-1, 0, 1) for dx in (-1, 0, 1)])
+        detail = (stack.max(axis=0) - stack.min(axis=0)).max(axis=-1) > 0.1
+        inner_detail = inner & detail
+        inner_smooth = inner & ~detail
         r = {"frame": fr, "pixels": int(glass.size), "glass_pixels": int(glass.sum()),
              "edge_pixels": int(edge.sum())}
         for region, sel in (("overall", every), ("glass", glass), ("edges", edge),
-                            ("interior", inner), ("outside", ~glass)):
+                            ("interior", inner), ("interior, detail", inner_detail),
+                            ("interior, smooth", inner_smooth), ("outside", ~glass)):
             m = mse(comp[0], ref[1], sel)
             sc = mse(comp[0], comp[1], sel) / 2
             sr = mse(ref[0], ref[1], sel) / 2
@@ -151,6 +179,8 @@ def main():
                         "glass_noise_variance_ratio_reference_over_composite": ratio,
                         "passes_cpu_s": passes_cpu, "reference_cpu_s": reference_cpu,
                         "reference_cpu_s_at_equal_glass_noise": reference_cpu * ratio}}
+    if len(sys.argv) > 2:
+        figure(runs, record["frames"][0]["frame"], sys.argv[2])
     with open(os.path.join(root, "metrics.json"), "w") as fh:
         json.dump(metrics, fh, indent=1)
     print("| frame | overall PSNR | glass PSNR | glass pixels (edges) | reference seeds, glass |")
@@ -162,7 +192,8 @@ def main():
     print()
     print("| region | PSNR | two-seed means | MSE | σc² composite noise | σr² reference noise | bias² (systematic) |")
     print("|---|---|---|---|---|---|---|")
-    for region in ("overall", "glass", "edges", "interior", "outside"):
+    for region in ("overall", "glass", "edges", "interior", "interior, detail",
+                   "interior, smooth", "outside"):
         s = summary[region]
         print("| %s (%d) | %.2f dB | %.2f dB | %.3g | %.3g | %.3g | %.3g |" % (
             region, s["pixels"], s["psnr_db"], s["psnr_two_seed_mean_db"],

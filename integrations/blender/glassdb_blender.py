@@ -22,12 +22,13 @@ One file, used two ways:
 
 How the passes are made:
 
-- Glass materials (the ones glassdb matched to a registry id) become a thin pane: for camera
-  rays a clear Transparent BSDF (the camera sees through: glassdb adds the glass), for every
-  other ray Glossy (roughness 0, colour r(θ)) + Transparent (colour t(θ)), r and t per
-  channel from the registry's curves through a 32-stop Color Ramp over |N·I| (front or back
-  reflectance by the Backfacing output), so sunlight through the window is filtered and
-  reflected by the glass.
+- Glass materials (the ones glassdb matched to a registry id) become a thin pane: Glossy
+  (roughness 0, colour r(θ)) + Transparent (colour t(θ)), r and t per channel from the
+  registry's curves through a 32-stop Color Ramp over |N·I| (front or back reflectance by the
+  Backfacing output), so sunlight through the window is filtered and reflected by the glass;
+  except for camera rays where glassdb adds the glass itself: a clear Transparent BSDF on the
+  first glass the camera meets (transmission pass) or on and behind the mirror's plane
+  (reflection pass), so that glass seen through glass or in a mirror stays a pane.
 - Reflection pass of plane n·x + d = 0: a copy of the camera with matrix R @ matrix_world (R the
   reflection about the plane, determinant −1); every other material mixes in a Transparent BSDF
   where Is Camera Ray and the shading point lies on the far side of the plane from the real
@@ -217,7 +218,8 @@ def colour_ramp(nt, cos_values, colours, location):
 
 def make_thin_pane(mat, glass, camera_sees_through):
     """Replaces mat's surface by the thin pane of `glass` (cos, r_front, r_back, t tables);
-    with camera_sees_through, camera rays pass it untouched."""
+    with camera_sees_through, camera rays pass the glass untouched where set_clip says (and
+    the GlassClip returned holds the nodes it sets)."""
     mat.use_nodes = True
     nt = mat.node_tree
     for node in list(nt.nodes):
@@ -259,18 +261,63 @@ def make_thin_pane(mat, glass, camera_sees_through):
     nt.links.new(through.outputs[0], add.inputs[1])
     if not camera_sees_through:
         nt.links.new(add.outputs[0], out.inputs["Surface"])
-        return
+        return None
+    # Clear for camera rays: in the transmission pass where no transparent surface was crossed
+    # yet (the first glass the camera sees; glass behind it stays a pane); in the reflection
+    # pass of plane K on or behind plane K (the mirror itself, and what is clipped), so that
+    # other glass seen in the mirror stays a pane. set_clip chooses the pass.
+    lp = nt.nodes.new("ShaderNodeLightPath")
+    lp.location = (400, 600)
+    first = nt.nodes.new("ShaderNodeMath")
+    first.operation = "LESS_THAN"
+    first.inputs[1].default_value = 0.5
+    nt.links.new(lp.outputs["Transparent Depth"], first.inputs[0])
+    enable_trans = nt.nodes.new("ShaderNodeMath")
+    enable_trans.operation = "MULTIPLY"
+    nt.links.new(first.outputs[0], enable_trans.inputs[0])
+    pos = nt.nodes.new("ShaderNodeNewGeometry")
+    dot_p = nt.nodes.new("ShaderNodeVectorMath")
+    dot_p.operation = "DOT_PRODUCT"
+    nt.links.new(pos.outputs["Position"], dot_p.inputs[0])
+    add_p = nt.nodes.new("ShaderNodeMath")
+    add_p.operation = "ADD"
+    nt.links.new(dot_p.outputs["Value"], add_p.inputs[0])
+    behind = nt.nodes.new("ShaderNodeMath")
+    behind.operation = "GREATER_THAN"
+    behind.name = CLIP_PREFIX + "_glass_tolerance"
+    nt.links.new(add_p.outputs["Value"], behind.inputs[0])
+    enable_refl = nt.nodes.new("ShaderNodeMath")
+    enable_refl.operation = "MULTIPLY"
+    nt.links.new(behind.outputs[0], enable_refl.inputs[0])
+    either = nt.nodes.new("ShaderNodeMath")
+    either.operation = "MAXIMUM"
+    nt.links.new(enable_trans.outputs[0], either.inputs[0])
+    nt.links.new(enable_refl.outputs[0], either.inputs[1])
+    camera = nt.nodes.new("ShaderNodeMath")
+    camera.operation = "MULTIPLY"
+    nt.links.new(lp.outputs["Is Camera Ray"], camera.inputs[0])
+    nt.links.new(either.outputs[0], camera.inputs[1])
+    for k, node in enumerate((first, enable_trans, pos, dot_p, add_p, behind, enable_refl, either,
+                              camera)):
+        node.location = (-900 + 150 * k, 700)
     clear = nt.nodes.new("ShaderNodeBsdfTransparent")
     clear.location = (400, -300)
     clear.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    lp = nt.nodes.new("ShaderNodeLightPath")
-    lp.location = (400, 400)
     mix = nt.nodes.new("ShaderNodeMixShader")
     mix.location = (650, 0)
-    nt.links.new(lp.outputs["Is Camera Ray"], mix.inputs["Fac"])
+    nt.links.new(camera.outputs[0], mix.inputs["Fac"])
     nt.links.new(add.outputs[0], mix.inputs[1])
     nt.links.new(clear.outputs[0], mix.inputs[2])
     nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    return GlassClip(dot_p, add_p, behind, enable_refl, enable_trans)
+
+
+class GlassClip:
+    """The nodes of a glass material that set_clip sets per pass."""
+
+    def __init__(self, dot, add, behind, enable_refl, enable_trans):
+        self.dot, self.add, self.behind = dot, add, behind
+        self.enable_refl, self.enable_trans = enable_refl, enable_trans
 
 
 def add_clip(mat):
@@ -316,9 +363,22 @@ def add_clip(mat):
     return dot, add, enable
 
 
-def set_clip(clips, plane):
+def set_clip(clips, glass_clips, plane, tolerance=0.0):
     """Camera rays see through what lies on the far side of `plane` ((a, b, c, d) with the
-    real camera on the positive side), or nothing is clipped when plane is None."""
+    real camera on the positive side) and through glass on or behind it (within `tolerance`),
+    or, when plane is None (the transmission pass), nothing is clipped and camera rays see
+    through the first glass they meet."""
+    for g in glass_clips:
+        if plane is None:
+            g.enable_refl.inputs[1].default_value = 0.0
+            g.enable_trans.inputs[1].default_value = 1.0
+            continue
+        a, b, c, d = plane
+        g.dot.inputs[1].default_value = (-a, -b, -c)
+        g.add.inputs[1].default_value = -d
+        g.behind.inputs[1].default_value = -tolerance
+        g.enable_refl.inputs[1].default_value = 1.0
+        g.enable_trans.inputs[1].default_value = 0.0
     for dot, add, enable in clips:
         if plane is None:
             enable.inputs[1].default_value = 0.0
@@ -380,9 +440,12 @@ def render(opts):
     if missing:
         fail("no material %s in %s" % (", ".join(missing), bpy.data.filepath))
     clips = []
+    glass_clips = []
     for mat in bpy.data.materials:
         if mat.name in glass_by_name:
-            make_thin_pane(mat, glass_by_name[mat.name], job.get("reference", False) is False)
+            g = make_thin_pane(mat, glass_by_name[mat.name], not job.get("reference", False))
+            if g is not None:
+                glass_clips.append(g)
         elif mat.use_nodes and mat.node_tree is not None:
             nodes = add_clip(mat)
             if nodes:
@@ -395,7 +458,7 @@ def render(opts):
         scene.frame_set(frame["frame"])
         scene.camera = real
         r.use_border = False
-        set_clip(clips, None)
+        set_clip(clips, glass_clips, None)
         render_still(scene, frame["trans"])
         m_real = real.matrix_world.copy()
         for plane in frame["planes"]:
@@ -408,7 +471,7 @@ def render(opts):
                 setattr(mirror_data, attr, getattr(real.data, attr))
             mirror.matrix_world = reflection_matrix(plane["equation"]) @ m_real
             scene.camera = mirror
-            set_clip(clips, plane["equation"])
+            set_clip(clips, glass_clips, plane["equation"], plane["tolerance"])
             x0, x1, y0, y1 = plane["border"]
             r.use_border = True
             r.use_crop_to_border = True

@@ -46,6 +46,8 @@ pub struct ScriptPlane {
     /// `[a, b, c, d]` of a·x + b·y + c·z + d = 0 in Blender's world, with the camera on the
     /// positive side.
     pub equation: [f64; 4],
+    /// Distance within which glass counts as on the plane (planes.json's tolerance).
+    pub tolerance: f64,
     /// Blender's render border `[min_x, max_x, min_y, max_y]`, fractions of the frame with y
     /// up, chosen so that Blender's truncation gives exactly the plane's pixel rectangle.
     pub border: [f64; 4],

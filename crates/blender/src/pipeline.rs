@@ -239,6 +239,7 @@ pub fn render(
                 script_planes.push(ScriptPlane {
                     index: k,
                     equation: facing.equation(),
+                    tolerance: report.planes.tolerance.distance,
                     border: b.blender_border(width, height),
                     output: staging.join(frame_name(&format!("refl_{k}"), frame)),
                 });

@@ -88,7 +88,7 @@ mod tests {
     }
 
     #[test]
-    fn the_bundled_glasses_ramp_within_a_percent() {
+    fn the_bundled_glasses_ramp_within_two_thousandths() {
         let registry = glassdb_registry::default_registry().unwrap();
         for glass in &registry.default_table().glasses {
             let pane = ThinPane::of("m", glass);
@@ -98,7 +98,8 @@ mod tests {
                 (glass.t0[1] * glass.c_t[1].eval(1.0)).clamp(0.0, 1.0)
             );
             let err = pane.ramp_error(glass, 2000);
-            assert!(err < 0.01, "glass {}: ramp error {err}", glass.id);
+            // Measured: 9.3e-4 (id 1), 8.9e-4 (id 5), absolute, in r or t.
+            assert!(err < 0.002, "glass {}: ramp error {err}", glass.id);
         }
     }
 }
