@@ -99,12 +99,12 @@ def time_v(path):
 
 def figure(runs, frame, out):
     """Frame `frame`: reference | composite | 4 × |error| (each the mean of its two seeds), sRGB
-    clipped, 2 × nearest."""
+    clipped."""
     name = lambda run, stem: os.path.join(runs[run], "%s.%04d.exr" % (stem, frame))
     ref = (rgb(name(0, "reference")) + rgb(name(1, "reference"))) / 2
     comp = (rgb(name(0, "composite")) + rgb(name(1, "composite"))) / 2
     panels = [srgb8(ref), srgb8(comp), srgb8(4 * np.abs(comp - ref))]
-    image = np.concatenate(panels, axis=1).repeat(2, axis=0).repeat(2, axis=1)
+    image = np.concatenate(panels, axis=1)
     write_png_rgb8(out, image)
 
 
