@@ -12,7 +12,7 @@ pub enum BlenderError {
         source: std::io::Error,
     },
     /// `blender --version` did not say which Blender it is.
-    #[error("{path} --version did not print a Blender version (it printed {printed:?})")]
+    #[error("{path} did not print a Blender version when asked for it (it printed {printed:?})")]
     VersionUnreadable { path: PathBuf, printed: String },
     /// A Blender older than the oldest one supported.
     #[error(
