@@ -63,6 +63,10 @@ pub struct RenderArgs {
     /// Blender's render threads (default: Blender's choice).
     #[arg(long)]
     pub threads: Option<u32>,
+    /// K×K rays per pixel for the masks' glass coverage at pane edges (1: the pixel centre
+    /// only).
+    #[arg(long, default_value_t = 1)]
+    pub mask_samples: u32,
     /// Also render the Cycles reference (the glass as a thin pane the camera sees, no passes)
     /// as DIR/reference.####.exr, for validation.
     #[arg(long)]
@@ -159,6 +163,7 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         seed: a.seed,
         threads: a.threads,
         reference: a.reference,
+        mask_samples: a.mask_samples,
     };
     let spinner = Spinner::on_terminal("blender");
     let report = glassdb_blender::render(&request, &registry, &spinner)?;

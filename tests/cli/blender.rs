@@ -487,6 +487,10 @@ fn bad_scene_files_and_output_dirs_are_refused() {
         &["missing.blend is not a Blender file"],
     );
     let blend = blend_stub(t.path());
+    fails_naming(
+        &mut render_with(&fake, &blend, &out, &["--mask-samples", "0"]),
+        &["samples"],
+    );
     let file = t.path().join("a-file");
     std::fs::write(&file, "").unwrap();
     fails_naming(

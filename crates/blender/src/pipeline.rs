@@ -52,6 +52,9 @@ pub struct RenderRequest {
     pub timeout: Duration,
     pub seed: u32,
     pub threads: Option<u32>,
+    /// K×K rays per pixel for the masks' glass coverage (1: the pixel centre only, no
+    /// coverage channel).
+    pub mask_samples: u32,
     /// Also render the Cycles reference (the glass as a thin pane seen by the camera) as
     /// `reference.####.exr`.
     pub reference: bool,
@@ -121,6 +124,11 @@ pub fn render(
             "no glass given: name the glass materials and their registry ids (PATTERN=ID)".into(),
         ));
     }
+    let options = RasterOptions {
+        cos: CosMode::Exact,
+        samples: request.mask_samples,
+    };
+    glassdb_scene::raster::check_options(&options)?;
     check_blend_file(&request.blend)?;
     let blender = Blender::find(request.blender.as_deref())?;
     let dir = &request.out_dir;
@@ -211,10 +219,7 @@ pub fn render(
                 })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let options = RasterOptions {
-        cos: CosMode::Exact,
-        samples: 1,
-    };
+
     let mut frames = Vec::new();
     let mut script_frames = Vec::new();
     let (mut width, mut height) = (0, 0);
