@@ -11,8 +11,8 @@ use glassdb_io::Progress;
 use glassdb_mask::{MaskFormat, write_mask};
 use glassdb_scene::{
     Camera, CameraSource, CosEncoding, CosMode, GlassMapping, MaskScene, MirrorRequest,
-    PlaneSource, PlaneTolerance, PlanesFile, RasterOptions, SceneWarning, build_mask_scene,
-    load_obj, rasterize, to_mask_image, write_virtual_scenes,
+    PlaneBoundsFile, PlaneSource, PlaneTolerance, PlanesFile, RasterOptions, SceneWarning,
+    build_mask_scene, load_obj, rasterize, to_mask_image, write_virtual_scenes,
 };
 
 use crate::cmd::progress::Spinner;
@@ -103,6 +103,10 @@ pub struct MaskArgs {
     /// matching reflection passes. Default: detect them as `mirror` does.
     #[arg(long, value_name = "PLANES.json")]
     pub planes: Option<PathBuf>,
+    /// Also write each plane's screen rectangle (pixel bounds, Blender render border) to this
+    /// JSON file, `####` replaced by the frame number as in -o (docs/scene.md, "Plane bounds").
+    #[arg(long, value_name = "BOUNDS.json")]
+    pub bounds: Option<PathBuf>,
     /// Plane grouping: largest angle between face normals, degrees.
     #[arg(long, default_value_t = 0.1)]
     pub angle_tolerance_deg: f64,
@@ -301,6 +305,15 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         ),
         _ => {}
     }
+    if let Some(bounds) = &args.bounds
+        && glassdb_io::is_frame_pattern(bounds) != glassdb_io::is_frame_pattern(&args.output)
+    {
+        bail!(
+            "--bounds {} and -o {} must both have #### for the frame number, or neither",
+            bounds.display(),
+            args.output.display()
+        );
+    }
     // Every file the mask is made from: the OBJ, its material libraries, the planes file and
     // the camera (of each frame). No output may replace one.
     let mut inputs: Vec<PathBuf> = vec![args.scene.clone()];
@@ -371,7 +384,16 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
     let Some(frames) = frames else {
         let camera = source.camera(None)?;
         let t1 = Instant::now();
-        let mask = job.render(&camera, &args.output, &spinner)?;
+        if let Some(bounds) = &args.bounds {
+            refuse_inputs(bounds, &args.camera, &inputs)?;
+        }
+        let mask = job.render(
+            &camera,
+            &args.output,
+            args.bounds.as_deref(),
+            None,
+            &spinner,
+        )?;
         let t_raster = t1.elapsed();
         spinner.finish();
         outln!(
@@ -426,8 +448,17 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             };
             let camera_path = source.path(Some(frame));
             refuse_inputs(&output, &camera_path, &inputs)?;
+            let bounds = match &args.bounds {
+                Some(b) if glassdb_io::is_frame_pattern(b) => {
+                    Some(glassdb_io::expand_frame_pattern(b, frame)?)
+                }
+                other => other.clone(),
+            };
+            if let Some(b) = &bounds {
+                refuse_inputs(b, &camera_path, &inputs)?;
+            }
             let camera = source.camera(Some(frame))?;
-            let mask = job.render(&camera, &output, &spinner)?;
+            let mask = job.render(&camera, &output, bounds.as_deref(), Some(frame), &spinner)?;
             Ok((output, mask))
         })();
         match result {
@@ -478,12 +509,14 @@ struct FrameMask {
 }
 
 impl MaskJob<'_> {
-    /// Rasterises the scene from `camera` and writes the mask to `output`, telling `progress`
-    /// of each stage.
+    /// Rasterises the scene from `camera` and writes the mask to `output` (and its planes'
+    /// rectangles to `bounds`), telling `progress` of each stage.
     fn render(
         &self,
         camera: &Camera,
         output: &Path,
+        bounds: Option<&Path>,
+        frame: Option<u32>,
         progress: &dyn Progress,
     ) -> anyhow::Result<FrameMask> {
         progress.stage("rasterise");
@@ -497,6 +530,9 @@ impl MaskJob<'_> {
         progress.stage("write");
         let mask = to_mask_image(out, encoding);
         write_mask(output, &mask, self.format)?;
+        if let Some(bounds) = bounds {
+            PlaneBoundsFile::from_mask(&mask, frame, &output.to_string_lossy()).write(bounds)?;
+        }
         Ok(FrameMask {
             width: mask.width,
             height: mask.height,

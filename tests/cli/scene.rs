@@ -564,3 +564,108 @@ fn mirror_refers_to_every_material_library_of_the_scene() {
     let area = planes["planes"][0]["area"].as_f64().unwrap();
     assert!((area - 5.0).abs() < 1e-9, "{area}");
 }
+
+/// Each plane's rectangle of glass pixels in a packed PNG mask (R plane, G id), computed here
+/// from the decoded samples: (plane, [x_min, y_min, x_max, y_max], glass pixels).
+fn png_mask_rectangles(path: &Path) -> Vec<(u16, [i64; 4], u64)> {
+    let img = crate::util::read_png_planes(path);
+    let mut found: std::collections::BTreeMap<u16, ([i64; 4], u64)> = Default::default();
+    for y in 0..img.height {
+        for x in 0..img.width {
+            let k = y * img.width + x;
+            if img.channels[1][k] == 0.0 {
+                continue;
+            }
+            let (x, y) = (x as i64, y as i64);
+            let e = found
+                .entry(img.channels[0][k] as u16)
+                .or_insert(([x, y, x, y], 0));
+            e.0 = [e.0[0].min(x), e.0[1].min(y), e.0[2].max(x), e.0[3].max(y)];
+            e.1 += 1;
+        }
+    }
+    found.into_iter().map(|(p, (r, n))| (p, r, n)).collect()
+}
+
+/// The rectangles of a bounds file, checking its frame, size and Blender border on the way.
+fn bounds_rectangles(path: &Path, frame: Option<u32>) -> Vec<(u16, [i64; 4], u64)> {
+    let b = json(path);
+    assert_eq!(b["format"], "glassdb-plane-bounds/1");
+    assert_eq!(b["frame"], serde_json::json!(frame));
+    let (w, h) = (b["width"].as_f64().unwrap(), b["height"].as_f64().unwrap());
+    b["planes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let r: Vec<i64> = p["data_window"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_i64().unwrap())
+                .collect();
+            let border = &p["blender_border"];
+            // Blender's border is y-up, in fractions of the frame, on the rectangle's edges.
+            let edges = [
+                (border["min_x"].as_f64().unwrap() * w).round() as i64,
+                (h - border["max_y"].as_f64().unwrap() * h).round() as i64,
+                (border["max_x"].as_f64().unwrap() * w).round() as i64 - 1,
+                (h - border["min_y"].as_f64().unwrap() * h).round() as i64 - 1,
+            ];
+            assert_eq!(edges.to_vec(), r, "{}", path.display());
+            (
+                p["plane"].as_u64().unwrap() as u16,
+                [r[0], r[1], r[2], r[3]],
+                p["glass_pixels"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn mask_bounds_give_each_planes_glass_rectangle_per_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mask.png");
+    let bounds = dir.path().join("bounds.json");
+    ok(mask_args(&out).arg("--bounds").arg(&bounds));
+    let want = png_mask_rectangles(&out);
+    assert_eq!(want.len(), 2, "both windows are in view");
+    assert_eq!(bounds_rectangles(&bounds, None), want);
+
+    // An animation: the camera steps right, so the rectangles move; one file per frame.
+    let cam = json(&camera());
+    let mut frames = serde_json::Map::new();
+    for (frame, dx) in [(1, 0.0), (2, 0.4)] {
+        let mut c = cam.clone();
+        c["origin"][0] = serde_json::json!(c["origin"][0].as_f64().unwrap() + dx);
+        frames.insert(frame.to_string(), c);
+    }
+    let anim = write_file(
+        dir.path(),
+        "anim.json",
+        serde_json::json!({ "frames": frames })
+            .to_string()
+            .as_bytes(),
+    );
+    let masks = dir.path().join("m.####.png");
+    ok(mask_cmd(&anim, &["Clear*=1", "Tinted*=2"], &masks)
+        .arg("--bounds")
+        .arg(dir.path().join("b.####.json")));
+    let mut seen = Vec::new();
+    for frame in [1, 2] {
+        let m = dir.path().join(format!("m.{frame:04}.png"));
+        let b = dir.path().join(format!("b.{frame:04}.json"));
+        let rects = bounds_rectangles(&b, Some(frame));
+        assert_eq!(rects, png_mask_rectangles(&m), "frame {frame}");
+        seen.push(rects);
+    }
+    assert_ne!(seen[0], seen[1], "the camera moved");
+
+    // A pattern on one side only would put every frame's bounds in one file.
+    fails_naming(
+        mask_cmd(&anim, &["Clear*=1"], &masks)
+            .arg("--bounds")
+            .arg(dir.path().join("b.json")),
+        &["--bounds", "####"],
+    );
+}

@@ -89,6 +89,29 @@ impl MaskImage {
     }
 }
 
+/// One plane's screen rectangle in a mask: inclusive pixel bounds as in an OpenEXR data window
+/// (`x_min..=x_max`, `y_min..=y_max`, row 0 at the top) and the glass pixels inside.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlaneBounds {
+    pub x_min: i32,
+    pub y_min: i32,
+    pub x_max: i32,
+    pub y_max: i32,
+    pub glass_pixels: u64,
+}
+
+impl PlaneBounds {
+    /// The rectangle as a [`PixelWindow`] (top-left pixel and size).
+    pub fn window(&self) -> PixelWindow {
+        PixelWindow {
+            x: self.x_min,
+            y: self.y_min,
+            width: (self.x_max - self.x_min) as usize + 1,
+            height: (self.y_max - self.y_min) as usize + 1,
+        }
+    }
+}
+
 /// cos θ as the mask stores it: quantised codes ([`CosCode`]) are kept as codes so that
 /// lookups into 256-entry tables stay exact.
 #[derive(Debug, Clone, PartialEq)]
@@ -150,6 +173,44 @@ impl MaskImage {
             }
         }
         range
+    }
+
+    /// Each plane's screen rectangle: the smallest window holding every glass pixel (id ≠ 0)
+    /// of that plane, in the mask's pixel coordinates (row 0 at the top), with its glass pixel
+    /// count. Planes without glass in view are absent. What a renderer's border (crop) region
+    /// must cover for that plane's reflection pass (docs/scene.md, "Plane bounds").
+    pub fn plane_bounds(&self) -> BTreeMap<u16, PlaneBounds> {
+        let width = self.width as usize;
+        let mut out: BTreeMap<u16, PlaneBounds> = BTreeMap::new();
+        if width == 0 {
+            return out;
+        }
+        for (row, (ids, planes)) in self
+            .id
+            .chunks_exact(width)
+            .zip(self.plane.chunks_exact(width))
+            .enumerate()
+        {
+            for (col, (&id, &plane)) in ids.iter().zip(planes).enumerate() {
+                if id == 0 {
+                    continue;
+                }
+                let (x, y) = (col as i32, row as i32);
+                let b = out.entry(plane).or_insert(PlaneBounds {
+                    x_min: x,
+                    y_min: y,
+                    x_max: x,
+                    y_max: y,
+                    glass_pixels: 0,
+                });
+                b.x_min = b.x_min.min(x);
+                b.y_min = b.y_min.min(y);
+                b.x_max = b.x_max.max(x);
+                b.y_max = b.y_max.max(y);
+                b.glass_pixels += 1;
+            }
+        }
+        out
     }
 
     /// Largest plane index over glass pixels (0 without glass).

@@ -501,3 +501,62 @@ fn the_header_says_where_the_mask_lies_and_what_reading_it_costs_without_decodin
     let err = chain(&read_mask_header(&exr, &opts()).unwrap_err());
     assert!(err.contains("cos_theta") && err.contains("id"), "{err}");
 }
+
+#[test]
+fn plane_bounds_are_the_glass_rectangles_per_plane() {
+    // packed8: glass at (1,0) id 7 plane 0, (2,0) id 200 plane 2, (0,1) id 7 plane 1,
+    // (2,1) id 3 plane 0.
+    let b = packed8().plane_bounds();
+    assert_eq!(b.keys().copied().collect::<Vec<_>>(), vec![0, 1, 2]);
+    let p0 = b[&0];
+    assert_eq!((p0.x_min, p0.y_min, p0.x_max, p0.y_max), (1, 0, 2, 1));
+    assert_eq!(p0.glass_pixels, 2);
+    assert_eq!(
+        p0.window(),
+        PixelWindow {
+            x: 1,
+            y: 0,
+            width: 2,
+            height: 2
+        }
+    );
+    assert_eq!((b[&1].x_min, b[&1].y_min, b[&1].glass_pixels), (0, 1, 1));
+    assert_eq!((b[&2].x_max, b[&2].y_max), (2, 0));
+}
+
+proptest! {
+    /// Every glass pixel lies in its plane's rectangle, and every side of the rectangle touches
+    /// a glass pixel of that plane (brute force over the pixels).
+    #[test]
+    fn plane_bounds_are_tight(
+        (w, h, cells) in (1u32..9, 1u32..9).prop_flat_map(|(w, h)| {
+            (Just(w), Just(h), proptest::collection::vec((0u16..3, 0u16..3), (w * h) as usize))
+        })
+    ) {
+        let mask = MaskImage {
+            width: w,
+            height: h,
+            id: cells.iter().map(|c| c.0).collect(),
+            cos_theta: CosTheta::Normal,
+            plane: cells.iter().map(|c| c.1).collect(),
+            coverage: None,
+        };
+        let bounds = mask.plane_bounds();
+        for plane in 0u16..3 {
+            let pixels: Vec<(i32, i32)> = (0..(w * h) as usize)
+                .filter(|&i| mask.id[i] != 0 && mask.plane[i] == plane)
+                .map(|i| ((i % w as usize) as i32, (i / w as usize) as i32))
+                .collect();
+            match bounds.get(&plane) {
+                None => prop_assert!(pixels.is_empty()),
+                Some(b) => {
+                    prop_assert_eq!(b.glass_pixels, pixels.len() as u64);
+                    prop_assert_eq!(b.x_min, pixels.iter().map(|p| p.0).min().unwrap());
+                    prop_assert_eq!(b.x_max, pixels.iter().map(|p| p.0).max().unwrap());
+                    prop_assert_eq!(b.y_min, pixels.iter().map(|p| p.1).min().unwrap());
+                    prop_assert_eq!(b.y_max, pixels.iter().map(|p| p.1).max().unwrap());
+                }
+            }
+        }
+    }
+}

@@ -85,6 +85,16 @@ pub enum SceneError {
         #[source]
         source: serde_json::Error,
     },
+    /// A plane-bounds file (`glassdb mask --bounds`) that is not valid JSON of its schema.
+    #[error("plane bounds file {path}")]
+    BoundsJson {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
+    /// A plane-bounds file with a wrong format tag or a rectangle outside its frame.
+    #[error("plane bounds file {path}: {message}")]
+    BadBounds { path: PathBuf, message: String },
     /// An option value is out of range (tolerances, plane count).
     #[error("{message}")]
     BadOption { message: String },
@@ -97,9 +107,10 @@ pub enum SceneError {
     /// Neither glass materials nor an explicit plane say where the mirrors are.
     #[error("give the glass materials or one plane to mirror across")]
     NoGlassSelected,
-    /// `planes.json` could not be encoded (a non-finite number in a plane).
+    /// A JSON output (`planes.json`, a plane-bounds file) could not be encoded (a non-finite
+    /// number).
     #[error("cannot encode {path}")]
-    EncodePlanes {
+    EncodeJson {
         path: PathBuf,
         source: serde_json::Error,
     },

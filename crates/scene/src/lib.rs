@@ -3,6 +3,7 @@
 //! (section 3, eqs. 4–7), and the id + cos θ mask (sections 5–6) by z-buffer rasterisation.
 //! Conventions and formats: docs/scene.md.
 
+pub mod bounds_file;
 pub mod camera;
 pub mod error;
 pub mod mask;
@@ -16,6 +17,7 @@ pub mod triangulate;
 pub mod virtual_scene;
 pub mod warning;
 
+pub use bounds_file::{BlenderBorder, PLANE_BOUNDS_FORMAT, PlaneBoundsEntry, PlaneBoundsFile};
 pub use camera::{Camera, CameraSource, CameraSpec, SensorFit, ViewPlane};
 pub use error::SceneError;
 pub use mask::{

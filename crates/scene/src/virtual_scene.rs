@@ -292,7 +292,7 @@ fn write_planes_file(
     let planes_path = out_dir.join("planes.json");
     let inputs = scene.input_files();
     glassdb_io::refuse_input_as_output(&planes_path, inputs.iter().map(PathBuf::as_path))?;
-    let json = serde_json::to_string_pretty(file).map_err(|source| SceneError::EncodePlanes {
+    let json = serde_json::to_string_pretty(file).map_err(|source| SceneError::EncodeJson {
         path: planes_path.clone(),
         source,
     })?;
