@@ -16,7 +16,7 @@ use glassdb_mask::{GlassMapping, MaskFormat};
 use glassdb_registry::{ColourBasis, Registry, Side};
 use glassdb_scene::{
     CameraSource, CosEncoding, CosMode, MirrorRequest, PlaneSource, PlaneTolerance, RasterOptions,
-    RasterOutput, build_mask_scene, load_obj, rasterize, to_mask_image, write_virtual_scenes,
+    build_mask_scene, load_obj, rasterize, to_mask_image, write_virtual_scenes,
 };
 
 use crate::BlenderError;
@@ -225,15 +225,14 @@ pub fn render(
     let (mut width, mut height) = (0, 0);
     for &frame in &info.frames {
         let camera = cameras.camera(Some(frame))?;
-        let out = rasterize(&labelled.raster, &camera, &options)?;
-        (width, height) = (out.width, out.height);
-        let bounds = plane_bounds(&out, planes.len());
+        let mask = to_mask_image(
+            rasterize(&labelled.raster, &camera, &options)?,
+            CosEncoding::Float,
+        );
+        (width, height) = (mask.width, mask.height);
+        let bounds = plane_bounds(&mask, planes.len());
         let mask_name = frame_name("mask", frame);
-        glassdb_mask::write_mask(
-            &dir.join(&mask_name),
-            &to_mask_image(out, CosEncoding::Float),
-            MaskFormat::Exr,
-        )?;
+        glassdb_mask::write_mask(&dir.join(&mask_name), &mask, MaskFormat::Exr)?;
         let mut sides = Vec::new();
         let mut script_planes = Vec::new();
         for (k, plane) in planes.iter().enumerate() {
@@ -417,27 +416,18 @@ fn glass_of_materials(
         .collect())
 }
 
-/// The bounding rectangle of each plane's glass pixels (`None` where a plane has none).
-pub fn plane_bounds(out: &RasterOutput, planes: usize) -> Vec<Option<PixelBounds>> {
-    let mut rect: Vec<Option<[u32; 4]>> = vec![None; planes];
-    for (i, (&id, &plane)) in out.id.iter().zip(&out.plane).enumerate() {
-        if id == 0 {
-            continue;
-        }
-        let (x, y) = (i as u32 % out.width, i as u32 / out.width);
-        let r = &mut rect[plane as usize];
-        *r = Some(match *r {
-            None => [x, y, x, y],
-            Some([x0, y0, x1, y1]) => [x0.min(x), y0.min(y), x1.max(x), y1.max(y)],
-        });
-    }
-    rect.into_iter()
-        .map(|r| {
-            r.map(|[x0, y0, x1, y1]| PixelBounds {
-                x: x0,
-                y: y0,
-                width: x1 - x0 + 1,
-                height: y1 - y0 + 1,
+/// Each plane's glass rectangle from the mask (glassdb-mask's `plane_bounds`), `None` where a
+/// plane has no glass in the frame.
+fn plane_bounds(mask: &glassdb_mask::MaskImage, planes: usize) -> Vec<Option<PixelBounds>> {
+    let found = mask.plane_bounds();
+    (0..planes)
+        .map(|k| {
+            let b = u16::try_from(k).ok().and_then(|k| found.get(&k))?;
+            Some(PixelBounds {
+                x: b.x_min as u32,
+                y: b.y_min as u32,
+                width: (b.x_max - b.x_min + 1) as u32,
+                height: (b.y_max - b.y_min + 1) as u32,
             })
         })
         .collect()
