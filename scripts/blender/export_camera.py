@@ -22,10 +22,16 @@ Licence: same as the project, MIT OR Apache-2.0.
 """
 
 import json
+import os
 import sys
 
 import bpy
 from bpy_extras.io_utils import axis_conversion
+
+# The camera JSON is written by glassdb's Blender integration (one definition of the fields).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                "integrations", "blender"))
+from glassdb_blender import camera_json  # noqa: E402
 
 
 def parse_args(argv):
@@ -49,26 +55,6 @@ def parse_args(argv):
         sys.exit("usage: blender -b scene.blend -P export_camera.py -- --out camera.json "
                  "[--frames A-B] [--axes obj|blender]")
     return out, frames, axes
-
-
-def camera_json(scene, to_file):
-    ob = scene.camera
-    cam = ob.data
-    if cam.type != "PERSP":
-        sys.exit(f"camera {ob.name} is {cam.type}: glassdb's camera is a perspective (pinhole) one")
-    r = scene.render
-    return {
-        "matrix_world": [list(row) for row in to_file @ ob.matrix_world],
-        "focal_length_mm": cam.lens,
-        "sensor_width_mm": cam.sensor_width,
-        "sensor_height_mm": cam.sensor_height,
-        "sensor_fit": cam.sensor_fit.lower(),
-        "shift_x": cam.shift_x,
-        "shift_y": cam.shift_y,
-        "pixel_aspect": r.pixel_aspect_x / r.pixel_aspect_y,
-        "width": r.resolution_x * r.resolution_percentage // 100,
-        "height": r.resolution_y * r.resolution_percentage // 100,
-    }
 
 
 def main():

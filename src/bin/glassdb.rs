@@ -36,6 +36,8 @@ enum Command {
     Plot(cmd::plot::Args),
     /// Regenerate the speed-against-error tables of docs/accuracy.md.
     Report(cmd::report::Args),
+    /// Render a .blend scene's passes with Blender and composite them; re-composite a render.
+    Blender(cmd::blender::Args),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +53,7 @@ fn main() -> ExitCode {
         Command::Mask(a) => cmd::scene::run_mask(a),
         Command::Plot(a) => cmd::plot::run(a),
         Command::Report(a) => cmd::report::run(a),
+        Command::Blender(a) => cmd::blender::run(a),
     };
     cmd::finish(result)
 }

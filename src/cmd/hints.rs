@@ -56,6 +56,9 @@ fn hint(cause: &(dyn std::error::Error + 'static)) -> Option<String> {
     if let Some(e) = cause.downcast_ref::<PlotError>() {
         return plot_hint(e);
     }
+    if let Some(e) = cause.downcast_ref::<glassdb_blender::BlenderError>() {
+        return blender_hint(e);
+    }
     if let Some(glassdb_io::FrameError::List { .. }) =
         cause.downcast_ref::<glassdb_io::FrameError>()
     {
@@ -245,4 +248,25 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
         }
         _ => None,
     }
+}
+
+fn blender_hint(e: &glassdb_blender::BlenderError) -> Option<String> {
+    use glassdb_blender::BlenderError as B;
+    Some(match e {
+        B::NotFound { .. } | B::VersionUnreadable { .. } => {
+            "install Blender 3.4 or newer (Debian: apt-get install blender), or give its path \
+             with --blender PATH"
+                .into()
+        }
+        B::TooOld { .. } => "give a newer Blender with --blender PATH".into(),
+        B::TimedOut { .. } => {
+            "raise --timeout-s, or render less: --samples, --resolution, --frames".into()
+        }
+        B::UnknownGlass { .. } => {
+            "give a registry with that id (--registry), or map the material to another id with \
+             --glass"
+                .into()
+        }
+        _ => return None,
+    })
 }

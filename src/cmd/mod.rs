@@ -19,6 +19,7 @@ macro_rules! out {
     };
 }
 
+pub mod blender;
 pub mod compose;
 pub mod fit;
 pub mod hints;

@@ -2,6 +2,7 @@
 //! One module per area; shared helpers in `util`.
 
 mod architecture;
+mod blender;
 mod cameras;
 mod colour;
 mod compose;

@@ -1,0 +1,317 @@
+//! The Blender program: finding it, its version, and running it headless with a time limit and
+//! its output captured in a log file.
+
+use std::fs::{File, OpenOptions};
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::BlenderError;
+
+/// The oldest Blender supported (Debian 12's 3.4; its Cycles, EXR and Python API are what the
+/// script was measured on).
+pub const MINIMUM_VERSION: (u32, u32) = (3, 4);
+/// Exit code of the Blender-side script when the scene itself is the problem.
+const SCENE_EXIT_CODE: i32 = 3;
+/// What the Blender-side script writes before a scene problem.
+const SCENE_ERROR_PREFIX: &str = "glassdb_blender: error: ";
+/// How long `blender --version` may take.
+const VERSION_TIMEOUT: Duration = Duration::from_secs(120);
+/// Bytes of the log shown when Blender fails.
+const LOG_TAIL_BYTES: u64 = 2000;
+
+/// A Blender program that answered `--version` with a supported version.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Blender {
+    pub path: PathBuf,
+    /// As Blender prints it (`3.4.1`).
+    pub version: String,
+    /// Major and minor version.
+    pub version_number: (u32, u32),
+}
+
+/// One headless run: the scene, the script and its arguments, the log and the time limit.
+#[derive(Debug, Clone)]
+pub struct BlenderRun<'a> {
+    /// What the run does, for messages (`export`, `render`).
+    pub step: &'static str,
+    pub blend: &'a Path,
+    pub script: &'a Path,
+    pub args: Vec<String>,
+    /// Blender's stdout and stderr are appended here.
+    pub log: &'a Path,
+    pub timeout: Duration,
+}
+
+/// `major.minor` from the first line of `blender --version` (`Blender 3.4.1`, `Blender 4.2.0 LTS`).
+pub fn parse_version(printed: &str) -> Option<(String, (u32, u32))> {
+    let line = printed
+        .lines()
+        .find(|l| l.trim_start().starts_with("Blender "))?;
+    let version = line
+        .trim_start()
+        .strip_prefix("Blender ")?
+        .split_whitespace()
+        .next()?;
+    let mut parts = version.split('.');
+    let major = parts.next()?.parse().ok()?;
+    let minor = parts.next()?.parse().ok()?;
+    Some((version.to_string(), (major, minor)))
+}
+
+impl Blender {
+    /// The Blender at `path`, or `blender` from PATH; refused when it cannot run or is older
+    /// than [`MINIMUM_VERSION`].
+    pub fn find(path: Option<&Path>) -> Result<Blender, BlenderError> {
+        let path = path.map_or_else(|| PathBuf::from("blender"), Path::to_path_buf);
+        let mut child = Command::new(&path)
+            .args(["-b", "--factory-startup", "--version"])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .map_err(|source| BlenderError::NotFound {
+                path: path.clone(),
+                source,
+            })?;
+        let mut printed = String::new();
+        if let Some(mut out) = child.stdout.take() {
+            // Bounded: a version line is short; a program printing without end is stopped.
+            let _ = (&mut out).take(1 << 20).read_to_string(&mut printed);
+        }
+        let started = Instant::now();
+        while child.try_wait().ok().flatten().is_none() {
+            if started.elapsed() > VERSION_TIMEOUT {
+                let _ = child.kill();
+                let _ = child.wait();
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let Some((version, number)) = parse_version(&printed) else {
+            return Err(BlenderError::VersionUnreadable {
+                path,
+                printed: printed.chars().take(200).collect(),
+            });
+        };
+        if number < MINIMUM_VERSION {
+            return Err(BlenderError::TooOld {
+                path,
+                found: version,
+                minimum: MINIMUM_VERSION,
+            });
+        }
+        Ok(Blender {
+            path,
+            version,
+            version_number: number,
+        })
+    }
+
+    /// Runs `blender -b BLEND --factory-startup -noaudio --python-exit-code 1 -P SCRIPT -- ARGS`,
+    /// its output appended to the log, stopped after the time limit.
+    pub fn run(&self, run: &BlenderRun<'_>) -> Result<(), BlenderError> {
+        let io = |action: &'static str, path: &Path| {
+            let path = path.to_path_buf();
+            move |source| BlenderError::Io {
+                action,
+                path,
+                source,
+            }
+        };
+        let mut log = OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(run.log)
+            .map_err(io("write the log", run.log))?;
+        let start = log
+            .seek(SeekFrom::End(0))
+            .map_err(io("write the log", run.log))?;
+        writeln!(
+            log,
+            "== glassdb blender {}: {} ==",
+            run.step,
+            self.path.display()
+        )
+        .map_err(io("write the log", run.log))?;
+        let err_log = log.try_clone().map_err(io("write the log", run.log))?;
+        let mut child = Command::new(&self.path)
+            .arg("-b")
+            .arg(run.blend)
+            .args([
+                "--factory-startup",
+                "-noaudio",
+                "--python-exit-code",
+                "1",
+                "-P",
+            ])
+            .arg(run.script)
+            .arg("--")
+            .args(&run.args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::from(log))
+            .stderr(Stdio::from(err_log))
+            .spawn()
+            .map_err(|source| BlenderError::NotFound {
+                path: self.path.clone(),
+                source,
+            })?;
+        let started = Instant::now();
+        let status = loop {
+            match child
+                .try_wait()
+                .map_err(io("wait for Blender", &self.path))?
+            {
+                Some(status) => break status,
+                None if started.elapsed() > run.timeout => {
+                    let _ = child.kill();
+                    let _ = child.wait();
+                    return Err(BlenderError::TimedOut {
+                        step: run.step,
+                        blend: run.blend.to_path_buf(),
+                        seconds: run.timeout.as_secs(),
+                        log: run.log.to_path_buf(),
+                    });
+                }
+                None => std::thread::sleep(Duration::from_millis(50)),
+            }
+        };
+        if status.success() {
+            return Ok(());
+        }
+        let tail = log_since(run.log, start);
+        if status.code() == Some(SCENE_EXIT_CODE)
+            && let Some(message) = tail
+                .lines()
+                .rev()
+                .find_map(|l| l.strip_prefix(SCENE_ERROR_PREFIX))
+        {
+            return Err(BlenderError::Scene {
+                step: run.step,
+                blend: run.blend.to_path_buf(),
+                message: message.to_string(),
+                log: run.log.to_path_buf(),
+            });
+        }
+        Err(BlenderError::Failed {
+            step: run.step,
+            blend: run.blend.to_path_buf(),
+            status: describe_status(status),
+            log: run.log.to_path_buf(),
+            tail: last_bytes(&tail, LOG_TAIL_BYTES as usize),
+        })
+    }
+}
+
+/// CPU seconds (user + system) of the child processes this process has waited for so far
+/// (every Blender run), from `/proc/self/stat` (Linux; fields `cutime` and `cstime` in clock
+/// ticks of 1/100 s, Linux's USER_HZ); `None` where that file cannot be read.
+pub fn children_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // After the command name in parentheses: field 3 (state) onwards.
+    let fields: Vec<&str> = stat[stat.rfind(')')? + 1..].split_whitespace().collect();
+    let cutime: f64 = fields.get(13)?.parse().ok()?;
+    let cstime: f64 = fields.get(14)?.parse().ok()?;
+    Some((cutime + cstime) / 100.0)
+}
+
+/// "exit code 1" or "killed by signal 11 (a crash)".
+fn describe_status(status: ExitStatus) -> String {
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::ExitStatusExt;
+        if let Some(signal) = status.signal() {
+            return format!("killed by signal {signal} (a crash)");
+        }
+    }
+    match status.code() {
+        Some(code) => format!("exit code {code}"),
+        None => "stopped".to_string(),
+    }
+}
+
+/// What the log holds from byte `start` on (at most a few MiB, lossily decoded).
+fn log_since(log: &Path, start: u64) -> String {
+    let mut text = Vec::new();
+    if let Ok(mut f) = File::open(log)
+        && f.seek(SeekFrom::Start(start)).is_ok()
+    {
+        let _ = f.take(4 << 20).read_to_end(&mut text);
+    }
+    String::from_utf8_lossy(&text).into_owned()
+}
+
+/// The last `n` bytes of `text`, cut at a character boundary.
+fn last_bytes(text: &str, n: usize) -> String {
+    let mut cut = text.len().saturating_sub(n);
+    while !text.is_char_boundary(cut) {
+        cut += 1;
+    }
+    text[cut..].trim().to_string()
+}
+
+/// Refuses a scene that is missing, not a regular file, or not a .blend file (plain, gzip or
+/// zstd compressed): Blender itself would go on with its default scene.
+pub fn check_blend_file(path: &Path) -> Result<(), BlenderError> {
+    let not = |reason: String| BlenderError::NotBlendFile {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| not(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(not("not a regular file".into()));
+    }
+    let mut head = [0u8; 7];
+    let mut f = File::open(path).map_err(|e| not(e.to_string()))?;
+    f.read_exact(&mut head)
+        .map_err(|_| not("shorter than a .blend header".into()))?;
+    let blend = &head == b"BLENDER";
+    let gzip = head.starts_with(&[0x1f, 0x8b]);
+    let zstd = head.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]);
+    if blend || gzip || zstd {
+        Ok(())
+    } else {
+        Err(not(
+            "it does not start with BLENDER (nor is it a compressed .blend)".into(),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn versions_as_blender_prints_them() {
+        assert_eq!(
+            parse_version("Blender 3.4.1\n\tbuild date: ..."),
+            Some(("3.4.1".into(), (3, 4)))
+        );
+        assert_eq!(
+            parse_version("Color management...\nBlender 4.2.0 LTS\n"),
+            Some(("4.2.0".into(), (4, 2)))
+        );
+        assert_eq!(parse_version("bash: blender: not found"), None);
+        assert!(parse_version("Blender 2.93.1").unwrap().1 < MINIMUM_VERSION);
+    }
+
+    #[test]
+    fn children_cpu_counts_a_waited_child() {
+        let before = children_cpu_seconds().expect("Linux /proc");
+        // A child that spins for a while on the CPU.
+        let status = Command::new("sh")
+            .args(["-c", "i=0; while [ $i -lt 200000 ]; do i=$((i+1)); done"])
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let after = children_cpu_seconds().unwrap();
+        assert!(after > before, "{before} -> {after}");
+    }
+
+    #[test]
+    fn log_tail_cuts_at_a_character() {
+        assert_eq!(last_bytes("aé b", 3), "b");
+        assert_eq!(last_bytes("short", 100), "short");
+    }
+}

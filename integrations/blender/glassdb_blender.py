@@ -1,0 +1,582 @@
+"""glassdb's Blender side: export a scene for `glassdb blender render`, render its passes, and
+a panel that runs the whole pipeline from Blender (docs/blender.md).
+
+One file, used two ways:
+
+- by the `glassdb` binary, which embeds it and runs it headless:
+
+      blender -b scene.blend --python-exit-code 1 -P glassdb_blender.py -- export --out DIR \
+          [--frames 1,2,3] [--resolution WxH]
+      blender -b scene.blend --python-exit-code 1 -P glassdb_blender.py -- render --job JOB.json
+
+  `export` writes the evaluated scene in world coordinates (Blender's Z-up axes) as
+  DIR/scene.obj + DIR/scene.mtl (one `usemtl` per material slot, named as in Blender), the
+  scene camera of every frame as DIR/camera.json (glassdb's camera JSON, docs/scene.md, in the
+  `frames` form) and DIR/export.json (Blender's version, the frames, the materials).
+  `render` renders what JOB.json (written by glassdb) asks: per frame the transmission pass and
+  one reflection pass per glass plane, as single-layer RGBA EXRs.
+
+- as an add-on (Edit > Preferences > Add-ons > Install… this file): Render Properties >
+  glassdb holds the same settings as the command line and a button that saves the file and
+  runs `glassdb blender render` on it.
+
+How the passes are made:
+
+- Glass materials (the ones glassdb matched to a registry id) become a thin pane: Glossy
+  (roughness 0, colour r(θ)) + Transparent (colour t(θ)), r and t per channel from the
+  registry's curves through a 32-stop Color Ramp over |N·I| (front or back reflectance by the
+  Backfacing output), so sunlight through the window is filtered and reflected by the glass;
+  except for camera rays where glassdb adds the glass itself: a clear Transparent BSDF on the
+  first glass the camera meets (transmission pass) or on and behind the mirror's plane
+  (reflection pass), so that glass seen through glass or in a mirror stays a pane.
+- Reflection pass of plane n·x + d = 0: a copy of the camera with matrix R @ matrix_world (R the
+  reflection about the plane, determinant −1); every other material mixes in a Transparent BSDF
+  where Is Camera Ray and the shading point lies on the far side of the plane from the real
+  camera; a render border of the plane's screen rectangle, cropped.
+
+Licence: same as the project, MIT OR Apache-2.0.
+"""
+
+import json
+import os
+import shlex
+import subprocess
+import sys
+
+import bpy
+
+bl_info = {
+    "name": "glassdb",
+    "author": "glassdb",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "Properties > Render > glassdb",
+    "description": "Physically based glazing by compositing: run `glassdb blender render` on this file",
+    "category": "Render",
+}
+
+# Node names of what this script adds, so that a second run finds them.
+CLIP_PREFIX = "glassdb_clip"
+MIRROR_CAMERA = "glassdb_mirror_camera"
+# Exporting: object types that have a mesh when evaluated.
+MESH_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
+
+
+def fail(message):
+    """Stops with a message glassdb shows; exit code 3 marks an error in the scene itself."""
+    sys.stderr.write("glassdb_blender: error: %s\n" % message)
+    sys.stderr.flush()
+    sys.exit(3)
+
+
+def parse_cli(argv):
+    """(mode, options) from the words after `--`."""
+    args = argv[argv.index("--") + 1:] if "--" in argv else []
+    if not args or args[0] not in ("export", "render"):
+        fail("usage: -- export --out DIR [--frames 1,2] [--resolution WxH] | render --job FILE")
+    mode, rest = args[0], args[1:]
+    opts = {}
+    while rest:
+        flag = rest.pop(0)
+        if not flag.startswith("--") or not rest:
+            fail("option %s needs a value" % flag)
+        opts[flag[2:]] = rest.pop(0)
+    return mode, opts
+
+
+def set_resolution(scene, resolution):
+    """`WxH` at 100 %, or the scene's own when None."""
+    if resolution:
+        w, _, h = resolution.partition("x")
+        scene.render.resolution_x, scene.render.resolution_y = int(w), int(h)
+        scene.render.resolution_percentage = 100
+
+
+def camera_json(scene, to_file=None):
+    """The scene camera now, as glassdb's camera JSON in Blender's world axes (or in the axes
+    of a file: `to_file` @ matrix_world; scripts/blender/export_camera.py uses this too)."""
+    ob = scene.camera
+    cam = ob.data
+    if cam.type != "PERSP":
+        fail("camera %s is %s: glassdb's camera is a perspective (pinhole) one" % (ob.name, cam.type))
+    r = scene.render
+    matrix = ob.matrix_world if to_file is None else to_file @ ob.matrix_world
+    return {
+        "matrix_world": [list(row) for row in matrix],
+        "focal_length_mm": cam.lens,
+        "sensor_width_mm": cam.sensor_width,
+        "sensor_height_mm": cam.sensor_height,
+        "sensor_fit": cam.sensor_fit.lower(),
+        "shift_x": cam.shift_x,
+        "shift_y": cam.shift_y,
+        "pixel_aspect": r.pixel_aspect_x / r.pixel_aspect_y,
+        "width": r.resolution_x * r.resolution_percentage // 100,
+        "height": r.resolution_y * r.resolution_percentage // 100,
+    }
+
+
+def exported_objects(scene):
+    return [ob for ob in scene.objects if ob.type in MESH_TYPES and not ob.hide_render]
+
+
+def export(opts):
+    out = opts.get("out") or fail("export needs --out DIR")
+    scene = bpy.context.scene
+    if scene.camera is None:
+        fail("the scene has no camera")
+    set_resolution(scene, opts.get("resolution"))
+    if "frames" in opts:
+        frames = [int(f) for f in opts["frames"].split(",")]
+    else:
+        frames = list(range(scene.frame_start, scene.frame_end + 1))
+    scene.frame_set(frames[0])
+    objects = exported_objects(scene)
+    matrices = {ob.name: [list(r) for r in ob.matrix_world] for ob in objects}
+    cameras = {}
+    for f in frames:
+        scene.frame_set(f)
+        cameras[str(f)] = camera_json(scene)
+        for ob in objects:
+            if [list(r) for r in ob.matrix_world] != matrices[ob.name]:
+                fail("object %s moves between frames %d and %d: glassdb blender renders a "
+                     "moving camera in a still scene" % (ob.name, frames[0], f))
+    scene.frame_set(frames[0])
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    materials = set()
+    lines = ["# glassdb_blender.py export of %s, frame %d, world coordinates (Z up)"
+             % (bpy.data.filepath, frames[0]), "mtllib scene.mtl"]
+    base = 1
+    for ob in objects:
+        ev = ob.evaluated_get(depsgraph)
+        mesh = ev.to_mesh()
+        if mesh is None:
+            continue
+        m = ev.matrix_world
+        lines.append("o %s" % ob.name.replace(" ", "_"))
+        for v in mesh.vertices:
+            p = m @ v.co
+            lines.append("v %r %r %r" % (p.x, p.y, p.z))
+        names = [s.material.name if s.material else None for s in ev.material_slots]
+        current = "unset"
+        for poly in mesh.polygons:
+            name = names[poly.material_index] if poly.material_index < len(names) else None
+            name = name or "glassdb_no_material"
+            if name != current:
+                lines.append("usemtl %s" % name)
+                materials.add(name)
+                current = name
+            lines.append("f " + " ".join(str(base + i) for i in poly.vertices))
+        base += len(mesh.vertices)
+        ev.to_mesh_clear()
+    for name in materials:
+        if any(c.isspace() for c in name):
+            fail("material %r has a space in its name, which an OBJ file cannot hold" % name)
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "scene.obj"), "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    with open(os.path.join(out, "scene.mtl"), "w") as fh:
+        for name in sorted(materials):
+            fh.write("newmtl %s\nKd 0.8 0.8 0.8\n\n" % name)
+    with open(os.path.join(out, "camera.json"), "w") as fh:
+        json.dump({"frames": cameras}, fh, indent=1)
+        fh.write("\n")
+    info = {
+        "blender": bpy.app.version_string,
+        "blender_version": list(bpy.app.version),
+        "file": bpy.data.filepath,
+        "frames": frames,
+        "materials": sorted(materials),
+        "objects": [ob.name for ob in objects],
+    }
+    with open(os.path.join(out, "export.json"), "w") as fh:
+        json.dump(info, fh, indent=1)
+        fh.write("\n")
+    print("glassdb_blender: exported %d objects, %d frames" % (len(objects), len(frames)))
+
+
+def output_node(nt):
+    outs = [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    active = [n for n in outs if n.is_active_output]
+    return (active or outs or [None])[0]
+
+
+def colour_ramp(nt, cos_values, colours, location):
+    """A Color Ramp node: colours[k] (RGB) at position cos_values[k], linear between."""
+    ramp = nt.nodes.new("ShaderNodeValToRGB")
+    ramp.location = location
+    els = ramp.color_ramp.elements
+    while len(els) > 1:
+        els.remove(els[-1])
+    els[0].position = cos_values[0]
+    els[0].color = tuple(colours[0]) + (1.0,)
+    for c, rgb in zip(cos_values[1:], colours[1:]):
+        e = els.new(c)
+        e.color = tuple(rgb) + (1.0,)
+    ramp.color_ramp.interpolation = "LINEAR"
+    return ramp
+
+
+def make_thin_pane(mat, glass, camera_sees_through):
+    """Replaces mat's surface by the thin pane of `glass` (cos, r_front, r_back, t tables);
+    with camera_sees_through, camera rays pass the glass untouched where set_clip says (and
+    the GlassClip returned holds the nodes it sets)."""
+    mat.use_nodes = True
+    nt = mat.node_tree
+    for node in list(nt.nodes):
+        nt.nodes.remove(node)
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    out.location = (900, 0)
+    geo = nt.nodes.new("ShaderNodeNewGeometry")
+    geo.location = (-900, 0)
+    dot = nt.nodes.new("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    dot.location = (-700, 0)
+    nt.links.new(geo.outputs["Normal"], dot.inputs[0])
+    nt.links.new(geo.outputs["Incoming"], dot.inputs[1])
+    absn = nt.nodes.new("ShaderNodeMath")
+    absn.operation = "ABSOLUTE"
+    absn.location = (-500, 0)
+    nt.links.new(dot.outputs["Value"], absn.inputs[0])
+    cos = glass["cos"]
+    r_front = colour_ramp(nt, cos, glass["r_front"], (-300, 300))
+    r_back = colour_ramp(nt, cos, glass["r_back"], (-300, 0))
+    t = colour_ramp(nt, cos, glass["t"], (-300, -300))
+    for ramp in (r_front, r_back, t):
+        nt.links.new(absn.outputs["Value"], ramp.inputs["Fac"])
+    side = nt.nodes.new("ShaderNodeMixRGB")
+    side.location = (0, 200)
+    nt.links.new(geo.outputs["Backfacing"], side.inputs["Fac"])
+    nt.links.new(r_front.outputs["Color"], side.inputs["Color1"])
+    nt.links.new(r_back.outputs["Color"], side.inputs["Color2"])
+    glossy = nt.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.location = (200, 200)
+    glossy.inputs["Roughness"].default_value = 0.0
+    nt.links.new(side.outputs["Color"], glossy.inputs["Color"])
+    through = nt.nodes.new("ShaderNodeBsdfTransparent")
+    through.location = (200, -200)
+    nt.links.new(t.outputs["Color"], through.inputs["Color"])
+    add = nt.nodes.new("ShaderNodeAddShader")
+    add.location = (400, 0)
+    nt.links.new(glossy.outputs[0], add.inputs[0])
+    nt.links.new(through.outputs[0], add.inputs[1])
+    if not camera_sees_through:
+        nt.links.new(add.outputs[0], out.inputs["Surface"])
+        return None
+    # Clear for camera rays: in the transmission pass where no transparent surface was crossed
+    # yet (the first glass the camera sees; glass behind it stays a pane); in the reflection
+    # pass of plane K on or behind plane K (the mirror itself, and what is clipped), so that
+    # other glass seen in the mirror stays a pane. set_clip chooses the pass.
+    lp = nt.nodes.new("ShaderNodeLightPath")
+    lp.location = (400, 600)
+    first = nt.nodes.new("ShaderNodeMath")
+    first.operation = "LESS_THAN"
+    first.inputs[1].default_value = 0.5
+    nt.links.new(lp.outputs["Transparent Depth"], first.inputs[0])
+    enable_trans = nt.nodes.new("ShaderNodeMath")
+    enable_trans.operation = "MULTIPLY"
+    nt.links.new(first.outputs[0], enable_trans.inputs[0])
+    pos = nt.nodes.new("ShaderNodeNewGeometry")
+    dot_p = nt.nodes.new("ShaderNodeVectorMath")
+    dot_p.operation = "DOT_PRODUCT"
+    nt.links.new(pos.outputs["Position"], dot_p.inputs[0])
+    add_p = nt.nodes.new("ShaderNodeMath")
+    add_p.operation = "ADD"
+    nt.links.new(dot_p.outputs["Value"], add_p.inputs[0])
+    behind = nt.nodes.new("ShaderNodeMath")
+    behind.operation = "GREATER_THAN"
+    behind.name = CLIP_PREFIX + "_glass_tolerance"
+    nt.links.new(add_p.outputs["Value"], behind.inputs[0])
+    enable_refl = nt.nodes.new("ShaderNodeMath")
+    enable_refl.operation = "MULTIPLY"
+    nt.links.new(behind.outputs[0], enable_refl.inputs[0])
+    either = nt.nodes.new("ShaderNodeMath")
+    either.operation = "MAXIMUM"
+    nt.links.new(enable_trans.outputs[0], either.inputs[0])
+    nt.links.new(enable_refl.outputs[0], either.inputs[1])
+    camera = nt.nodes.new("ShaderNodeMath")
+    camera.operation = "MULTIPLY"
+    nt.links.new(lp.outputs["Is Camera Ray"], camera.inputs[0])
+    nt.links.new(either.outputs[0], camera.inputs[1])
+    for k, node in enumerate((first, enable_trans, pos, dot_p, add_p, behind, enable_refl, either,
+                              camera)):
+        node.location = (-900 + 150 * k, 700)
+    clear = nt.nodes.new("ShaderNodeBsdfTransparent")
+    clear.location = (400, -300)
+    clear.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    mix.location = (650, 0)
+    nt.links.new(camera.outputs[0], mix.inputs["Fac"])
+    nt.links.new(add.outputs[0], mix.inputs[1])
+    nt.links.new(clear.outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    return GlassClip(dot_p, add_p, behind, enable_refl, enable_trans)
+
+
+class GlassClip:
+    """The nodes of a glass material that set_clip sets per pass."""
+
+    def __init__(self, dot, add, behind, enable_refl, enable_trans):
+        self.dot, self.add, self.behind = dot, add, behind
+        self.enable_refl, self.enable_trans = enable_refl, enable_trans
+
+
+def add_clip(mat):
+    """Mixes a Transparent BSDF into mat's surface for camera rays on the far side of a plane
+    (set later by set_clip); returns the (dot, add, enable) nodes that hold the plane."""
+    nt = mat.node_tree
+    out = output_node(nt)
+    if out is None or not out.inputs["Surface"].links:
+        return None
+    source = out.inputs["Surface"].links[0].from_socket
+    geo = nt.nodes.new("ShaderNodeNewGeometry")
+    dot = nt.nodes.new("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    dot.name = CLIP_PREFIX + "_dot"
+    add = nt.nodes.new("ShaderNodeMath")
+    add.operation = "ADD"
+    add.name = CLIP_PREFIX + "_add"
+    gt = nt.nodes.new("ShaderNodeMath")
+    gt.operation = "GREATER_THAN"
+    gt.inputs[1].default_value = 0.0
+    lp = nt.nodes.new("ShaderNodeLightPath")
+    mul = nt.nodes.new("ShaderNodeMath")
+    mul.operation = "MULTIPLY"
+    enable = nt.nodes.new("ShaderNodeMath")
+    enable.operation = "MULTIPLY"
+    enable.name = CLIP_PREFIX + "_enable"
+    tr = nt.nodes.new("ShaderNodeBsdfTransparent")
+    tr.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    x, y = out.location
+    for k, node in enumerate((geo, dot, add, gt, lp, mul, enable, tr, mix)):
+        node.location = (x - 1400 + 150 * k, y + 500)
+    nt.links.new(geo.outputs["Position"], dot.inputs[0])
+    nt.links.new(dot.outputs["Value"], add.inputs[0])
+    nt.links.new(add.outputs["Value"], gt.inputs[0])
+    nt.links.new(lp.outputs["Is Camera Ray"], mul.inputs[0])
+    nt.links.new(gt.outputs["Value"], mul.inputs[1])
+    nt.links.new(mul.outputs["Value"], enable.inputs[0])
+    nt.links.new(enable.outputs["Value"], mix.inputs["Fac"])
+    nt.links.new(source, mix.inputs[1])
+    nt.links.new(tr.outputs["BSDF"], mix.inputs[2])
+    nt.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+    return dot, add, enable
+
+
+def set_clip(clips, glass_clips, plane, tolerance=0.0):
+    """Camera rays see through what lies on the far side of `plane` ((a, b, c, d) with the
+    real camera on the positive side) and through glass on or behind it (within `tolerance`),
+    or, when plane is None (the transmission pass), nothing is clipped and camera rays see
+    through the first glass they meet."""
+    for g in glass_clips:
+        if plane is None:
+            g.enable_refl.inputs[1].default_value = 0.0
+            g.enable_trans.inputs[1].default_value = 1.0
+            continue
+        a, b, c, d = plane
+        g.dot.inputs[1].default_value = (-a, -b, -c)
+        g.add.inputs[1].default_value = -d
+        g.behind.inputs[1].default_value = -tolerance
+        g.enable_refl.inputs[1].default_value = 1.0
+        g.enable_trans.inputs[1].default_value = 0.0
+    for dot, add, enable in clips:
+        if plane is None:
+            enable.inputs[1].default_value = 0.0
+            continue
+        a, b, c, d = plane
+        dot.inputs[1].default_value = (-a, -b, -c)
+        add.inputs[1].default_value = -d
+        enable.inputs[1].default_value = 1.0
+
+
+def set_exr_output(scene):
+    im = scene.render.image_settings
+    if hasattr(im, "media_type"):  # Blender 5.0: the media type first, then the format
+        im.media_type = "IMAGE"
+    im.file_format = "OPEN_EXR"
+    im.color_mode = "RGBA"
+    im.color_depth = "16"
+    im.exr_codec = "ZIP"
+    scene.render.use_file_extension = False
+
+
+def render_still(scene, path):
+    scene.render.filepath = path
+    bpy.ops.render.render(write_still=True)
+    if not os.path.isfile(path):
+        fail("Blender wrote no image at %s" % path)
+
+
+def reflection_matrix(plane):
+    from mathutils import Matrix
+
+    a, b, c, d = plane
+    n = (a, b, c)
+    rows = [[(1.0 if i == j else 0.0) - 2.0 * n[i] * n[j] for j in range(3)] + [-2.0 * d * n[i]]
+            for i in range(3)]
+    rows.append([0.0, 0.0, 0.0, 1.0])
+    return Matrix(rows)
+
+
+def render(opts):
+    path = opts.get("job") or fail("render needs --job FILE")
+    with open(path) as fh:
+        job = json.load(fh)
+    scene = bpy.context.scene
+    if scene.camera is None:
+        fail("the scene has no camera")
+    if scene.render.engine != "CYCLES":
+        scene.render.engine = "CYCLES"
+    set_resolution(scene, job.get("resolution"))
+    if job.get("samples"):
+        scene.cycles.samples = int(job["samples"])
+    scene.cycles.seed = int(job.get("seed", 0))
+    if job.get("threads"):
+        scene.render.threads_mode = "FIXED"
+        scene.render.threads = int(job["threads"])
+    set_exr_output(scene)
+    glass_by_name = {g["material"]: g for g in job["glass"]}
+    missing = [m for m in glass_by_name if m not in bpy.data.materials]
+    if missing:
+        fail("no material %s in %s" % (", ".join(missing), bpy.data.filepath))
+    clips = []
+    glass_clips = []
+    for mat in bpy.data.materials:
+        if mat.name in glass_by_name:
+            g = make_thin_pane(mat, glass_by_name[mat.name], not job.get("reference", False))
+            if g is not None:
+                glass_clips.append(g)
+        elif mat.use_nodes and mat.node_tree is not None:
+            nodes = add_clip(mat)
+            if nodes:
+                clips.append(nodes)
+    real = scene.camera
+    mirror_data = None
+    mirror = None
+    r = scene.render
+    for frame in job["frames"]:
+        scene.frame_set(frame["frame"])
+        scene.camera = real
+        r.use_border = False
+        set_clip(clips, glass_clips, None)
+        render_still(scene, frame["trans"])
+        m_real = real.matrix_world.copy()
+        for plane in frame["planes"]:
+            if mirror is None:
+                mirror_data = real.data.copy()
+                mirror = bpy.data.objects.new(MIRROR_CAMERA, mirror_data)
+                scene.collection.objects.link(mirror)
+            for attr in ("lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x",
+                         "shift_y", "clip_start", "clip_end", "type"):
+                setattr(mirror_data, attr, getattr(real.data, attr))
+            mirror.matrix_world = reflection_matrix(plane["equation"]) @ m_real
+            scene.camera = mirror
+            set_clip(clips, glass_clips, plane["equation"], plane["tolerance"])
+            x0, x1, y0, y1 = plane["border"]
+            r.use_border = True
+            r.use_crop_to_border = True
+            r.border_min_x, r.border_max_x = x0, x1
+            r.border_min_y, r.border_max_y = y0, y1
+            render_still(scene, plane["output"])
+        scene.camera = real
+        r.use_border = False
+    print("glassdb_blender: rendered %d frames" % len(job["frames"]))
+
+
+# ----------------------------------------------------------------------------------------------
+# The add-on: the same settings as the command line, and a button that runs glassdb.
+# ----------------------------------------------------------------------------------------------
+
+
+class GlassdbSettings(bpy.types.PropertyGroup):
+    binary: bpy.props.StringProperty(name="glassdb", default="glassdb", subtype="FILE_PATH",
+                                     description="The glassdb program")
+    glass: bpy.props.StringProperty(
+        name="Glass", default="Glass*=1",
+        description="Material patterns and registry ids, PATTERN=ID separated by spaces")
+    frames: bpy.props.StringProperty(name="Frames", default="",
+                                     description="e.g. 1-24; empty: the scene's frame range")
+    out_dir: bpy.props.StringProperty(name="Output", default="//glassdb/", subtype="DIR_PATH")
+    registry: bpy.props.StringProperty(name="Registry", default="", subtype="FILE_PATH",
+                                       description="Registry JSON; empty: the bundled one")
+    samples: bpy.props.IntProperty(name="Samples", default=0, min=0,
+                                   description="0: the scene's Cycles samples")
+
+
+def addon_command(context):
+    """The `glassdb blender render` command line for the current file and settings."""
+    s = context.scene.glassdb
+    cmd = [bpy.path.abspath(s.binary) if s.binary.startswith("//") else s.binary,
+           "blender", "render", bpy.data.filepath,
+           "--out-dir", bpy.path.abspath(s.out_dir), "--blender", bpy.app.binary_path]
+    for g in s.glass.split():
+        cmd += ["--glass", g]
+    if s.frames:
+        cmd += ["--frames", s.frames]
+    if s.registry:
+        cmd += ["--registry", bpy.path.abspath(s.registry)]
+    if s.samples:
+        cmd += ["--samples", str(s.samples)]
+    return cmd
+
+
+class GLASSDB_OT_render(bpy.types.Operator):
+    """Save the file and run glassdb blender render on it"""
+
+    bl_idname = "glassdb.render"
+    bl_label = "Render with glassdb"
+
+    def execute(self, context):
+        if not bpy.data.filepath:
+            self.report({"ERROR"}, "save the .blend file first")
+            return {"CANCELLED"}
+        bpy.ops.wm.save_mainfile()
+        cmd = addon_command(context)
+        print("glassdb:", " ".join(shlex.quote(c) for c in cmd))
+        done = subprocess.run(cmd, capture_output=True, text=True)
+        if done.returncode != 0:
+            self.report({"ERROR"}, (done.stderr.strip() or "glassdb failed")[-400:])
+            return {"CANCELLED"}
+        self.report({"INFO"}, done.stdout.strip().splitlines()[-1] if done.stdout else "done")
+        return {"FINISHED"}
+
+
+class GLASSDB_PT_panel(bpy.types.Panel):
+    bl_label = "glassdb"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+
+    def draw(self, context):
+        s = context.scene.glassdb
+        col = self.layout.column()
+        for prop in ("binary", "glass", "frames", "out_dir", "registry", "samples"):
+            col.prop(s, prop)
+        col.operator(GLASSDB_OT_render.bl_idname)
+
+
+CLASSES = (GlassdbSettings, GLASSDB_OT_render, GLASSDB_PT_panel)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.glassdb = bpy.props.PointerProperty(type=GlassdbSettings)
+
+
+def unregister():
+    del bpy.types.Scene.glassdb
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)
+
+
+def main():
+    mode, opts = parse_cli(sys.argv)
+    if mode == "export":
+        export(opts)
+    else:
+        render(opts)
+
+
+if __name__ == "__main__":
+    main()

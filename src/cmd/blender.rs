@@ -1,0 +1,204 @@
+//! `glassdb blender render` / `glassdb blender compose`: a .blend scene to composited glazing
+//! (docs/blender.md). The work is in `glassdb-blender`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::{Args as ClapArgs, Subcommand};
+use glassdb_blender::{ComposeReport, RegistryChoice, RenderRequest};
+use glassdb_registry::Registry;
+
+use crate::cmd::progress::Spinner;
+
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: BlenderCommand,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum BlenderCommand {
+    /// Render a .blend file's passes with Blender (headless) and composite every frame into
+    /// DIR/composite.####.exr.
+    Render(RenderArgs),
+    /// Composite an existing `glassdb blender render` output again (other glasses), without
+    /// Blender.
+    Compose(ComposeArgs),
+}
+
+#[derive(ClapArgs, Debug)]
+pub struct RenderArgs {
+    /// The Blender scene.
+    pub blend: PathBuf,
+    /// Glass materials and their registry ids, `PATTERN=ID` (e.g. 'Glass_6mm*=1'); repeatable,
+    /// first match wins.
+    #[arg(long, required = true)]
+    pub glass: Vec<String>,
+    /// Frames (`1-24`, `1,5,10-20`); default: the scene's frame range.
+    #[arg(long)]
+    pub frames: Option<String>,
+    /// Directory for the passes, masks, planes.json, cameras and composites.
+    #[arg(long)]
+    pub out_dir: PathBuf,
+    /// Cycles samples per pixel (default: the scene's).
+    #[arg(long)]
+    pub samples: Option<u32>,
+    /// Image size `WxH` (default: the scene's resolution × %).
+    #[arg(long)]
+    pub resolution: Option<String>,
+    /// The Blender program (default: `blender` on PATH); 3.4 or newer.
+    #[arg(long)]
+    pub blender: Option<PathBuf>,
+    /// Registry JSON (default: the bundled one).
+    #[arg(long)]
+    pub registry: Option<PathBuf>,
+    /// Longest time one Blender run (export, passes) may take, in seconds.
+    #[arg(long, default_value_t = 3600)]
+    pub timeout_s: u64,
+    /// Cycles seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Blender's render threads (default: Blender's choice).
+    #[arg(long)]
+    pub threads: Option<u32>,
+    /// K×K rays per pixel for the masks' glass coverage at pane edges (1: the pixel centre
+    /// only).
+    #[arg(long, default_value_t = 1)]
+    pub mask_samples: u32,
+    /// Also render the Cycles reference (the glass as a thin pane the camera sees, no passes)
+    /// as DIR/reference.####.exr, for validation.
+    #[arg(long)]
+    pub reference: bool,
+}
+
+#[derive(ClapArgs, Debug)]
+pub struct ComposeArgs {
+    /// The output directory of `glassdb blender render`.
+    pub dir: PathBuf,
+    /// Registry JSON (default: the bundled one).
+    #[arg(long)]
+    pub registry: Option<PathBuf>,
+}
+
+fn registry_choice(path: &Option<PathBuf>) -> anyhow::Result<RegistryChoice> {
+    Ok(match path {
+        Some(p) => RegistryChoice {
+            registry: Registry::from_json_file(p).map_err(anyhow::Error::new)?,
+            label: p.display().to_string(),
+        },
+        None => RegistryChoice {
+            registry: glassdb_registry::default_registry()?,
+            label: "the bundled catalog".into(),
+        },
+    })
+}
+
+fn parse_resolution(text: &str) -> anyhow::Result<(u32, u32)> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .with_context(|| format!("--resolution {text}: give WxH, e.g. 320x240"))?;
+    let size = |s: &str| -> anyhow::Result<u32> {
+        let v: u32 = s
+            .trim()
+            .parse()
+            .with_context(|| format!("--resolution {text}: {s:?} is not a whole number"))?;
+        anyhow::ensure!(v > 0, "--resolution {text}: sizes must be at least 1");
+        Ok(v)
+    };
+    let (w, h) = (size(w)?, size(h)?);
+    glassdb_scene::camera::check_image_size(w, h)?;
+    Ok((w, h))
+}
+
+fn print_composites(dir: &std::path::Path, report: &ComposeReport) {
+    for (frame, f) in &report.frames {
+        let glass: u64 = f.id_counts.values().sum();
+        outln!(
+            "frame {frame}: {}x{}, {glass} glass pixels on {} plane(s) -> {}",
+            f.width,
+            f.height,
+            f.planes,
+            f.output.path.display()
+        );
+    }
+    outln!(
+        "composited {} frame(s) in {} in {:.3} s",
+        report.frames.len(),
+        dir.display(),
+        report.seconds
+    );
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    match args.command {
+        BlenderCommand::Render(a) => run_render(a),
+        BlenderCommand::Compose(a) => {
+            let registry = registry_choice(&a.registry)?;
+            let report = glassdb_blender::compose_dir(&a.dir, &registry)?;
+            print_composites(&a.dir, &report);
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
+    let registry = registry_choice(&a.registry)?;
+    let frames = a
+        .frames
+        .as_deref()
+        .map(glassdb_io::parse_frame_list)
+        .transpose()?;
+    anyhow::ensure!(a.samples != Some(0), "--samples must be at least 1");
+    let request = RenderRequest {
+        blend: a.blend,
+        glass: a.glass,
+        frames,
+        out_dir: a.out_dir.clone(),
+        samples: a.samples,
+        resolution: a.resolution.as_deref().map(parse_resolution).transpose()?,
+        blender: a.blender,
+        timeout: Duration::from_secs(a.timeout_s.max(1)),
+        seed: a.seed,
+        threads: a.threads,
+        reference: a.reference,
+        mask_samples: a.mask_samples,
+    };
+    let spinner = Spinner::on_terminal("blender");
+    let report = glassdb_blender::render(&request, &registry, &spinner)?;
+    spinner.finish();
+    outln!(
+        "Blender {} ({}): {} frame(s), {} glass plane(s); glass materials {}",
+        report.blender.version,
+        report.blender.path.display(),
+        report.record.frames.len(),
+        report.planes,
+        report
+            .glass_materials
+            .iter()
+            .map(|(m, id)| format!("{m}={id}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    print_composites(&a.out_dir, &report.compose);
+    outln!(
+        "Blender export {:.2} s, passes {:.2} s{}; planes and masks {:.3} s",
+        report.export_s,
+        report.render_s,
+        if request.reference {
+            format!(", reference {:.2} s", report.reference_s)
+        } else {
+            String::new()
+        },
+        report.mask_s
+    );
+    if let Some(cpu) = report.render_cpu_s {
+        out!("Blender CPU: passes {cpu:.2} s");
+        if let Some(r) = report.reference_cpu_s {
+            out!(", reference {r:.2} s");
+        }
+        outln!();
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,518 @@
+//! `glassdb blender render` / `compose` end to end with Debian's Blender (scripts/test-all
+//! installs it): a tiny scene built by scripts/blender/make_glassdb_scene.py, rendered once and
+//! shared by the tests. Geometry and planes are checked against the scene's own corners,
+//! the masks against Cycles' Material Index through each pixel centre, the composite against
+//! the Cycles reference (the same glass seen by the camera) within the noise of its samples.
+//! Bad inputs use small stand-in `blender` scripts.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use crate::util::{Planes, fails_naming, glassdb, ok, read_exr_planes, repo_path};
+
+/// The tiny scene, its facts, Cycles' index renders and two glassdb runs (seeds 0 and 1).
+struct Rendered {
+    _dir: tempfile::TempDir,
+    root: PathBuf,
+    blend: PathBuf,
+    facts: serde_json::Value,
+    /// `glassdb blender render … --reference` with seed 0 and with seed 1.
+    runs: [PathBuf; 2],
+}
+
+const GLASS: [&str; 2] = ["Glass_clear=1", "Tinted*=5"];
+
+fn blender_program() -> &'static str {
+    let found = Command::new("blender")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "these tests need Blender 3.4+ on PATH (scripts/test-all installs Debian's `blender`)"
+    );
+    "blender"
+}
+
+fn render_run(blend: &Path, out: &Path, seed: u32) {
+    let mut cmd = glassdb();
+    cmd.args(["blender", "render"]).arg(blend);
+    for g in GLASS {
+        cmd.args(["--glass", g]);
+    }
+    cmd.arg("--out-dir")
+        .arg(out)
+        .args(["--reference", "--threads", "2", "--seed"])
+        .arg(seed.to_string());
+    ok(&mut cmd);
+}
+
+fn rendered() -> &'static Rendered {
+    static R: OnceLock<Rendered> = OnceLock::new();
+    R.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().to_path_buf();
+        let blend = root.join("tiny.blend");
+        let status = Command::new(blender_program())
+            .args([
+                "-b",
+                "--factory-startup",
+                "-noaudio",
+                "--python-exit-code",
+                "1",
+                "-P",
+            ])
+            .arg(repo_path("scripts/blender/make_glassdb_scene.py"))
+            .args(["--", "--scene", "tiny", "--out"])
+            .arg(&blend)
+            .arg("--facts")
+            .arg(root.join("facts.json"))
+            .arg("--index")
+            .arg(root.join("index"))
+            .output()
+            .unwrap();
+        assert!(
+            status.status.success(),
+            "building the scene: {}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+        let facts =
+            serde_json::from_str(&std::fs::read_to_string(root.join("facts.json")).unwrap())
+                .unwrap();
+        let runs = [root.join("run0"), root.join("run1")];
+        for (seed, run) in runs.iter().enumerate() {
+            render_run(&blend, run, seed as u32);
+        }
+        Rendered {
+            _dir: dir,
+            root,
+            blend,
+            facts,
+            runs,
+        }
+    })
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn corners(facts: &serde_json::Value, pane: &str) -> Vec<[f64; 3]> {
+    facts["panes"][pane]["corners"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| std::array::from_fn(|i| c[i].as_f64().unwrap()))
+        .collect()
+}
+
+/// The plane through a pane's first three corners, by the cross product: (unit normal, d).
+fn plane_of(c: &[[f64; 3]]) -> ([f64; 3], f64) {
+    let u: [f64; 3] = std::array::from_fn(|i| c[1][i] - c[0][i]);
+    let v: [f64; 3] = std::array::from_fn(|i| c[2][i] - c[0][i]);
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let n = n.map(|x| x / len);
+    (n, -(n[0] * c[0][0] + n[1] * c[0][1] + n[2] * c[0][2]))
+}
+
+/// The vertices written under `o NAME` in the exported OBJ.
+fn obj_vertices(obj: &str, name: &str) -> Vec<[f64; 3]> {
+    let mut inside = false;
+    let mut out = Vec::new();
+    for line in obj.lines() {
+        if let Some(o) = line.strip_prefix("o ") {
+            inside = o == name;
+        } else if inside && let Some(v) = line.strip_prefix("v ") {
+            let p: Vec<f64> = v.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            out.push([p[0], p[1], p[2]]);
+        }
+    }
+    out
+}
+
+#[test]
+fn exported_geometry_and_planes_are_the_scenes_own() {
+    let r = rendered();
+    let dir = &r.runs[0];
+    let obj = std::fs::read_to_string(dir.join("scene.obj")).unwrap();
+    let planes = json(&dir.join("planes.json"));
+    let planes = planes["planes"].as_array().unwrap();
+    assert_eq!(planes.len(), 2, "one plane per pane");
+    for (k, pane) in ["Pane_clear", "Pane_bronze"].iter().enumerate() {
+        let want = corners(&r.facts, pane);
+        // Multiples of 1/8: exact in float32 and in the OBJ text.
+        assert_eq!(obj_vertices(&obj, pane), want, "{pane} corners");
+        let (n, d) = plane_of(&want);
+        let eq: Vec<f64> = planes[k]["equation"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let s = if eq[0] * n[0] + eq[1] * n[1] + eq[2] * n[2] < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        for i in 0..3 {
+            assert!((eq[i] - s * n[i]).abs() < 1e-12, "{pane}: {eq:?} vs {n:?}");
+        }
+        assert!((eq[3] - s * d).abs() < 1e-12, "{pane}: d {} vs {d}", eq[3]);
+    }
+    // The camera of each frame where the scene put it (float32 in Blender).
+    let cams = json(&dir.join("camera.json"));
+    for f in ["1", "2"] {
+        let m = &cams["frames"][f]["matrix_world"];
+        let eye = &r.facts["cameras"][f]["eye"];
+        for i in 0..3 {
+            let got = m[i][3].as_f64().unwrap();
+            assert!(
+                (got - eye[i].as_f64().unwrap()).abs() < 1e-6,
+                "frame {f} eye"
+            );
+        }
+    }
+}
+
+fn channel<'a>(p: &'a Planes, suffix: &str) -> &'a [f64] {
+    let k = p
+        .names
+        .iter()
+        .position(|n| n == suffix || n.ends_with(&format!(".{suffix}")))
+        .unwrap_or_else(|| panic!("no channel {suffix} in {:?}", p.names));
+    &p.channels[k]
+}
+
+/// Reads one layer of a multilayer EXR by the name of its channels' prefix.
+fn read_exr_layer_channel(path: &Path, name_end: &str) -> (usize, usize, Vec<f64>) {
+    let image = exr::prelude::read_all_flat_layers_from_file(path).unwrap();
+    for layer in &image.layer_data {
+        for ch in &layer.channel_data.list {
+            if ch.name.to_string().ends_with(name_end) {
+                let size = layer.size;
+                return (
+                    size.width(),
+                    size.height(),
+                    ch.sample_data.values_as_f32().map(f64::from).collect(),
+                );
+            }
+        }
+    }
+    panic!("no channel {name_end} in {}", path.display());
+}
+
+#[test]
+fn masks_match_cycles_material_index() {
+    let r = rendered();
+    for frame in [1, 2] {
+        let mask = read_exr_planes(&r.runs[0].join(format!("mask.{frame:04}.exr")));
+        let (w, h, index) = read_exr_layer_channel(
+            &r.root.join(format!("index/index.{frame:04}.exr")),
+            "IndexMA.X",
+        );
+        assert_eq!((mask.width, mask.height), (w, h));
+        let id = channel(&mask, "id");
+        let differ = (0..w * h).filter(|&i| id[i] != index[i]).count();
+        let glass = index.iter().filter(|&&v| v > 0.0).count();
+        assert!(glass > 200, "frame {frame}: {glass} glass pixels");
+        assert_eq!(
+            differ, 0,
+            "frame {frame}: {differ} pixels differ from Cycles"
+        );
+    }
+}
+
+#[test]
+fn reflection_passes_cover_exactly_their_planes_pixels() {
+    let r = rendered();
+    let dir = &r.runs[0];
+    let record = json(&dir.join("glassdb-blender.json"));
+    for f in record["frames"].as_array().unwrap() {
+        let mask = read_exr_planes(&dir.join(f["mask"].as_str().unwrap()));
+        let (id, plane) = (channel(&mask, "id"), channel(&mask, "plane"));
+        for (k, refl) in f["refl"].as_array().unwrap().iter().enumerate() {
+            let header =
+                exr::meta::MetaData::read_from_file(dir.join(refl.as_str().unwrap()), false)
+                    .unwrap();
+            let h = &header.headers[0];
+            let (x0, y0) = (
+                h.own_attributes.layer_position.x(),
+                h.own_attributes.layer_position.y(),
+            );
+            let (bw, bh) = (h.layer_size.width() as i32, h.layer_size.height() as i32);
+            let mut bbox: Option<[i32; 4]> = None;
+            for i in 0..mask.width * mask.height {
+                if id[i] > 0.0 && plane[i] as usize == k {
+                    let (x, y) = ((i % mask.width) as i32, (i / mask.width) as i32);
+                    let b = bbox.get_or_insert([x, y, x, y]);
+                    *b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+                }
+            }
+            let b = bbox.expect("each plane has glass in the tiny scene");
+            assert_eq!(
+                [x0, y0, x0 + bw - 1, y0 + bh - 1],
+                b,
+                "plane {k}: data window"
+            );
+            let display = h.shared_attributes.display_window;
+            assert_eq!(
+                (display.size.width(), display.size.height()),
+                (mask.width, mask.height)
+            );
+        }
+    }
+}
+
+/// Mean |a − b| over the pixels `keep` selects, per channel R, G, B.
+fn mean_abs(a: &Planes, b: &Planes, keep: &[bool]) -> [f64; 3] {
+    let n = keep.iter().filter(|&&k| k).count() as f64;
+    ["R", "G", "B"].map(|c| {
+        let (x, y) = (channel(a, c), channel(b, c));
+        (0..keep.len())
+            .filter(|&i| keep[i])
+            .map(|i| (x[i] - y[i]).abs())
+            .sum::<f64>()
+            / n
+    })
+}
+
+/// Pixels whose 3 × 3 neighbourhood has one id and one plane (Cycles filters its pixels over
+/// 1.5 px, glassdb's mask is sampled at the centre: edges differ by construction).
+fn interior(mask: &Planes, glass: bool) -> Vec<bool> {
+    let (w, h) = (mask.width as i64, mask.height as i64);
+    let (id, plane) = (channel(mask, "id"), channel(mask, "plane"));
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let same = (-1..=1).all(|dy| {
+                (-1..=1).all(|dx| {
+                    let (u, v) = (x + dx, y + dy);
+                    (0..w).contains(&u)
+                        && (0..h).contains(&v)
+                        && id[(v * w + u) as usize] == id[i as usize]
+                        && plane[(v * w + u) as usize] == plane[i as usize]
+                })
+            });
+            same && (id[i as usize] > 0.0) == glass
+        })
+        .collect()
+}
+
+#[test]
+fn composite_matches_the_cycles_reference_within_its_noise() {
+    let r = rendered();
+    for frame in [1, 2] {
+        let name = |run: usize, stem: &str| r.runs[run].join(format!("{stem}.{frame:04}.exr"));
+        let mask = read_exr_planes(&name(0, "mask"));
+        let comp = read_exr_planes(&name(0, "composite"));
+        let reference = [
+            read_exr_planes(&name(0, "reference")),
+            read_exr_planes(&name(1, "reference")),
+        ];
+        for glass in [true, false] {
+            let keep = interior(&mask, glass);
+            assert!(keep.iter().filter(|&&k| k).count() > 100);
+            // The noise of 16 samples, measured: the same reference with two seeds.
+            let noise = mean_abs(&reference[0], &reference[1], &keep);
+            let err = mean_abs(&comp, &reference[1], &keep);
+            for c in 0..3 {
+                // Two independent estimates differ by √2 σ; the composite (its own noise plus
+                // the reference's) may differ by up to about that, with a quarter for what
+                // the method leaves out (glass-to-glass reflections, the ramp).
+                assert!(
+                    err[c] < 1.25 * noise[c] + 0.002,
+                    "frame {frame}, glass {glass}, channel {c}: composite error {} vs noise {}",
+                    err[c],
+                    noise[c]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn compose_dir_recomposites_with_another_registry() {
+    let r = rendered();
+    let dir = r.root.join("recompose");
+    copy_dir(&r.runs[0], &dir);
+    let first = read_exr_planes(&dir.join("composite.0001.exr"));
+    // The bundled registry again: the same composite, sample for sample.
+    ok(glassdb().args(["blender", "compose"]).arg(&dir));
+    let again = read_exr_planes(&dir.join("composite.0001.exr"));
+    assert_eq!(first.channels, again.channels);
+    // Other glasses with the same ids: glass pixels change, the rest stays the transmission.
+    let registry = r.root.join("atrium.json");
+    ok(glassdb()
+        .args(["registry", "build"])
+        .arg(repo_path("fixtures/atrium/catalog.toml"))
+        .arg("-o")
+        .arg(&registry));
+    let out = ok(glassdb()
+        .args(["blender", "compose"])
+        .arg(&dir)
+        .arg("--registry")
+        .arg(&registry));
+    assert!(out.contains("composited 2 frame(s)"), "{out}");
+    let other = read_exr_planes(&dir.join("composite.0001.exr"));
+    let trans = read_exr_planes(&dir.join("trans.0001.exr"));
+    let mask = read_exr_planes(&dir.join("mask.0001.exr"));
+    let id = channel(&mask, "id");
+    let r_other = channel(&other, "R");
+    let r_first = channel(&first, "R");
+    let r_trans = channel(&trans, "R");
+    let changed = (0..id.len())
+        .filter(|&i| id[i] > 0.0 && r_other[i] != r_first[i])
+        .count();
+    assert!(changed > 100, "{changed} glass pixels changed");
+    assert!(
+        (0..id.len())
+            .filter(|&i| id[i] == 0.0)
+            .all(|i| r_other[i] == r_trans[i])
+    );
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+}
+
+/// A stand-in `blender`: prints `version` for --version, else runs `body` (sh).
+fn fake_blender(dir: &Path, version: &str, body: &str) -> PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let path = dir.join("blender");
+    std::fs::write(
+        &path,
+        format!(
+            "#!/bin/sh\ncase \"$*\" in *--version*) echo \"Blender {version}\"; exit 0;; esac\n{body}\n"
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    path
+}
+
+fn render_with(blender: &Path, blend: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut cmd = glassdb();
+    cmd.args(["blender", "render"])
+        .arg(blend)
+        .args(["--glass", "Glass*=1", "--out-dir"])
+        .arg(out)
+        .arg("--blender")
+        .arg(blender)
+        .args(extra);
+    cmd
+}
+
+/// A file that starts like a .blend (the stand-ins never read it).
+fn blend_stub(dir: &Path) -> PathBuf {
+    let p = dir.join("scene.blend");
+    std::fs::write(&p, b"BLENDER-v304RENDH").unwrap();
+    p
+}
+
+#[test]
+fn missing_and_old_blender_are_refused() {
+    let t = tempfile::tempdir().unwrap();
+    let blend = blend_stub(t.path());
+    let out = t.path().join("out");
+    fails_naming(
+        &mut render_with(&t.path().join("no-such-blender"), &blend, &out, &[]),
+        &["cannot run Blender", "no-such-blender"],
+    );
+    let old = fake_blender(t.path(), "2.93.18", "exit 0");
+    fails_naming(
+        &mut render_with(&old, &blend, &out, &[]),
+        &["Blender 2.93.18", "needs Blender 3.4 or newer"],
+    );
+    let not_blender = t.path().join("not-blender");
+    std::fs::write(&not_blender, "#!/bin/sh\necho hello\n").unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&not_blender, std::fs::Permissions::from_mode(0o755)).unwrap();
+    fails_naming(
+        &mut render_with(&not_blender, &blend, &out, &[]),
+        &["did not print a Blender version", "hello"],
+    );
+}
+
+#[test]
+fn crashing_and_hanging_blender_are_reported() {
+    let t = tempfile::tempdir().unwrap();
+    let blend = blend_stub(t.path());
+    let out = t.path().join("out");
+    let crash = fake_blender(
+        t.path(),
+        "3.4.1",
+        "echo 'Writing: /tmp/blender.crash.txt'\nkill -SEGV $$",
+    );
+    let err = fails_naming(
+        &mut render_with(&crash, &blend, &out, &[]),
+        &[
+            "Blender (export) failed",
+            "killed by signal 11",
+            "blender.crash.txt",
+        ],
+    );
+    assert!(err.contains("blender.log"), "{err}");
+    let hang = fake_blender(t.path(), "3.4.1", "exec sleep 30");
+    let started = std::time::Instant::now();
+    fails_naming(
+        &mut render_with(&hang, &blend, &out, &["--timeout-s", "1"]),
+        &["took longer than 1 s", "was stopped"],
+    );
+    assert!(started.elapsed().as_secs() < 20);
+}
+
+#[test]
+fn bad_scene_files_and_output_dirs_are_refused() {
+    let t = tempfile::tempdir().unwrap();
+    let fake = fake_blender(t.path(), "3.4.1", "exit 0");
+    let text = t.path().join("notes.blend");
+    std::fs::write(&text, "just text").unwrap();
+    let out = t.path().join("out");
+    fails_naming(
+        &mut render_with(&fake, &text, &out, &[]),
+        &["notes.blend is not a Blender file", "BLENDER"],
+    );
+    fails_naming(
+        &mut render_with(&fake, &t.path().join("missing.blend"), &out, &[]),
+        &["missing.blend is not a Blender file"],
+    );
+    let blend = blend_stub(t.path());
+    fails_naming(
+        &mut render_with(&fake, &blend, &out, &["--mask-samples", "0"]),
+        &["samples"],
+    );
+    let file = t.path().join("a-file");
+    std::fs::write(&file, "").unwrap();
+    fails_naming(
+        &mut render_with(&fake, &blend, &file.join("out"), &[]),
+        &["cannot create the output directory", "a-file"],
+    );
+}
+
+#[test]
+fn a_scene_without_the_glass_materials_is_refused() {
+    let r = rendered();
+    let out = r.root.join("no-glass");
+    let err = fails_naming(
+        glassdb()
+            .args(["blender", "render"])
+            .arg(&r.blend)
+            .args(["--glass", "Glazing*=1", "--out-dir"])
+            .arg(&out),
+        &["Glazing*"],
+    );
+    // The message lists the scene's materials.
+    for m in ["Glass_clear", "Tinted_bronze", "Floor"] {
+        assert!(err.contains(m), "{err}");
+    }
+}
