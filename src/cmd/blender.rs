@@ -51,6 +51,10 @@ pub struct RenderArgs {
     /// The Blender program (default: `blender` on PATH); 3.4 or newer.
     #[arg(long)]
     pub blender: Option<PathBuf>,
+    /// Run Blender as the `bpy` module of this Python interpreter (PyPI `bpy` 4.2–5.0 on
+    /// Python 3.11) instead of a Blender executable.
+    #[arg(long, value_name = "PYTHON", conflicts_with = "blender")]
+    pub bpy_python: Option<PathBuf>,
     /// Registry JSON (default: the bundled one).
     #[arg(long)]
     pub registry: Option<PathBuf>,
@@ -159,6 +163,7 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         samples: a.samples,
         resolution: a.resolution.as_deref().map(parse_resolution).transpose()?,
         blender: a.blender,
+        bpy_python: a.bpy_python,
         timeout: Duration::from_secs(a.timeout_s.max(1)),
         seed: a.seed,
         threads: a.threads,

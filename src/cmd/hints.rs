@@ -259,6 +259,10 @@ fn blender_hint(e: &glassdb_blender::BlenderError) -> Option<String> {
                 .into()
         }
         B::TooOld { .. } => "give a newer Blender with --blender PATH".into(),
+        B::NoBpyModule { .. } => "install it in a Python 3.11 environment (python3.11 -m venv \
+             ENV && ENV/bin/pip install bpy==5.0.1) and give ENV/bin/python, or use a Blender \
+             executable (--blender PATH)"
+            .into(),
         B::TimedOut { .. } => {
             "raise --timeout-s, or render less: --samples, --resolution, --frames".into()
         }

@@ -444,6 +444,26 @@ fn missing_and_old_blender_are_refused() {
 }
 
 #[test]
+fn python_without_bpy_is_refused() {
+    let t = tempfile::tempdir().unwrap();
+    let blend = blend_stub(t.path());
+    let mut cmd = glassdb();
+    cmd.args(["blender", "render"])
+        .arg(&blend)
+        .args(["--glass", "Glass*=1", "--out-dir"])
+        .arg(t.path().join("out"))
+        .args(["--bpy-python", "python3"]);
+    fails_naming(
+        &mut cmd,
+        &[
+            "python3 cannot import the bpy module",
+            "No module named",
+            "bpy==5.0.1",
+        ],
+    );
+}
+
+#[test]
 fn crashing_and_hanging_blender_are_reported() {
     let t = tempfile::tempdir().unwrap();
     let blend = blend_stub(t.path());

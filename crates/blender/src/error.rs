@@ -11,6 +11,9 @@ pub enum BlenderError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// The Python interpreter given for the `bpy` module cannot import it.
+    #[error("{python} cannot import the bpy module (Blender as a Python module): {said}")]
+    NoBpyModule { python: PathBuf, said: String },
     /// `blender --version` did not say which Blender it is.
     #[error("{path} did not print a Blender version when asked for it (it printed {printed:?})")]
     VersionUnreadable { path: PathBuf, printed: String },

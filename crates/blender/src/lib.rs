@@ -16,5 +16,5 @@ pub use job::{PixelBounds, RunRecord};
 pub use pipeline::{
     ComposeReport, RegistryChoice, RenderReport, RenderRequest, compose_dir, render,
 };
-pub use program::Blender;
+pub use program::{Blender, Launcher};
 pub use thin_pane::ThinPane;

@@ -48,6 +48,8 @@ pub struct RenderRequest {
     pub resolution: Option<(u32, u32)>,
     /// The Blender program, or `blender` on PATH.
     pub blender: Option<PathBuf>,
+    /// A Python interpreter with the `bpy` module, used instead of a Blender executable.
+    pub bpy_python: Option<PathBuf>,
     /// Longest time one Blender run may take.
     pub timeout: Duration,
     pub seed: u32,
@@ -130,7 +132,10 @@ pub fn render(
     };
     glassdb_scene::raster::check_options(&options)?;
     check_blend_file(&request.blend)?;
-    let blender = Blender::find(request.blender.as_deref())?;
+    let blender = match &request.bpy_python {
+        Some(python) => Blender::find_bpy(python)?,
+        None => Blender::find(request.blender.as_deref())?,
+    };
     let dir = &request.out_dir;
     std::fs::create_dir_all(dir).map_err(io_error("create the output directory", dir))?;
     let log = dir.join(LOG_NAME);

@@ -21,10 +21,51 @@ const VERSION_TIMEOUT: Duration = Duration::from_secs(120);
 /// Bytes of the log shown when Blender fails.
 const LOG_TAIL_BYTES: u64 = 2000;
 
+/// Python run by a `bpy` interpreter: opens the .blend (argv[1]), then runs the script
+/// (argv[2]) as `__main__` with Blender's own argv (`… -- ARGS`), as `blender -b BLEND -P SCRIPT`
+/// would; an exception exits 1, as `--python-exit-code 1` does.
+const BPY_LAUNCHER: &str = "\
+import runpy, sys, traceback
+import bpy
+blend, script = sys.argv[1], sys.argv[2]
+bpy.ops.wm.open_mainfile(filepath=blend, load_ui=False)
+sys.argv = ['blender', '-b', blend, '-P', script] + sys.argv[3:]
+try:
+    runpy.run_path(script, run_name='__main__')
+except SystemExit:
+    raise
+except BaseException:
+    traceback.print_exc()
+    sys.exit(1)
+";
+
+/// Prints `Blender VERSION` from a `bpy` interpreter, or `no bpy: WHY` (on stdout, which is
+/// the stream read).
+const BPY_VERSION: &str = "\
+import sys
+try:
+    import bpy
+except Exception as e:
+    print('no bpy:', type(e).__name__, e)
+    sys.exit(1)
+print('Blender', bpy.app.version_string)
+";
+
+/// How Blender is run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Launcher {
+    /// Blender's own executable, headless (`blender -b`).
+    Executable,
+    /// A Python interpreter with the `bpy` module (Blender as a Python module, PyPI `bpy`).
+    BpyModule,
+}
+
 /// A Blender program that answered `--version` with a supported version.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Blender {
+    /// The Blender executable, or the Python interpreter that has `bpy`.
     pub path: PathBuf,
+    pub launcher: Launcher,
     /// As Blender prints it (`3.4.1`).
     pub version: String,
     /// Major and minor version.
@@ -65,8 +106,22 @@ impl Blender {
     /// than [`MINIMUM_VERSION`].
     pub fn find(path: Option<&Path>) -> Result<Blender, BlenderError> {
         let path = path.map_or_else(|| PathBuf::from("blender"), Path::to_path_buf);
-        let mut child = Command::new(&path)
-            .args(["-b", "--factory-startup", "--version"])
+        Self::find_with(path, Launcher::Executable)
+    }
+
+    /// Blender as the `bpy` module of the Python interpreter `python` (PyPI `bpy`, e.g. 4.2–5.0
+    /// on Python 3.11); refused when it cannot import `bpy` or the version is too old.
+    pub fn find_bpy(python: &Path) -> Result<Blender, BlenderError> {
+        Self::find_with(python.to_path_buf(), Launcher::BpyModule)
+    }
+
+    fn find_with(path: PathBuf, launcher: Launcher) -> Result<Blender, BlenderError> {
+        let mut command = Command::new(&path);
+        match launcher {
+            Launcher::Executable => command.args(["-b", "--factory-startup", "--version"]),
+            Launcher::BpyModule => command.args(["-c", BPY_VERSION]),
+        };
+        let mut child = command
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -89,6 +144,14 @@ impl Blender {
             }
             std::thread::sleep(Duration::from_millis(20));
         }
+        if launcher == Launcher::BpyModule
+            && let Some(said) = printed.lines().find_map(|l| l.strip_prefix("no bpy: "))
+        {
+            return Err(BlenderError::NoBpyModule {
+                python: path,
+                said: said.chars().take(300).collect(),
+            });
+        }
         let Some((version, number)) = parse_version(&printed) else {
             return Err(BlenderError::VersionUnreadable {
                 path,
@@ -104,13 +167,14 @@ impl Blender {
         }
         Ok(Blender {
             path,
+            launcher,
             version,
             version_number: number,
         })
     }
 
-    /// Runs `blender -b BLEND --factory-startup -noaudio --python-exit-code 1 -P SCRIPT -- ARGS`,
-    /// its output appended to the log, stopped after the time limit.
+    /// Runs `blender -b BLEND --factory-startup -noaudio --python-exit-code 1 -P SCRIPT -- ARGS`
+    /// (or the same through a `bpy` interpreter), its output appended to the log, stopped after the time limit.
     pub fn run(&self, run: &BlenderRun<'_>) -> Result<(), BlenderError> {
         let io = |action: &'static str, path: &Path| {
             let path = path.to_path_buf();
@@ -136,16 +200,18 @@ impl Blender {
         )
         .map_err(io("write the log", run.log))?;
         let err_log = log.try_clone().map_err(io("write the log", run.log))?;
-        let mut child = Command::new(&self.path)
-            .arg("-b")
-            .arg(run.blend)
-            .args([
+        let mut command = Command::new(&self.path);
+        match self.launcher {
+            Launcher::Executable => command.arg("-b").arg(run.blend).args([
                 "--factory-startup",
                 "-noaudio",
                 "--python-exit-code",
                 "1",
                 "-P",
-            ])
+            ]),
+            Launcher::BpyModule => command.args(["-c", BPY_LAUNCHER]).arg(run.blend),
+        };
+        let mut child = command
             .arg(run.script)
             .arg("--")
             .args(&run.args)
