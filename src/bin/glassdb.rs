@@ -36,6 +36,8 @@ enum Command {
     Plot(cmd::plot::Args),
     /// Regenerate the speed-against-error tables of docs/accuracy.md.
     Report(cmd::report::Args),
+    /// Serve the glass-swap viewer: pick products per glass and see the composite at once.
+    View(Box<cmd::view::Args>),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +53,7 @@ fn main() -> ExitCode {
         Command::Mask(a) => cmd::scene::run_mask(a),
         Command::Plot(a) => cmd::plot::run(a),
         Command::Report(a) => cmd::report::run(a),
+        Command::View(a) => cmd::view::run(*a),
     };
     cmd::finish(result)
 }

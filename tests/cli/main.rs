@@ -20,3 +20,4 @@ mod util;
 mod validation;
 mod values;
 mod view;
+mod viewer;
