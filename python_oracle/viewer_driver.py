@@ -6,7 +6,7 @@
         for the new frame, and writes the canvas's RGBA bytes (rows top to bottom) to --out.
         Prints JSON: size, frames drawn, the product sets, the last swap's time, page errors.
 
-    viewer_driver.py bench URL --id ID --products P1,P2 [--repeat N]
+    viewer_driver.py bench URL --id ID --products 'P1|P2' [--repeat N]
         Times product choices through the page's automation hook: from the choice to the new
         frame drawn (a 1-pixel read-back finishes the drawing), and the page's load time.
 
@@ -111,9 +111,8 @@ def bench(args):
         driver.get(args.url)
         wait_ready(driver, args.timeout)
         load_ms = (time.perf_counter() - t0) * 1e3
-        page_ms = driver.execute_script(
-            "const n = performance.getEntriesByType('navigation')[0]; return performance.now() - 0")
-        products = args.products.split(",")
+        page_ms = driver.execute_script("return window.glassdbReadyMs")
+        products = args.products.split("|")
         swaps = []
         for k in range(args.repeat):
             for p in products:
@@ -148,7 +147,7 @@ def main():
     b = sub.add_parser("bench")
     b.add_argument("url")
     b.add_argument("--id", type=int, required=True)
-    b.add_argument("--products", required=True)
+    b.add_argument("--products", required=True, help="product names separated by |")
     b.add_argument("--repeat", type=int, default=5)
     for p in (c, b):
         p.add_argument("--timeout", type=float, default=60)

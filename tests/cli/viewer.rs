@@ -169,6 +169,23 @@ fn a_product_swapped_on_the_page_gives_composes_pixels_and_the_export_the_same()
     let (got, _) = canvas(&by_url, &[], &dir.path().join("url.rgba"));
     let db = psnr(&got, &want);
     assert!(db >= 50.0, "page with ?glass= vs compose: {db:.1} dB");
+
+    // A/B split: set A as bundled left of the middle, set B with the swap right of it.
+    let split = format!("{}?glassB=5:Stopray&ab=split&split=0.5", served.url);
+    let (got, report) = canvas(&split, &[], &dir.path().join("split.rgba"));
+    assert_eq!(report["products"]["B"]["5"], SWAP_PRODUCT, "{report}");
+    let width = report["width"].as_u64().unwrap() as usize;
+    let half = |img: &[[f64; 3]], right: bool| -> Vec<[f64; 3]> {
+        img.iter()
+            .enumerate()
+            .filter(|(i, _)| (i % width >= width / 2) == right)
+            .map(|(_, p)| *p)
+            .collect()
+    };
+    for (right, reference, name) in [(false, &unswapped, "A (left)"), (true, &want, "B (right)")] {
+        let db = psnr(&half(&got, right), &half(reference, right));
+        assert!(db >= 50.0, "split view, {name}: {db:.1} dB");
+    }
     drop(served);
 
     // The export, opened from disk, starts with the chosen product.

@@ -596,6 +596,8 @@ void main() {
     if (state.selected === null && first !== undefined) { state.selected = first; renderGlasses(); }
     renderProducts();
     if (!errors.length) status('ready: ' + W + '×' + H + ', ' + scene.planes + ' plane(s), ' + products.length + ' products');
+    // Milliseconds from the start of navigation to the first frame drawn and the page ready.
+    window.glassdbReadyMs = performance.now();
     window.glassdbReady = true;
   }
 
