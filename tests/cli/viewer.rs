@@ -45,12 +45,17 @@ impl Drop for Served {
     }
 }
 
+/// Serves the atrium with `extra` arguments.
 fn serve(extra: &[&std::ffi::OsStr]) -> Served {
     let mut cmd = glassdb();
     cmd.arg("view");
-    atrium_inputs(&mut cmd)
-        .args(["--port", "0"])
-        .args(extra)
+    atrium_inputs(&mut cmd).args(extra);
+    spawn_viewer(&mut cmd)
+}
+
+/// Starts `cmd` (a `glassdb view` with its inputs) on a free port and reads its URL.
+fn spawn_viewer(cmd: &mut Command) -> Served {
+    cmd.args(["--port", "0"])
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit());
     let mut child = cmd.spawn().expect("start glassdb view");
@@ -328,4 +333,60 @@ fn bad_choices_and_export_paths_are_refused_naming_them() {
         &["a-file"],
     );
     assert!(!out.exists());
+}
+
+/// Frame 2 of a two-frame sequence whose second frame has other pixels (the atrium's plane-1
+/// reflection as its transmission pass) and the float mask with coverage (`mask.exr`): the
+/// fine-table interpolation and the coverage weights, after the frame slider moved.
+#[test]
+fn a_second_frame_with_a_float_mask_gives_composes_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = |f: &str| repo_path("fixtures/atrium").join(f);
+    let copy = |from: &str, to: String| std::fs::copy(a(from), dir.path().join(to)).unwrap();
+    for frame in [1, 2] {
+        let trans = if frame == 1 {
+            "trans.exr"
+        } else {
+            "refl_1.exr"
+        };
+        copy(trans, format!("trans.{frame:04}.exr"));
+        copy("mask.exr", format!("mask.{frame:04}.exr"));
+        for k in 0..3 {
+            copy(&format!("refl_{k}.exr"), format!("refl_{k}.{frame:04}.exr"));
+        }
+    }
+    let d = dir.path();
+    let files = |cmd: &mut Command, frame: &str| {
+        cmd.arg("--trans").arg(d.join(format!("trans.{frame}.exr")));
+        for k in 0..3 {
+            cmd.arg("--refl")
+                .arg(d.join(format!("refl_{k}.{frame}.exr")));
+        }
+        cmd.arg("--mask")
+            .arg(d.join(format!("mask.{frame}.exr")))
+            .arg("--planes")
+            .arg(a("virtual/planes.json"));
+    };
+    let out = d.join("frame2.png");
+    let mut cmd = glassdb();
+    cmd.arg("compose");
+    files(&mut cmd, "0002");
+    ok(cmd.args(["--dither", "none", "-o"]).arg(&out));
+    let p = read_png_planes(&out);
+    let want: Vec<[f64; 3]> = (0..p.width * p.height)
+        .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
+        .collect();
+
+    let mut cmd = glassdb();
+    cmd.arg("view");
+    files(&mut cmd, "####");
+    cmd.args(["--frames", "1-2"]);
+    let served = spawn_viewer(&mut cmd);
+    let (got, report) = canvas(&format!("{}?frame=1", served.url), &[], &d.join("f2.rgba"));
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    let db = psnr(&got, &want);
+    assert!(
+        db >= 50.0,
+        "frame 2 with the float mask vs compose: {db:.1} dB"
+    );
 }
