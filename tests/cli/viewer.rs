@@ -333,6 +333,13 @@ fn bad_choices_and_export_paths_are_refused_naming_them() {
         &["a-file"],
     );
     assert!(!out.exists());
+    // A port another program holds: refused, with the way out.
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = taken.local_addr().unwrap().port().to_string();
+    fails_naming(
+        &mut view(&["--port".as_ref(), port.as_ref()]),
+        &["cannot listen", &port, "--port 0"],
+    );
 }
 
 /// Frame 2 of a two-frame sequence whose second frame has other pixels (the atrium's plane-1
