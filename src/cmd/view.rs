@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use glassdb_compose::io::PassReadOptions;
 use glassdb_compose::pixels::InputTransfer;
+use glassdb_compose::view::CubeLut;
 use glassdb_compose::{
     ComposeJob, ComposeSettings, InputLayers, OutsidePolicy, UnknownIds, sequence,
 };
@@ -55,6 +56,10 @@ pub struct Args {
     /// the zero-padded frame number; the page gets a frame slider.
     #[arg(long, value_name = "LIST")]
     pub frames: Option<String>,
+    /// A `.cube` view the page offers beside `standard` (repeat for several; docs/colour.md):
+    /// as compose's --view, its output is display-encoded.
+    #[arg(long, value_name = "FILE.cube")]
+    pub view: Vec<PathBuf>,
     /// Address to listen on. The default serves this machine only.
     #[arg(long, default_value = "127.0.0.1", value_name = "ADDRESS")]
     pub bind: String,
@@ -110,7 +115,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         unknown: UnknownIds::Error,
         output: Default::default(),
         registry_label: label,
-        protected: args.registry.iter().chain(&args.planes).cloned().collect(),
+        protected: args
+            .registry
+            .iter()
+            .chain(&args.planes)
+            .chain(&args.view)
+            .cloned()
+            .collect(),
         input_space: args.input_space,
         max_memory: args.max_memory.unwrap_or_else(default_max_memory),
     };
@@ -132,6 +143,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         frames,
         settings,
         registry,
+        views: args
+            .view
+            .iter()
+            .map(|p| CubeLut::read(p))
+            .collect::<Result<_, _>>()?,
     })?;
     let choices = match &args.glass {
         Some(spec) => viewer.parse_choices(spec).context("--glass")?,

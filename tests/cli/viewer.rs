@@ -397,3 +397,61 @@ fn a_second_frame_with_a_float_mask_gives_composes_pixels() {
         "frame 2 with the float mask vs compose: {db:.1} dB"
     );
 }
+
+/// A `.cube` view (a 1D shaper over 0–4, then a 3D table mixing channels), written here.
+fn write_cube(path: &Path) {
+    let mut text =
+        String::from("# test view\nLUT_1D_SIZE 17\nLUT_1D_INPUT_RANGE 0 4\nLUT_3D_SIZE 9\n");
+    for i in 0..17 {
+        let y = (i as f64 / 16.0).powf(1.0 / 2.2);
+        text += &format!("{y:.6} {:.6} {:.6}\n", y * 0.98, y.powf(1.1));
+    }
+    for b in 0..9 {
+        for g in 0..9 {
+            for r in 0..9 {
+                let [r, g, b] = [r, g, b].map(|v| f64::from(v) / 8.0);
+                let out = [0.9 * r + 0.1 * g, g * g.sqrt(), 0.6 * b + 0.4 * r * g];
+                text += &format!("{:.6} {:.6} {:.6}\n", out[0], out[1], out[2]);
+            }
+        }
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn a_cube_view_on_the_page_gives_composes_pixels_through_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("look.cube");
+    write_cube(&cube);
+    let out = dir.path().join("look.png");
+    let mut cmd = glassdb();
+    cmd.arg("compose");
+    atrium_inputs(&mut cmd)
+        .args(["--dither", "none", "--view"])
+        .arg(&cube)
+        .arg("-o")
+        .arg(&out);
+    ok(&mut cmd);
+    let p = read_png_planes(&out);
+    let want: Vec<[f64; 3]> = (0..p.width * p.height)
+        .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
+        .collect();
+    let standard = compose_png(dir.path(), None, "standard.png");
+    assert!(
+        psnr(&want, &standard) < 40.0,
+        "the view changes the picture"
+    );
+
+    let served = serve(&["--view".as_ref(), cube.as_os_str()]);
+    let (got, report) = canvas(
+        &format!("{}?view=look", served.url),
+        &[],
+        &dir.path().join("look.rgba"),
+    );
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    let db = psnr(&got, &want);
+    assert!(
+        db >= 50.0,
+        "page through the .cube view vs compose: {db:.1} dB"
+    );
+}

@@ -49,6 +49,7 @@
   const source = EXPORT ? {
     scene: async () => EXPORT.scene,
     luts: async () => EXPORT.luts.map((text) => new Float32Array(base64Bytes(text))),
+    view: async (i) => new Float32Array(base64Bytes(EXPORT.views[i])),
     frame: async (i) => {
       if (!EXPORT.frames[i]) await loadScript(window.GLASSDB_EXPORT_FRAME_FILES[i]);
       const f = EXPORT.frames[i];
@@ -67,6 +68,7 @@
       const size = all.byteLength / n;
       return Array.from({ length: n }, (_, i) => new Float32Array(all, i * size, size / 4));
     },
+    view: async (i) => new Float32Array(await fetchOk('api/view/' + i)),
     frame: async (i) => {
       const info = await fetchOk('api/frame/' + i, 'json');
       const passes = await fetchOk('api/frame/' + i + '/passes');
@@ -149,6 +151,7 @@ precision highp float;
 precision highp int;
 precision highp sampler2D;
 precision highp sampler2DArray;
+precision highp sampler3D;
 uniform sampler2D uTrans;
 uniform sampler2DArray uRefl;
 uniform sampler2D uMask;
@@ -163,6 +166,17 @@ uniform bool uConvert;
 uniform mat3 uDisplay;  // passes' space to linear Rec.709
 uniform int uAB;        // 0: A, 1: B, 2: split
 uniform float uSplitX;  // split position in pixels
+uniform int uView;      // 0: standard, 1: a .cube view
+uniform sampler2D uShaper;
+uniform highp sampler3D uCube;
+uniform bool uHasShaper;
+uniform bool uHasCube;
+uniform int uShaperLen;
+uniform vec3 uShaperScale;
+uniform vec3 uShaperOffset;
+uniform int uCubeN;
+uniform vec3 uCubeScale;
+uniform vec3 uCubeOffset;
 out vec4 outColor;
 const int W = ${lut.width};
 const int ROWS_CURVE = ${lut.rows_per_curve};
@@ -170,6 +184,11 @@ const int ROWS_SLOT = ${lut.rows_per_slot};
 const int FINE = ${lut.fine_offset};
 const int STEPS = ${lut.fine_steps};
 const int NORMAL = ${lut.normal_offset};
+
+// a + f·(b − a), as compose's lerp (not GLSL's mix, whose rounding may differ).
+vec3 mix3(vec3 a, vec3 b, float f) {
+  return a + f * (b - a);
+}
 
 vec3 entry(sampler2D lut, int row, int e) {
   return texelFetch(lut, ivec2(e % W, row + e / W), 0).rgb;
@@ -204,6 +223,50 @@ vec3 srgb(vec3 c) {
   return mix(hi, lo, vec3(lessThanEqual(c, vec3(0.0031308))));
 }
 
+// A table's index of x, as compose's CubeLut: (x·scale + offset)·last, NaN → 0, clamped.
+float tableIndex(float x, float last) {
+  float v = x * last;
+  return isnan(v) ? 0.0 : clamp(v, 0.0, last);
+}
+
+vec3 shaperAt(int i) {
+  return texelFetch(uShaper, ivec2(i % W, i / W), 0).rgb;
+}
+
+// compose's CubeLut::apply: the 1D table per channel (linear), then the 3D table (trilinear).
+vec3 cubeView(vec3 v) {
+  if (uHasShaper) {
+    float last = float(uShaperLen - 1);
+    for (int c = 0; c < 3; c++) {
+      float f = tableIndex(v[c] * uShaperScale[c] + uShaperOffset[c], last);
+      int lo = min(int(floor(f)), uShaperLen - 1);
+      int hi = min(lo + 1, uShaperLen - 1);
+      float d = f - float(lo);
+      float a = shaperAt(lo)[c];
+      float b = shaperAt(hi)[c];
+      v[c] = a + d * (b - a);
+    }
+  }
+  if (uHasCube) {
+    float last = float(uCubeN - 1);
+    ivec3 lo;
+    ivec3 hi;
+    vec3 d;
+    for (int c = 0; c < 3; c++) {
+      float f = tableIndex(v[c] * uCubeScale[c] + uCubeOffset[c], last);
+      lo[c] = min(int(floor(f)), uCubeN - 1);
+      hi[c] = min(lo[c] + 1, uCubeN - 1);
+      d[c] = f - float(lo[c]);
+    }
+    vec3 c00 = mix3(texelFetch(uCube, ivec3(lo.x, lo.y, lo.z), 0).rgb, texelFetch(uCube, ivec3(hi.x, lo.y, lo.z), 0).rgb, d.x);
+    vec3 c10 = mix3(texelFetch(uCube, ivec3(lo.x, hi.y, lo.z), 0).rgb, texelFetch(uCube, ivec3(hi.x, hi.y, lo.z), 0).rgb, d.x);
+    vec3 c01 = mix3(texelFetch(uCube, ivec3(lo.x, lo.y, hi.z), 0).rgb, texelFetch(uCube, ivec3(hi.x, lo.y, hi.z), 0).rgb, d.x);
+    vec3 c11 = mix3(texelFetch(uCube, ivec3(lo.x, hi.y, hi.z), 0).rgb, texelFetch(uCube, ivec3(hi.x, hi.y, hi.z), 0).rgb, d.x);
+    v = mix3(mix3(c00, c10, d.y), mix3(c01, c11, d.y), d.z);
+  }
+  return v;
+}
+
 void main() {
   int x = int(gl_FragCoord.x);
   int y = uHeight - 1 - int(gl_FragCoord.y);
@@ -228,9 +291,14 @@ void main() {
     col = tr.rgb * t + rf * r;
   }
   col *= uGain;
-  if (uConvert) col = uDisplay * col;
+  if (uConvert && uView == 0) col = uDisplay * col;
   if (tr.a > 0.0) col /= tr.a;
-  outColor = vec4(srgb(col), 1.0);
+  if (uView == 0) {
+    outColor = vec4(srgb(col), 1.0);
+  } else {
+    vec3 v = cubeView(col);
+    outColor = vec4(mix(clamp(v, 0.0, 1.0), vec3(0.0), vec3(isnan(v))), 1.0);
+  }
 }`;
   }
 
@@ -279,6 +347,13 @@ void main() {
     const reflTex = texture(gl, gl.TEXTURE_2D_ARRAY);
     const maskTex = texture(gl, gl.TEXTURE_2D);
     const lutTex = { A: texture(gl, gl.TEXTURE_2D), B: texture(gl, gl.TEXTURE_2D) };
+    const shaperTex = texture(gl, gl.TEXTURE_2D);
+    const cubeTex = texture(gl, gl.TEXTURE_3D);
+    gl.texParameteri(gl.TEXTURE_3D, gl.TEXTURE_WRAP_R, gl.CLAMP_TO_EDGE);
+    // Complete from the start (a 1-texel placeholder) until a view's tables replace them.
+    gl.texImage3D(gl.TEXTURE_3D, 0, gl.RGB32F, 1, 1, 1, 0, gl.RGB, gl.FLOAT, new Float32Array(3));
+    gl.bindTexture(gl.TEXTURE_2D, shaperTex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, 1, 1, 0, gl.RGB, gl.FLOAT, new Float32Array(3));
     gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, gl.RGBA16F, W, H, scene.planes);
     gl.bindTexture(gl.TEXTURE_2D, transTex);
     gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA16F, W, H);
@@ -289,13 +364,46 @@ void main() {
       gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, lutLayout.width, lutLayout.rows_per_slot * slots.length);
     }
     const units = [['uTrans', gl.TEXTURE_2D, transTex], ['uRefl', gl.TEXTURE_2D_ARRAY, reflTex],
-      ['uMask', gl.TEXTURE_2D, maskTex], ['uLutA', gl.TEXTURE_2D, lutTex.A], ['uLutB', gl.TEXTURE_2D, lutTex.B]];
+      ['uMask', gl.TEXTURE_2D, maskTex], ['uLutA', gl.TEXTURE_2D, lutTex.A], ['uLutB', gl.TEXTURE_2D, lutTex.B],
+      ['uShaper', gl.TEXTURE_2D, shaperTex], ['uCube', gl.TEXTURE_3D, cubeTex]];
+    const unitOf = (name) => units.findIndex(([n]) => n === name);
     units.forEach(([name, target, tex], i) => {
       gl.activeTexture(gl.TEXTURE0 + i);
       gl.bindTexture(target, tex);
       gl.uniform1i(u(name), i);
     });
+    // Texture units: one per sampler, then an idle one that uploads bind to.
     gl.activeTexture(gl.TEXTURE0 + units.length);
+    // A view's tables, uploaded when it is chosen (index into scene.views; -1: standard).
+    const viewTables = {};
+    async function setView(i) {
+      if (i >= 0 && !viewTables[i]) viewTables[i] = await source.view(i);
+      const v = scene.views[i];
+      gl.uniform1i(u('uView'), v ? 1 : 0);
+      if (v) {
+        const data = viewTables[i];
+        const shaperFloats = v.shaper ? v.shaper.rows * lutLayout.width * 3 : 0;
+        gl.uniform1i(u('uHasShaper'), v.shaper ? 1 : 0);
+        gl.uniform1i(u('uHasCube'), v.cube ? 1 : 0);
+        if (v.shaper) {
+          gl.activeTexture(gl.TEXTURE0 + unitOf('uShaper'));
+          gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, lutLayout.width, v.shaper.rows, 0, gl.RGB, gl.FLOAT, data.subarray(0, shaperFloats));
+          gl.uniform1i(u('uShaperLen'), v.shaper.len);
+          gl.uniform3fv(u('uShaperScale'), v.shaper.scale);
+          gl.uniform3fv(u('uShaperOffset'), v.shaper.offset);
+        }
+        if (v.cube) {
+          const n = v.cube.n;
+          gl.activeTexture(gl.TEXTURE0 + unitOf('uCube'));
+          gl.texImage3D(gl.TEXTURE_3D, 0, gl.RGB32F, n, n, n, 0, gl.RGB, gl.FLOAT, data.subarray(shaperFloats, shaperFloats + n * n * n * 3));
+          gl.uniform1i(u('uCubeN'), n);
+          gl.uniform3fv(u('uCubeScale'), v.cube.scale);
+          gl.uniform3fv(u('uCubeOffset'), v.cube.offset);
+        }
+        gl.activeTexture(gl.TEXTURE0 + units.length);
+      }
+      state.view = i;
+    }
     gl.uniform1i(u('uHeight'), H);
     gl.uniform1i(u('uMode'), { code8: 0, cos: 1, normal: 2 }[scene.mask_mode]);
     gl.uniform1i(u('uPlanes'), scene.planes);
@@ -314,6 +422,7 @@ void main() {
       split: Number(params.get('split') ?? 0.5),
       edit: 'A',
       frame: Number(params.get('frame') ?? 0),
+      view: -1,
       selected: null,
       data: null,
       drawn: 0,
@@ -525,6 +634,28 @@ void main() {
         frameLabel();
       } catch (e) { status(e.message, true); }
     };
+    const viewSelect = $('view');
+    scene.views.forEach((v, i) => {
+      const o = document.createElement('option');
+      o.value = String(i);
+      o.textContent = v.name + (v.title ? ' (' + v.title + ')' : '');
+      viewSelect.append(o);
+    });
+    viewSelect.value = 'standard';
+    viewSelect.onchange = async () => {
+      try {
+        await setView(viewSelect.value === 'standard' ? -1 : Number(viewSelect.value));
+        draw();
+      } catch (e) { status(e.message, true); }
+    };
+    const wantView = params.get('view');
+    if (wantView && wantView !== 'standard') {
+      const i = scene.views.findIndex((v) => v.name === wantView);
+      if (i < 0) status('no view named "' + wantView + '"', true);
+      else { await setView(i); viewSelect.value = String(i); }
+    } else {
+      await setView(-1);
+    }
     const evInput = $('ev');
     evInput.value = String(state.ev);
     $('ev-label').textContent = state.ev.toFixed(1);
@@ -568,6 +699,7 @@ void main() {
       scene,
       choose: (id, product, set) => choose(id, typeof product === 'number' ? product : findProduct(products, product), set),
       setEv: (ev) => { state.ev = ev; draw(); },
+      setView: async (name) => { await setView(scene.views.findIndex((v) => v.name === name)); draw(); },
       setAB: (mode, split) => { state.ab = mode; if (split !== undefined) state.split = split; draw(); },
       loadFrame,
       products: () => ({ A: Object.fromEntries(slots.map((id, s) => [id, products[state.sets.A[s]].name])),

@@ -13,6 +13,7 @@
 
 use glassdb_compose::DecodedFrame;
 use glassdb_compose::lut::{FINE_STEPS, GlassSideLut, RtTriple};
+use glassdb_compose::view::CubeLut;
 use glassdb_mask::{CosCode, CosTheta};
 
 /// Texels per row of the lookup-table texture (WebGL2 guarantees 2048).
@@ -132,6 +133,20 @@ pub fn mask_bytes(frame: &DecodedFrame<'_>, slot_of: impl Fn(u16) -> Option<usiz
         };
         let coverage = mask.coverage.as_ref().map_or(1.0, |c| c[i]);
         texels.extend_from_slice(&[slot, f32::from(mask.plane[i]), cos, coverage]);
+    }
+    f32_bytes(&texels)
+}
+
+/// A `.cube` view's tables as `f32` RGB texels: the 1D table (if any) in rows of
+/// [`LUT_WIDTH`], the last row padded with zeros, then the 3D table (if any), red fastest.
+pub fn view_bytes(lut: &CubeLut) -> Vec<u8> {
+    let mut texels: Vec<f32> = Vec::new();
+    if let Some(t) = lut.shaper_table() {
+        texels.extend_from_slice(t.values);
+        texels.resize(t.size.div_ceil(LUT_WIDTH) * LUT_WIDTH * 3, 0.0);
+    }
+    if let Some(t) = lut.cube_table() {
+        texels.extend_from_slice(t.values);
     }
     f32_bytes(&texels)
 }

@@ -54,9 +54,18 @@ pub fn write_export(
                 .unwrap_or_default()
         })
         .collect();
+    let views: Vec<String> = (0..viewer.view_count())
+        .map(|i| {
+            viewer
+                .view_data(i)
+                .map(|b| STANDARD.encode(b))
+                .unwrap_or_default()
+        })
+        .collect();
     let data = format!(
-        "window.GLASSDB_EXPORT = {{\"scene\": {scene}, \"luts\": {}, \"frames\": {{}}}};\n",
-        json!(luts)
+        "window.GLASSDB_EXPORT = {{\"scene\": {scene}, \"luts\": {}, \"views\": {}, \"frames\": {{}}}};\n",
+        json!(luts),
+        json!(views)
     );
     staged.write_bytes(&dir.join("data.js"), data.as_bytes())?;
     for i in 0..frames {

@@ -9,6 +9,7 @@ use glassdb_colour::RgbSpace;
 use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::lut::GlassLut;
 use glassdb_compose::memory::MemoryBudget;
+use glassdb_compose::view::CubeLut;
 use glassdb_compose::{ComposeJob, ComposeSettings, decode_frame, sequence};
 use glassdb_registry::{GlassRecord, Registry, Side};
 use serde_json::{Value, json};
@@ -24,6 +25,8 @@ pub struct ViewerInputs {
     pub frames: Vec<u32>,
     pub settings: ComposeSettings,
     pub registry: Registry,
+    /// `.cube` views the page offers beside `standard`.
+    pub views: Vec<CubeLut>,
 }
 
 /// One decoded frame as the page uploads it.
@@ -119,6 +122,7 @@ impl Viewer {
             "slots": products.iter().map(|g| g.id).collect::<Vec<_>>(),
             "products": products.iter().enumerate().map(|(i, g)| product_json(i, g)).collect::<Vec<_>>(),
             "first_frame_ids": first,
+            "views": inputs.views.iter().map(view_json).collect::<Vec<_>>(),
         });
         let product_luts = products.iter().map(|_| OnceLock::new()).collect();
         Ok(Viewer {
@@ -165,6 +169,16 @@ impl Viewer {
             cell.get_or_init(|| Arc::new(data::lut_bytes(&sides)))
                 .clone(),
         )
+    }
+
+    /// View `index`'s tables as the page uploads them ([`data::view_bytes`]).
+    pub fn view_data(&self, index: usize) -> Option<Vec<u8>> {
+        self.inputs.views.get(index).map(data::view_bytes)
+    }
+
+    /// How many `.cube` views there are.
+    pub fn view_count(&self) -> usize {
+        self.inputs.views.len()
     }
 
     /// Every product's table, one after the other (the page loads them in one request, so a
@@ -325,6 +339,29 @@ fn side_name(side: Side) -> &'static str {
         Side::Front => "front",
         Side::Back => "back",
     }
+}
+
+/// A `.cube` view as the scene lists it: its name and its tables' sizes and domains.
+fn view_json(lut: &CubeLut) -> Value {
+    let name = lut.path.file_stem().map_or_else(
+        || lut.path.display().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    json!({
+        "name": name,
+        "title": lut.title,
+        "shaper": lut.shaper_table().map(|t| json!({
+            "len": t.size,
+            "rows": t.size.div_ceil(data::LUT_WIDTH),
+            "scale": t.scale,
+            "offset": t.offset,
+        })),
+        "cube": lut.cube_table().map(|t| json!({
+            "n": t.size,
+            "scale": t.scale,
+            "offset": t.offset,
+        })),
+    })
 }
 
 fn product_json(index: usize, g: &GlassRecord) -> Value {

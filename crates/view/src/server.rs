@@ -9,6 +9,7 @@
 //! | `GET /api/frame/N` | frame N's JSON: glass pixels per id |
 //! | `GET /api/frame/N/passes`, `/api/frame/N/mask` | frame N's binary data ([`crate::data`]) |
 //! | `GET /api/product/N/lut` | product N's lookup table |
+//! | `GET /api/view/N` | `.cube` view N's tables ([`crate::data::view_bytes`]) |
 //! | `GET /api/luts` | every product's table, one after the other (the page's one request) |
 //! | `POST /api/export` | `{"glass": "1:NAME,…", "ev": 0}`: writes the export folder given at start |
 
@@ -117,6 +118,12 @@ impl ViewServer {
                 match parts.as_slice() {
                     ["api", "frame", n, rest @ ..] => self.frame(n, rest),
                     ["api", "luts"] => Reply::binary(v.all_product_luts()),
+                    ["api", "view", n] => match index(n, v.view_count()) {
+                        Some(i) => v
+                            .view_data(i)
+                            .map_or_else(|| Reply::error(404, "no such view"), Reply::binary),
+                        None => Reply::error(404, "no such view"),
+                    },
                     ["api", "product", n, "lut"] => match index(n, self.viewer.products().len()) {
                         Some(i) => match v.product_lut(i) {
                             Some(bytes) => Reply::binary(bytes.as_ref().clone()),
