@@ -10,7 +10,7 @@ use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::lut::GlassLut;
 use glassdb_compose::memory::MemoryBudget;
 use glassdb_compose::view::CubeLut;
-use glassdb_compose::{ComposeJob, ComposeSettings, decode_frame, sequence};
+use glassdb_compose::{ComposeJob, ComposeSettings, DecodedFrame, decode_frame, sequence};
 use glassdb_registry::{GlassRecord, Registry, Side};
 use serde_json::{Value, json};
 
@@ -69,23 +69,23 @@ impl Viewer {
         let luts = RegistryLuts::new(&inputs.registry);
         let budget = MemoryBudget::new(inputs.settings.max_memory);
         let first_job = job_of(&inputs, 0)?;
-        let (width, height, planes, space, table, mask_mode, first) = {
-            let f = decode_frame(&first_job, &inputs.settings, &luts, &budget, (false, false))?;
-            (
-                f.trans.image.width,
-                f.trans.image.height,
-                f.refl.len(),
-                f.space.clone(),
-                f.table,
-                MaskMode::of(&f.mask.cos_theta),
-                f.id_counts.clone(),
-            )
-        };
+        let first = decode_frame(&first_job, &inputs.settings, &luts, &budget, (false, false))?;
+        let (width, height, planes) = (
+            first.trans.image.width,
+            first.trans.image.height,
+            first.refl.len(),
+        );
+        let (space, table) = (first.space.clone(), first.table);
+        let mask_mode = MaskMode::of(&first.mask.cos_theta);
         let products = inputs
             .registry
             .table(table.basis)
             .map(|t| t.glasses.clone())
             .unwrap_or_default();
+        // Kept for the page's first request.
+        let first_data = Arc::new(frame_data(&first, &first_job, &products));
+        let first_ids = first.id_counts.clone();
+        drop(first);
         let display_matrix = (space.space != RgbSpace::Srgb).then(|| {
             let m = glassdb_colour::rgb_to_rgb(space.space, RgbSpace::Srgb);
             (0..3)
@@ -121,7 +121,7 @@ impl Viewer {
             },
             "slots": products.iter().map(|g| g.id).collect::<Vec<_>>(),
             "products": products.iter().enumerate().map(|(i, g)| product_json(i, g)).collect::<Vec<_>>(),
-            "first_frame_ids": first,
+            "first_frame_ids": first_ids,
             "views": inputs.views.iter().map(view_json).collect::<Vec<_>>(),
         });
         let product_luts = products.iter().map(|_| OnceLock::new()).collect();
@@ -133,7 +133,7 @@ impl Viewer {
             product_luts,
             scene,
             mask_mode,
-            cache: Mutex::new(None),
+            cache: Mutex::new(Some((0, first_data))),
         })
     }
 
@@ -217,12 +217,7 @@ impl Viewer {
                 first: self.mask_mode.name(),
             });
         }
-        let slot_of = |id: u16| self.products.iter().position(|g| g.id == id);
-        let data = Arc::new(FrameData {
-            info: json!({ "ids": frame.id_counts, "trans": job.trans.display().to_string() }),
-            passes: data::pass_bytes(&frame),
-            mask: data::mask_bytes(&frame, slot_of),
-        });
+        let data = Arc::new(frame_data(&frame, &job, &self.products));
         drop(frame);
         *cache = Some((index, data.clone()));
         Ok(data)
@@ -314,6 +309,16 @@ impl Viewer {
     }
 }
 
+/// A decoded frame as the page uploads it; `products` give the glass slots.
+fn frame_data(frame: &DecodedFrame<'_>, job: &ComposeJob, products: &[GlassRecord]) -> FrameData {
+    let slot_of = |id: u16| products.iter().position(|g| g.id == id);
+    FrameData {
+        info: json!({ "ids": frame.id_counts, "trans": job.trans.display().to_string() }),
+        passes: data::pass_bytes(frame),
+        mask: data::mask_bytes(frame, slot_of),
+    }
+}
+
 /// `a:b,c:d` split at the commas that an `ID:` follows.
 fn split_choices(spec: &str) -> Vec<&str> {
     let mut parts = Vec::new();
@@ -386,5 +391,25 @@ fn job_of(inputs: &ViewerInputs, index: usize) -> Result<ComposeJob, ViewError> 
     match inputs.frames.get(index) {
         Some(&n) => Ok(sequence::frame_job(&inputs.job, n)?),
         None => Ok(inputs.job.clone()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split_choices;
+
+    #[test]
+    fn choices_split_only_where_an_id_follows_the_comma() {
+        assert_eq!(
+            split_choices("1:Clear float 3 mm (Generic Clear Glass, NFRC 102),5: Stopray"),
+            [
+                "1:Clear float 3 mm (Generic Clear Glass, NFRC 102)",
+                "5: Stopray"
+            ]
+        );
+        // A comma not followed by `ID:` belongs to the name.
+        assert_eq!(split_choices("1:a, 20:b,"), ["1:a", " 20:b,"]);
+        assert_eq!(split_choices("1:a,b:c"), ["1:a,b:c"]);
+        assert!(split_choices("").is_empty());
     }
 }
