@@ -44,8 +44,12 @@ pub struct Args {
     pub side: Vec<String>,
     /// Registry JSON whose records are the candidate products and the glasses' first choice
     /// (default: the bundled registry, every product of data/catalog.toml).
-    #[arg(long, value_name = "JSON")]
+    #[arg(long, value_name = "JSON", conflicts_with = "catalog")]
     pub registry: Option<PathBuf>,
+    /// Build the candidates from this catalog at start (docs/registry.md), with the tables the
+    /// bundled registry has (its spectral method in each of its spaces), instead of --registry.
+    #[arg(long, value_name = "TOML")]
+    pub catalog: Option<PathBuf>,
     /// EXR layer of every pass without its own.
     #[arg(long, value_name = "NAME")]
     pub layer: Option<String>,
@@ -89,7 +93,17 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let (registry, label) = load_registry(args.registry.as_deref())?;
+    let (registry, label) = match &args.catalog {
+        Some(catalog) => (
+            registry_from_catalog(catalog)?,
+            catalog.display().to_string(),
+        ),
+        None => load_registry(args.registry.as_deref())?,
+    };
+    let mut protected: Vec<PathBuf> = match &args.catalog {
+        Some(c) => glassdb_registry::catalog_inputs(c).map_err(anyhow::Error::new)?,
+        None => Vec::new(),
+    };
     let plane_sides = plane_sides(args.planes.as_deref(), &args.side, args.refl.len())?;
     let settings = ComposeSettings {
         pass: PassReadOptions {
@@ -115,13 +129,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         unknown: UnknownIds::Error,
         output: Default::default(),
         registry_label: label,
-        protected: args
-            .registry
-            .iter()
-            .chain(&args.planes)
-            .chain(&args.view)
-            .cloned()
-            .collect(),
+        protected: {
+            protected.extend(
+                args.registry
+                    .iter()
+                    .chain(&args.planes)
+                    .chain(&args.view)
+                    .cloned(),
+            );
+            protected
+        },
         input_space: args.input_space,
         max_memory: args.max_memory.unwrap_or_else(default_max_memory),
     };
@@ -168,6 +185,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     outln!("(Ctrl-C stops the viewer)");
     server.run();
     Ok(ExitCode::SUCCESS)
+}
+
+/// A registry built from `catalog` with the bundled registry's tables: its spectral method in
+/// each of its spaces, so that passes in any of those spaces find their table.
+fn registry_from_catalog(catalog: &std::path::Path) -> anyhow::Result<glassdb_registry::Registry> {
+    let bundled = glassdb_registry::default_registry()?;
+    let opts = glassdb_registry::BuildOptions {
+        tables: bundled.tables().iter().map(|t| t.spectral).collect(),
+        ..Default::default()
+    };
+    glassdb_registry::build_registry(catalog, &opts)
+        .map_err(anyhow::Error::new)
+        .with_context(|| format!("building the candidates from {}", catalog.display()))
 }
 
 /// The `--glass` text as given (the page resolves the names itself).

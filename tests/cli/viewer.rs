@@ -10,7 +10,9 @@ use std::net::TcpStream;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
-use crate::util::{fails_naming, glassdb, ok, read_png_planes, repo_path, run_oracle};
+use crate::util::{
+    fails_naming, glassdb, ok, read_png_planes, registry_build, repo_path, run_oracle,
+};
 
 const SWAP_ID: u16 = 5;
 /// The product the tests put on the atrium's tinted glass (id 5).
@@ -454,4 +456,59 @@ fn a_cube_view_on_the_page_gives_composes_pixels_through_it() {
         db >= 50.0,
         "page through the .cube view vs compose: {db:.1} dB"
     );
+}
+
+/// `--catalog`: the candidates are the catalog's products (here the atrium's two validation
+/// glasses), built at start as `glassdb registry build` builds them; the exported page with
+/// the tinted one on glass 1 gives compose's pixels with that registry and swap.
+#[test]
+fn candidates_built_from_a_catalog_give_composes_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let catalog = repo_path("fixtures/atrium/catalog.toml");
+    let registry = dir.path().join("atrium.json");
+    ok(&mut registry_build(
+        &catalog,
+        &registry,
+        &["--space", "srgb,acescg,rec2020,aces2065-1"],
+    ));
+    let tinted = "thin dielectric n=1.5, green-grey tint (Mitsuba thindielectric)";
+    let swapped = {
+        let text = std::fs::read_to_string(&registry).unwrap();
+        let mut reg: serde_json::Value = serde_json::from_str(&text).unwrap();
+        for table in reg["tables"].as_array_mut().unwrap() {
+            let glasses = table["glasses"].as_array_mut().unwrap();
+            let mut record = glasses
+                .iter()
+                .find(|g| g["name"] == tinted)
+                .unwrap()
+                .clone();
+            record["id"] = 1.into();
+            glasses[0] = record;
+        }
+        let path = dir.path().join("swapped.json");
+        std::fs::write(&path, reg.to_string()).unwrap();
+        path
+    };
+    let want = compose_png(dir.path(), Some(&swapped), "want.png");
+
+    let export = dir.path().join("export");
+    let mut cmd = glassdb();
+    cmd.arg("view");
+    atrium_inputs(&mut cmd)
+        .arg("--catalog")
+        .arg(&catalog)
+        .arg("--export")
+        .arg(&export)
+        .args(["--glass", "1:green-grey"]);
+    ok(&mut cmd);
+    let url = format!("file://{}", export.join("index.html").display());
+    let (got, report) = canvas(&url, &[], &dir.path().join("got.rgba"));
+    assert_eq!(report["products"]["A"]["1"], tinted, "{report}");
+    assert_eq!(
+        report["products"]["A"].as_object().unwrap().len(),
+        2,
+        "{report}"
+    );
+    let db = psnr(&got, &want);
+    assert!(db >= 50.0, "page from the catalog vs compose: {db:.1} dB");
 }
