@@ -77,10 +77,10 @@ fn spawn_viewer(cmd: &mut Command) -> Served {
     }
 }
 
-/// The bundled registry with `product`'s record under id `id` in every table: what the page
+/// The registry `source` with `product`'s record under id `id` in every table: what the page
 /// composites after the swap, written independently of the viewer (JSON edited directly).
-fn swapped_registry(dir: &Path, id: u16, product: &str) -> PathBuf {
-    let text = std::fs::read_to_string(repo_path("data/registry.json")).unwrap();
+fn swapped_registry(source: &Path, dir: &Path, id: u16, product: &str) -> PathBuf {
+    let text = std::fs::read_to_string(source).unwrap();
     let mut reg: serde_json::Value = serde_json::from_str(&text).unwrap();
     for table in reg["tables"].as_array_mut().unwrap() {
         let glasses = table["glasses"].as_array_mut().unwrap();
@@ -135,6 +135,21 @@ fn canvas(url: &str, swaps: &[String], out: &Path) -> (Vec<[f64; 3]>, serde_json
     (pixels, report)
 }
 
+/// The atrium exported with `extra` arguments into `dir/export`, opened from `file://`: its
+/// canvas and the driver's report.
+fn exported_canvas(dir: &Path, extra: &[&str]) -> (Vec<[f64; 3]>, serde_json::Value) {
+    let export = dir.join("export");
+    let mut cmd = glassdb();
+    cmd.arg("view");
+    atrium_inputs(&mut cmd)
+        .arg("--export")
+        .arg(&export)
+        .args(extra);
+    ok(&mut cmd);
+    let url = format!("file://{}", export.join("index.html").display());
+    canvas(&url, &[], &dir.join("export.rgba"))
+}
+
 fn psnr(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     assert_eq!(a.len(), b.len(), "image sizes differ");
     let se: f64 = a
@@ -153,7 +168,12 @@ fn psnr(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
 #[test]
 fn a_product_swapped_on_the_page_gives_composes_pixels_and_the_export_the_same() {
     let dir = tempfile::tempdir().unwrap();
-    let registry = swapped_registry(dir.path(), SWAP_ID, SWAP_PRODUCT);
+    let registry = swapped_registry(
+        &repo_path("data/registry.json"),
+        dir.path(),
+        SWAP_ID,
+        SWAP_PRODUCT,
+    );
     let want = compose_png(dir.path(), Some(&registry), "swapped.png");
     let unswapped = compose_png(dir.path(), None, "bundled.png");
     // The swap changes the picture visibly, so matching `want` says the swap happened.
@@ -196,16 +216,7 @@ fn a_product_swapped_on_the_page_gives_composes_pixels_and_the_export_the_same()
     drop(served);
 
     // The export, opened from disk, starts with the chosen product.
-    let export = dir.path().join("export");
-    let mut cmd = glassdb();
-    cmd.arg("view");
-    atrium_inputs(&mut cmd)
-        .arg("--export")
-        .arg(&export)
-        .args(["--glass", "5:stopray titanium"]);
-    ok(&mut cmd);
-    let url = format!("file://{}", export.join("index.html").display());
-    let (got, report) = canvas(&url, &[], &dir.path().join("export.rgba"));
+    let (got, report) = exported_canvas(dir.path(), &["--glass", "5:stopray titanium"]);
     assert_eq!(report["products"]["A"]["5"], SWAP_PRODUCT, "{report}");
     let db = psnr(&got, &want);
     assert!(db >= 50.0, "exported page vs compose: {db:.1} dB");
@@ -472,37 +483,14 @@ fn candidates_built_from_a_catalog_give_composes_pixels() {
         &["--space", "srgb,acescg,rec2020,aces2065-1"],
     ));
     let tinted = "thin dielectric n=1.5, green-grey tint (Mitsuba thindielectric)";
-    let swapped = {
-        let text = std::fs::read_to_string(&registry).unwrap();
-        let mut reg: serde_json::Value = serde_json::from_str(&text).unwrap();
-        for table in reg["tables"].as_array_mut().unwrap() {
-            let glasses = table["glasses"].as_array_mut().unwrap();
-            let mut record = glasses
-                .iter()
-                .find(|g| g["name"] == tinted)
-                .unwrap()
-                .clone();
-            record["id"] = 1.into();
-            glasses[0] = record;
-        }
-        let path = dir.path().join("swapped.json");
-        std::fs::write(&path, reg.to_string()).unwrap();
-        path
-    };
+    let swapped = swapped_registry(&registry, dir.path(), 1, tinted);
     let want = compose_png(dir.path(), Some(&swapped), "want.png");
 
-    let export = dir.path().join("export");
-    let mut cmd = glassdb();
-    cmd.arg("view");
-    atrium_inputs(&mut cmd)
-        .arg("--catalog")
-        .arg(&catalog)
-        .arg("--export")
-        .arg(&export)
-        .args(["--glass", "1:green-grey"]);
-    ok(&mut cmd);
-    let url = format!("file://{}", export.join("index.html").display());
-    let (got, report) = canvas(&url, &[], &dir.path().join("got.rgba"));
+    let catalog_arg = catalog.to_str().unwrap();
+    let (got, report) = exported_canvas(
+        dir.path(),
+        &["--catalog", catalog_arg, "--glass", "1:green-grey"],
+    );
     assert_eq!(report["products"]["A"]["1"], tinted, "{report}");
     assert_eq!(
         report["products"]["A"].as_object().unwrap().len(),
