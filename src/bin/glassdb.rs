@@ -38,6 +38,8 @@ enum Command {
     Report(cmd::report::Args),
     /// Render a .blend scene's passes with Blender and composite them; re-composite a render.
     Blender(cmd::blender::Args),
+    /// Serve the glass-swap viewer: pick products per glass and see the composite at once.
+    View(Box<cmd::view::Args>),
 }
 
 fn main() -> ExitCode {
@@ -54,6 +56,7 @@ fn main() -> ExitCode {
         Command::Plot(a) => cmd::plot::run(a),
         Command::Report(a) => cmd::report::run(a),
         Command::Blender(a) => cmd::blender::run(a),
+        Command::View(a) => cmd::view::run(*a),
     };
     cmd::finish(result)
 }

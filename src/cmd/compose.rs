@@ -176,7 +176,7 @@ pub struct Args {
 
 /// `--max-memory`: a number of bytes with an optional unit K, M, G or T (powers of 1024; `KiB`,
 /// `MB`, `g` … are read the same), e.g. `8G`, `512M`, `1.5G`, `1048576`.
-fn parse_size(text: &str) -> Result<u64, String> {
+pub(crate) fn parse_size(text: &str) -> Result<u64, String> {
     let t = text.trim();
     let split = t
         .find(|c: char| !(c.is_ascii_digit() || c == '.'))
@@ -211,7 +211,7 @@ fn parse_size(text: &str) -> Result<u64, String> {
 
 /// The default memory limit: 8 GiB, or half the machine's memory (or of the control group's
 /// limit) where that is less, leaving the rest to the system and to other work.
-fn default_max_memory() -> u64 {
+pub(crate) fn default_max_memory() -> u64 {
     let half = machine_memory().map_or(u64::MAX, |m| m / 2);
     glassdb_compose::memory::DEFAULT_MAX_MEMORY.min(half)
 }
@@ -299,7 +299,7 @@ fn parse_channel_spec(spec: &str, keys: &[&str]) -> anyhow::Result<Vec<(String, 
 }
 
 /// `--mask-channels id=…,cos=…,plane=…,coverage=…` over the defaults.
-fn parse_mask_channels(spec: &str) -> anyhow::Result<ExrMaskChannels> {
+pub(crate) fn parse_mask_channels(spec: &str) -> anyhow::Result<ExrMaskChannels> {
     let mut ch = ExrMaskChannels::default();
     for (key, name) in parse_channel_spec(spec, &["id", "cos", "plane", "coverage"])? {
         match key.as_str() {
@@ -407,7 +407,7 @@ fn default_output(trans: &Path) -> PathBuf {
 
 /// `FILE.exr:LAYER` → (`FILE.exr`, `LAYER`): split at the last `:` when what precedes it ends
 /// in `.exr` (any case) and what follows has no path separator; anything else is a plain path.
-fn split_layer(arg: &Path) -> (PathBuf, Option<String>) {
+pub(crate) fn split_layer(arg: &Path) -> (PathBuf, Option<String>) {
     let text = arg.to_string_lossy();
     if let Some((file, layer)) = text.rsplit_once(':')
         && file.to_ascii_lowercase().ends_with(".exr")
@@ -419,8 +419,31 @@ fn split_layer(arg: &Path) -> (PathBuf, Option<String>) {
     (arg.to_path_buf(), None)
 }
 
-fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)> {
-    let (registry, label) = match &args.registry {
+/// The side each plane shows: from `planes.json` (when given), then each `--side K=SIDE`.
+pub(crate) fn plane_sides(
+    planes: Option<&Path>,
+    side_specs: &[String],
+    passes: usize,
+) -> anyhow::Result<std::collections::BTreeMap<usize, Side>> {
+    let mut sides = match planes {
+        Some(p) => glassdb_compose::sides_from_planes_json(p, passes)?,
+        None => Default::default(),
+    };
+    for spec in side_specs {
+        let (k, side) = parse_side_spec(spec)?;
+        if k >= passes {
+            bail!(
+                "--side {spec}: plane {k} has no reflection pass ({passes} given; planes count from 0)"
+            );
+        }
+        sides.insert(k, side);
+    }
+    Ok(sides)
+}
+
+/// The registry at `path`, or the bundled one, with the label outputs and messages name it by.
+pub(crate) fn load_registry(path: Option<&Path>) -> anyhow::Result<(Registry, String)> {
+    Ok(match path {
         Some(p) => (
             Registry::from_json_file(p).map_err(anyhow::Error::new)?,
             p.display().to_string(),
@@ -429,7 +452,11 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)>
             glassdb_registry::default_registry()?,
             "the bundled catalog".to_string(),
         ),
-    };
+    })
+}
+
+fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)> {
+    let (registry, label) = load_registry(args.registry.as_deref())?;
     let luts = RegistryLuts::new(&registry);
     let registry_sha256 = registry.content_sha256()?;
     if let Some(id) = args.glass
@@ -437,20 +464,7 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)>
     {
         bail!("--glass {id}: {label} has no glass with id {id}");
     }
-    let mut plane_sides = match &args.planes {
-        Some(p) => glassdb_compose::sides_from_planes_json(p, args.refl.len())?,
-        None => Default::default(),
-    };
-    for spec in &args.side {
-        let (k, side) = parse_side_spec(spec)?;
-        if k >= args.refl.len() {
-            bail!(
-                "--side {spec}: plane {k} has no reflection pass ({} given; planes count from 0)",
-                args.refl.len()
-            );
-        }
-        plane_sides.insert(k, side);
-    }
+    let plane_sides = plane_sides(args.planes.as_deref(), &args.side, args.refl.len())?;
     let cryptomatte = match &args.mask_cryptomatte {
         Some(layer) => Some(cryptomatte_options(args, layer)?),
         None => None,

@@ -9,6 +9,7 @@ use glassdb_plot::PlotError;
 use glassdb_registry::RegistryError;
 use glassdb_scene::SceneError;
 use glassdb_spectral::SpectralError;
+use glassdb_view::ViewError;
 
 /// The hints for every error in `err`'s cause chain, outermost first, without repeats.
 pub fn hints(err: &anyhow::Error) -> Vec<String> {
@@ -52,6 +53,9 @@ fn hint(cause: &(dyn std::error::Error + 'static)) -> Option<String> {
     }
     if let Some(e) = cause.downcast_ref::<ComposeError>() {
         return compose_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<ViewError>() {
+        return view_hint(e);
     }
     if let Some(e) = cause.downcast_ref::<PlotError>() {
         return plot_hint(e);
@@ -273,4 +277,39 @@ fn blender_hint(e: &glassdb_blender::BlenderError) -> Option<String> {
         }
         _ => return None,
     })
+}
+
+/// `glassdb view`: its compose errors (the viewer has no --unknown or --outside-pass) and its own.
+fn view_hint(e: &ViewError) -> Option<String> {
+    match e {
+        ViewError::Compose(ComposeError::UnknownIds { .. }) => Some(
+            "the viewer swaps products of the registry's glass ids: add the ids to a registry \
+             (glassdb registry build) and give it with --registry"
+                .into(),
+        ),
+        ViewError::Compose(ComposeError::GlassOutsidePass { .. }) => Some(
+            "the viewer needs every glass pixel inside its plane's reflection pass; render the \
+             pass over the whole pane"
+                .into(),
+        ),
+        ViewError::Compose(ComposeError::AmbiguousLayer { .. } | ComposeError::LayerNotFound { .. }) => {
+            Some("choose a layer with FILE.exr:LAYER or --layer".into())
+        }
+        ViewError::Compose(c) => compose_hint(c),
+        ViewError::Bind { .. } => Some(
+            "another program may be listening there; --port 0 picks a free port, --bind the address"
+                .into(),
+        ),
+        ViewError::UnknownProduct { .. } | ViewError::AmbiguousProduct { .. } => Some(
+            "--glass takes ID:PRODUCT with a product's name, a part only it has, or its registry id"
+                .into(),
+        ),
+        ViewError::MaskKindChanges { .. } => {
+            Some("write every frame's mask the same way (8-bit PNG, 16-bit PNG or EXR)".into())
+        }
+        ViewError::GlassSpec { .. }
+        | ViewError::UnknownGlassId { .. }
+        | ViewError::ExportDir { .. }
+        | ViewError::Output(_) => None,
+    }
 }

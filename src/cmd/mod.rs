@@ -30,6 +30,7 @@ pub mod registry;
 pub mod report;
 pub mod scene;
 pub mod spectral;
+pub mod view;
 
 use std::process::ExitCode;
 

@@ -22,3 +22,4 @@ mod util;
 mod validation;
 mod values;
 mod view;
+mod viewer;

@@ -246,14 +246,12 @@ fn decode_inputs(
     job: &ComposeJob,
     settings: &ComposeSettings,
     display: &PixelWindow,
+    (keep, beside): (bool, bool),
 ) -> Result<DecodedInputs, ComposeError> {
     let read_trans = || -> Result<(Pass, OutputFrame), ComposeError> {
         let opts = settings.pass_options(Some(&settings.layers.trans));
         let bytes = io::read_file(&job.trans)?;
         let pass = io::read_pass_bytes(&bytes, &job.trans, &opts)?;
-        let keep = settings.output.keep_channels
-            && io::output_format(&job.output)? == io::OutputFormat::Exr;
-        let beside = settings.output.output_layer.is_some();
         let frame = OutputFrame::of_transmission(
             &pass,
             &bytes,
@@ -467,6 +465,136 @@ fn absolute_from(w: &PixelWindow, origin: &PixelWindow) -> PixelWindow {
     }
 }
 
+/// One frame's inputs decoded, placed in the transmission pass's frame and checked, ready for
+/// the kernel (compose) or for the viewer's GPU textures.
+pub struct DecodedFrame<'a> {
+    /// The transmission pass: its image is the frame (its data window).
+    pub trans: Pass,
+    /// What an output would carry from the transmission pass's file.
+    pub frame: OutputFrame,
+    /// The reflection passes, plane k at k.
+    pub refl: Vec<Pass>,
+    /// Each reflection pass's data window relative to the frame's top-left pixel.
+    pub refl_windows: Vec<PixelWindow>,
+    /// The mask, moved into the frame's data window.
+    pub mask: MaskImage,
+    /// The passes' colour space.
+    pub space: PassSpace,
+    /// The registry table chosen for that space, and its lookup table.
+    pub table: ChosenTable,
+    pub lut: &'a GlassLut,
+    /// Glass pixels per id.
+    pub id_counts: BTreeMap<u16, u64>,
+    /// Per plane: glass pixels outside its reflection pass and their bounding box (frame-relative).
+    pub outside: BTreeMap<usize, (u64, PixelWindow)>,
+    /// The frame's memory estimate.
+    pub memory: MemoryEstimate,
+    /// The estimate held from the budget until this is dropped.
+    pub reservation: memory::Reservation<'a>,
+}
+
+/// Reads every input's header and checks the frame from them (memory within `budget`), decodes
+/// the inputs, places them in the transmission pass's frame and checks ids, planes and glass
+/// outside cropped passes (as `settings` says). `keep` is (carry the transmission file's other
+/// channels, the composite goes beside them), as the output will need.
+pub fn decode_frame<'a>(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    luts: &'a RegistryLuts,
+    budget: &'a MemoryBudget,
+    keep: (bool, bool),
+) -> Result<DecodedFrame<'a>, ComposeError> {
+    if job.refl.is_empty() {
+        return Err(ComposeError::NoReflectionPass);
+    }
+    let plan::FramePlan {
+        space,
+        display,
+        refl_windows: stored_refl_windows,
+        memory,
+    } = plan::plan_frame(job, settings)?;
+    let (table, lut) = luts.for_space(&space, &job.trans, &settings.registry_label)?;
+    if memory.total > budget.limit() {
+        return Err(ComposeError::MemoryLimit {
+            trans: job.trans.clone(),
+            estimate: memory.total,
+            limit: budget.limit(),
+            items: memory.items,
+            carried: memory.carried,
+        });
+    }
+    let reservation = budget.reserve(memory.total);
+    let DecodedInputs {
+        trans,
+        frame,
+        refl,
+        mask,
+    } = decode_inputs(job, settings, &display, keep)?;
+    let data = trans.windows.data;
+    let display = trans.windows.display;
+    let mask_windows = in_frame(mask.windows, !mask.has_coordinates, &display);
+    let refl_windows: Vec<ImageWindows> = refl
+        .iter()
+        .map(|p| {
+            in_frame(
+                p.windows,
+                matches!(p.source, io::PassSource::Png { .. }),
+                &display,
+            )
+        })
+        .collect();
+    let mut others: Vec<(&Path, ImageWindows)> = vec![(job.mask.as_path(), mask_windows)];
+    others.extend(
+        job.refl
+            .iter()
+            .map(PathBuf::as_path)
+            .zip(refl_windows.iter().copied()),
+    );
+    check_frames(job, &trans.windows, &others)?;
+    let PlacedMask { image: mask, .. } = mask;
+    let mask = if mask_windows.data == data {
+        mask
+    } else {
+        let placed = mask.placed(&mask_windows.data, &data);
+        drop(mask);
+        placed
+    };
+    let id_counts = mask.id_pixel_counts();
+    check_inputs(job, settings, lut, refl.len(), &mask, &id_counts)?;
+    let windows: Vec<PixelWindow> = refl_windows
+        .iter()
+        .map(|w| relative_to(&w.data, &data))
+        .collect();
+    let outside = glass_outside_passes(&mask, lut, &windows);
+    if let (OutsidePolicy::Error, Some((&plane, &(pixels, bounds)))) =
+        (settings.outside, outside.iter().next())
+    {
+        return Err(ComposeError::GlassOutsidePass {
+            plane,
+            pass: job.refl[plane].clone(),
+            pixels,
+            pass_window: stored_refl_windows
+                .get(plane)
+                .map_or(refl_windows[plane].data, |w| w.data),
+            bounds: absolute_from(&bounds, &data),
+        });
+    }
+    Ok(DecodedFrame {
+        trans,
+        frame,
+        refl,
+        refl_windows: windows,
+        mask,
+        space,
+        table,
+        lut,
+        id_counts,
+        outside,
+        memory,
+        reservation,
+    })
+}
+
 /// The stages [`compose_frame_with_progress`] reports, in order.
 pub const FRAME_STAGES: [&str; 3] = ["decode", "composite", "encode"];
 
@@ -520,82 +648,28 @@ pub(crate) fn compose_frame_within(
 
     progress.stage(decode_stage);
     let t0 = Instant::now();
-    let plan::FramePlan {
-        space,
-        display,
-        refl_windows: stored_refl_windows,
-        memory,
-    } = plan::plan_frame(job, settings)?;
-    let (table, lut) = luts.for_space(&space, &job.trans, &settings.registry_label)?;
-    if memory.total > budget.limit() {
-        return Err(ComposeError::MemoryLimit {
-            trans: job.trans.clone(),
-            estimate: memory.total,
-            limit: budget.limit(),
-            items: memory.items,
-            carried: memory.carried,
-        });
-    }
-    let _reserved = budget.reserve(memory.total);
-    let DecodedInputs {
+    let keep = (
+        settings.output.keep_channels && io::output_format(&job.output)? == io::OutputFormat::Exr,
+        settings.output.output_layer.is_some(),
+    );
+    let DecodedFrame {
         mut trans,
         mut frame,
         refl,
+        refl_windows: windows,
         mask,
-    } = decode_inputs(job, settings, &display)?;
+        space,
+        table,
+        lut,
+        id_counts,
+        outside,
+        memory,
+        reservation: _reserved,
+    } = decode_frame(job, settings, luts, budget, keep)?;
     let decode = t0.elapsed();
 
     progress.stage(composite_stage);
     let t1 = Instant::now();
-    let data = trans.windows.data;
-    let display = trans.windows.display;
-    let mask_windows = in_frame(mask.windows, !mask.has_coordinates, &display);
-    let refl_windows: Vec<ImageWindows> = refl
-        .iter()
-        .map(|p| {
-            in_frame(
-                p.windows,
-                matches!(p.source, io::PassSource::Png { .. }),
-                &display,
-            )
-        })
-        .collect();
-    let mut others: Vec<(&Path, ImageWindows)> = vec![(job.mask.as_path(), mask_windows)];
-    others.extend(
-        job.refl
-            .iter()
-            .map(PathBuf::as_path)
-            .zip(refl_windows.iter().copied()),
-    );
-    check_frames(job, &trans.windows, &others)?;
-    let PlacedMask { image: mask, .. } = mask;
-    let mask = if mask_windows.data == data {
-        mask
-    } else {
-        let placed = mask.placed(&mask_windows.data, &data);
-        drop(mask);
-        placed
-    };
-    let id_counts = mask.id_pixel_counts();
-    check_inputs(job, settings, lut, refl.len(), &mask, &id_counts)?;
-    let windows: Vec<PixelWindow> = refl_windows
-        .iter()
-        .map(|w| relative_to(&w.data, &data))
-        .collect();
-    let outside = glass_outside_passes(&mask, lut, &windows);
-    if let (OutsidePolicy::Error, Some((&plane, &(pixels, bounds)))) =
-        (settings.outside, outside.iter().next())
-    {
-        return Err(ComposeError::GlassOutsidePass {
-            plane,
-            pass: job.refl[plane].clone(),
-            pixels,
-            pass_window: stored_refl_windows
-                .get(plane)
-                .map_or(refl_windows[plane].data, |w| w.data),
-            bounds: absolute_from(&bounds, &data),
-        });
-    }
     let placed: Vec<PlacedRefl<'_>> = refl
         .iter()
         .zip(&windows)

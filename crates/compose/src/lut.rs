@@ -10,7 +10,7 @@
 //! - normal incidence from `r0`, `t0` (`r0_back` for the back side) for binary masks.
 
 use glassdb_mask::CosCode;
-use glassdb_registry::{RegistryTable, Side};
+use glassdb_registry::{GlassRecord, RegistryTable, Side};
 
 /// Intervals of the fine table over cos θ ∈ [0, 1].
 pub const FINE_STEPS: usize = 4096;
@@ -147,16 +147,22 @@ impl GlassLut {
 
     /// Builds the tables for every glass of a registry table (its `eval` and normal values).
     pub fn from_table(registry: &RegistryTable) -> GlassLut {
-        let ids: Vec<u16> = registry.glasses.iter().map(|g| g.id).collect();
+        let records: Vec<(u16, &GlassRecord)> =
+            registry.glasses.iter().map(|g| (g.id, g)).collect();
+        GlassLut::from_records(&records)
+    }
+
+    /// Builds the tables of the given records, each under the id it is paired with (the
+    /// viewer's product swap: another product's record under a mask id). The first record of
+    /// an id wins.
+    pub fn from_records(records: &[(u16, &GlassRecord)]) -> GlassLut {
+        let ids: Vec<u16> = records.iter().map(|(id, _)| *id).collect();
+        let record = |id: u16| records.iter().find(|(i, _)| *i == id).map(|(_, g)| *g);
         GlassLut::from_fn(
             &ids,
-            |id, side, cos| {
-                registry
-                    .glass(id)
-                    .map_or(([0.0; 3], [0.0; 3]), |g| g.eval(side, cos))
-            },
+            |id, side, cos| record(id).map_or(([0.0; 3], [0.0; 3]), |g| g.eval(side, cos)),
             |id, side| {
-                registry.glass(id).map_or(([0.0; 3], [0.0; 3]), |g| {
+                record(id).map_or(([0.0; 3], [0.0; 3]), |g| {
                     let r = match side {
                         Side::Front => g.r0,
                         Side::Back => g.r0_back,

@@ -108,6 +108,18 @@ struct Table3d {
     values: Vec<f32>,
 }
 
+/// One table of a `.cube` file as [`CubeLut::apply`] reads it.
+#[derive(Debug, Clone, Copy)]
+pub struct CubeTable<'a> {
+    /// Entries of a 1D table; edge of a 3D table.
+    pub size: usize,
+    /// Per channel, `x·scale + offset` maps the table's domain to [0, 1].
+    pub scale: [f32; 3],
+    pub offset: [f32; 3],
+    /// The entries, interleaved R, G, B.
+    pub values: &'a [f32],
+}
+
 /// A parsed `.cube` file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CubeLut {
@@ -415,6 +427,26 @@ impl CubeLut {
             title,
             shaper,
             cube,
+        })
+    }
+
+    /// The 1D table, if any (the viewer's shader evaluates it as [`CubeLut::apply`]).
+    pub fn shaper_table(&self) -> Option<CubeTable<'_>> {
+        self.shaper.as_ref().map(|t| CubeTable {
+            size: t.values.len() / 3,
+            scale: t.scale,
+            offset: t.offset,
+            values: &t.values,
+        })
+    }
+
+    /// The 3D table, if any: `size` is its edge n, `values` its n³ entries, red index fastest.
+    pub fn cube_table(&self) -> Option<CubeTable<'_>> {
+        self.cube.as_ref().map(|t| CubeTable {
+            size: t.n,
+            scale: t.scale,
+            offset: t.offset,
+            values: &t.values,
         })
     }
 

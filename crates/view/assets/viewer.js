@@ -1,0 +1,737 @@
+// glassdb view: the composite of compose (method.md eqs. 8-10) on the GPU with WebGL2.
+// Data: from the server (/api/...) or, in an exported folder, from the scripts data.js and
+// frame-NNNN.js (browsers refuse fetch() of local files). Layouts: crates/view/src/data.rs.
+'use strict';
+
+(function () {
+  const EXPORT = window.GLASSDB_EXPORT;
+  const $ = (id) => document.getElementById(id);
+  const canvas = $('view-canvas');
+  const errors = [];
+  window.glassdbErrors = errors;
+
+  function status(text, isError) {
+    const s = $('status');
+    s.textContent = text;
+    s.className = isError ? 'error' : '';
+    if (isError) errors.push(text);
+  }
+
+  // ---- data sources ------------------------------------------------------------------------
+
+  function base64Bytes(text) {
+    const bin = atob(text);
+    const out = new Uint8Array(bin.length);
+    for (let i = 0; i < bin.length; i++) out[i] = bin.charCodeAt(i);
+    return out.buffer;
+  }
+
+  function loadScript(src) {
+    return new Promise((resolve, reject) => {
+      const s = document.createElement('script');
+      s.src = src;
+      s.onload = resolve;
+      s.onerror = () => reject(new Error('cannot load ' + src));
+      document.head.appendChild(s);
+    });
+  }
+
+  async function fetchOk(url, kind) {
+    const r = await fetch(url);
+    if (!r.ok) {
+      let message = r.status + ' ' + r.statusText;
+      try { message = (await r.json()).error || message; } catch (e) { /* not JSON */ }
+      throw new Error(url + ': ' + message);
+    }
+    return kind === 'json' ? r.json() : r.arrayBuffer();
+  }
+
+  const source = EXPORT ? {
+    scene: async () => EXPORT.scene,
+    luts: async () => EXPORT.luts.map((text) => new Float32Array(base64Bytes(text))),
+    view: async (i) => new Float32Array(base64Bytes(EXPORT.views[i])),
+    frame: async (i) => {
+      if (!EXPORT.frames[i]) await loadScript(window.GLASSDB_EXPORT_FRAME_FILES[i]);
+      const f = EXPORT.frames[i];
+      return {
+        info: f.info,
+        passes: new Uint16Array(base64Bytes(f.passes)),
+        mask: new Float32Array(base64Bytes(f.mask)),
+      };
+    },
+  } : {
+    scene: () => fetchOk('api/scene', 'json'),
+    // One request for every table, and a frame's parts one after the other: the page keeps to
+    // one connection.
+    luts: async (n) => {
+      const all = await fetchOk('api/luts');
+      const size = all.byteLength / n;
+      return Array.from({ length: n }, (_, i) => new Float32Array(all, i * size, size / 4));
+    },
+    view: async (i) => new Float32Array(await fetchOk('api/view/' + i)),
+    frame: async (i) => {
+      const info = await fetchOk('api/frame/' + i, 'json');
+      const passes = await fetchOk('api/frame/' + i + '/passes');
+      const mask = await fetchOk('api/frame/' + i + '/mask');
+      return { info, passes: new Uint16Array(passes), mask: new Float32Array(mask) };
+    },
+  };
+
+  // ---- product names (the `glass` parameter: ID:PRODUCT,...) ---------------------------------
+
+  // Splits at the commas an `ID:` follows (product names may hold commas).
+  function splitChoices(spec) {
+    const parts = [];
+    let start = 0;
+    for (let i = 0; i < spec.length; i++) {
+      if (spec[i] === ',' && /^\s*\d+:/.test(spec.slice(i + 1))) {
+        parts.push(spec.slice(start, i));
+        start = i + 1;
+      }
+    }
+    parts.push(spec.slice(start));
+    return parts.filter((p) => p.trim() !== '');
+  }
+
+  // A product's full name (any case), its registry id, or a part of one name only.
+  function findProduct(products, name) {
+    const lower = name.trim().toLowerCase();
+    let i = products.findIndex((p) => p.name.toLowerCase() === lower);
+    if (i >= 0) return i;
+    if (/^\d+$/.test(lower)) {
+      i = products.findIndex((p) => p.id === Number(lower));
+      if (i >= 0) return i;
+    }
+    const matches = products.filter((p) => p.name.toLowerCase().includes(lower));
+    if (matches.length === 1) return matches[0].index;
+    throw new Error(matches.length === 0 ? 'no product matches "' + name + '"'
+      : '"' + name + '" matches several products: ' + matches.map((p) => p.name).join('; '));
+  }
+
+  function parseChoices(products, slots, spec) {
+    const out = [];
+    for (const part of splitChoices(spec)) {
+      const colon = part.indexOf(':');
+      const id = Number(part.slice(0, colon));
+      if (colon < 0 || !Number.isInteger(id) || slots.indexOf(id) < 0) {
+        throw new Error('glass choice "' + part + '": expected ID:PRODUCT with an id of the registry');
+      }
+      out.push([id, findProduct(products, part.slice(colon + 1))]);
+    }
+    return out;
+  }
+
+  // ---- half floats and colour for the page's own numbers ------------------------------------
+
+  function halfToFloat(h) {
+    const s = (h & 0x8000) ? -1 : 1;
+    const e = (h >> 10) & 0x1f;
+    const m = h & 0x3ff;
+    if (e === 0) return s * m * Math.pow(2, -24);
+    if (e === 31) return m ? NaN : s * Infinity;
+    return s * (1 + m / 1024) * Math.pow(2, e - 15);
+  }
+
+  function srgbEncode(c) {
+    c = Math.min(1, Math.max(0, c || 0));
+    return c <= 0.0031308 ? c * 12.92 : 1.055 * Math.pow(c, 1 / 2.4) - 0.055;
+  }
+
+  // ---- WebGL2 -------------------------------------------------------------------------------
+
+  const VERTEX = `#version 300 es
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}`;
+
+  function fragmentSource(lut) {
+    return `#version 300 es
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+precision highp sampler2DArray;
+precision highp sampler3D;
+uniform sampler2D uTrans;
+uniform sampler2DArray uRefl;
+uniform sampler2D uMask;
+uniform sampler2D uLutA;
+uniform sampler2D uLutB;
+uniform int uHeight;
+uniform int uMode;      // 0: 8-bit code, 1: cos, 2: normal incidence
+uniform int uPlanes;
+uniform int uSide[64];  // 0 front, 1 back, per plane
+uniform float uGain;    // 2^ev
+uniform bool uConvert;
+uniform mat3 uDisplay;  // passes' space to linear Rec.709
+uniform int uAB;        // 0: A, 1: B, 2: split
+uniform float uSplitX;  // split position in pixels
+uniform int uView;      // 0: standard, 1: a .cube view
+uniform sampler2D uShaper;
+uniform highp sampler3D uCube;
+uniform bool uHasShaper;
+uniform bool uHasCube;
+uniform int uShaperLen;
+uniform vec3 uShaperScale;
+uniform vec3 uShaperOffset;
+uniform int uCubeN;
+uniform vec3 uCubeScale;
+uniform vec3 uCubeOffset;
+out vec4 outColor;
+const int W = ${lut.width};
+const int ROWS_CURVE = ${lut.rows_per_curve};
+const int ROWS_SLOT = ${lut.rows_per_slot};
+const int FINE = ${lut.fine_offset};
+const int STEPS = ${lut.fine_steps};
+const int NORMAL = ${lut.normal_offset};
+
+// a + f·(b − a), as compose's lerp (not GLSL's mix, whose rounding may differ).
+vec3 mix3(vec3 a, vec3 b, float f) {
+  return a + f * (b - a);
+}
+
+vec3 entry(sampler2D lut, int row, int e) {
+  return texelFetch(lut, ivec2(e % W, row + e / W), 0).rgb;
+}
+
+// r and t exactly as compose's GlassSideLut: at_code8, at_cos (linear in the fine table), normal.
+void lookup(sampler2D lut, int slot, int side, float c, out vec3 r, out vec3 t) {
+  int rRow = slot * ROWS_SLOT + side * 2 * ROWS_CURVE;
+  int tRow = rRow + ROWS_CURVE;
+  if (uMode == 0) {
+    int e = int(c + 0.5);
+    r = entry(lut, rRow, e);
+    t = entry(lut, tRow, e);
+  } else if (uMode == 1) {
+    float x = clamp(c, 0.0, 1.0) * float(STEPS);
+    int i = min(int(x), STEPS - 1);
+    float f = x - float(i);
+    vec3 r0 = entry(lut, rRow, FINE + i);
+    vec3 t0 = entry(lut, tRow, FINE + i);
+    r = r0 + (entry(lut, rRow, FINE + i + 1) - r0) * f;
+    t = t0 + (entry(lut, tRow, FINE + i + 1) - t0) * f;
+  } else {
+    r = entry(lut, rRow, NORMAL);
+    t = entry(lut, tRow, NORMAL);
+  }
+}
+
+vec3 srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  vec3 lo = c * 12.92;
+  vec3 hi = 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055;
+  return mix(hi, lo, vec3(lessThanEqual(c, vec3(0.0031308))));
+}
+
+// A table's index of x, as compose's CubeLut: (x·scale + offset)·last, NaN → 0, clamped.
+float tableIndex(float x, float last) {
+  float v = x * last;
+  return isnan(v) ? 0.0 : clamp(v, 0.0, last);
+}
+
+vec3 shaperAt(int i) {
+  return texelFetch(uShaper, ivec2(i % W, i / W), 0).rgb;
+}
+
+// compose's CubeLut::apply: the 1D table per channel (linear), then the 3D table (trilinear).
+vec3 cubeView(vec3 v) {
+  if (uHasShaper) {
+    float last = float(uShaperLen - 1);
+    for (int c = 0; c < 3; c++) {
+      float f = tableIndex(v[c] * uShaperScale[c] + uShaperOffset[c], last);
+      int lo = min(int(floor(f)), uShaperLen - 1);
+      int hi = min(lo + 1, uShaperLen - 1);
+      float d = f - float(lo);
+      float a = shaperAt(lo)[c];
+      float b = shaperAt(hi)[c];
+      v[c] = a + d * (b - a);
+    }
+  }
+  if (uHasCube) {
+    float last = float(uCubeN - 1);
+    ivec3 lo;
+    ivec3 hi;
+    vec3 d;
+    for (int c = 0; c < 3; c++) {
+      float f = tableIndex(v[c] * uCubeScale[c] + uCubeOffset[c], last);
+      lo[c] = min(int(floor(f)), uCubeN - 1);
+      hi[c] = min(lo[c] + 1, uCubeN - 1);
+      d[c] = f - float(lo[c]);
+    }
+    vec3 c00 = mix3(texelFetch(uCube, ivec3(lo.x, lo.y, lo.z), 0).rgb, texelFetch(uCube, ivec3(hi.x, lo.y, lo.z), 0).rgb, d.x);
+    vec3 c10 = mix3(texelFetch(uCube, ivec3(lo.x, hi.y, lo.z), 0).rgb, texelFetch(uCube, ivec3(hi.x, hi.y, lo.z), 0).rgb, d.x);
+    vec3 c01 = mix3(texelFetch(uCube, ivec3(lo.x, lo.y, hi.z), 0).rgb, texelFetch(uCube, ivec3(hi.x, lo.y, hi.z), 0).rgb, d.x);
+    vec3 c11 = mix3(texelFetch(uCube, ivec3(lo.x, hi.y, hi.z), 0).rgb, texelFetch(uCube, ivec3(hi.x, hi.y, hi.z), 0).rgb, d.x);
+    v = mix3(mix3(c00, c10, d.y), mix3(c01, c11, d.y), d.z);
+  }
+  return v;
+}
+
+void main() {
+  int x = int(gl_FragCoord.x);
+  int y = uHeight - 1 - int(gl_FragCoord.y);
+  vec4 tr = texelFetch(uTrans, ivec2(x, y), 0);
+  vec4 m = texelFetch(uMask, ivec2(x, y), 0);
+  vec3 col = tr.rgb;
+  int slot = int(m.r + 0.5) - 1;
+  int plane = int(m.g + 0.5);
+  if (slot >= 0 && plane < uPlanes) {
+    vec3 r;
+    vec3 t;
+    bool useB = uAB == 1 || (uAB == 2 && float(x) >= uSplitX);
+    if (useB) {
+      lookup(uLutB, slot, uSide[plane], m.b, r, t);
+    } else {
+      lookup(uLutA, slot, uSide[plane], m.b, r, t);
+    }
+    float k = m.a;
+    t = 1.0 - k + k * t;
+    r = r * k;
+    vec3 rf = texelFetch(uRefl, ivec3(x, y, plane), 0).rgb;
+    col = tr.rgb * t + rf * r;
+  }
+  col *= uGain;
+  if (uConvert && uView == 0) col = uDisplay * col;
+  if (tr.a > 0.0) col /= tr.a;
+  if (uView == 0) {
+    outColor = vec4(srgb(col), 1.0);
+  } else {
+    vec3 v = cubeView(col);
+    outColor = vec4(mix(clamp(v, 0.0, 1.0), vec3(0.0), vec3(isnan(v))), 1.0);
+  }
+}`;
+  }
+
+  function compile(gl, type, text) {
+    const s = gl.createShader(type);
+    gl.shaderSource(s, text);
+    gl.compileShader(s);
+    if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
+    return s;
+  }
+
+  function texture(gl, target) {
+    const t = gl.createTexture();
+    gl.bindTexture(target, t);
+    for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(target, p, gl.NEAREST);
+    gl.texParameteri(target, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+    gl.texParameteri(target, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    return t;
+  }
+
+  // ---- the viewer ---------------------------------------------------------------------------
+
+  async function main() {
+    const scene = await source.scene();
+    const W = scene.width, H = scene.height;
+    const products = scene.products;
+    const slots = scene.slots;
+    const lutLayout = scene.lut;
+    const slotFloats = lutLayout.rows_per_slot * lutLayout.width * 4;
+    canvas.width = W;
+    canvas.height = H;
+    const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false, alpha: false });
+    if (!gl) throw new Error('this browser has no WebGL2');
+    if (scene.planes > 64) throw new Error('the page handles at most 64 planes');
+    const program = gl.createProgram();
+    gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX));
+    gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragmentSource(lutLayout)));
+    gl.linkProgram(program);
+    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
+    gl.useProgram(program);
+    gl.bindVertexArray(gl.createVertexArray());
+    const u = (name) => gl.getUniformLocation(program, name);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+
+    const transTex = texture(gl, gl.TEXTURE_2D);
+    const reflTex = texture(gl, gl.TEXTURE_2D_ARRAY);
+    const maskTex = texture(gl, gl.TEXTURE_2D);
+    const lutTex = { A: texture(gl, gl.TEXTURE_2D), B: texture(gl, gl.TEXTURE_2D) };
+    const shaperTex = texture(gl, gl.TEXTURE_2D);
+    const cubeTex = texture(gl, gl.TEXTURE_3D);
+    gl.texParameteri(gl.TEXTURE_3D, gl.TEXTURE_WRAP_R, gl.CLAMP_TO_EDGE);
+    // Complete from the start (a 1-texel placeholder) until a view's tables replace them.
+    gl.texImage3D(gl.TEXTURE_3D, 0, gl.RGB32F, 1, 1, 1, 0, gl.RGB, gl.FLOAT, new Float32Array(3));
+    gl.bindTexture(gl.TEXTURE_2D, shaperTex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, 1, 1, 0, gl.RGB, gl.FLOAT, new Float32Array(3));
+    gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, gl.RGBA16F, W, H, scene.planes);
+    gl.bindTexture(gl.TEXTURE_2D, transTex);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA16F, W, H);
+    gl.bindTexture(gl.TEXTURE_2D, maskTex);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, W, H);
+    for (const set of ['A', 'B']) {
+      gl.bindTexture(gl.TEXTURE_2D, lutTex[set]);
+      gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, lutLayout.width, lutLayout.rows_per_slot * slots.length);
+    }
+    const units = [['uTrans', gl.TEXTURE_2D, transTex], ['uRefl', gl.TEXTURE_2D_ARRAY, reflTex],
+      ['uMask', gl.TEXTURE_2D, maskTex], ['uLutA', gl.TEXTURE_2D, lutTex.A], ['uLutB', gl.TEXTURE_2D, lutTex.B],
+      ['uShaper', gl.TEXTURE_2D, shaperTex], ['uCube', gl.TEXTURE_3D, cubeTex]];
+    const unitOf = (name) => units.findIndex(([n]) => n === name);
+    units.forEach(([name, target, tex], i) => {
+      gl.activeTexture(gl.TEXTURE0 + i);
+      gl.bindTexture(target, tex);
+      gl.uniform1i(u(name), i);
+    });
+    // Texture units: one per sampler, then an idle one that uploads bind to.
+    gl.activeTexture(gl.TEXTURE0 + units.length);
+    // A view's tables, uploaded when it is chosen (index into scene.views; -1: standard).
+    const viewTables = {};
+    async function setView(i) {
+      if (i >= 0 && !viewTables[i]) viewTables[i] = await source.view(i);
+      const v = scene.views[i];
+      gl.uniform1i(u('uView'), v ? 1 : 0);
+      if (v) {
+        const data = viewTables[i];
+        const shaperFloats = v.shaper ? v.shaper.rows * lutLayout.width * 3 : 0;
+        gl.uniform1i(u('uHasShaper'), v.shaper ? 1 : 0);
+        gl.uniform1i(u('uHasCube'), v.cube ? 1 : 0);
+        if (v.shaper) {
+          gl.activeTexture(gl.TEXTURE0 + unitOf('uShaper'));
+          gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, lutLayout.width, v.shaper.rows, 0, gl.RGB, gl.FLOAT, data.subarray(0, shaperFloats));
+          gl.uniform1i(u('uShaperLen'), v.shaper.len);
+          gl.uniform3fv(u('uShaperScale'), v.shaper.scale);
+          gl.uniform3fv(u('uShaperOffset'), v.shaper.offset);
+        }
+        if (v.cube) {
+          const n = v.cube.n;
+          gl.activeTexture(gl.TEXTURE0 + unitOf('uCube'));
+          gl.texImage3D(gl.TEXTURE_3D, 0, gl.RGB32F, n, n, n, 0, gl.RGB, gl.FLOAT, data.subarray(shaperFloats, shaperFloats + n * n * n * 3));
+          gl.uniform1i(u('uCubeN'), n);
+          gl.uniform3fv(u('uCubeScale'), v.cube.scale);
+          gl.uniform3fv(u('uCubeOffset'), v.cube.offset);
+        }
+        gl.activeTexture(gl.TEXTURE0 + units.length);
+      }
+      state.view = i;
+    }
+    gl.uniform1i(u('uHeight'), H);
+    gl.uniform1i(u('uMode'), { code8: 0, cos: 1, normal: 2 }[scene.mask_mode]);
+    gl.uniform1i(u('uPlanes'), scene.planes);
+    gl.uniform1iv(u('uSide'), Int32Array.from({ length: 64 }, (_, k) => scene.plane_sides[k] === 'back' ? 1 : 0));
+    gl.uniform1i(u('uConvert'), scene.display_matrix ? 1 : 0);
+    gl.uniformMatrix3fv(u('uDisplay'), true, scene.display_matrix || [1, 0, 0, 0, 1, 0, 0, 0, 1]);
+
+    // Every product's table, on the CPU (a swap then uploads one slot's rows and nothing else).
+    const luts = await source.luts(products.length);
+
+    const params = new URLSearchParams(location.search);
+    const state = {
+      sets: { A: slots.map((id) => products.findIndex((p) => p.id === id)), B: null },
+      ev: Number(params.get('ev') ?? scene.initial_ev ?? 0),
+      ab: params.get('ab') || 'A',
+      split: Number(params.get('split') ?? 0.5),
+      edit: 'A',
+      frame: Number(params.get('frame') ?? 0),
+      view: -1,
+      selected: null,
+      data: null,
+      drawn: 0,
+      lastSwapMs: null,
+      lastFrameLoadMs: null,
+    };
+    const applySpec = (set, spec) => {
+      for (const [id, p] of parseChoices(products, slots, spec)) state.sets[set][slots.indexOf(id)] = p;
+    };
+    try {
+      applySpec('A', params.get('glass') ?? scene.initial_glass ?? '');
+      state.sets.B = state.sets.A.slice();
+      applySpec('B', params.get('glassB') ?? '');
+    } catch (e) {
+      state.sets.B = state.sets.B || state.sets.A.slice();
+      status(e.message, true);
+    }
+    if (!Number.isFinite(state.ev)) state.ev = 0;
+
+    function uploadSlot(set, slot) {
+      gl.bindTexture(gl.TEXTURE_2D, lutTex[set]);
+      gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, slot * lutLayout.rows_per_slot, lutLayout.width,
+        lutLayout.rows_per_slot, gl.RGBA, gl.FLOAT, luts[state.sets[set][slot]]);
+    }
+
+    function draw() {
+      gl.uniform1f(u('uGain'), Math.pow(2, state.ev));
+      gl.uniform1i(u('uAB'), { A: 0, B: 1, split: 2 }[state.ab] ?? 0);
+      gl.uniform1f(u('uSplitX'), state.split * W);
+      gl.viewport(0, 0, W, H);
+      gl.drawArrays(gl.TRIANGLES, 0, 3);
+      // Wait for the frame: reading a pixel back finishes the drawing.
+      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+      state.drawn += 1;
+      canvas.dataset.drawn = String(state.drawn);
+      window.glassdbFrameDrawn = state.drawn;
+    }
+
+    async function loadFrame(i) {
+      const t0 = performance.now();
+      const data = await source.frame(i);
+      gl.bindTexture(gl.TEXTURE_2D, transTex);
+      gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.HALF_FLOAT, data.passes.subarray(0, W * H * 4));
+      gl.bindTexture(gl.TEXTURE_2D_ARRAY, reflTex);
+      gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 0, W, H, scene.planes, gl.RGBA, gl.HALF_FLOAT,
+        data.passes.subarray(W * H * 4));
+      gl.bindTexture(gl.TEXTURE_2D, maskTex);
+      gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.FLOAT, data.mask);
+      state.frame = i;
+      state.data = data;
+      renderGlasses();
+      draw();
+      state.lastFrameLoadMs = performance.now() - t0;
+    }
+
+    // Chooses product `p` for glass `id` in set `set` (default: the edited one) and draws.
+    function choose(id, p, set) {
+      set = set || state.edit;
+      const t0 = performance.now();
+      const slot = slots.indexOf(id);
+      if (slot < 0 || !luts[p]) throw new Error('no glass ' + id + ' or product ' + p);
+      state.sets[set][slot] = p;
+      uploadSlot(set, slot);
+      draw();
+      state.lastSwapMs = performance.now() - t0;
+      renderGlasses();
+      renderProducts();
+      return state.lastSwapMs;
+    }
+
+    // ---- the page's lists ----
+
+    function swatch(rgb) {
+      let c = rgb;
+      if (scene.display_matrix) {
+        const m = scene.display_matrix;
+        c = [0, 1, 2].map((r) => m[3 * r] * rgb[0] + m[3 * r + 1] * rgb[1] + m[3 * r + 2] * rgb[2]);
+      }
+      const s = document.createElement('span');
+      s.className = 'swatch';
+      s.style.background = 'rgb(' + c.map((v) => Math.round(255 * srgbEncode(v))).join(',') + ')';
+      return s;
+    }
+
+    function productValues(p) {
+      const f = (v) => v.toFixed(3);
+      const l = p.luminous;
+      return (l ? 'τv ' + f(l.transmittance) + ' ρv ' + f(l.reflectance) : 'no luminous values') +
+        ' · t0 ' + p.t0.map(f).join('/') + ' · r0 ' + p.r0.map(f).join('/');
+    }
+
+    function renderGlasses() {
+      const ul = $('glasses');
+      ul.textContent = '';
+      const ids = state.data ? Object.keys(state.data.info.ids).map(Number) : [];
+      for (const id of ids) {
+        const slot = slots.indexOf(id);
+        const li = document.createElement('li');
+        li.dataset.id = String(id);
+        if (state.selected === id) li.className = 'selected';
+        const a = products[state.sets.A[slot]], b = products[state.sets.B[slot]];
+        li.append(swatch(a.t0));
+        const name = document.createElement('span');
+        name.className = 'name';
+        name.textContent = 'id ' + id + ': A ' + a.name + (a !== b ? ' | B ' + b.name : '');
+        li.append(name);
+        const px = document.createElement('span');
+        px.className = 'values';
+        px.textContent = state.data.info.ids[id] + ' px';
+        li.append(px);
+        li.onclick = () => { state.selected = id; renderGlasses(); renderProducts(); };
+        ul.append(li);
+      }
+    }
+
+    function renderProducts() {
+      const ul = $('products');
+      ul.textContent = '';
+      const q = $('search').value.trim().toLowerCase();
+      const slot = slots.indexOf(state.selected);
+      for (const p of products) {
+        if (q && !p.name.toLowerCase().includes(q) && String(p.id) !== q) continue;
+        const li = document.createElement('li');
+        li.dataset.index = String(p.index);
+        if (slot >= 0 && state.sets[state.edit][slot] === p.index) li.className = 'current';
+        li.title = 'registry id ' + p.id + ', angle model ' + p.angle_model;
+        li.append(swatch(p.r0), swatch(p.t0));
+        const name = document.createElement('span');
+        name.className = 'name';
+        name.textContent = p.name;
+        const values = document.createElement('div');
+        values.className = 'values';
+        values.textContent = productValues(p);
+        name.append(values);
+        li.append(name);
+        li.onclick = () => {
+          if (state.selected === null) { status('click a glass first', true); return; }
+          choose(state.selected, p.index);
+          status('id ' + state.selected + ' → ' + p.name + ' (' + state.lastSwapMs.toFixed(1) + ' ms)');
+        };
+        ul.append(li);
+      }
+    }
+
+    // ---- the probe: the same numbers on the CPU ----
+
+    function probe(x, y) {
+      const d = state.data;
+      if (!d || x < 0 || y < 0 || x >= W || y >= H) return;
+      const i = y * W + x;
+      const px = (base) => [0, 1, 2, 3].map((c) => halfToFloat(d.passes[base + 4 * i + c]));
+      const tr = px(0);
+      const m = d.mask.subarray(4 * i, 4 * i + 4);
+      const f = (v) => v.toPrecision(4);
+      let text = 'pixel (' + x + ', ' + y + ')\ntransmission ' + tr.slice(0, 3).map(f).join(' ') + '  alpha ' + f(tr[3]);
+      const slot = Math.round(m[0]) - 1;
+      if (slot < 0) {
+        $('probe').textContent = text + '\nno glass';
+        return;
+      }
+      const plane = Math.round(m[1]);
+      const side = scene.plane_sides[plane] === 'back' ? 1 : 0;
+      const cos = scene.mask_mode === 'code8' ? m[2] / 255 : scene.mask_mode === 'cos' ? m[2] : 1;
+      const set = state.ab === 'B' || (state.ab === 'split' && x >= state.split * W) ? 'B' : 'A';
+      const lut = luts[state.sets[set][slot]];
+      const at = (term, e) => {
+        const base = (side * 2 + term) * lutLayout.rows_per_curve * lutLayout.width * 4 + e * 4;
+        return [lut[base], lut[base + 1], lut[base + 2]];
+      };
+      let r, t;
+      if (scene.mask_mode === 'code8') {
+        r = at(0, Math.round(m[2])); t = at(1, Math.round(m[2]));
+      } else if (scene.mask_mode === 'cos') {
+        const xf = Math.min(1, Math.max(0, m[2])) * lutLayout.fine_steps;
+        const k = Math.min(Math.floor(xf), lutLayout.fine_steps - 1), fr = xf - k;
+        const lerp = (term) => at(term, lutLayout.fine_offset + k).map((v, c) => v + (at(term, lutLayout.fine_offset + k + 1)[c] - v) * fr);
+        r = lerp(0); t = lerp(1);
+      } else {
+        r = at(0, lutLayout.normal_offset); t = at(1, lutLayout.normal_offset);
+      }
+      const rf = px(W * H * 4 * (1 + plane)).slice(0, 3);
+      const k = m[3];
+      const out = [0, 1, 2].map((c) => tr[c] * (1 - k + k * t[c]) + rf[c] * r[c] * k);
+      text += '\nid ' + slots[slot] + ' (' + products[state.sets[set][slot]].name + ', set ' + set + ')' +
+        '\nplane ' + plane + ' (' + (side ? 'back' : 'front') + ')' +
+        '\nθ ' + (Math.acos(Math.min(1, Math.max(-1, cos))) * 180 / Math.PI).toFixed(2) + '°  cos θ ' + cos.toFixed(4) +
+        (k !== 1 ? '  coverage ' + f(k) : '') +
+        '\nr ' + r.map(f).join(' ') + '\nt ' + t.map(f).join(' ') +
+        '\nreflection ' + rf.map(f).join(' ') + '\ncomposite (linear) ' + out.map(f).join(' ');
+      $('probe').textContent = text;
+    }
+
+    function canvasPixel(ev) {
+      const rect = canvas.getBoundingClientRect();
+      return [Math.floor((ev.clientX - rect.left) * W / rect.width), Math.floor((ev.clientY - rect.top) * H / rect.height)];
+    }
+    canvas.addEventListener('mousemove', (ev) => probe(...canvasPixel(ev)));
+    canvas.addEventListener('click', (ev) => probe(...canvasPixel(ev)));
+
+    // ---- controls ----
+
+    const frameInput = $('frame');
+    frameInput.max = String(scene.frames.length - 1);
+    frameInput.disabled = scene.frames.length < 2;
+    const frameLabel = () => { $('frame-label').textContent = scene.frames[state.frame]; };
+    frameInput.oninput = async () => {
+      try {
+        await loadFrame(Number(frameInput.value));
+        frameLabel();
+      } catch (e) { status(e.message, true); }
+    };
+    const viewSelect = $('view');
+    scene.views.forEach((v, i) => {
+      const o = document.createElement('option');
+      o.value = String(i);
+      o.textContent = v.name + (v.title ? ' (' + v.title + ')' : '');
+      viewSelect.append(o);
+    });
+    viewSelect.value = 'standard';
+    viewSelect.onchange = async () => {
+      try {
+        await setView(viewSelect.value === 'standard' ? -1 : Number(viewSelect.value));
+        draw();
+      } catch (e) { status(e.message, true); }
+    };
+    const wantView = params.get('view');
+    if (wantView && wantView !== 'standard') {
+      const i = scene.views.findIndex((v) => v.name === wantView);
+      if (i < 0) status('no view named "' + wantView + '"', true);
+      else { await setView(i); viewSelect.value = String(i); }
+    } else {
+      await setView(-1);
+    }
+    const evInput = $('ev');
+    evInput.value = String(state.ev);
+    $('ev-label').textContent = state.ev.toFixed(1);
+    evInput.oninput = () => { state.ev = Number(evInput.value); $('ev-label').textContent = state.ev.toFixed(1); draw(); };
+    for (const r of document.querySelectorAll('input[name=ab]')) {
+      r.checked = r.value === state.ab;
+      r.onchange = () => { state.ab = r.value; draw(); };
+    }
+    $('split').value = String(state.split);
+    $('split').oninput = () => { state.split = Number($('split').value); draw(); };
+    for (const r of document.querySelectorAll('input[name=edit]')) {
+      r.onchange = () => { state.edit = r.value; renderProducts(); };
+    }
+    $('copy-ab').onclick = () => {
+      const other = state.edit === 'A' ? 'B' : 'A';
+      state.sets[other] = state.sets[state.edit].slice();
+      slots.forEach((_, s) => uploadSlot(other, s));
+      draw();
+      renderGlasses();
+    };
+    $('search').oninput = renderProducts;
+    const choicesParam = (set) => slots
+      .map((id, s) => [id, state.sets[set][s]])
+      .filter(([id, p]) => state.data && state.data.info.ids[id] !== undefined)
+      .map(([id, p]) => id + ':' + products[p].name).join(',');
+    const exportButton = $('export');
+    exportButton.disabled = !scene.export_available;
+    exportButton.title = scene.export_available ? 'write the self-contained folder with the current products'
+      : (EXPORT ? 'this is an exported page' : 'start glassdb view with --export-dir DIR to enable');
+    exportButton.onclick = async () => {
+      try {
+        const r = await fetch('api/export', { method: 'POST', body: JSON.stringify({ glass: choicesParam(state.edit), ev: state.ev }) });
+        const body = await r.json();
+        if (!r.ok) throw new Error(body.error);
+        status('exported to ' + body.path);
+      } catch (e) { status('export failed: ' + e.message, true); }
+    };
+
+    // ---- automation hooks ----
+    window.glassdb = {
+      scene,
+      choose: (id, product, set) => choose(id, typeof product === 'number' ? product : findProduct(products, product), set),
+      setEv: (ev) => { state.ev = ev; draw(); },
+      setView: async (name) => { await setView(scene.views.findIndex((v) => v.name === name)); draw(); },
+      setAB: (mode, split) => { state.ab = mode; if (split !== undefined) state.split = split; draw(); },
+      loadFrame,
+      products: () => ({ A: Object.fromEntries(slots.map((id, s) => [id, products[state.sets.A[s]].name])),
+        B: Object.fromEntries(slots.map((id, s) => [id, products[state.sets.B[s]].name])) }),
+      lastSwapMs: () => state.lastSwapMs,
+      lastFrameLoadMs: () => state.lastFrameLoadMs,
+      // The canvas's RGBA bytes, rows top to bottom, in base64.
+      readPixels: () => {
+        const px = new Uint8Array(W * H * 4);
+        gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, px);
+        const flipped = new Uint8Array(W * H * 4);
+        for (let y = 0; y < H; y++) flipped.set(px.subarray((H - 1 - y) * W * 4, (H - y) * W * 4), y * W * 4);
+        let bin = '';
+        for (let i = 0; i < flipped.length; i += 0x8000) bin += String.fromCharCode.apply(null, flipped.subarray(i, i + 0x8000));
+        return btoa(bin);
+      },
+    };
+    window.glassdbProducts = window.glassdb.products;
+
+    for (const set of ['A', 'B']) slots.forEach((_, s) => uploadSlot(set, s));
+    state.frame = Math.min(Math.max(0, Math.floor(state.frame) || 0), scene.frames.length - 1);
+    frameInput.value = String(state.frame);
+    await loadFrame(state.frame);
+    frameLabel();
+    const first = state.data ? Object.keys(state.data.info.ids).map(Number)[0] : undefined;
+    if (state.selected === null && first !== undefined) { state.selected = first; renderGlasses(); }
+    renderProducts();
+    if (!errors.length) status('ready: ' + W + '×' + H + ', ' + scene.planes + ' plane(s), ' + products.length + ' products');
+    // Milliseconds from the start of navigation to the first frame drawn and the page ready.
+    window.glassdbReadyMs = performance.now();
+    window.glassdbReady = true;
+  }
+
+  main().catch((e) => { status(String(e.message || e), true); window.glassdbReady = true; });
+})();

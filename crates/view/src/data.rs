@@ -1,0 +1,186 @@
+//! The binary data the page uploads as textures, little-endian, rows top to bottom:
+//!
+//! - passes: half floats, RGBA per pixel: the transmission pass (its alpha, or 1), then each
+//!   reflection pass placed in the frame (0 where it holds no pixels: the kernel's "no
+//!   reflection" there);
+//! - mask: `f32` RGBA per pixel: glass slot + 1 (0: no glass), plane, cos θ (the 8-bit code
+//!   for an 8-bit mask; cos θ for 16-bit and float masks, NaN as 1 as the kernel reads it; 1
+//!   for a binary mask), coverage (1 without);
+//! - a product's table: `f32` RGBA texels (RGB, 0), [`LUT_ROWS_PER_CURVE`] rows of
+//!   [`LUT_WIDTH`] per curve, curves in the order front r, front t, back r, back t; each curve
+//!   holds the 256 8-bit entries, then the [`FINE_STEPS`] + 1 fine entries, then normal
+//!   incidence.
+
+use glassdb_compose::DecodedFrame;
+use glassdb_compose::lut::{FINE_STEPS, GlassSideLut, RtTriple};
+use glassdb_compose::view::CubeLut;
+use glassdb_mask::{CosCode, CosTheta};
+
+/// Texels per row of the lookup-table texture (WebGL2 guarantees 2048).
+pub const LUT_WIDTH: usize = 1024;
+/// Texels of one curve: 256 8-bit entries, the fine table, normal incidence.
+pub const LUT_TEXELS_PER_CURVE: usize = 256 + FINE_STEPS + 1 + 1;
+/// Rows of one curve.
+pub const LUT_ROWS_PER_CURVE: usize = LUT_TEXELS_PER_CURVE.div_ceil(LUT_WIDTH);
+/// Rows of one glass slot (front r, front t, back r, back t).
+pub const LUT_ROWS_PER_SLOT: usize = 4 * LUT_ROWS_PER_CURVE;
+/// Offset of the fine table in a curve.
+pub const LUT_FINE_OFFSET: usize = 256;
+/// Offset of the normal-incidence entry in a curve.
+pub const LUT_NORMAL_OFFSET: usize = 256 + FINE_STEPS + 1;
+
+/// How the mask's third channel holds cos θ, which the shader follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MaskMode {
+    /// The 8-bit code: an exact entry of the 8-bit table.
+    Code8,
+    /// cos θ, linearly interpolated in the fine table.
+    Cos,
+    /// No angle: normal incidence.
+    Normal,
+}
+
+impl MaskMode {
+    /// The mode of a decoded mask.
+    pub fn of(cos: &CosTheta) -> MaskMode {
+        match cos {
+            CosTheta::Quantized8(_) => MaskMode::Code8,
+            CosTheta::Quantized16(_) | CosTheta::Float(_) => MaskMode::Cos,
+            CosTheta::Normal => MaskMode::Normal,
+        }
+    }
+
+    /// Its name in the scene JSON and in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            MaskMode::Code8 => "code8",
+            MaskMode::Cos => "cos",
+            MaskMode::Normal => "normal",
+        }
+    }
+}
+
+/// A product's table for one glass: both sides, r and t, in the texture layout.
+pub fn lut_bytes(sides: &[GlassSideLut; 2]) -> Vec<u8> {
+    let curve_len = LUT_ROWS_PER_CURVE * LUT_WIDTH * 4;
+    let mut texels = vec![0f32; 4 * curve_len];
+    let picks: [fn(&RtTriple) -> [f32; 3]; 2] = [|e| e.r, |e| e.t];
+    let mut k = 0;
+    for side in sides {
+        for pick in picks {
+            let curve = &mut texels[k * curve_len..(k + 1) * curve_len];
+            let entries = side
+                .q8
+                .iter()
+                .chain(side.fine.iter())
+                .chain(std::iter::once(&side.normal));
+            for (texel, e) in curve.chunks_exact_mut(4).zip(entries) {
+                texel[..3].copy_from_slice(&pick(e));
+            }
+            k += 1;
+        }
+    }
+    f32_bytes(&texels)
+}
+
+/// The passes of a decoded frame as half-float RGBA planes (see the module docs).
+pub fn pass_bytes(frame: &DecodedFrame<'_>) -> Vec<u8> {
+    let trans = &frame.trans.image;
+    let (w, h) = (trans.width as usize, trans.height as usize);
+    let n = w * h;
+    let mut out: Vec<u8> = Vec::with_capacity(n * 8 * (1 + frame.refl.len()));
+    let mut push = |v: f32| out.extend_from_slice(&half::f16::from_f32(v).to_le_bytes());
+    for i in 0..n {
+        for c in 0..3 {
+            push(trans.rgb[c][i]);
+        }
+        push(trans.alpha.as_ref().map_or(1.0, |a| a[i]));
+    }
+    for (pass, window) in frame.refl.iter().zip(&frame.refl_windows) {
+        let rgb = &pass.image.rgb;
+        for y in 0..h {
+            for x in 0..w {
+                match window.index_of(x as i64, y as i64) {
+                    Some(j) => (0..3).for_each(|c| push(rgb[c][j])),
+                    None => (0..3).for_each(|_| push(0.0)),
+                }
+                push(1.0);
+            }
+        }
+    }
+    out
+}
+
+/// The mask of a decoded frame as `f32` RGBA (see the module docs); `slot_of(id)` is the
+/// glass slot of a mask id (every id of a checked frame has one).
+pub fn mask_bytes(frame: &DecodedFrame<'_>, slot_of: impl Fn(u16) -> Option<usize>) -> Vec<u8> {
+    let mask = &frame.mask;
+    let n = mask.pixel_count();
+    let mut texels = Vec::with_capacity(n * 4);
+    for i in 0..n {
+        let id = mask.id[i];
+        let slot = if id == 0 {
+            0.0
+        } else {
+            slot_of(id).map_or(0.0, |s| s as f32 + 1.0)
+        };
+        let cos = match &mask.cos_theta {
+            CosTheta::Quantized8(c) => f32::from(c[i]),
+            CosTheta::Quantized16(c) => CosCode::Bits16.decode_f32(c[i]),
+            CosTheta::Float(c) if c[i].is_nan() => 1.0,
+            CosTheta::Float(c) => c[i],
+            CosTheta::Normal => 1.0,
+        };
+        let coverage = mask.coverage.as_ref().map_or(1.0, |c| c[i]);
+        texels.extend_from_slice(&[slot, f32::from(mask.plane[i]), cos, coverage]);
+    }
+    f32_bytes(&texels)
+}
+
+/// A `.cube` view's tables as `f32` RGB texels: the 1D table (if any) in rows of
+/// [`LUT_WIDTH`], the last row padded with zeros, then the 3D table (if any), red fastest.
+pub fn view_bytes(lut: &CubeLut) -> Vec<u8> {
+    let mut texels: Vec<f32> = Vec::new();
+    if let Some(t) = lut.shaper_table() {
+        texels.extend_from_slice(t.values);
+        texels.resize(t.size.div_ceil(LUT_WIDTH) * LUT_WIDTH * 3, 0.0);
+    }
+    if let Some(t) = lut.cube_table() {
+        texels.extend_from_slice(t.values);
+    }
+    f32_bytes(&texels)
+}
+
+fn f32_bytes(values: &[f32]) -> Vec<u8> {
+    values.iter().flat_map(|v| v.to_le_bytes()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glassdb_compose::lut::GlassLut;
+
+    #[test]
+    fn a_lut_holds_the_compositors_entries_where_the_layout_says() {
+        let reg = glassdb_registry::default_registry().unwrap();
+        let g = &reg.default_table().glasses[3];
+        let lut = GlassLut::from_records(&[(1, g)]);
+        let sides = [
+            lut.side(1, glassdb_registry::Side::Front).unwrap().clone(),
+            lut.side(1, glassdb_registry::Side::Back).unwrap().clone(),
+        ];
+        let bytes = lut_bytes(&sides);
+        let texel = |curve: usize, e: usize, c: usize| {
+            let at = ((curve * LUT_ROWS_PER_CURVE * LUT_WIDTH) + e) * 4 + c;
+            f32::from_le_bytes(bytes[at * 4..at * 4 + 4].try_into().unwrap())
+        };
+        // Back t at code 77, front r at fine entry 4000, back r at normal incidence.
+        assert_eq!(texel(3, 77, 1), sides[1].q8[77].t[1]);
+        assert_eq!(
+            texel(0, LUT_FINE_OFFSET + 4000, 2),
+            sides[0].fine[4000].r[2]
+        );
+        assert_eq!(texel(2, LUT_NORMAL_OFFSET, 0), g.r0_back[0] as f32);
+        assert_eq!(bytes.len(), 4 * LUT_ROWS_PER_CURVE * LUT_WIDTH * 16);
+    }
+}

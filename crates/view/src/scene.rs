@@ -1,0 +1,415 @@
+//! What the viewer shows: the frames (decoded on request, the last one kept), the candidate
+//! products (every record of the registry's table in the passes' space) and their lookup
+//! tables, and the choice of a product per glass id.
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use glassdb_colour::RgbSpace;
+use glassdb_compose::colour::RegistryLuts;
+use glassdb_compose::lut::GlassLut;
+use glassdb_compose::memory::MemoryBudget;
+use glassdb_compose::view::CubeLut;
+use glassdb_compose::{ComposeJob, ComposeSettings, DecodedFrame, decode_frame, sequence};
+use glassdb_registry::{GlassRecord, Registry, Side};
+use serde_json::{Value, json};
+
+use crate::ViewError;
+use crate::data::{self, MaskMode};
+
+/// The viewer's inputs: the compose job (paths may hold `####` when `frames` is given), how
+/// to read it, and the registry whose records are the candidate products.
+pub struct ViewerInputs {
+    pub job: ComposeJob,
+    /// Frame numbers of a sequence; empty for a single frame.
+    pub frames: Vec<u32>,
+    pub settings: ComposeSettings,
+    pub registry: Registry,
+    /// `.cube` views the page offers beside `standard`.
+    pub views: Vec<CubeLut>,
+}
+
+/// One decoded frame as the page uploads it.
+#[derive(Debug)]
+pub struct FrameData {
+    /// Glass pixels per id, the mask kind: the frame's JSON.
+    pub info: Value,
+    /// Half-float passes ([`data::pass_bytes`]).
+    pub passes: Vec<u8>,
+    /// The mask ([`data::mask_bytes`]).
+    pub mask: Vec<u8>,
+}
+
+/// A product chosen for a glass id: (id, index of the product in [`Viewer::products`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GlassChoice {
+    pub id: u16,
+    pub product: usize,
+}
+
+/// The loaded viewer: scene description, candidate products, frames on request.
+pub struct Viewer {
+    inputs: ViewerInputs,
+    luts: RegistryLuts,
+    budget: MemoryBudget,
+    /// The candidate products: the records of the table the frames composite with.
+    products: Vec<GlassRecord>,
+    /// Each product's table in the page's layout, built when first asked for.
+    product_luts: Vec<OnceLock<Arc<Vec<u8>>>>,
+    scene: Value,
+    mask_mode: MaskMode,
+    /// The last frame decoded.
+    cache: Mutex<Option<(usize, Arc<FrameData>)>>,
+}
+
+impl Viewer {
+    /// Decodes the first frame (checking it as `compose` does) to learn the size, the colour
+    /// space and its registry table, and the mask kind.
+    pub fn open(inputs: ViewerInputs) -> Result<Viewer, ViewError> {
+        let luts = RegistryLuts::new(&inputs.registry);
+        let budget = MemoryBudget::new(inputs.settings.max_memory);
+        let first_job = job_of(&inputs, 0)?;
+        let first = decode_frame(&first_job, &inputs.settings, &luts, &budget, (false, false))?;
+        let (width, height, planes) = (
+            first.trans.image.width,
+            first.trans.image.height,
+            first.refl.len(),
+        );
+        let (space, table) = (first.space.clone(), first.table);
+        let mask_mode = MaskMode::of(&first.mask.cos_theta);
+        let products = inputs
+            .registry
+            .table(table.basis)
+            .map(|t| t.glasses.clone())
+            .unwrap_or_default();
+        // Kept for the page's first request.
+        let first_data = Arc::new(frame_data(&first, &first_job, &products));
+        let first_ids = first.id_counts.clone();
+        drop(first);
+        let display_matrix = (space.space != RgbSpace::Srgb).then(|| {
+            let m = glassdb_colour::rgb_to_rgb(space.space, RgbSpace::Srgb);
+            (0..3)
+                .flat_map(|r| (0..3).map(move |c| (r, c)))
+                .map(|(r, c)| m[(r, c)])
+                .collect::<Vec<f64>>()
+        });
+        let frames: Vec<String> = if inputs.frames.is_empty() {
+            vec![first_job.trans.display().to_string()]
+        } else {
+            inputs.frames.iter().map(u32::to_string).collect()
+        };
+        let scene = json!({
+            "width": width,
+            "height": height,
+            "planes": planes,
+            "plane_sides": (0..planes).map(|k| side_name(inputs.settings.plane_sides.get(&k).copied().unwrap_or(Side::Front))).collect::<Vec<_>>(),
+            "frames": frames,
+            "space": space.to_string(),
+            "table": table.basis.to_string(),
+            "approximate_table": table.approximate,
+            "display_matrix": display_matrix,
+            "registry": inputs.settings.registry_label,
+            "mask_mode": mask_mode.name(),
+            "trans": first_job.trans.display().to_string(),
+            "lut": {
+                "width": data::LUT_WIDTH,
+                "rows_per_curve": data::LUT_ROWS_PER_CURVE,
+                "rows_per_slot": data::LUT_ROWS_PER_SLOT,
+                "fine_offset": data::LUT_FINE_OFFSET,
+                "fine_steps": glassdb_compose::lut::FINE_STEPS,
+                "normal_offset": data::LUT_NORMAL_OFFSET,
+            },
+            "slots": products.iter().map(|g| g.id).collect::<Vec<_>>(),
+            "products": products.iter().enumerate().map(|(i, g)| product_json(i, g)).collect::<Vec<_>>(),
+            "first_frame_ids": first_ids,
+            "views": inputs.views.iter().map(view_json).collect::<Vec<_>>(),
+        });
+        let product_luts = products.iter().map(|_| OnceLock::new()).collect();
+        Ok(Viewer {
+            inputs,
+            luts,
+            budget,
+            products,
+            product_luts,
+            scene,
+            mask_mode,
+            cache: Mutex::new(Some((0, first_data))),
+        })
+    }
+
+    /// The scene description the page starts from.
+    pub fn scene(&self) -> &Value {
+        &self.scene
+    }
+
+    /// The candidate products.
+    pub fn products(&self) -> &[GlassRecord] {
+        &self.products
+    }
+
+    /// How many frames there are.
+    pub fn frame_count(&self) -> usize {
+        self.inputs.frames.len().max(1)
+    }
+
+    /// Product `index`'s lookup table in the page's layout ([`data::lut_bytes`]): the table
+    /// the compositor builds for a mask id whose record is this product's.
+    pub fn product_lut(&self, index: usize) -> Option<Arc<Vec<u8>>> {
+        let record = self.products.get(index)?;
+        let cell = self.product_luts.get(index)?;
+        if let Some(bytes) = cell.get() {
+            return Some(bytes.clone());
+        }
+        let lut = GlassLut::from_records(&[(record.id, record)]);
+        let sides = [
+            lut.side(record.id, Side::Front)?.clone(),
+            lut.side(record.id, Side::Back)?.clone(),
+        ];
+        Some(
+            cell.get_or_init(|| Arc::new(data::lut_bytes(&sides)))
+                .clone(),
+        )
+    }
+
+    /// View `index`'s tables as the page uploads them ([`data::view_bytes`]).
+    pub fn view_data(&self, index: usize) -> Option<Vec<u8>> {
+        self.inputs.views.get(index).map(data::view_bytes)
+    }
+
+    /// How many `.cube` views there are.
+    pub fn view_count(&self) -> usize {
+        self.inputs.views.len()
+    }
+
+    /// Every product's table, one after the other (the page loads them in one request, so a
+    /// later swap needs none).
+    pub fn all_product_luts(&self) -> Vec<u8> {
+        (0..self.products.len())
+            .filter_map(|i| self.product_lut(i))
+            .flat_map(|b| b.as_ref().clone())
+            .collect()
+    }
+
+    /// Frame `index` (0-based), decoded and checked as `compose` does; the last one is kept.
+    pub fn frame(&self, index: usize) -> Result<Arc<FrameData>, ViewError> {
+        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((i, data)) = cache.as_ref()
+            && *i == index
+        {
+            return Ok(data.clone());
+        }
+        // Free the old frame first: two frames need not fit in memory together.
+        *cache = None;
+        let job = job_of(&self.inputs, index)?;
+        let frame = decode_frame(
+            &job,
+            &self.inputs.settings,
+            &self.luts,
+            &self.budget,
+            (false, false),
+        )?;
+        let mode = MaskMode::of(&frame.mask.cos_theta);
+        if mode != self.mask_mode {
+            return Err(ViewError::MaskKindChanges {
+                frame: self.inputs.frames.get(index).copied().unwrap_or(0),
+                mask: job.mask.clone(),
+                found: mode.name(),
+                first: self.mask_mode.name(),
+            });
+        }
+        let data = Arc::new(frame_data(&frame, &job, &self.products));
+        drop(frame);
+        *cache = Some((index, data.clone()));
+        Ok(data)
+    }
+
+    /// Parses `ID:PRODUCT,ID:PRODUCT` (PRODUCT: a product's full name, any case; its registry
+    /// id; or a part of its name matching one product only). Names may hold commas: a comma
+    /// starts a new choice only when `ID:` follows it.
+    pub fn parse_choices(&self, spec: &str) -> Result<Vec<GlassChoice>, ViewError> {
+        split_choices(spec)
+            .into_iter()
+            .map(|part| {
+                let bad = |why: &str| ViewError::GlassSpec {
+                    spec: part.to_string(),
+                    why: why.to_string(),
+                };
+                let (id, name) = part
+                    .split_once(':')
+                    .ok_or_else(|| bad("expected ID:PRODUCT, e.g. 1:Clear"))?;
+                let id: u16 = id
+                    .trim()
+                    .parse()
+                    .map_err(|_| bad("the glass id must be a number 1–65535"))?;
+                if !self.products.iter().any(|g| g.id == id) {
+                    return Err(ViewError::UnknownGlassId { id });
+                }
+                Ok(GlassChoice {
+                    id,
+                    product: self.find_product(name.trim())?,
+                })
+            })
+            .collect()
+    }
+
+    /// The product a name means (see [`Viewer::parse_choices`]).
+    pub fn find_product(&self, name: &str) -> Result<usize, ViewError> {
+        let lower = name.to_lowercase();
+        if let Some(i) = self
+            .products
+            .iter()
+            .position(|g| g.name.to_lowercase() == lower)
+        {
+            return Ok(i);
+        }
+        if let Ok(id) = name.parse::<u16>()
+            && let Some(i) = self.products.iter().position(|g| g.id == id)
+        {
+            return Ok(i);
+        }
+        let matches: Vec<usize> = (0..self.products.len())
+            .filter(|&i| self.products[i].name.to_lowercase().contains(&lower))
+            .collect();
+        match matches.as_slice() {
+            [i] => Ok(*i),
+            [] => Err(ViewError::UnknownProduct {
+                name: name.to_string(),
+                candidates: self
+                    .products
+                    .iter()
+                    .map(|g| format!("{} ({})", g.name, g.id))
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            }),
+            many => Err(ViewError::AmbiguousProduct {
+                name: name.to_string(),
+                matches: many
+                    .iter()
+                    .map(|&i| self.products[i].name.clone())
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            }),
+        }
+    }
+
+    /// Glass choices as the page's `glass` parameter (product names).
+    pub fn choices_param(&self, choices: &[GlassChoice]) -> String {
+        choices
+            .iter()
+            .map(|c| format!("{}:{}", c.id, self.products[c.product].name))
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+
+    /// The path of frame `index`'s transmission pass (messages).
+    pub fn frame_label(&self, index: usize) -> PathBuf {
+        job_of(&self.inputs, index)
+            .map(|j| j.trans)
+            .unwrap_or_else(|_| self.inputs.job.trans.clone())
+    }
+}
+
+/// A decoded frame as the page uploads it; `products` give the glass slots.
+fn frame_data(frame: &DecodedFrame<'_>, job: &ComposeJob, products: &[GlassRecord]) -> FrameData {
+    let slot_of = |id: u16| products.iter().position(|g| g.id == id);
+    FrameData {
+        info: json!({ "ids": frame.id_counts, "trans": job.trans.display().to_string() }),
+        passes: data::pass_bytes(frame),
+        mask: data::mask_bytes(frame, slot_of),
+    }
+}
+
+/// `a:b,c:d` split at the commas that an `ID:` follows.
+fn split_choices(spec: &str) -> Vec<&str> {
+    let mut parts = Vec::new();
+    let mut start = 0;
+    for (i, _) in spec.match_indices(',') {
+        let rest = &spec[i + 1..];
+        let digits = rest
+            .trim_start()
+            .bytes()
+            .take_while(u8::is_ascii_digit)
+            .count();
+        if digits > 0 && rest.trim_start()[digits..].starts_with(':') {
+            parts.push(&spec[start..i]);
+            start = i + 1;
+        }
+    }
+    parts.push(&spec[start..]);
+    parts.into_iter().filter(|p| !p.trim().is_empty()).collect()
+}
+
+fn side_name(side: Side) -> &'static str {
+    match side {
+        Side::Front => "front",
+        Side::Back => "back",
+    }
+}
+
+/// A `.cube` view as the scene lists it: its name and its tables' sizes and domains.
+fn view_json(lut: &CubeLut) -> Value {
+    let name = lut.path.file_stem().map_or_else(
+        || lut.path.display().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    json!({
+        "name": name,
+        "title": lut.title,
+        "shaper": lut.shaper_table().map(|t| json!({
+            "len": t.size,
+            "rows": t.size.div_ceil(data::LUT_WIDTH),
+            "scale": t.scale,
+            "offset": t.offset,
+        })),
+        "cube": lut.cube_table().map(|t| json!({
+            "n": t.size,
+            "scale": t.scale,
+            "offset": t.offset,
+        })),
+    })
+}
+
+fn product_json(index: usize, g: &GlassRecord) -> Value {
+    json!({
+        "index": index,
+        "id": g.id,
+        "name": g.name,
+        "r0": g.r0,
+        "t0": g.t0,
+        "r0_back": g.r0_back,
+        "luminous": g.luminous.map(|l| json!({
+            "transmittance": l.transmittance,
+            "reflectance": l.reflectance,
+            "reflectance_back": l.reflectance_back,
+        })),
+        "angle_model": g.angle_model.kind,
+    })
+}
+
+/// The job of frame `index`: the pattern's paths with its number, or the job itself.
+fn job_of(inputs: &ViewerInputs, index: usize) -> Result<ComposeJob, ViewError> {
+    match inputs.frames.get(index) {
+        Some(&n) => Ok(sequence::frame_job(&inputs.job, n)?),
+        None => Ok(inputs.job.clone()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split_choices;
+
+    #[test]
+    fn choices_split_only_where_an_id_follows_the_comma() {
+        assert_eq!(
+            split_choices("1:Clear float 3 mm (Generic Clear Glass, NFRC 102),5: Stopray"),
+            [
+                "1:Clear float 3 mm (Generic Clear Glass, NFRC 102)",
+                "5: Stopray"
+            ]
+        );
+        // A comma not followed by `ID:` belongs to the name.
+        assert_eq!(split_choices("1:a, 20:b,"), ["1:a", " 20:b,"]);
+        assert_eq!(split_choices("1:a,b:c"), ["1:a,b:c"]);
+        assert!(split_choices("").is_empty());
+    }
+}

@@ -1,0 +1,160 @@
+"""Drives the glassdb viewer page in headless Chromium through WebDriver (selenium).
+
+    viewer_driver.py check URL [--swap ID:PRODUCT ...] [--out FILE.rgba]
+        Opens the page, waits for its first frame, swaps each product through the page's own
+        controls (click the glass in the list, type in the search box, click the product), waits
+        for the new frame, and writes the canvas's RGBA bytes (rows top to bottom) to --out.
+        Prints JSON: size, frames drawn, the product sets, the last swap's time, page errors.
+
+    viewer_driver.py bench URL --id ID --products 'P1|P2' [--repeat N]
+        Times product choices through the page's automation hook: from the choice to the new
+        frame drawn (a 1-pixel read-back finishes the drawing), and the page's load time.
+
+Chromium runs as Debian ships it (/usr/bin/chromium, /usr/bin/chromedriver), WebGL2 on
+SwiftShader when there is no GPU.
+"""
+
+import argparse
+import base64
+import json
+import sys
+import time
+
+from selenium import webdriver
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.ui import WebDriverWait
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMEDRIVER = "/usr/bin/chromedriver"
+
+
+def browser(gpu):
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for flag in ["--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
+                 "--allow-file-access-from-files", "--window-size=1400,1000"]:
+        options.add_argument(flag)
+    if not gpu:
+        for flag in ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]:
+            options.add_argument(flag)
+    return webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
+
+
+def wait_ready(driver, timeout):
+    try:
+        WebDriverWait(driver, timeout).until(lambda d: d.execute_script("return window.glassdbReady === true"))
+    except Exception:
+        state = driver.execute_script(
+            "return [document.getElementById('status').textContent, typeof window.glassdb,"
+            " performance.getEntriesByType('resource').map(e => e.name)]")
+        log = driver.get_log("browser")
+        raise SystemExit(f"the page did not get ready: status, hooks, loaded: {state}; browser log: {log}")
+    errors = driver.execute_script("return window.glassdbErrors || []")
+    if errors:
+        raise SystemExit("page errors: " + "; ".join(errors))
+
+
+def drawn(driver):
+    return int(driver.execute_script("return window.glassdbFrameDrawn || 0"))
+
+
+def swap_through_ui(driver, spec, timeout):
+    glass_id, name = spec.split(":", 1)
+    products = driver.execute_script("return window.glassdb.scene.products")
+    matches = [p for p in products if p["name"] == name]
+    if len(matches) != 1:
+        raise SystemExit(f"no product named {name!r}")
+    before = drawn(driver)
+    driver.find_element(By.CSS_SELECTOR, f'#glasses li[data-id="{int(glass_id)}"]').click()
+    search = driver.find_element(By.ID, "search")
+    search.clear()
+    search.send_keys(name[:12])
+    driver.find_element(By.CSS_SELECTOR, f'#products li[data-index="{matches[0]["index"]}"]').click()
+    WebDriverWait(driver, timeout).until(lambda d: drawn(d) > before)
+
+
+def check(args):
+    driver = browser(args.gpu)
+    try:
+        driver.get(args.url)
+        wait_ready(driver, args.timeout)
+        for spec in args.swap:
+            swap_through_ui(driver, spec, args.timeout)
+        scene = driver.execute_script("return {w: window.glassdb.scene.width, h: window.glassdb.scene.height}")
+        pixels = base64.b64decode(driver.execute_script("return window.glassdb.readPixels()"))
+        if args.out:
+            with open(args.out, "wb") as f:
+                f.write(pixels)
+        report = {
+            "width": scene["w"],
+            "height": scene["h"],
+            "drawn": drawn(driver),
+            "marker": driver.find_element(By.ID, "view-canvas").get_attribute("data-drawn"),
+            "products": driver.execute_script("return window.glassdbProducts()"),
+            "swap_ms": driver.execute_script("return window.glassdb.lastSwapMs()"),
+            "errors": driver.execute_script("return window.glassdbErrors"),
+            "renderer": driver.execute_script(
+                "const gl = document.createElement('canvas').getContext('webgl2');"
+                "const e = gl && gl.getExtension('WEBGL_debug_renderer_info');"
+                "return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : null;"),
+        }
+        print(json.dumps(report))
+    finally:
+        driver.quit()
+
+
+def bench(args):
+    driver = browser(args.gpu)
+    try:
+        t0 = time.perf_counter()
+        driver.get(args.url)
+        wait_ready(driver, args.timeout)
+        load_ms = (time.perf_counter() - t0) * 1e3
+        page_ms = driver.execute_script("return window.glassdbReadyMs")
+        products = args.products.split("|")
+        swaps = []
+        for k in range(args.repeat):
+            for p in products:
+                ms = driver.execute_script(
+                    "return window.glassdb.choose(arguments[0], arguments[1])", args.id, p)
+                swaps.append(ms)
+        swaps.sort()
+        print(json.dumps({
+            "load_ms": load_ms,
+            "page_ready_ms": page_ms,
+            "frame_load_ms": driver.execute_script("return window.glassdb.lastFrameLoadMs()"),
+            "swaps": len(swaps),
+            "swap_ms_median": swaps[len(swaps) // 2],
+            "swap_ms_min": swaps[0],
+            "swap_ms_max": swaps[-1],
+            "renderer": driver.execute_script(
+                "const gl = document.createElement('canvas').getContext('webgl2');"
+                "const e = gl && gl.getExtension('WEBGL_debug_renderer_info');"
+                "return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : null;"),
+        }))
+    finally:
+        driver.quit()
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    c = sub.add_parser("check")
+    c.add_argument("url")
+    c.add_argument("--swap", action="append", default=[])
+    c.add_argument("--out")
+    b = sub.add_parser("bench")
+    b.add_argument("url")
+    b.add_argument("--id", type=int, required=True)
+    b.add_argument("--products", required=True, help="product names separated by |")
+    b.add_argument("--repeat", type=int, default=5)
+    for p in (c, b):
+        p.add_argument("--timeout", type=float, default=60)
+        p.add_argument("--gpu", action="store_true", help="use the machine's GPU, not SwiftShader")
+    args = ap.parse_args()
+    {"check": check, "bench": bench}[args.cmd](args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

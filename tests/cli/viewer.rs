@@ -1,0 +1,502 @@
+//! `glassdb view` in a real browser (headless Chromium through WebDriver,
+//! `python_oracle/viewer_driver.py`; WebGL2 on SwiftShader here): a product swapped through the
+//! page's controls gives the canvas `compose` writes for the same products (its PNG, standard
+//! view, undithered), the exported folder gives the same pixels from `file://`, and the server
+//! answers bad requests with 4xx. Chromium missing is a failure, not a skip
+//! (`scripts/test-all` installs it).
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+use crate::util::{
+    fails_naming, glassdb, ok, read_png_planes, registry_build, repo_path, run_oracle,
+};
+
+const SWAP_ID: u16 = 5;
+/// The product the tests put on the atrium's tinted glass (id 5).
+const SWAP_PRODUCT: &str = "AGC Stopray Titanium 34T on grey 8 mm (NFRC 20748)";
+
+/// The atrium's inputs as `glassdb view` and `compose` take them.
+fn atrium_inputs(cmd: &mut Command) -> &mut Command {
+    let a = |f: &str| repo_path("fixtures/atrium").join(f);
+    cmd.arg("--trans").arg(a("trans.exr"));
+    for k in 0..3 {
+        cmd.arg("--refl").arg(a(&format!("refl_{k}.exr")));
+    }
+    cmd.arg("--mask")
+        .arg(a("mask.png"))
+        .arg("--planes")
+        .arg(a("virtual/planes.json"))
+}
+
+/// A running viewer, stopped when dropped.
+struct Served {
+    child: Child,
+    url: String,
+    /// Kept open: the viewer ends quietly when its standard output is closed, as every
+    /// glassdb command does on a closed pipe.
+    _stdout: BufReader<std::process::ChildStdout>,
+}
+
+impl Drop for Served {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Serves the atrium with `extra` arguments.
+fn serve(extra: &[&std::ffi::OsStr]) -> Served {
+    let mut cmd = glassdb();
+    cmd.arg("view");
+    atrium_inputs(&mut cmd).args(extra);
+    spawn_viewer(&mut cmd)
+}
+
+/// Starts `cmd` (a `glassdb view` with its inputs) on a free port and reads its URL.
+fn spawn_viewer(cmd: &mut Command) -> Served {
+    cmd.args(["--port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit());
+    let mut child = cmd.spawn().expect("start glassdb view");
+    let mut line = String::new();
+    let mut stdout = BufReader::new(child.stdout.take().expect("stdout"));
+    stdout.read_line(&mut line).expect("read the URL");
+    let url = line
+        .trim()
+        .strip_prefix("serving ")
+        .unwrap_or_else(|| panic!("no URL in {line:?}"))
+        .to_string();
+    assert!(url.starts_with("http://127.0.0.1:"), "{url}");
+    Served {
+        child,
+        url,
+        _stdout: stdout,
+    }
+}
+
+/// The registry `source` with `product`'s record under id `id` in every table: what the page
+/// composites after the swap, written independently of the viewer (JSON edited directly).
+fn swapped_registry(source: &Path, dir: &Path, id: u16, product: &str) -> PathBuf {
+    let text = std::fs::read_to_string(source).unwrap();
+    let mut reg: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for table in reg["tables"].as_array_mut().unwrap() {
+        let glasses = table["glasses"].as_array_mut().unwrap();
+        let mut record = glasses
+            .iter()
+            .find(|g| g["name"] == product)
+            .expect("product in the registry")
+            .clone();
+        record["id"] = id.into();
+        let slot = glasses.iter().position(|g| g["id"] == id).unwrap();
+        glasses[slot] = record;
+    }
+    let path = dir.join("swapped.json");
+    std::fs::write(&path, reg.to_string()).unwrap();
+    path
+}
+
+/// compose's 8-bit PNG of the atrium (standard view, no dither) with `registry`.
+fn compose_png(dir: &Path, registry: Option<&Path>, name: &str) -> Vec<[f64; 3]> {
+    let out = dir.join(name);
+    let mut cmd = glassdb();
+    cmd.arg("compose");
+    atrium_inputs(&mut cmd)
+        .args(["--dither", "none", "-o"])
+        .arg(&out);
+    if let Some(r) = registry {
+        cmd.arg("--registry").arg(r);
+    }
+    ok(&mut cmd);
+    let p = read_png_planes(&out);
+    (0..p.width * p.height)
+        .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
+        .collect()
+}
+
+/// The canvas after the driver's swaps, as RGB per pixel (the page's RGBA read back).
+fn canvas(url: &str, swaps: &[String], out: &Path) -> (Vec<[f64; 3]>, serde_json::Value) {
+    let mut args: Vec<std::ffi::OsString> = vec!["check".into(), url.into(), "--out".into()];
+    args.push(out.into());
+    for s in swaps {
+        args.push("--swap".into());
+        args.push(s.into());
+    }
+    let refs: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let report: serde_json::Value =
+        serde_json::from_str(run_oracle("viewer_driver.py", &refs).trim()).unwrap();
+    let bytes = std::fs::read(out).unwrap();
+    let pixels = bytes
+        .chunks_exact(4)
+        .map(|p| [0, 1, 2].map(|c| f64::from(p[c])))
+        .collect();
+    (pixels, report)
+}
+
+/// The atrium exported with `extra` arguments into `dir/export`, opened from `file://`: its
+/// canvas and the driver's report.
+fn exported_canvas(dir: &Path, extra: &[&str]) -> (Vec<[f64; 3]>, serde_json::Value) {
+    let export = dir.join("export");
+    let mut cmd = glassdb();
+    cmd.arg("view");
+    atrium_inputs(&mut cmd)
+        .arg("--export")
+        .arg(&export)
+        .args(extra);
+    ok(&mut cmd);
+    let url = format!("file://{}", export.join("index.html").display());
+    canvas(&url, &[], &dir.join("export.rgba"))
+}
+
+fn psnr(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    assert_eq!(a.len(), b.len(), "image sizes differ");
+    let se: f64 = a
+        .iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).powi(2)))
+        .sum();
+    let mse = se / (3 * a.len()) as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (255.0f64 * 255.0 / mse).log10()
+    }
+}
+
+#[test]
+fn a_product_swapped_on_the_page_gives_composes_pixels_and_the_export_the_same() {
+    let dir = tempfile::tempdir().unwrap();
+    let registry = swapped_registry(
+        &repo_path("data/registry.json"),
+        dir.path(),
+        SWAP_ID,
+        SWAP_PRODUCT,
+    );
+    let want = compose_png(dir.path(), Some(&registry), "swapped.png");
+    let unswapped = compose_png(dir.path(), None, "bundled.png");
+    // The swap changes the picture visibly, so matching `want` says the swap happened.
+    assert!(psnr(&want, &unswapped) < 40.0);
+
+    let served = serve(&[]);
+    let swap = format!("{SWAP_ID}:{SWAP_PRODUCT}");
+    let (got, report) = canvas(&served.url, &[swap], &dir.path().join("canvas.rgba"));
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    assert_eq!(report["products"]["A"]["5"], SWAP_PRODUCT, "{report}");
+    assert_eq!(
+        report["marker"], "2",
+        "first frame, then the swap: {report}"
+    );
+    let db = psnr(&got, &want);
+    assert!(db >= 50.0, "page vs compose after the swap: {db:.1} dB");
+
+    // URL parameters choose the same product (by a unique part of its name).
+    let by_url = format!("{}?glass=5:Stopray&ev=0", served.url);
+    let (got, _) = canvas(&by_url, &[], &dir.path().join("url.rgba"));
+    let db = psnr(&got, &want);
+    assert!(db >= 50.0, "page with ?glass= vs compose: {db:.1} dB");
+
+    // A/B split: set A as bundled left of the middle, set B with the swap right of it.
+    let split = format!("{}?glassB=5:Stopray&ab=split&split=0.5", served.url);
+    let (got, report) = canvas(&split, &[], &dir.path().join("split.rgba"));
+    assert_eq!(report["products"]["B"]["5"], SWAP_PRODUCT, "{report}");
+    let width = report["width"].as_u64().unwrap() as usize;
+    let half = |img: &[[f64; 3]], right: bool| -> Vec<[f64; 3]> {
+        img.iter()
+            .enumerate()
+            .filter(|(i, _)| (i % width >= width / 2) == right)
+            .map(|(_, p)| *p)
+            .collect()
+    };
+    for (right, reference, name) in [(false, &unswapped, "A (left)"), (true, &want, "B (right)")] {
+        let db = psnr(&half(&got, right), &half(reference, right));
+        assert!(db >= 50.0, "split view, {name}: {db:.1} dB");
+    }
+    drop(served);
+
+    // The export, opened from disk, starts with the chosen product.
+    let (got, report) = exported_canvas(dir.path(), &["--glass", "5:stopray titanium"]);
+    assert_eq!(report["products"]["A"]["5"], SWAP_PRODUCT, "{report}");
+    let db = psnr(&got, &want);
+    assert!(db >= 50.0, "exported page vs compose: {db:.1} dB");
+}
+
+/// One raw HTTP/1.1 request; the status code.
+fn status(url: &str, request: &[u8]) -> u16 {
+    let host = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut s = TcpStream::connect(host).unwrap();
+    s.write_all(request).unwrap();
+    let mut reply = Vec::new();
+    let _ = s.read_to_end(&mut reply);
+    let text = String::from_utf8_lossy(&reply);
+    text.split_whitespace()
+        .nth(1)
+        .and_then(|c| c.parse().ok())
+        .unwrap_or_else(|| panic!("no status in {text:?}"))
+}
+
+fn get(url: &str, path: &str) -> u16 {
+    status(
+        url,
+        format!("GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n").as_bytes(),
+    )
+}
+
+fn post(url: &str, path: &str, body: &[u8]) -> u16 {
+    let mut req = format!(
+        "POST {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\nContent-Length: {}\r\n\r\n",
+        body.len()
+    )
+    .into_bytes();
+    req.extend_from_slice(body);
+    status(url, &req)
+}
+
+#[test]
+fn the_server_answers_bad_requests_with_4xx_and_serves_no_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let export = dir.path().join("from-page");
+    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    let u = &served.url;
+    assert_eq!(get(u, "/"), 200);
+    assert_eq!(get(u, "/api/scene"), 200);
+    for path in [
+        "/../Cargo.toml",
+        "/..%2f..%2fetc%2fpasswd",
+        "/fixtures/atrium/trans.exr",
+        "/api/frame/1/passes",
+        "/api/frame/-1",
+        "/api/frame/0/../../scene",
+        "/api/product/99/lut",
+        "/api/product/x/lut",
+        "/api/frame/99999999999999999999",
+    ] {
+        assert_eq!(get(u, path), 404, "{path}");
+    }
+    let long = format!("/{}", "a".repeat(10_000));
+    assert_eq!(get(u, &long), 414);
+    let delete = b"DELETE / HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
+    assert_eq!(status(u, delete), 405);
+    assert_eq!(post(u, "/api/export", &vec![b' '; 100_000]), 413);
+    assert_eq!(post(u, "/api/export", b"not json"), 400);
+    assert_eq!(
+        post(u, "/api/export", br#"{"glass": "5:no such glass"}"#),
+        400
+    );
+    assert_eq!(post(u, "/api/export", br#"{"glass": "77:Stopray"}"#), 400);
+    assert_eq!(post(u, "/api/scene", b"{}"), 404);
+    // Nothing was written by the refused exports; a good one writes the folder.
+    assert!(!export.exists());
+    assert_eq!(
+        post(u, "/api/export", br#"{"glass": "5:Stopray", "ev": 1}"#),
+        200
+    );
+    for f in [
+        "index.html",
+        "viewer.js",
+        "viewer.css",
+        "data.js",
+        "frame-0000.js",
+    ] {
+        assert!(export.join(f).is_file(), "{f}");
+    }
+    // Still serving after all that.
+    assert_eq!(get(u, "/viewer.js"), 200);
+}
+
+#[test]
+fn without_an_export_folder_the_page_export_is_refused() {
+    let served = serve(&[]);
+    assert_eq!(post(&served.url, "/api/export", b"{}"), 409);
+}
+
+#[test]
+fn bad_choices_and_export_paths_are_refused_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, b"x").unwrap();
+    let view = |extra: &[&std::ffi::OsStr]| {
+        let mut cmd = glassdb();
+        cmd.arg("view");
+        atrium_inputs(&mut cmd).args(extra);
+        cmd
+    };
+    let out = dir.path().join("out");
+    fails_naming(
+        &mut view(&[
+            "--export".as_ref(),
+            out.as_os_str(),
+            "--glass".as_ref(),
+            "5:no such glass".as_ref(),
+        ]),
+        &["no such glass", "Stopray"],
+    );
+    fails_naming(
+        &mut view(&[
+            "--export".as_ref(),
+            out.as_os_str(),
+            "--glass".as_ref(),
+            "5:clear".as_ref(),
+        ]),
+        &["clear", "several products"],
+    );
+    fails_naming(
+        &mut view(&["--export".as_ref(), file.as_os_str()]),
+        &["a-file"],
+    );
+    assert!(!out.exists());
+    // A port another program holds: refused, with the way out.
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = taken.local_addr().unwrap().port().to_string();
+    fails_naming(
+        &mut view(&["--port".as_ref(), port.as_ref()]),
+        &["cannot listen", &port, "--port 0"],
+    );
+}
+
+/// Frame 2 of a two-frame sequence whose second frame has other pixels (the atrium's plane-1
+/// reflection as its transmission pass) and the float mask with coverage (`mask.exr`): the
+/// fine-table interpolation and the coverage weights, after the frame slider moved.
+#[test]
+fn a_second_frame_with_a_float_mask_gives_composes_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = |f: &str| repo_path("fixtures/atrium").join(f);
+    let copy = |from: &str, to: String| std::fs::copy(a(from), dir.path().join(to)).unwrap();
+    for frame in [1, 2] {
+        let trans = if frame == 1 {
+            "trans.exr"
+        } else {
+            "refl_1.exr"
+        };
+        copy(trans, format!("trans.{frame:04}.exr"));
+        copy("mask.exr", format!("mask.{frame:04}.exr"));
+        for k in 0..3 {
+            copy(&format!("refl_{k}.exr"), format!("refl_{k}.{frame:04}.exr"));
+        }
+    }
+    let d = dir.path();
+    let files = |cmd: &mut Command, frame: &str| {
+        cmd.arg("--trans").arg(d.join(format!("trans.{frame}.exr")));
+        for k in 0..3 {
+            cmd.arg("--refl")
+                .arg(d.join(format!("refl_{k}.{frame}.exr")));
+        }
+        cmd.arg("--mask")
+            .arg(d.join(format!("mask.{frame}.exr")))
+            .arg("--planes")
+            .arg(a("virtual/planes.json"));
+    };
+    let out = d.join("frame2.png");
+    let mut cmd = glassdb();
+    cmd.arg("compose");
+    files(&mut cmd, "0002");
+    ok(cmd.args(["--dither", "none", "-o"]).arg(&out));
+    let p = read_png_planes(&out);
+    let want: Vec<[f64; 3]> = (0..p.width * p.height)
+        .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
+        .collect();
+
+    let mut cmd = glassdb();
+    cmd.arg("view");
+    files(&mut cmd, "####");
+    cmd.args(["--frames", "1-2"]);
+    let served = spawn_viewer(&mut cmd);
+    let (got, report) = canvas(&format!("{}?frame=1", served.url), &[], &d.join("f2.rgba"));
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    let db = psnr(&got, &want);
+    assert!(
+        db >= 50.0,
+        "frame 2 with the float mask vs compose: {db:.1} dB"
+    );
+}
+
+/// A `.cube` view (a 1D shaper over 0–4, then a 3D table mixing channels), written here.
+fn write_cube(path: &Path) {
+    let mut text =
+        String::from("# test view\nLUT_1D_SIZE 17\nLUT_1D_INPUT_RANGE 0 4\nLUT_3D_SIZE 9\n");
+    for i in 0..17 {
+        let y = (i as f64 / 16.0).powf(1.0 / 2.2);
+        text += &format!("{y:.6} {:.6} {:.6}\n", y * 0.98, y.powf(1.1));
+    }
+    for b in 0..9 {
+        for g in 0..9 {
+            for r in 0..9 {
+                let [r, g, b] = [r, g, b].map(|v| f64::from(v) / 8.0);
+                let out = [0.9 * r + 0.1 * g, g * g.sqrt(), 0.6 * b + 0.4 * r * g];
+                text += &format!("{:.6} {:.6} {:.6}\n", out[0], out[1], out[2]);
+            }
+        }
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn a_cube_view_on_the_page_gives_composes_pixels_through_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("look.cube");
+    write_cube(&cube);
+    let out = dir.path().join("look.png");
+    let mut cmd = glassdb();
+    cmd.arg("compose");
+    atrium_inputs(&mut cmd)
+        .args(["--dither", "none", "--view"])
+        .arg(&cube)
+        .arg("-o")
+        .arg(&out);
+    ok(&mut cmd);
+    let p = read_png_planes(&out);
+    let want: Vec<[f64; 3]> = (0..p.width * p.height)
+        .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
+        .collect();
+    let standard = compose_png(dir.path(), None, "standard.png");
+    assert!(
+        psnr(&want, &standard) < 40.0,
+        "the view changes the picture"
+    );
+
+    let served = serve(&["--view".as_ref(), cube.as_os_str()]);
+    let (got, report) = canvas(
+        &format!("{}?view=look", served.url),
+        &[],
+        &dir.path().join("look.rgba"),
+    );
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    let db = psnr(&got, &want);
+    assert!(
+        db >= 50.0,
+        "page through the .cube view vs compose: {db:.1} dB"
+    );
+}
+
+/// `--catalog`: the candidates are the catalog's products (here the atrium's two validation
+/// glasses), built at start as `glassdb registry build` builds them; the exported page with
+/// the tinted one on glass 1 gives compose's pixels with that registry and swap.
+#[test]
+fn candidates_built_from_a_catalog_give_composes_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let catalog = repo_path("fixtures/atrium/catalog.toml");
+    let registry = dir.path().join("atrium.json");
+    ok(&mut registry_build(
+        &catalog,
+        &registry,
+        &["--space", "srgb,acescg,rec2020,aces2065-1"],
+    ));
+    let tinted = "thin dielectric n=1.5, green-grey tint (Mitsuba thindielectric)";
+    let swapped = swapped_registry(&registry, dir.path(), 1, tinted);
+    let want = compose_png(dir.path(), Some(&swapped), "want.png");
+
+    let catalog_arg = catalog.to_str().unwrap();
+    let (got, report) = exported_canvas(
+        dir.path(),
+        &["--catalog", catalog_arg, "--glass", "1:green-grey"],
+    );
+    assert_eq!(report["products"]["A"]["1"], tinted, "{report}");
+    assert_eq!(
+        report["products"]["A"].as_object().unwrap().len(),
+        2,
+        "{report}"
+    );
+    let db = psnr(&got, &want);
+    assert!(db >= 50.0, "page from the catalog vs compose: {db:.1} dB");
+}
