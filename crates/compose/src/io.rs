@@ -5,11 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use glassdb_image::{
-    ExactExr, ExactPart, ExrColourTag, ExrFile, ExrImageAttributes, ExrImageOut,
-    ExrLayerAttributes, ExrPart, ExrPartOut, ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions,
-    ExrWriteReport, ImageError, ImageFile, ImageHeader, ImageWindows, LayerChoiceError,
-    PlaneSamples, PngColor, PngCompression, PngEncodeOptions, PngPixels, PngSampleSlice,
-    PngSamples, ReadMemory,
+    ExactExr, ExactPart, ExrColourTag, ExrImageAttributes, ExrImageOut, ExrLayerAttributes,
+    ExrPart, ExrPartOut, ExrPlane, ExrSampleType, ExrStorage, ExrWriteOptions, ExrWriteReport,
+    ImageError, ImageFile, ImageHeader, ImageWindows, LayerChoiceError, PlaneSamples, PngColor,
+    PngCompression, PngEncodeOptions, PngPixels, PngSampleSlice, PngSamples, ReadMemory,
 };
 
 use exr::meta::attribute::{AttributeValue, Text};
@@ -132,6 +131,21 @@ pub fn plane_layers_of(path: &Path, max_pixels: u64) -> Result<Option<Vec<String
 /// is decompressed) and checks what [`read_pass`] would refuse from it: an unknown format, a
 /// missing or ambiguous layer, too many pixels, deep data, subsampled channels.
 pub fn read_pass_header(path: &Path, opts: &PassReadOptions) -> Result<PassHeader, ComposeError> {
+    pass_header(path, opts, false)
+}
+
+/// [`read_pass_header`] of a reflection pass, read as [`read_pass_rows`] reads it: an EXR's
+/// memory counts its compressed blocks, not the whole file, and the planes of its whole data
+/// window (the rows its plane needs are known only once the mask is decoded).
+pub fn read_refl_header(path: &Path, opts: &PassReadOptions) -> Result<PassHeader, ComposeError> {
+    pass_header(path, opts, true)
+}
+
+fn pass_header(
+    path: &Path,
+    opts: &PassReadOptions,
+    seeking: bool,
+) -> Result<PassHeader, ComposeError> {
     let read_err = |cause| ComposeError::Read {
         path: path.to_path_buf(),
         cause,
@@ -189,7 +203,11 @@ pub fn read_pass_header(path: &Path, opts: &PassReadOptions) -> Result<PassHeade
             Ok(PassHeader {
                 windows: info.windows(),
                 colour: info.colour.clone(),
-                memory: ReadMemory::exr_planes(file_len, info.pixel_count(), channels.len()),
+                memory: if seeking {
+                    ReadMemory::exr_planes_from_file(file_len, info.pixel_count(), channels.len())
+                } else {
+                    ReadMemory::exr_planes(file_len, info.pixel_count(), channels.len())
+                },
                 source,
                 parts,
             })
@@ -234,13 +252,27 @@ pub fn read_pass_rows(
     opts: &PassReadOptions,
     rows: (i64, i64),
 ) -> Result<Pass, ComposeError> {
-    let bytes = read_file(path)?;
-    let decoded = glassdb_image::open_image(&bytes, opts.max_pixels)
-        .map_err(|source| decode_err(path, source))?;
-    match decoded {
-        ImageFile::Png(png) => Ok(pass_from_png(png, opts.transfer)),
-        ImageFile::Exr(exr) => read_exr_pass(&exr, path, opts, Some(rows)),
+    use std::io::{Read, Seek, SeekFrom};
+    let read_err = |cause| ComposeError::Read {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let io_err = |e: std::io::Error| read_err(glassdb_io::InputError::from(e));
+    let (file, _) = glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(read_err)?;
+    // The size limit was checked from the metadata as opened; the file is read by seeking.
+    let mut file = std::io::BufReader::with_capacity(1 << 16, file.into_inner());
+    let mut magic = [0u8; 4];
+    let n = file.read(&mut magic).map_err(io_err)?;
+    file.seek(SeekFrom::Start(0)).map_err(io_err)?;
+    if glassdb_image::sniff_image_kind(&magic[..n]) != Some(glassdb_image::ImageFileKind::Exr) {
+        return read_pass(path, opts);
     }
+    let headers = glassdb_image::read_exr_header_info(&mut file)
+        .map_err(|source| decode_err(path, source))?;
+    file.seek(SeekFrom::Start(0)).map_err(io_err)?;
+    read_exr_pass(&headers.parts, path, opts, |part, channels| {
+        glassdb_image::read_exr_channel_rows_from(file, part, channels, opts.max_pixels, Some(rows))
+    })
 }
 
 /// The bytes of an input image, of at most [`glassdb_io::limits::IMAGE`].
@@ -261,7 +293,9 @@ pub fn read_pass_bytes(
         .map_err(|source| decode_err(path, source))?;
     match decoded {
         ImageFile::Png(png) => Ok(pass_from_png(png, opts.transfer)),
-        ImageFile::Exr(exr) => read_exr_pass(&exr, path, opts, None),
+        ImageFile::Exr(exr) => read_exr_pass(exr.parts(), path, opts, |part, channels| {
+            exr.read_channels(part, channels)
+        }),
     }
 }
 
@@ -298,21 +332,19 @@ fn pass_from_png(png: PngPixels, transfer: InputTransfer) -> Pass {
     }
 }
 
+/// The pass in the RGB layer of an EXR with parts `parts`; `decode(part, channels)` decodes
+/// the chosen channels (all rows, or those a plane needs).
 fn read_exr_pass(
-    exr: &ExrFile<'_>,
+    parts: &[ExrPart],
     path: &Path,
     opts: &PassReadOptions,
-    rows: Option<(i64, i64)>,
+    decode: impl FnOnce(usize, &[usize]) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError>,
 ) -> Result<Pass, ComposeError> {
-    let parts = exr.parts();
     let chosen = choose_layer(parts, opts.layer.as_deref(), path)?;
     let mut channels = chosen.rgb.to_vec();
     channels.extend(chosen.alpha);
-    let (info, mut buffers) = match rows {
-        Some(rows) => exr.read_channel_rows(chosen.part, &channels, rows),
-        None => exr.read_channels(chosen.part, &channels),
-    }
-    .map_err(|source| decode_err(path, source))?;
+    let (info, mut buffers) =
+        decode(chosen.part, &channels).map_err(|source| decode_err(path, source))?;
     let channel_names = channels
         .iter()
         .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))

@@ -262,8 +262,8 @@ fn decode_inputs(
         Ok((pass, frame))
     };
     // The reflection passes a few at a time (as many as there are threads): each holds its
-    // file and compressed blocks only while it is decoded, so that many planes do not hold
-    // every file at once (`memory` counts it so). Of each, only the rows of its plane's glass
+    // compressed blocks (read from its file by seeking) only while it is decoded, so that many
+    // planes do not hold every file at once (`memory` counts it so). Of each, only the rows of its plane's glass
     // in the mask are decoded (`rows`, frame coordinates; a plane without glass decodes one
     // block).
     let read_refl = |rows: &BTreeMap<u16, (i64, i64)>| -> Result<Vec<Pass>, ComposeError> {

@@ -5,11 +5,15 @@
 //!
 //! What is counted, per frame (docs/compose.md, "Memory"):
 //! - decoding: what every input's read keeps (passes as `f32` planes, the mask as ids,
-//!   planes, cos θ and coverage), and what a read holds only while it runs (the file, read
-//!   whole; an EXR's compressed blocks copied out of it; a PNG's decoding buffer) for the
+//!   planes, cos θ and coverage), and what a read holds only while it runs for the
 //!   transmission pass, the mask and as many reflection passes as are decoded at once
-//!   ([`decoding_at_once`], the largest counted); the transmission file's other channels in
-//!   their own sample types when they are carried over;
+//!   ([`decoding_at_once`], the largest counted): the transmission pass's and the mask's file,
+//!   read whole, and an EXR's compressed blocks copied out of it, or a PNG's decoding buffer;
+//!   a reflection EXR is read by seeking, so only its compressed blocks (at most its file);
+//!   the transmission file's other channels in their own sample types when they are carried
+//!   over. A reflection pass counts the planes of its whole data window (a crop: its
+//!   rectangle), an upper bound: decoding keeps only the blocks of its plane's glass rows,
+//!   known once the mask is decoded, after the frame's memory is reserved;
 //! - compositing: the decoded inputs, and the mask placed in the frame when its data window
 //!   differs from the transmission pass's;
 //! - encoding: the composite and the carried channels, a half-float copy of one plane (half

@@ -42,7 +42,7 @@ pub(crate) fn plan_frame(
         .refl
         .iter()
         .enumerate()
-        .map(|(k, p)| io::read_pass_header(p, &settings.pass_options(settings.layers.refl.get(k))))
+        .map(|(k, p)| io::read_refl_header(p, &settings.pass_options(settings.layers.refl.get(k))))
         .collect::<Result<Vec<_>, _>>()?;
 
     let display = trans.windows.display;

@@ -3,7 +3,7 @@
 //! one task per band of rows) and written straight into the output buffers, and a panic in the
 //! decoder on a corrupt block becomes an `Internal` error. Used for masks and for passes.
 
-use std::io::Cursor;
+use std::io::{Cursor, Read, Seek, SeekFrom};
 
 use exr::block::UncompressedBlock;
 use exr::block::chunk::Chunk;
@@ -215,7 +215,7 @@ pub struct ExrHeaders {
 
 /// Reads the headers of an EXR from `reader`, which is read only as far as the headers go: no
 /// offset table or pixel data is read (a file need not be loaded to be checked).
-pub fn read_exr_header_info(reader: impl std::io::Read) -> Result<ExrHeaders, ImageError> {
+pub fn read_exr_header_info(reader: impl Read) -> Result<ExrHeaders, ImageError> {
     let meta = guarded(|| exr::meta::MetaData::read_from_buffered(reader, false))?;
     let multi_part = meta.headers.len() > 1;
     Ok(ExrHeaders {
@@ -268,15 +268,31 @@ pub fn read_exr_channel_rows(
     max_pixels: u64,
     rows: Option<(i64, i64)>,
 ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
+    read_exr_channel_rows_from(Cursor::new(bytes), part, channels, max_pixels, rows)
+}
+
+/// [`read_exr_channel_rows`] from a seekable reader (a file): only the headers, the offset
+/// tables and the compressed blocks holding the rows asked for are read, so a pass whose plane
+/// covers a third of the frame costs a third of the file's reading, and its memory.
+pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
+    mut source: R,
+    part: usize,
+    channels: &[usize],
+    max_pixels: u64,
+    rows: Option<(i64, i64)>,
+) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
     // Headers first, so that the size limit is enforced before the offset tables are read.
-    let parts = read_exr_headers(bytes)?;
+    let parts = read_exr_header_info(&mut source)?.parts;
     let mut info = parts
         .get(part)
         .cloned()
         .ok_or_else(|| unsupported(format!("part {part} (the file has {})", parts.len())))?;
     check_exr_readable(&info, channels, max_pixels)?;
+    source
+        .seek(SeekFrom::Start(0))
+        .map_err(|e| ImageError::ExrDecode(exr::error::Error::Io(e)))?;
 
-    let reader = guarded(|| exr::block::read(Cursor::new(bytes), false))?;
+    let reader = guarded(|| exr::block::read(source, false))?;
     let meta = reader.meta_data().clone();
     let header = meta
         .headers

@@ -1,10 +1,10 @@
-//! OpenEXR ZIP / ZIPS output with a chosen deflate level, compressed by zlib-rs.
+//! OpenEXR ZIP / ZIPS output with a chosen deflate level, compressed by libdeflate.
 //!
 //! ZIP output is the compositor's largest single cost (docs/performance.md). The `exr` crate
 //! compresses ZIP blocks with miniz_oxide at a fixed level 4; this module prepares each block
 //! exactly as OpenEXR does (little-endian samples line by line and channel by channel, bytes
 //! split into even and odd halves, then a byte-delta predictor, then zlib) and deflates it with
-//! zlib-rs at the level asked for (OpenEXR's default is 4). Headers, offset table and chunk
+//! libdeflate at the level asked for, as OpenEXR ≥ 3.2 does (its default level is 4). Headers, offset table and chunk
 //! layout stay `exr`'s own (`exr::block::write`), so the file is what `exr` would write with a
 //! different deflate stream; any EXR reader decodes it.
 
@@ -142,16 +142,21 @@ fn block_bytes_le(
 }
 
 /// OpenEXR's ZIP transform of one block: even bytes then odd bytes, a byte-delta predictor
-/// (`d[i] = s[i] − s[i−1] + 128`), then a zlib stream at `level`.
+/// (`d[i] = s[i] − s[i−1] + 128`), then a zlib stream at `level` (libdeflate).
 fn deflate_block(raw: &[u8], level: u32) -> exr::error::Result<Vec<u8>> {
     let half = raw.len().div_ceil(2);
     let mut split = vec![0u8; raw.len()];
     let (evens, odds) = split.split_at_mut(half);
-    for (i, pair) in raw.chunks(2).enumerate() {
-        evens[i] = pair[0];
-        if let Some(&b) = pair.get(1) {
-            odds[i] = b;
-        }
+    for ((pair, e), o) in raw
+        .chunks_exact(2)
+        .zip(evens.iter_mut())
+        .zip(odds.iter_mut())
+    {
+        *e = pair[0];
+        *o = pair[1];
+    }
+    if raw.len() % 2 == 1 {
+        evens[half - 1] = raw[raw.len() - 1];
     }
     let mut previous = split.first().copied().unwrap_or(0);
     for b in split.iter_mut().skip(1) {
@@ -159,12 +164,31 @@ fn deflate_block(raw: &[u8], level: u32) -> exr::error::Result<Vec<u8>> {
         *b = current.wrapping_sub(previous).wrapping_add(128);
         previous = current;
     }
-    let mut encoder = flate2::write::ZlibEncoder::new(
-        Vec::with_capacity(raw.len() / 2),
-        flate2::Compression::new(level),
-    );
-    encoder.write_all(&split)?;
-    Ok(encoder.finish()?)
+    COMPRESSOR.with(|cell| {
+        let mut slot = cell.borrow_mut();
+        let compressor = match slot.as_mut() {
+            Some((l, c)) if *l == level => c,
+            _ => {
+                let lvl = libdeflater::CompressionLvl::new(level as i32).map_err(|_| {
+                    exr::error::Error::NotSupported(format!("zip level {level}").into())
+                })?;
+                &mut slot.insert((level, libdeflater::Compressor::new(lvl))).1
+            }
+        };
+        let mut out = vec![0u8; compressor.zlib_compress_bound(split.len())];
+        let n = compressor
+            .zlib_compress(&split, &mut out)
+            .map_err(|e| exr::error::Error::Io(std::io::Error::other(e.to_string())))?;
+        out.truncate(n);
+        Ok(out)
+    })
+}
+
+thread_local! {
+    /// One libdeflate compressor per thread (with its level): it holds about 1 MB of tables,
+    /// too much to allocate per block.
+    static COMPRESSOR: std::cell::RefCell<Option<(u32, libdeflater::Compressor)>> =
+        const { std::cell::RefCell::new(None) };
 }
 
 #[cfg(test)]

@@ -28,6 +28,17 @@ impl ReadMemory {
         }
     }
 
+    /// Reading `channels` `f32` planes of `pixels` pixels each with
+    /// [`read_exr_channel_rows_from`](crate::read_exr_channel_rows_from) from a file of
+    /// `file_len` bytes: the file is not held, only the part's compressed blocks (at most the
+    /// file), and the planes (`pixels`: the rows decoded, at most the data window).
+    pub fn exr_planes_from_file(file_len: u64, pixels: u64, channels: usize) -> ReadMemory {
+        ReadMemory {
+            transient: file_len,
+            kept: pixels.saturating_mul(4 * channels as u64),
+        }
+    }
+
     /// Decoding a PNG of `file_len` bytes held in memory with [`decode_png`](crate::decode_png):
     /// the file and the decoder's buffers; what the caller makes of the samples is added with
     /// [`ReadMemory::keeping`].
