@@ -23,6 +23,7 @@ pub mod blender;
 pub mod compose;
 pub mod fit;
 pub mod hints;
+pub mod inputs;
 pub mod out;
 pub mod plot;
 pub mod progress;

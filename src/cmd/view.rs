@@ -5,43 +5,18 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use glassdb_compose::io::PassReadOptions;
-use glassdb_compose::pixels::InputTransfer;
 use glassdb_compose::view::CubeLut;
-use glassdb_compose::{
-    ComposeJob, ComposeSettings, InputLayers, OutsidePolicy, UnknownIds, sequence,
-};
-use glassdb_mask::{ExrMaskChannels, MaskReadOptions};
-use glassdb_spectral::RgbSpace;
+use glassdb_compose::{ComposeSettings, OutsidePolicy, UnknownIds};
 use glassdb_view::server::ViewServer;
 use glassdb_view::{Viewer, ViewerInputs};
 
-use crate::cmd::compose::{
-    default_max_memory, load_registry, parse_mask_channels, parse_size, plane_sides, split_layer,
-};
+use crate::cmd::compose::load_registry;
+use crate::cmd::inputs::{FrameInputArgs, split_layer};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Reflection pass (EXR or PNG; `FILE.exr:LAYER` picks its layer); repeat, the k-th is
-    /// plane k of the mask.
-    #[arg(long, required = true, value_name = "FILE[:LAYER]")]
-    pub refl: Vec<PathBuf>,
-    /// Transmission pass (the scene without glass).
-    #[arg(long, value_name = "FILE[:LAYER]")]
-    pub trans: PathBuf,
-    /// Glass mask: 8-bit or 16-bit RGB PNG, or an EXR with `id` and `cos_theta` channels
-    /// (docs/mask.md).
-    #[arg(long, value_name = "FILE[:LAYER]")]
-    pub mask: PathBuf,
-    /// EXR mask channel names, e.g. `id=IndexMA,cos=facing` (keys id, cos, plane, coverage).
-    #[arg(long, value_name = "KEY=NAME,...")]
-    pub mask_channels: Option<String>,
-    /// `planes.json` from `glassdb mirror`: the side of every plane (--side overrides it).
-    #[arg(long, value_name = "JSON")]
-    pub planes: Option<PathBuf>,
-    /// Plane K shows the glass's back face (`K=back`) or front face (`K=front`).
-    #[arg(long, value_name = "K=SIDE")]
-    pub side: Vec<String>,
+    #[command(flatten)]
+    pub inputs: FrameInputArgs,
     /// Registry JSON whose records are the candidate products and the glasses' first choice
     /// (default: the bundled registry, every product of data/catalog.toml).
     #[arg(long, value_name = "JSON", conflicts_with = "catalog")]
@@ -50,16 +25,6 @@ pub struct Args {
     /// bundled registry has (its spectral method in each of its spaces), instead of --registry.
     #[arg(long, value_name = "TOML")]
     pub catalog: Option<PathBuf>,
-    /// EXR layer of every pass without its own.
-    #[arg(long, value_name = "NAME")]
-    pub layer: Option<String>,
-    /// The passes' linear RGB space, over what their headers say (as compose's --input-space).
-    #[arg(long, value_name = "SPACE")]
-    pub input_space: Option<RgbSpace>,
-    /// Frames of an animation, e.g. `1-24`: `####` in --refl, --trans and --mask is replaced by
-    /// the zero-padded frame number; the page gets a frame slider.
-    #[arg(long, value_name = "LIST")]
-    pub frames: Option<String>,
     /// A `.cube` view the page offers beside `standard` (repeat for several; docs/colour.md):
     /// as compose's --view, its output is display-encoded.
     #[arg(long, value_name = "FILE.cube")]
@@ -84,15 +49,10 @@ pub struct Args {
     /// The export's first exposure, in stops.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub ev: f64,
-    /// Refuse inputs with more pixels than this (checked before decoding).
-    #[arg(long, value_name = "N", default_value_t = glassdb_mask::DEFAULT_MAX_PIXELS)]
-    pub max_pixels: u64,
-    /// Refuse a frame that would hold more memory than SIZE (as compose's --max-memory).
-    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
-    pub max_memory: Option<u64>,
 }
 
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
+    args.inputs.expand_plane_layers()?;
     let (registry, label) = match &args.catalog {
         Some(catalog) => (
             registry_from_catalog(catalog)?,
@@ -104,28 +64,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(c) => glassdb_registry::catalog_inputs(c).map_err(anyhow::Error::new)?,
         None => Vec::new(),
     };
-    let plane_sides = plane_sides(args.planes.as_deref(), &args.side, args.refl.len())?;
+    let inputs = &args.inputs;
     let settings = ComposeSettings {
-        pass: PassReadOptions {
-            layer: args.layer.clone(),
-            transfer: InputTransfer::Srgb,
-            max_pixels: args.max_pixels,
-        },
-        layers: InputLayers {
-            trans: split_layer(&args.trans).1,
-            refl: args.refl.iter().map(|r| split_layer(r).1).collect(),
-        },
-        mask: MaskReadOptions {
-            exr_channels: match &args.mask_channels {
-                Some(s) => parse_mask_channels(s)?,
-                None => ExrMaskChannels::default(),
-            },
-            max_pixels: args.max_pixels,
-            layer: split_layer(&args.mask).1,
-            ..MaskReadOptions::default()
-        },
+        pass: inputs.pass_options(),
+        layers: inputs.layers(),
+        mask: inputs.mask_options()?,
         outside: OutsidePolicy::Error,
-        plane_sides,
+        plane_sides: inputs.plane_sides()?,
         unknown: UnknownIds::Error,
         output: Default::default(),
         registry_label: label,
@@ -133,28 +78,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             protected.extend(
                 args.registry
                     .iter()
-                    .chain(&args.planes)
-                    .chain(&args.view)
-                    .cloned(),
+                    .cloned()
+                    .chain(inputs.side_inputs())
+                    .chain(args.view.iter().cloned()),
             );
             protected
         },
-        input_space: args.input_space,
-        max_memory: args.max_memory.unwrap_or_else(default_max_memory),
+        input_space: inputs.input_space,
+        max_memory: inputs.max_memory(),
     };
-    let trans = split_layer(&args.trans).0;
-    let job = ComposeJob {
-        refl: args.refl.iter().map(|r| split_layer(r).0).collect(),
-        // Never written (the viewer only decodes the inputs); the frame's memory estimate
-        // counts encoding it as the PNG the page shows.
-        output: trans.with_extension("viewer.png"),
-        trans,
-        mask: split_layer(&args.mask).0,
-    };
-    let frames = match &args.frames {
-        Some(spec) => sequence::parse_frames(spec)?,
-        None => Vec::new(),
-    };
+    let trans = split_layer(&inputs.trans).0;
+    // Never written (the viewer only decodes the inputs); the frame's memory estimate counts
+    // encoding it as the PNG the page shows.
+    let job = inputs.job(trans.with_extension("viewer.png"));
+    let frames = inputs.frame_numbers()?;
     let viewer = Viewer::open(ViewerInputs {
         job,
         frames,

@@ -411,6 +411,43 @@ fn a_second_frame_with_a_float_mask_gives_composes_pixels() {
     );
 }
 
+/// The viewer takes compose's input flags (one struct): one multi-part `--refl planes.exr`,
+/// written by OpenEXR with every plane's pass cropped to its glass, gives the page the pixels
+/// compose writes from the three separate passes.
+#[test]
+fn a_multi_part_reflection_file_gives_composes_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = |f: &str| repo_path("fixtures/atrium").join(f);
+    let parts = dir.path().join("planes.exr");
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "parts".into(),
+        "--mask".into(),
+        a("mask.png").into(),
+        "--out".into(),
+        parts.clone().into(),
+    ];
+    args.extend((0..3).map(|k| a(&format!("refl_{k}.exr")).into_os_string()));
+    let refs: Vec<&std::ffi::OsStr> = args.iter().map(|s| s.as_os_str()).collect();
+    run_oracle("plane_parts.py", &refs);
+    let want = compose_png(dir.path(), None, "separate.png");
+
+    let mut cmd = glassdb();
+    cmd.arg("view")
+        .arg("--trans")
+        .arg(a("trans.exr"))
+        .arg("--refl")
+        .arg(&parts)
+        .arg("--mask")
+        .arg(a("mask.png"))
+        .arg("--planes")
+        .arg(a("virtual/planes.json"));
+    let served = spawn_viewer(&mut cmd);
+    let (got, report) = canvas(&served.url, &[], &dir.path().join("parts.rgba"));
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    let db = psnr(&got, &want);
+    assert!(db >= 50.0, "page from planes.exr vs compose: {db:.1} dB");
+}
+
 /// A `.cube` view (a 1D shaper over 0–4, then a 3D table mixing channels), written here.
 fn write_cube(path: &Path) {
     let mut text =
