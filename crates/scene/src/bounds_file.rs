@@ -97,18 +97,9 @@ impl PlaneBoundsFile {
 
     /// Reads a bounds file, checking its format and that every rectangle lies in the frame.
     pub fn load(path: &Path) -> Result<PlaneBoundsFile, SceneError> {
-        let text =
-            glassdb_io::read_input_string(path, glassdb_io::limits::JSON).map_err(|source| {
-                SceneError::Read {
-                    path: path.to_path_buf(),
-                    source,
-                }
-            })?;
-        let file: PlaneBoundsFile =
-            serde_json::from_str(&text).map_err(|source| SceneError::BoundsJson {
-                path: path.to_path_buf(),
-                source,
-            })?;
+        let file: PlaneBoundsFile = crate::planes_file::read_json_file(path, |path, source| {
+            SceneError::BoundsJson { path, source }
+        })?;
         let bad = |message: String| SceneError::BadBounds {
             path: path.to_path_buf(),
             message,

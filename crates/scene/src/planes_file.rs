@@ -62,18 +62,8 @@ impl PlanesFile {
             path: path.to_path_buf(),
             message,
         };
-        let text =
-            glassdb_io::read_input_string(path, glassdb_io::limits::JSON).map_err(|source| {
-                SceneError::Read {
-                    path: path.to_path_buf(),
-                    source,
-                }
-            })?;
         let file: PlanesFile =
-            serde_json::from_str(&text).map_err(|source| SceneError::PlanesJson {
-                path: path.to_path_buf(),
-                source,
-            })?;
+            read_json_file(path, |path, source| SceneError::PlanesJson { path, source })?;
         if file.format != PLANES_FORMAT {
             return Err(bad(format!(
                 "format {:?} is not {PLANES_FORMAT:?}",
@@ -109,4 +99,19 @@ impl PlanesFile {
             distance: self.tolerance.distance,
         }
     }
+}
+
+/// A JSON file of at most [`glassdb_io::limits::JSON`] bytes as `T`; `json_error` makes the
+/// error of a file that is not valid JSON of that shape (each file kind has its variant).
+pub(crate) fn read_json_file<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    json_error: impl FnOnce(std::path::PathBuf, serde_json::Error) -> SceneError,
+) -> Result<T, SceneError> {
+    let text = glassdb_io::read_input_string(path, glassdb_io::limits::JSON).map_err(|source| {
+        SceneError::Read {
+            path: path.to_path_buf(),
+            source,
+        }
+    })?;
+    serde_json::from_str(&text).map_err(|source| json_error(path.to_path_buf(), source))
 }
