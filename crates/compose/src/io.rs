@@ -424,7 +424,7 @@ pub fn exr_compression_name(c: exr::compression::Compression) -> &'static str {
         .map_or("other", |(n, _)| n)
 }
 
-/// The default output compression: ZIP (16-line blocks), compressed in parallel by zlib-rs
+/// The default output compression: ZIP (16-line blocks), compressed in parallel by libdeflate
 /// (glassdb-image's `exr_zip`) and read by every EXR reader; docs/performance.md has the measured alternatives.
 pub const DEFAULT_EXR_COMPRESSION: exr::compression::Compression =
     exr::compression::Compression::ZIP16;

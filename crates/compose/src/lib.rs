@@ -263,9 +263,9 @@ fn decode_inputs(
     };
     // The reflection passes a few at a time (as many as there are threads): each holds its
     // compressed blocks (read from its file by seeking) only while it is decoded, so that many
-    // planes do not hold every file at once (`memory` counts it so). Of each, only the rows of its plane's glass
-    // in the mask are decoded (`rows`, frame coordinates; a plane without glass decodes one
-    // block).
+    // planes do not hold every file at once (`memory` counts it so). Of each, only the rows of
+    // its plane's glass in the mask are decoded (`rows`, frame coordinates; a plane without
+    // glass decodes one block).
     let read_refl = |rows: &BTreeMap<u16, (i64, i64)>| -> Result<Vec<Pass>, ComposeError> {
         let at_once = memory::decoding_at_once();
         let mut passes = Vec::with_capacity(job.refl.len());

@@ -94,7 +94,7 @@ pub struct ExrImageOut {
 pub struct ExrWriteOptions {
     pub storage: ExrStorage,
     pub compression: Compression,
-    /// zlib level (0–9) for ZIP/ZIPS, deflated in parallel by zlib-rs (`exr_zip`); `None`
+    /// zlib level (0–9) for ZIP/ZIPS, deflated in parallel by libdeflate (`exr_zip`); `None`
     /// leaves ZIP to the `exr` crate's own encoder (level 4).
     pub zip_level: Option<u32>,
 }

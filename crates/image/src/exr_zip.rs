@@ -4,9 +4,9 @@
 //! compresses ZIP blocks with miniz_oxide at a fixed level 4; this module prepares each block
 //! exactly as OpenEXR does (little-endian samples line by line and channel by channel, bytes
 //! split into even and odd halves, then a byte-delta predictor, then zlib) and deflates it with
-//! libdeflate at the level asked for, as OpenEXR ≥ 3.2 does (its default level is 4). Headers, offset table and chunk
-//! layout stay `exr`'s own (`exr::block::write`), so the file is what `exr` would write with a
-//! different deflate stream; any EXR reader decodes it.
+//! libdeflate at the level asked for, as OpenEXR ≥ 3.2 does (its default level is 4). Headers,
+//! offset table and chunk layout stay `exr`'s own (`exr::block::write`), so the file is what
+//! `exr` would write with a different deflate stream; any EXR reader decodes it.
 
 use std::io::{Seek, Write};
 

@@ -1,6 +1,6 @@
 //! Image files for passes, masks and plots: PNG and OpenEXR decoding into flat buffers (EXR:
 //! one `f32` plane per channel; PNG: interleaved 8- or 16-bit samples), the one PNG encoder
-//! and the one EXR encoder (ZIP deflated in parallel by zlib-rs), all behind one error type, [`ImageError`], whose
+//! and the one EXR encoder (ZIP deflated in parallel by libdeflate), all behind one error type, [`ImageError`], whose
 //! [`kind`](ImageError::kind) is the class a user can act on.
 //!
 //! Every call into a codec runs under a panic guard: a panic becomes
