@@ -57,6 +57,13 @@ pub enum PassSource {
     },
 }
 
+impl PassSource {
+    /// Whether the pass states its pixels' coordinates (an EXR; a PNG does not).
+    pub fn has_coordinates(&self) -> bool {
+        !matches!(self, PassSource::Png { .. })
+    }
+}
+
 /// A decoded pass: linear, premultiplied RGB(A) over its data window.
 #[derive(Debug, Clone)]
 pub struct Pass {
@@ -79,13 +86,6 @@ pub struct PassHeader {
     pub parts: Vec<ExrPart>,
     /// Reading it: the file and the decoder's buffers while reading, the linear planes after.
     pub memory: ReadMemory,
-}
-
-impl PassHeader {
-    /// Whether the pass states its pixels' coordinates (an EXR; a PNG does not).
-    pub fn has_coordinates(&self) -> bool {
-        !matches!(self.source, PassSource::Png { .. })
-    }
 }
 
 /// The plane layers of a reflection file holding several planes' passes (docs/compose.md,
@@ -175,8 +175,7 @@ fn pass_header(
         ImageHeader::Exr(headers) => {
             let parts = headers.parts;
             let chosen = choose_layer(&parts, opts.layer.as_deref(), path)?;
-            let mut channels = chosen.rgb.to_vec();
-            channels.extend(chosen.alpha);
+            let channels = layer_channels(&chosen);
             let info = parts.get(chosen.part).ok_or_else(|| {
                 decode_err(
                     path,
@@ -187,19 +186,7 @@ fn pass_header(
             })?;
             glassdb_image::check_exr_readable(info, &channels, opts.max_pixels)
                 .map_err(|source| decode_err(path, source))?;
-            let source = PassSource::Exr {
-                sample_type: info
-                    .channels
-                    .get(chosen.rgb[0])
-                    .map_or(ExrSampleType::Float, |c| c.sample_type),
-                compression: info.compression,
-                layer: chosen.name.clone(),
-                part: chosen.part,
-                channel_names: channels
-                    .iter()
-                    .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))
-                    .collect(),
-            };
+            let source = exr_source(info, chosen, &channels);
             Ok(PassHeader {
                 windows: info.windows(),
                 colour: info.colour.clone(),
@@ -252,26 +239,31 @@ pub fn read_pass_rows(
     opts: &PassReadOptions,
     rows: (i64, i64),
 ) -> Result<Pass, ComposeError> {
-    use std::io::{Read, Seek, SeekFrom};
+    use std::io::{Seek, SeekFrom};
     let read_err = |cause| ComposeError::Read {
         path: path.to_path_buf(),
         cause,
     };
-    let io_err = |e: std::io::Error| read_err(glassdb_io::InputError::from(e));
     let (file, _) = glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(read_err)?;
     // The size limit was checked from the metadata as opened; the file is read by seeking.
     let mut file = std::io::BufReader::with_capacity(1 << 16, file.into_inner());
-    let mut magic = [0u8; 4];
-    let n = file.read(&mut magic).map_err(io_err)?;
-    file.seek(SeekFrom::Start(0)).map_err(io_err)?;
-    if glassdb_image::sniff_image_kind(&magic[..n]) != Some(glassdb_image::ImageFileKind::Exr) {
-        return read_pass(path, opts);
-    }
-    let headers = glassdb_image::read_exr_header_info(&mut file)
+    let header = glassdb_image::read_image_header(&mut file, opts.max_pixels)
         .map_err(|source| decode_err(path, source))?;
-    file.seek(SeekFrom::Start(0)).map_err(io_err)?;
+    let ImageHeader::Exr(headers) = header else {
+        return read_pass(path, opts);
+    };
+    file.seek(SeekFrom::Start(0))
+        .map_err(|e| read_err(glassdb_io::InputError::from(e)))?;
     read_exr_pass(&headers.parts, path, opts, |part, channels| {
-        glassdb_image::read_exr_channel_rows_from(file, part, channels, opts.max_pixels, Some(rows))
+        let max = opts.max_pixels;
+        glassdb_image::read_exr_channel_rows_from(
+            file,
+            &headers.parts,
+            part,
+            channels,
+            max,
+            Some(rows),
+        )
     })
 }
 
@@ -341,18 +333,9 @@ fn read_exr_pass(
     decode: impl FnOnce(usize, &[usize]) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError>,
 ) -> Result<Pass, ComposeError> {
     let chosen = choose_layer(parts, opts.layer.as_deref(), path)?;
-    let mut channels = chosen.rgb.to_vec();
-    channels.extend(chosen.alpha);
+    let channels = layer_channels(&chosen);
     let (info, mut buffers) =
         decode(chosen.part, &channels).map_err(|source| decode_err(path, source))?;
-    let channel_names = channels
-        .iter()
-        .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))
-        .collect();
-    let sample_type = info
-        .channels
-        .get(chosen.rgb[0])
-        .map_or(ExrSampleType::Float, |c| c.sample_type);
     let alpha_plane = if chosen.alpha.is_some() {
         buffers.pop()
     } else {
@@ -372,14 +355,32 @@ fn read_exr_pass(
             alpha: alpha_plane,
         },
         windows: info.windows(),
-        source: PassSource::Exr {
-            sample_type,
-            compression: info.compression,
-            layer: chosen.name,
-            part: chosen.part,
-            channel_names,
-        },
+        source: exr_source(&info, chosen, &channels),
     })
+}
+
+/// The channels of `layer` a pass decodes: R, G, B, then A where the layer has one.
+fn layer_channels(layer: &glassdb_image::RgbLayer) -> Vec<usize> {
+    let mut channels = layer.rgb.to_vec();
+    channels.extend(layer.alpha);
+    channels
+}
+
+/// What an EXR pass decoded from `layer`'s `channels` of part `info` is.
+fn exr_source(info: &ExrPart, layer: glassdb_image::RgbLayer, channels: &[usize]) -> PassSource {
+    PassSource::Exr {
+        sample_type: info
+            .channels
+            .get(layer.rgb[0])
+            .map_or(ExrSampleType::Float, |c| c.sample_type),
+        compression: info.compression,
+        layer: layer.name,
+        part: layer.part,
+        channel_names: channels
+            .iter()
+            .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))
+            .collect(),
+    }
 }
 
 /// EXR sample type of the output.
@@ -555,10 +556,6 @@ impl OutputFrame {
             });
         };
         let parts = glassdb_image::read_exr_headers(bytes).map_err(|s| decode_err(path, s))?;
-        let only_the_layer = parts.len() == 1
-            && parts
-                .first()
-                .is_some_and(|p| p.channels.len() == channel_names.len());
         let exr = if carries_whole_file(&parts, channel_names, (keep_channels, beside)) {
             let file = glassdb_image::read_exr_exact(bytes, max_pixels).map_err(|source| {
                 ComposeError::KeepChannels {
@@ -577,7 +574,8 @@ impl OutputFrame {
             ExrCarried::Attributes {
                 image: Box::new(image),
                 part: Box::new(part),
-                names: (keep_channels && only_the_layer).then(|| channel_names.clone()),
+                names: (keep_channels && only_the_layer(&parts, channel_names))
+                    .then(|| channel_names.clone()),
             }
         };
         Ok(OutputFrame {
@@ -732,11 +730,15 @@ pub fn carries_whole_file(
     channel_names: &[String],
     (keep_channels, beside): (bool, bool),
 ) -> bool {
-    let only_the_layer = parts.len() == 1
+    keep_channels && (beside || !only_the_layer(parts, channel_names))
+}
+
+/// Whether the file (`parts`) holds nothing but the chosen layer's channels `channel_names`.
+fn only_the_layer(parts: &[ExrPart], channel_names: &[String]) -> bool {
+    parts.len() == 1
         && parts
             .first()
-            .is_some_and(|p| p.channels.len() == channel_names.len());
-    keep_channels && (beside || !only_the_layer)
+            .is_some_and(|p| p.channels.len() == channel_names.len())
 }
 
 /// Refuses a view transform for an EXR output (scene-linear) before any work is done.

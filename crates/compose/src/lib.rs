@@ -535,14 +535,11 @@ pub fn decode_frame<'a>(
     let mask_windows = in_frame(mask.windows, !mask.has_coordinates, &display);
     let refl_windows: Vec<ImageWindows> = refl
         .iter()
-        .map(|p| {
-            in_frame(
-                p.windows,
-                matches!(p.source, io::PassSource::Png { .. }),
-                &display,
-            )
-        })
+        .map(|p| in_frame(p.windows, !p.source.has_coordinates(), &display))
         .collect();
+    // Checked again on what was decoded: `plan_frame` checked the headers, and a file
+    // replaced between the two reads (a pass re-rendered while a farm composites) must not
+    // give a silently misplaced image.
     let mut others: Vec<(&Path, ImageWindows)> = vec![(job.mask.as_path(), mask_windows)];
     others.extend(
         job.refl
@@ -635,7 +632,7 @@ pub(crate) fn compose_frame_within(
     if job.refl.is_empty() {
         return Err(ComposeError::NoReflectionPass);
     }
-    io::output_format(&job.output)?;
+    let format = io::output_format(&job.output)?;
     io::check_view(&job.output, &settings.output)?;
     if let Some(name) = &settings.output.output_layer {
         io::check_layer_name(name)?;
@@ -649,7 +646,7 @@ pub(crate) fn compose_frame_within(
     progress.stage(decode_stage);
     let t0 = Instant::now();
     let keep = (
-        settings.output.keep_channels && io::output_format(&job.output)? == io::OutputFormat::Exr,
+        settings.output.keep_channels && format == io::OutputFormat::Exr,
         settings.output.output_layer.is_some(),
     );
     let DecodedFrame {
@@ -702,7 +699,7 @@ pub(crate) fn compose_frame_within(
     if space.source != SpaceSource::Untagged {
         frame.tag_space = Some(space.space);
     }
-    let converted_for_display = io::output_format(&job.output)? == io::OutputFormat::Png
+    let converted_for_display = format == io::OutputFormat::Png
         && matches!(
             settings.output.view,
             None | Some(view::ViewTransform::Standard)

@@ -51,7 +51,7 @@ pub(crate) fn plan_frame(
     others.extend(job.refl.iter().zip(&refl).map(|(path, p)| {
         (
             path.as_path(),
-            in_frame(p.windows, !p.has_coordinates(), &display),
+            in_frame(p.windows, !p.source.has_coordinates(), &display),
         )
     }));
     check_frames(job, &trans.windows, &others)?;

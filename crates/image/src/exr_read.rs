@@ -268,21 +268,23 @@ pub fn read_exr_channel_rows(
     max_pixels: u64,
     rows: Option<(i64, i64)>,
 ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
-    read_exr_channel_rows_from(Cursor::new(bytes), part, channels, max_pixels, rows)
+    let parts = read_exr_headers(bytes)?;
+    read_exr_channel_rows_from(Cursor::new(bytes), &parts, part, channels, max_pixels, rows)
 }
 
-/// [`read_exr_channel_rows`] from a seekable reader (a file): only the headers, the offset
-/// tables and the compressed blocks holding the rows asked for are read, so a pass whose plane
-/// covers a third of the frame costs a third of the file's reading, and its memory.
+/// [`read_exr_channel_rows`] from a seekable reader (a file) whose headers the caller has read
+/// (`parts`, from [`read_exr_header_info`] or [`read_exr_headers`]; the size limit is checked
+/// on them before the offset tables are read): only the offset tables and the compressed
+/// blocks holding the rows asked for are read, so a pass whose plane covers a third of the
+/// frame costs a third of the file's reading, and its memory.
 pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
     mut source: R,
+    parts: &[ExrPart],
     part: usize,
     channels: &[usize],
     max_pixels: u64,
     rows: Option<(i64, i64)>,
 ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
-    // Headers first, so that the size limit is enforced before the offset tables are read.
-    let parts = read_exr_header_info(&mut source)?.parts;
     let mut info = parts
         .get(part)
         .cloned()
@@ -340,8 +342,7 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
         end_band,
     };
     if (first_band, end_band) != (0, band_count) {
-        let y_start = first_band * band_height;
-        let decoded_rows = (end_band * band_height).min(info.height) - y_start;
+        let (y_start, decoded_rows) = (layout.y_start(), layout.decoded_rows());
         info.data_window.y += y_start as i32;
         info.data_window.height = decoded_rows;
         info.height = decoded_rows;
@@ -438,6 +439,20 @@ struct BandLayout {
     end_band: usize,
 }
 
+impl BandLayout {
+    /// The first row decoded, from the data window's top.
+    fn y_start(&self) -> usize {
+        self.first_band * self.band_height
+    }
+
+    /// How many rows are decoded (whole bands, the last cut at the image's bottom).
+    fn decoded_rows(&self) -> usize {
+        (self.end_band * self.band_height)
+            .min(self.height)
+            .saturating_sub(self.y_start())
+    }
+}
+
 /// Decompresses every band in parallel straight into one output buffer per selected channel,
 /// checking that each band's rows are fully covered.
 fn decode_bands(
@@ -453,10 +468,9 @@ fn decode_bands(
         height,
         band_height,
         first_band,
-        end_band,
+        ..
     } = *layout;
-    let y_start = first_band * band_height;
-    let decoded_rows = (end_band * band_height).min(height).saturating_sub(y_start);
+    let decoded_rows = layout.decoded_rows();
     // Which output buffer each channel of the part goes to.
     let mut target: Vec<Option<usize>> = vec![None; info.channels.len()];
     for (k, &c) in channels.iter().enumerate() {

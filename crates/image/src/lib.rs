@@ -136,18 +136,8 @@ impl ExrFile<'_> {
         part: usize,
         channels: &[usize],
     ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
-        read_exr_channels(self.bytes, part, channels, self.max_pixels)
-    }
-
-    /// [`Self::read_channels`] of rows `y_first..=y_last` only (absolute pixel coordinates;
-    /// see [`read_exr_channel_rows`]): the part returned has the decoded blocks' window.
-    pub fn read_channel_rows(
-        &self,
-        part: usize,
-        channels: &[usize],
-        rows: (i64, i64),
-    ) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError> {
-        read_exr_channel_rows(self.bytes, part, channels, self.max_pixels, Some(rows))
+        let bytes = std::io::Cursor::new(self.bytes);
+        read_exr_channel_rows_from(bytes, &self.parts, part, channels, self.max_pixels, None)
     }
 }
 
