@@ -26,8 +26,8 @@ pub struct InputLimit {
 pub mod limits {
     use super::InputLimit;
 
-    const MIB: u64 = 1 << 20;
-    const GIB: u64 = 1 << 30;
+    pub(super) const MIB: u64 = 1 << 20;
+    pub(super) const GIB: u64 = 1 << 30;
 
     /// A registry catalog (`catalog.toml`).
     pub const CATALOG: InputLimit = InputLimit {
@@ -97,9 +97,8 @@ pub mod limits {
 }
 
 /// `n` bytes as people write them: `16 MiB`, `2 GiB`, `1500 bytes`.
-pub fn byte_size_text(n: u64) -> String {
-    const MIB: u64 = 1 << 20;
-    const GIB: u64 = 1 << 30;
+fn byte_size_text(n: u64) -> String {
+    use limits::{GIB, MIB};
     if n >= GIB && n.is_multiple_of(GIB) {
         format!("{} GiB", n / GIB)
     } else if n >= MIB && n.is_multiple_of(MIB) {
@@ -347,5 +346,25 @@ mod tests {
         assert_eq!(byte_size_text(limits::OBJ.bytes), "2 GiB");
         assert_eq!(byte_size_text(limits::CATALOG.bytes), "16 MiB");
         assert_eq!(byte_size_text(1500), "1500 bytes");
+    }
+
+    #[test]
+    fn the_documented_table_lists_every_limit_in_order() {
+        let doc = include_str!("../../../docs/reliability.md");
+        let table = doc
+            .split("| kind | limit | read by |")
+            .nth(1)
+            .expect("docs/reliability.md has the limits table");
+        let documented: Vec<&str> = table
+            .lines()
+            .skip(2)
+            .take_while(|l| l.starts_with('|'))
+            .filter_map(|l| l.split('|').nth(2).map(str::trim))
+            .collect();
+        let limits: Vec<String> = limits::ALL
+            .iter()
+            .map(|l| byte_size_text(l.bytes))
+            .collect();
+        assert_eq!(documented, limits);
     }
 }

@@ -19,14 +19,13 @@ mod registry;
 
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
 pub use input::{
-    InputError, InputLimit, byte_size_text, limits, open_input, read_input, read_input_string,
-    read_previous_output,
+    InputError, InputLimit, limits, open_input, read_input, read_input_string, read_previous_output,
 };
 pub use kind::FileKind;
 pub use output::{
     OutputError, StagedOutput, refuse_input_as_output, write_atomic, write_bytes_atomic,
 };
-pub use registry::{TEMP_PREFIX, exit_removing_temporaries, live_temporaries, protect_inputs};
+pub use registry::{TEMP_PREFIX, exit_removing_temporaries, protect_inputs};
 pub mod progress;
 pub use progress::{NoProgress, Progress, StageLog};
 

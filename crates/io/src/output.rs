@@ -123,10 +123,7 @@ where
 {
     let target = resolve_target(path)?;
     refuse_input_as_output(path, [])?;
-    let dir = match target.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let dir = registry::parent_dir(&target).to_path_buf();
     if !dir.is_dir() {
         return Err(OutputError::MissingDirectory {
             path: path.to_path_buf(),
@@ -248,10 +245,7 @@ impl StagedOutput {
 /// A copy of the existing regular file `target` under a temporary name beside it: a hard
 /// link, or where the file system has none, a copy of its bytes.
 fn keep_aside(target: &Path) -> std::io::Result<TempPath> {
-    let dir = match target.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
+    let dir = registry::parent_dir(target);
     let builder = {
         let mut b = tempfile::Builder::new();
         b.prefix(TEMP_PREFIX);

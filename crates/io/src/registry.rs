@@ -51,11 +51,9 @@ impl FileId {
             return Some(FileId::of_meta(&meta, path));
         }
         let name = path.file_name()?;
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        Some(FileId::Path(dir.canonicalize().ok()?.join(name)))
+        Some(FileId::Path(
+            parent_dir(path).canonicalize().ok()?.join(name),
+        ))
     }
 }
 
@@ -195,7 +193,16 @@ pub fn exit_removing_temporaries(code: i32) -> ! {
     std::process::exit(code)
 }
 
+/// The folder `path` is in: its parent, or `.` for a bare file name.
+pub(crate) fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
 /// The temporary files that exist now (for tests).
-pub fn live_temporaries() -> Vec<PathBuf> {
+#[cfg(test)]
+pub(crate) fn live_temporaries() -> Vec<PathBuf> {
     state().temporaries.iter().cloned().collect()
 }

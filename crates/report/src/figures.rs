@@ -2,7 +2,7 @@
 //! `glassdb plot`), saved into the figures directory and linked from the page.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glassdb_fit::cos_deg;
 use glassdb_io::StagedOutput;
@@ -30,7 +30,6 @@ struct FigureSink<'a> {
     dir: &'a Path,
     /// How the page links the directory.
     link: &'a str,
-    written: Vec<PathBuf>,
     /// The figures, each in its temporary file until the report is written.
     staged: &'a mut StagedOutput,
 }
@@ -53,12 +52,11 @@ impl FigureSink<'_> {
             "![{caption}]({}/{file})\n\n*{caption}* ({kb} KB)\n",
             self.link
         );
-        self.written.push(path);
         Ok(())
     }
 }
 
-/// Writes the section and stages the figures for `dir` in `staged`; returns their paths.
+/// Writes the section and stages the figures for `dir` in `staged`.
 pub(crate) fn section_figures(
     md: &mut String,
     opts: &ReportOptions,
@@ -66,7 +64,7 @@ pub(crate) fn section_figures(
     refs: &[Reference],
     scene_mask: Option<&SceneMask>,
     staged: &mut StagedOutput,
-) -> Result<Vec<PathBuf>, ReportError> {
+) -> Result<(), ReportError> {
     std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateDir {
         path: dir.into(),
         source,
@@ -74,7 +72,6 @@ pub(crate) fn section_figures(
     let mut sink = FigureSink {
         dir,
         link: &opts.figures_link,
-        written: Vec::new(),
         staged,
     };
     let _ = writeln!(md, "## Figures\n");
@@ -95,7 +92,7 @@ pub(crate) fn section_figures(
         mask_figure(md, sm, &mut sink)?;
     }
     cos_storage_figure(md, refs, &mut sink)?;
-    Ok(sink.written)
+    Ok(())
 }
 
 /// One fit figure per angle table: measured points, default fit and paper basis.

@@ -141,17 +141,14 @@ pub fn generate_with_progress(
         None => None,
     };
     let mut staged = glassdb_io::StagedOutput::new();
-    let figures = match &opts.figures_dir {
-        Some(dir) => {
-            section(5);
-            figures::section_figures(&mut md, opts, dir, &refs, scene_mask.as_ref(), &mut staged)?
-        }
-        None => Vec::new(),
-    };
+    if let Some(dir) = &opts.figures_dir {
+        section(5);
+        figures::section_figures(&mut md, opts, dir, &refs, scene_mask.as_ref(), &mut staged)?;
+    }
     progress.step(total, total);
     Ok(Report {
         markdown: md,
-        figures,
+        figures: staged.paths().map(Path::to_path_buf).collect(),
         staged,
     })
 }
