@@ -47,18 +47,19 @@ pub fn init_process() {
 }
 
 /// The signals this process was started with set to be ignored (`nohup` ignores SIGHUP, a
-/// shell's background job SIGINT), from the `SigIgn` mask of `/proc/self/status`: such a
-/// signal keeps being ignored rather than handled.
+/// shell's background job SIGINT), as the `SigIgn` mask of `/proc/self/status` (bit N − 1 for
+/// signal N; 0 where it cannot be read): such a signal keeps being ignored rather than handled.
 #[cfg(unix)]
-fn ignored_at_start(signal: i32) -> bool {
-    let Ok(status) = std::fs::read_to_string("/proc/self/status") else {
-        return false;
-    };
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("SigIgn:"))
-        .and_then(|mask| u64::from_str_radix(mask.trim(), 16).ok())
-        .is_some_and(|mask| (1..=64).contains(&signal) && mask & (1 << (signal - 1)) != 0)
+fn ignored_at_start() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|status| {
+            status
+                .lines()
+                .find_map(|l| l.strip_prefix("SigIgn:"))
+                .and_then(|mask| u64::from_str_radix(mask.trim(), 16).ok())
+        })
+        .unwrap_or(0)
 }
 
 #[cfg(unix)]
@@ -70,9 +71,10 @@ fn install_signal_cleanup() {
             glassdb_io::TEMP_PREFIX
         );
     };
+    let ignored = ignored_at_start();
     let handled: Vec<i32> = [SIGINT, SIGTERM, SIGHUP]
         .into_iter()
-        .filter(|&s| !ignored_at_start(s))
+        .filter(|&s| !((1..=64).contains(&s) && ignored & (1 << (s - 1)) != 0))
         .collect();
     let mut signals = match signal_hook::iterator::Signals::new(handled) {
         Ok(s) => s,

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::util::{assert_names, compose, glassdb, ok, repo_path, write_file};
+use crate::util::{assert_names, compose, glassdb, ok, registry_build, repo_path, write_file};
 
 /// Runs `cmd` (no standard input) and returns its output, failing the test if it runs longer
 /// than `limit`: an input read without end or a FIFO opened for writing would hang it.
@@ -40,7 +40,12 @@ fn run_within(cmd: &mut Command, limit: Duration) -> (Output, String) {
 /// Runs `cmd`, which must fail within 60 s with an error (not a panic) naming every one of
 /// `parts`; returns its stderr.
 fn refused(cmd: &mut Command, parts: &[&str]) -> String {
-    let (out, stderr) = run_within(cmd, Duration::from_secs(60));
+    refused_within(cmd, Duration::from_secs(60), parts)
+}
+
+/// [`refused`] within `limit`.
+fn refused_within(cmd: &mut Command, limit: Duration, parts: &[&str]) -> String {
+    let (out, stderr) = run_within(cmd, limit);
     assert_eq!(out.status.code(), Some(1), "{cmd:?}:\n{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_names(&stderr, parts);
@@ -61,7 +66,7 @@ fn names(dir: &Path) -> Vec<String> {
 fn assert_no_temporaries(dir: &Path) {
     let left: Vec<String> = names(dir)
         .into_iter()
-        .filter(|n| n.starts_with(".glassdb-tmp-"))
+        .filter(|n| n.starts_with(glassdb_io::TEMP_PREFIX))
         .collect();
     assert!(left.is_empty(), "temporary files left: {left:?}");
 }
@@ -111,15 +116,6 @@ angles = "angles.csv"
     )
 }
 
-fn registry_build(catalog: &Path, out: &Path) -> Command {
-    let mut c = glassdb();
-    c.args(["registry", "build"])
-        .arg(catalog)
-        .arg("-o")
-        .arg(out);
-    c
-}
-
 #[test]
 fn registry_build_refuses_to_overwrite_a_file_its_catalog_names() {
     let dir = tempfile::tempdir().unwrap();
@@ -139,7 +135,7 @@ fn registry_build_refuses_to_overwrite_a_file_its_catalog_names() {
         catalog.clone(),
     ] {
         refused(
-            &mut registry_build(&catalog, &out),
+            &mut registry_build(&catalog, &out, &[]),
             &["refusing to overwrite the input file"],
         );
     }
@@ -152,7 +148,7 @@ fn registry_build_refuses_to_overwrite_a_file_its_catalog_names() {
             .is_symlink()
     );
     // The same catalog builds into a new file.
-    ok(&mut registry_build(&catalog, &d.join("registry.json")));
+    ok(&mut registry_build(&catalog, &d.join("registry.json"), &[]));
     assert_no_temporaries(d);
 }
 
@@ -262,7 +258,7 @@ fn outputs_that_are_devices_fifos_or_directories_are_refused_and_kept() {
     refused(&mut fit_to(&table, &sub), &["sub.json", "a directory"]);
     let catalog = catalog_with_files(d);
     refused(
-        &mut registry_build(&catalog, &fifo),
+        &mut registry_build(&catalog, &fifo, &[]),
         &["out.fifo", "a FIFO"],
     );
     let obj = room_in(d);
@@ -356,7 +352,8 @@ fn devices_and_fifos_named_as_inputs_are_refused_at_once() {
             name,
             format!("[[glass]]\nid = 1\nname = \"g\"\nspectral = \"{target}\"\n").as_bytes(),
         );
-        let (out, stderr) = run_within(&mut registry_build(&catalog, &d.join("r.json")), quick);
+        let (out, stderr) =
+            run_within(&mut registry_build(&catalog, &d.join("r.json"), &[]), quick);
         assert_eq!(out.status.code(), Some(1), "{stderr}");
         assert_names(&stderr, &[target, kind, "not a regular file"]);
     }
@@ -377,45 +374,44 @@ fn devices_and_fifos_named_as_inputs_are_refused_at_once() {
             .arg(&obj)
             .args(["--glass-material", "Clear*", "--out-dir"])
             .arg(d.join("v"));
-        let (out, stderr) = run_within(&mut c, quick);
-        assert_eq!(out.status.code(), Some(1), "{stderr}");
-        assert_names(&stderr, &[lib, kind]);
+        refused_within(&mut c, quick, &[lib, kind]);
     }
     // Direct inputs: an angle table, a spectral file, a registry, a camera.
-    let (out, stderr) = run_within(glassdb().arg("fit").arg("/dev/zero"), quick);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_names(&stderr, &["/dev/zero", "a character device"]);
-    let (out, stderr) = run_within(glassdb().arg("spectral").arg(&fifo), quick);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_names(&stderr, &["data.fifo", "a FIFO"]);
-    let (out, stderr) = run_within(glassdb().args(["registry", "check", "/dev/zero"]), quick);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_names(&stderr, &["/dev/zero", "a character device"]);
+    refused_within(
+        glassdb().arg("fit").arg("/dev/zero"),
+        quick,
+        &["/dev/zero", "a character device"],
+    );
+    refused_within(
+        glassdb().arg("spectral").arg(&fifo),
+        quick,
+        &["data.fifo", "a FIFO"],
+    );
+    refused_within(
+        glassdb().args(["registry", "check", "/dev/zero"]),
+        quick,
+        &["/dev/zero", "a character device"],
+    );
     let obj = room_in(d);
     let mut c = glassdb();
     c.arg("mask")
         .arg(&obj)
         .args(["--camera", "/dev/urandom", "--glass", "Clear*=1", "-o"])
         .arg(d.join("m.png"));
-    let (out, stderr) = run_within(&mut c, quick);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_names(&stderr, &["/dev/urandom", "a character device"]);
+    refused_within(&mut c, quick, &["/dev/urandom", "a character device"]);
     // Images: compose's passes and mask, a registry build's mask.
     let mut c = compose();
     c.arg("--refl")
         .arg(&fifo)
         .args(["--trans", "/dev/zero", "--mask", "/dev/zero", "-o"])
         .arg(d.join("c.exr"));
-    let (out, stderr) = run_within(&mut c, quick);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_names(&stderr, &["/dev/zero", "a character device"]);
+    refused_within(&mut c, quick, &["/dev/zero", "a character device"]);
     let catalog = catalog_with_files(d);
-    let (out, stderr) = run_within(
-        registry_build(&catalog, &d.join("r.json")).args(["--mask", "/dev/zero"]),
+    refused_within(
+        registry_build(&catalog, &d.join("r.json"), &[]).args(["--mask", "/dev/zero"]),
         quick,
+        &["/dev/zero", "a character device"],
     );
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_names(&stderr, &["/dev/zero", "a character device"]);
     assert!(is_fifo(&fifo));
 }
 
@@ -432,7 +428,7 @@ fn oversized_inputs_are_refused_from_their_size() {
     };
     let catalog = big("big.toml", 400 << 20);
     refused(
-        &mut registry_build(&catalog, &d.join("r.json")),
+        &mut registry_build(&catalog, &d.join("r.json"), &[]),
         &[
             "big.toml",
             "it has 419430400 bytes, more than the 16 MiB a catalog may have",
@@ -555,7 +551,9 @@ fn stop_while_writing(dir: &Path, out: &Path, signal: &str) -> Option<i32> {
             assert!(!stderr.contains("panicked"), "{stderr}");
             return status.code();
         }
-        let writing = names(dir).iter().any(|n| n.starts_with(".glassdb-tmp-"));
+        let writing = names(dir)
+            .iter()
+            .any(|n| n.starts_with(glassdb_io::TEMP_PREFIX));
         if writing && !sent {
             let status = Command::new("kill")
                 .arg(format!("-{signal}"))

@@ -7,7 +7,9 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, ExitStatus, Stdio};
 
-use crate::util::{assert_names, compose, fails, fails_naming, glassdb, ok, repo_path, write_file};
+use crate::util::{
+    assert_names, compose, fails, fails_naming, glassdb, ok, registry_build, repo_path, write_file,
+};
 
 /// A curve C = 1 with the given recorded tolerance.
 fn constant_curve(tolerance: f64) -> serde_json::Value {
@@ -76,14 +78,8 @@ fn a_registry_cannot_widen_its_own_validation_tolerance() {
         b"[[glass]]\nid = 1\nname = \"g\"\nr0 = [0.1, 0.1, 0.1]\nt0 = [0.8, 0.8, 0.8]\n",
     );
     let out = dir.path().join("r.json");
-    let mut build = glassdb();
-    build
-        .args(["registry", "build"])
-        .arg(&catalog)
-        .arg("-o")
-        .arg(&out);
     fails_naming(
-        build.args(["--tol", "0.5"]),
+        &mut registry_build(&catalog, &out, &["--tol", "0.5"]),
         &["fit tolerance 0.5", "--tol"],
     );
     assert!(!out.exists());
@@ -176,12 +172,7 @@ fn spectral_refuses_a_gapped_spectrum_with_the_registry_builds_message() {
         b"[[glass]]\nid = 1\nname = \"gap\"\nspectral = \"gap.csv\"\n",
     );
     let out = dir.path().join("r.json");
-    let mut build = glassdb();
-    build
-        .args(["registry", "build"])
-        .arg(&catalog)
-        .arg("-o")
-        .arg(&out);
+    let mut build = registry_build(&catalog, &out, &[]);
     let registry = fails(&mut build);
     assert!(registry.contains(message), "{message}\n{registry}");
     assert!(!out.exists());
