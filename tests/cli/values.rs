@@ -128,6 +128,17 @@ fn eval_refuses_unphysical_fit_files() {
         "1.20e-2",
     ];
     fails_naming(glassdb().arg("eval").arg(&p), &parts);
+    // A recorded data range outside 0–90° (or inverted) does not take the check away.
+    for (name, lo, hi) in [("away.json", 100, 120), ("inverted.json", 80, 10)] {
+        let range =
+            format!(r#""condition_number": 1, "angle_min_deg": {lo}, "angle_max_deg": {hi}"#);
+        let text = fit_file("0.3", 0.0).replace(r#""condition_number": 1"#, &range);
+        let p = write_file(dir.path(), name, text.as_bytes());
+        fails_naming(
+            glassdb().arg("eval").arg(&p),
+            &[name, "glass `g`", "r + t > 1"],
+        );
+    }
 }
 
 #[test]

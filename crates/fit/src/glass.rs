@@ -158,13 +158,19 @@ impl CurveFit {
     }
 
     /// The angles (degrees) the curve was fitted over, where validation holds it to the
-    /// physical range: the measured range when the file records it, else 0–90°. Beyond it the
-    /// curve is an extrapolation, which `glassdb eval` warns about.
+    /// physical range: the measured range when the file records it, else 0–90°; a recorded
+    /// range reaching outside 0–90° or inverted counts as 0–90°, so that an edited file cannot
+    /// escape validation. Beyond it the curve is an extrapolation, which `glassdb eval`
+    /// warns about.
     pub fn data_range(&self) -> (f64, f64) {
         let d = &self.diagnostics;
         let lo = d.angle_min_deg.filter(|a| a.is_finite()).unwrap_or(0.0);
         let hi = d.angle_max_deg.filter(|a| a.is_finite()).unwrap_or(90.0);
-        (lo, hi)
+        if 0.0 <= lo && lo <= hi && hi <= 90.0 {
+            (lo, hi)
+        } else {
+            (0.0, 90.0)
+        }
     }
 }
 

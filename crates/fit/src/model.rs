@@ -272,8 +272,7 @@ impl CurveFit {
     /// True when `angle_deg` lies outside the measured range by more than `margin_deg`
     /// (unknown range: false).
     pub fn is_extrapolated(&self, angle_deg: f64, margin_deg: f64) -> bool {
-        let lo = self.diagnostics.angle_min_deg.unwrap_or(0.0);
-        let hi = self.diagnostics.angle_max_deg.unwrap_or(90.0);
+        let (lo, hi) = self.data_range();
         angle_deg < lo - margin_deg || angle_deg > hi + margin_deg
     }
 }
