@@ -377,29 +377,6 @@ impl CryptomattePlan {
     }
 }
 
-/// Builds a mask from the Cryptomatte layer of an EXR render (see the module docs): per pixel
-/// the glass id with the largest coverage among the ranks whose manifest name is glass, its
-/// coverage, cos θ from the chosen source, and the plane from the plane AOV.
-pub fn mask_from_cryptomatte(
-    exr: &ExrFile<'_>,
-    path: &Path,
-    opts: &CryptomatteOptions,
-) -> Result<PlacedMask, MaskError> {
-    let text_attributes =
-        glassdb_image::read_exr_text_attributes(exr.bytes()).map_err(|source| {
-            MaskError::Decode {
-                path: path.to_path_buf(),
-                source,
-            }
-        })?;
-    let headers = ExrHeaders {
-        parts: exr.parts().to_vec(),
-        text_attributes,
-    };
-    let plan = plan_cryptomatte(&headers, path, opts, exr.max_pixels())?;
-    decode_cryptomatte(exr, path, opts, plan)
-}
-
 /// Decodes the channels `plan` chose and builds the mask.
 pub(crate) fn decode_cryptomatte(
     exr: &ExrFile<'_>,

@@ -24,7 +24,6 @@ use std::collections::BTreeMap;
 pub use cos_code::CosCode;
 pub use cryptomatte::{
     AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, PlaneSource, cryptomatte_layers,
-    mask_from_cryptomatte,
 };
 pub use error::MaskError;
 pub use glass_names::{GlassMapping, GlassNames};

@@ -24,7 +24,7 @@ pub use mask::{
     CosEncoding, GlassMapping, MaskScene, PlaneSource, build_mask_scene, to_mask_image,
 };
 pub use mirror::{MirrorStats, mirror_scene};
-pub use obj::{Mesh, Scene, load_obj, stage_obj, write_obj};
+pub use obj::{Mesh, Scene, load_obj, stage_obj};
 pub use planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_planes};
 pub use planes_file::PlanesFile;
 pub use raster::{CosMode, RasterOptions, RasterOutput, RasterScene, rasterize};

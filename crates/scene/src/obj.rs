@@ -778,22 +778,9 @@ fn mtllib_argument(name: &str) -> Cow<'_, str> {
     }
 }
 
-/// Writes meshes as an OBJ (atomically), with `mtllib` lines pointing at `mtllibs` (already
-/// expressed relative to the output's directory) and `header` as leading comment lines.
-pub fn write_obj(
-    path: &Path,
-    header: &[String],
-    mtllibs: &[String],
-    materials: &[String],
-    meshes: &[Mesh],
-) -> Result<(), SceneError> {
-    glassdb_io::write_atomic(path, |w| {
-        write_obj_text(w, header, mtllibs, materials, meshes)
-    })?;
-    Ok(())
-}
-
-/// [`write_obj`] into a set of outputs that land together.
+/// Stages meshes as an OBJ into a set of outputs that land together, with `mtllib` lines
+/// pointing at `mtllibs` (already expressed relative to the output's directory) and `header`
+/// as leading comment lines.
 pub fn stage_obj(
     staged: &mut glassdb_io::StagedOutput,
     path: &Path,
@@ -808,7 +795,7 @@ pub fn stage_obj(
     Ok(())
 }
 
-/// The text of the OBJ [`write_obj`] writes.
+/// The text of the OBJ [`stage_obj`] writes.
 fn write_obj_text<W: std::io::Write>(
     w: &mut W,
     header: &[String],
