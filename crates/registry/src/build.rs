@@ -139,6 +139,7 @@ pub fn catalog_inputs(catalog_path: &Path) -> Result<Vec<PathBuf>, RegistryError
             files.push(resolve(catalog_path, path));
         }
     }
+    files.sort();
     files.dedup();
     Ok(files)
 }

@@ -82,13 +82,7 @@ pub(super) fn nearest_labels(
             },
             None => (s.i0, s.i1),
         };
-        let [x0, x1, x2] = s.x;
-        let [y0, y1, y2] = s.y;
-        let edges = [
-            CanonicalEdge::new(x1, y1, x2, y2),
-            CanonicalEdge::new(x2, y2, x0, y0),
-            CanonicalEdge::new(x0, y0, x1, y1),
-        ];
+        let edges = s.edges();
         for j in j0..=j1 {
             let rowbase = (j - row0) as usize * w;
             for (si, off) in offsets.iter().enumerate() {
@@ -264,13 +258,7 @@ fn z_bound(s: &Setup) -> f64 {
 mod tests {
     use super::*;
 
-    /// Deterministic pseudo-random numbers in [0, 1).
-    fn lcg(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::raster::tests::lcg;
 
     /// A projected triangle as `setup` makes it (counter-clockwise, box clamped to the image).
     fn setup(mut x: [f64; 3], mut y: [f64; 3], mut w: [f64; 3], label: u32, size: u32) -> Setup {
@@ -300,13 +288,7 @@ mod tests {
         let mut depth = vec![0f64; (rows * width) as usize * ns];
         let mut winner = vec![0u32; depth.len()];
         for s in setups {
-            let [x0, x1, x2] = s.x;
-            let [y0, y1, y2] = s.y;
-            let edges = [
-                CanonicalEdge::new(x1, y1, x2, y2),
-                CanonicalEdge::new(x2, y2, x0, y0),
-                CanonicalEdge::new(x0, y0, x1, y1),
-            ];
+            let edges = s.edges();
             for j in s.j0..=s.j1.min(rows - 1) {
                 for i in s.i0..=s.i1 {
                     for (si, off) in offsets.iter().enumerate() {

@@ -58,13 +58,7 @@ impl CanonicalEdge {
 mod tests {
     use super::*;
 
-    /// Deterministic pseudo-random numbers in [0, 1).
-    fn lcg(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::raster::tests::lcg;
 
     #[test]
     fn shared_edges_get_exactly_opposite_values_and_one_owner() {

@@ -191,3 +191,14 @@ pub fn rasterize(
         triangles_drawn: setups.len(),
     })
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    /// Deterministic pseudo-random numbers in [0, 1).
+    pub(crate) fn lcg(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

@@ -4,6 +4,7 @@
 use rayon::prelude::*;
 
 use super::RasterScene;
+use super::edge::CanonicalEdge;
 use crate::camera::Camera;
 use crate::math::{self, Vec3};
 
@@ -68,6 +69,21 @@ pub(super) struct Setup {
     pub(super) i1: u32,
     pub(super) j0: u32,
     pub(super) j1: u32,
+}
+
+impl Setup {
+    /// The triangle's three edges, each opposite its corner (edge k from corner k + 1 to
+    /// k + 2), as the sample test evaluates them.
+    #[inline(always)]
+    pub(super) fn edges(&self) -> [CanonicalEdge; 3] {
+        let [x0, x1, x2] = self.x;
+        let [y0, y1, y2] = self.y;
+        [
+            CanonicalEdge::new(x1, y1, x2, y2),
+            CanonicalEdge::new(x2, y2, x0, y0),
+            CanonicalEdge::new(x0, y0, x1, y1),
+        ]
+    }
 }
 
 /// Clips a camera-space polygon against depth ≥ near (Sutherland–Hodgman).
