@@ -76,14 +76,14 @@ for size in $SIZES; do
             runs[o_crop]+="$(measure oiiotool --threads "$THREADS" "$d/mask_planes.png" "${composite[@]}" "${oiio_crop[@]}" --mul --swap --colormap "$T_KNOTS" "$d/trans.exr" --mul --add -d "$type" --compression zip -o "$d/o_crop.exr")"$'\n'
         done
         med() { printf '%s' "${runs[$1]}" | awk 'NF' | cut -d' ' -f"$2" | median; }
-        diff() {
+        max_diff() {
             oiiotool "$1" "$2" --absdiff --mulc 1e6 --printstats |
                 awk '/Stats Max/ { m = 0; for (i = 3; i <= 5; i++) if ($i > m) m = $i; printf "%.2g", m / 1e6 }'
         }
         row() { # LABEL COMPOSE_KEY OIIO_KEY COMPOSE_OUT OIIO_OUT
             local cs cr os or
             cs=$(med "$2" 1) cr=$(med "$2" 2) os=$(med "$3" 1) or=$(med "$3" 2)
-            echo "| ${w}×${h} | $type | $1 | $cs | $cr | $os | $or | $(awk -v a="$os" -v b="$cs" 'BEGIN { printf "%.2f", a / b }')× | $(diff "$4" "$5") |"
+            echo "| ${w}×${h} | $type | $1 | $cs | $cr | $os | $or | $(awk -v a="$os" -v b="$cs" 'BEGIN { printf "%.2f", a / b }')× | $(max_diff "$4" "$5") |"
         }
         row "1 plane, 1 full-frame pass (same glass)" one o_one "$d/c_one.exr" "$d/o_one.exr"
         row "$PLANES planes, full-frame passes" full o_full "$d/c_full.exr" "$d/o_full.exr"
