@@ -50,7 +50,7 @@ pub fn write_export(
         .map(|i| {
             viewer
                 .product_lut(i)
-                .map(|b| STANDARD.encode(b.as_slice()))
+                .map(|b| STANDARD.encode(b))
                 .unwrap_or_default()
         })
         .collect();
@@ -58,7 +58,7 @@ pub fn write_export(
         .map(|i| {
             viewer
                 .view_data(i)
-                .map(|b| STANDARD.encode(b))
+                .map(|b| STANDARD.encode(&b[..]))
                 .unwrap_or_default()
         })
         .collect();

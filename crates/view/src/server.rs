@@ -117,16 +117,17 @@ impl ViewServer {
                 let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
                 match parts.as_slice() {
                     ["api", "frame", n, rest @ ..] => self.frame(n, rest),
-                    ["api", "luts"] => Reply::binary(v.all_product_luts()),
+                    ["api", "luts"] => Reply::binary(v.all_product_luts().to_vec()),
                     ["api", "view", n] => match index(n, v.view_count()) {
-                        Some(i) => v
-                            .view_data(i)
-                            .map_or_else(|| Reply::error(404, "no such view"), Reply::binary),
+                        Some(i) => v.view_data(i).map_or_else(
+                            || Reply::error(404, "no such view"),
+                            |b| Reply::binary(b.to_vec()),
+                        ),
                         None => Reply::error(404, "no such view"),
                     },
                     ["api", "product", n, "lut"] => match index(n, self.viewer.products().len()) {
                         Some(i) => match v.product_lut(i) {
-                            Some(bytes) => Reply::binary(bytes.as_ref().clone()),
+                            Some(bytes) => Reply::binary(bytes.to_vec()),
                             None => Reply::error(404, "no such product"),
                         },
                         None => Reply::error(404, "no such product"),
