@@ -4,7 +4,6 @@
 
 use std::collections::HashMap;
 use std::ops::Range;
-use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use glassdb_colour::RgbSpace;
@@ -93,7 +92,6 @@ impl Viewer {
         let product_luts = product_tables(&products, &slots, first.lut);
         // Kept for the page's first request.
         let first_data = Arc::new(frame_data(&first, &first_job, &slots));
-        let first_ids = first.id_counts.clone();
         drop(first);
         let display_matrix = (space.space != RgbSpace::Srgb).then(|| {
             let m = glassdb_colour::rgb_to_rgb(space.space, RgbSpace::Srgb);
@@ -130,7 +128,6 @@ impl Viewer {
             },
             "slots": products.iter().map(|g| g.id).collect::<Vec<_>>(),
             "products": products.iter().enumerate().map(|(i, g)| product_json(i, g)).collect::<Vec<_>>(),
-            "first_frame_ids": first_ids,
             "views": inputs.views.iter().map(view_json).collect::<Vec<_>>(),
         });
         let view_tables = inputs
@@ -305,13 +302,6 @@ impl Viewer {
             .map(|c| format!("{}:{}", c.id, self.products[c.product].name))
             .collect::<Vec<_>>()
             .join(",")
-    }
-
-    /// The path of frame `index`'s transmission pass (messages).
-    pub fn frame_label(&self, index: usize) -> PathBuf {
-        job_of(&self.inputs, index)
-            .map(|j| j.trans)
-            .unwrap_or_else(|_| self.inputs.job.trans.clone())
     }
 }
 
