@@ -104,7 +104,11 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     let query = if choices.is_empty() {
         String::new()
     } else {
-        format!("?glass={}", percent_encode(&server_choices(&args)))
+        // The --glass text as given: the page resolves the names itself.
+        format!(
+            "?glass={}",
+            percent_encode(args.glass.as_deref().unwrap_or_default())
+        )
     };
     outln!("serving {}{query}", server.url());
     outln!("(Ctrl-C stops the viewer)");
@@ -123,11 +127,6 @@ fn registry_from_catalog(catalog: &std::path::Path) -> anyhow::Result<glassdb_re
     glassdb_registry::build_registry(catalog, &opts)
         .map_err(anyhow::Error::new)
         .with_context(|| format!("building the candidates from {}", catalog.display()))
-}
-
-/// The `--glass` text as given (the page resolves the names itself).
-fn server_choices(args: &Args) -> String {
-    args.glass.clone().unwrap_or_default()
 }
 
 /// Percent-encodes everything but unreserved characters, `,` and `:` (a URL's query).
