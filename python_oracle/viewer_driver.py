@@ -55,6 +55,14 @@ def wait_ready(driver, timeout):
         raise SystemExit("page errors: " + "; ".join(errors))
 
 
+def renderer(driver):
+    """The WebGL2 renderer's name (SwiftShader or the GPU), or None where the browser hides it."""
+    return driver.execute_script(
+        "const gl = document.createElement('canvas').getContext('webgl2');"
+        "const e = gl && gl.getExtension('WEBGL_debug_renderer_info');"
+        "return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : null;")
+
+
 def drawn(driver):
     return int(driver.execute_script("return window.glassdbFrameDrawn || 0"))
 
@@ -94,10 +102,7 @@ def check(args):
             "products": driver.execute_script("return window.glassdbProducts()"),
             "swap_ms": driver.execute_script("return window.glassdb.lastSwapMs()"),
             "errors": driver.execute_script("return window.glassdbErrors"),
-            "renderer": driver.execute_script(
-                "const gl = document.createElement('canvas').getContext('webgl2');"
-                "const e = gl && gl.getExtension('WEBGL_debug_renderer_info');"
-                "return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : null;"),
+            "renderer": renderer(driver),
         }
         print(json.dumps(report))
     finally:
@@ -128,10 +133,7 @@ def bench(args):
             "swap_ms_median": swaps[len(swaps) // 2],
             "swap_ms_min": swaps[0],
             "swap_ms_max": swaps[-1],
-            "renderer": driver.execute_script(
-                "const gl = document.createElement('canvas').getContext('webgl2');"
-                "const e = gl && gl.getExtension('WEBGL_debug_renderer_info');"
-                "return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : null;"),
+            "renderer": renderer(driver),
         }))
     finally:
         driver.quit()

@@ -18,7 +18,7 @@ PY=${GLASSDB_PYTHON:-.venv/bin/python}
 cargo build --release --quiet
 BIN=${CARGO_TARGET_DIR:-target}/release/glassdb
 WORK=$(mktemp -d)
-trap 'kill $SERVER 2>/dev/null || true; rm -rf "$WORK"' EXIT
+trap 'kill ${SERVER:-} 2>/dev/null || true; rm -rf "$WORK"' EXIT
 A=fixtures/atrium
 
 mkdir -p "$WORK/1080p"

@@ -17,7 +17,6 @@ use glassdb_compose::view::ViewTransform;
 use glassdb_compose::{
     ComposeSettings, FrameReport, OutsidePolicy, UnknownIds, compose_frame_with_progress,
 };
-use glassdb_mask::MaskReadOptions;
 use glassdb_registry::{ColourBasis, Registry};
 
 use crate::cmd::inputs::{FrameInputArgs, split_layer};
@@ -164,11 +163,6 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)>
     {
         bail!("--glass {id}: {label} has no glass with id {id}");
     }
-    let inputs = &args.inputs;
-    let mask = MaskReadOptions {
-        binary_glass_id: args.glass,
-        ..inputs.mask_options()?
-    };
     let output = OutputOptions {
         exr_data_type: args.data_type.map(|d| match d {
             DataTypeArg::Half => ExrDataType::Half,
@@ -204,38 +198,27 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)>
             ("glassdb/registrySha256".to_string(), registry_sha256),
         ],
     };
-    let settings = ComposeSettings {
-        pass: inputs.pass_options(),
-        layers: inputs.layers(),
-        mask,
-        outside: match args.outside_pass {
-            OutsideArg::Error => OutsidePolicy::Error,
-            OutsideArg::NoReflection => OutsidePolicy::NoReflection,
-            OutsideArg::Transmission => OutsidePolicy::Transmission,
-        },
-        plane_sides: inputs.plane_sides()?,
-        unknown: match args.unknown {
-            UnknownArg::Error => UnknownIds::Error,
-            UnknownArg::Passthrough => UnknownIds::Passthrough,
-        },
-        output,
-        registry_label: label,
-        // Every input besides the passes and the mask: no output may replace one.
-        protected: args
-            .registry
-            .iter()
-            .cloned()
-            .chain(inputs.side_inputs())
-            .chain(
-                args.view
-                    .as_deref()
-                    .filter(|v| *v != "standard")
-                    .map(PathBuf::from),
-            )
-            .collect(),
-        input_space: inputs.input_space,
-        max_memory: inputs.max_memory(),
+    let outside = match args.outside_pass {
+        OutsideArg::Error => OutsidePolicy::Error,
+        OutsideArg::NoReflection => OutsidePolicy::NoReflection,
+        OutsideArg::Transmission => OutsidePolicy::Transmission,
     };
+    let unknown = match args.unknown {
+        UnknownArg::Error => UnknownIds::Error,
+        UnknownArg::Passthrough => UnknownIds::Passthrough,
+    };
+    // Every input besides the passes and the mask: no output may replace one.
+    let protected = args.registry.iter().cloned().chain(
+        args.view
+            .as_deref()
+            .filter(|v| *v != "standard")
+            .map(PathBuf::from),
+    );
+    let mut settings = args
+        .inputs
+        .settings(outside, unknown, output, label, protected)?;
+    // A binary mask's glass (--glass).
+    settings.mask.binary_glass_id = args.glass;
     Ok((settings, luts))
 }
 

@@ -6,9 +6,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use glassdb_compose::io::PassReadOptions;
+use glassdb_compose::io::{OutputOptions, PassReadOptions};
 use glassdb_compose::pixels::InputTransfer;
-use glassdb_compose::{ComposeJob, InputLayers, sequence};
+use glassdb_compose::{
+    ComposeJob, ComposeSettings, InputLayers, OutsidePolicy, UnknownIds, sequence,
+};
 use glassdb_mask::{
     AovWeighting, CosSource, CryptomatteOptions, ExrMaskChannels, GlassMapping, GlassNames,
     MaskReadOptions, PlaneSource,
@@ -127,6 +129,32 @@ impl FrameInputArgs {
             mask: split_layer(&self.mask).0,
             output,
         }
+    }
+
+    /// The settings of a frame read from these inputs (passes, layers, mask, planes' sides,
+    /// space, memory limit), with the rest as given. No output may replace a file of
+    /// `protected` (the registry, a view, …) or of [`FrameInputArgs::side_inputs`].
+    pub fn settings(
+        &self,
+        outside: OutsidePolicy,
+        unknown: UnknownIds,
+        output: OutputOptions,
+        registry_label: String,
+        protected: impl IntoIterator<Item = PathBuf>,
+    ) -> anyhow::Result<ComposeSettings> {
+        Ok(ComposeSettings {
+            pass: self.pass_options(),
+            layers: self.layers(),
+            mask: self.mask_options()?,
+            outside,
+            plane_sides: self.plane_sides()?,
+            unknown,
+            output,
+            registry_label,
+            protected: protected.into_iter().chain(self.side_inputs()).collect(),
+            input_space: self.input_space,
+            max_memory: self.max_memory(),
+        })
     }
 
     /// How the passes are read: the default layer, PNG transfer and pixel limit.

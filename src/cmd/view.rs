@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use glassdb_compose::view::CubeLut;
-use glassdb_compose::{ComposeSettings, OutsidePolicy, UnknownIds};
+use glassdb_compose::{OutsidePolicy, UnknownIds};
 use glassdb_view::server::ViewServer;
 use glassdb_view::{Viewer, ViewerInputs};
 
@@ -60,33 +60,21 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         ),
         None => load_registry(args.registry.as_deref())?,
     };
-    let mut protected: Vec<PathBuf> = match &args.catalog {
+    let catalog_inputs = match &args.catalog {
         Some(c) => glassdb_registry::catalog_inputs(c).map_err(anyhow::Error::new)?,
         None => Vec::new(),
     };
     let inputs = &args.inputs;
-    let settings = ComposeSettings {
-        pass: inputs.pass_options(),
-        layers: inputs.layers(),
-        mask: inputs.mask_options()?,
-        outside: OutsidePolicy::Error,
-        plane_sides: inputs.plane_sides()?,
-        unknown: UnknownIds::Error,
-        output: Default::default(),
-        registry_label: label,
-        protected: {
-            protected.extend(
-                args.registry
-                    .iter()
-                    .cloned()
-                    .chain(inputs.side_inputs())
-                    .chain(args.view.iter().cloned()),
-            );
-            protected
-        },
-        input_space: inputs.input_space,
-        max_memory: inputs.max_memory(),
-    };
+    let settings = inputs.settings(
+        OutsidePolicy::Error,
+        UnknownIds::Error,
+        Default::default(),
+        label,
+        catalog_inputs
+            .into_iter()
+            .chain(args.registry.iter().cloned())
+            .chain(args.view.iter().cloned()),
+    )?;
     let trans = split_layer(&inputs.trans).0;
     // Never written (the viewer only decodes the inputs); the frame's memory estimate counts
     // encoding it as the PNG the page shows.
@@ -116,7 +104,11 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     let query = if choices.is_empty() {
         String::new()
     } else {
-        format!("?glass={}", percent_encode(&server_choices(&args)))
+        // The --glass text as given: the page resolves the names itself.
+        format!(
+            "?glass={}",
+            percent_encode(args.glass.as_deref().unwrap_or_default())
+        )
     };
     outln!("serving {}{query}", server.url());
     outln!("(Ctrl-C stops the viewer)");
@@ -135,11 +127,6 @@ fn registry_from_catalog(catalog: &std::path::Path) -> anyhow::Result<glassdb_re
     glassdb_registry::build_registry(catalog, &opts)
         .map_err(anyhow::Error::new)
         .with_context(|| format!("building the candidates from {}", catalog.display()))
-}
-
-/// The `--glass` text as given (the page resolves the names itself).
-fn server_choices(args: &Args) -> String {
-    args.glass.clone().unwrap_or_default()
 }
 
 /// Percent-encodes everything but unreserved characters, `,` and `:` (a URL's query).

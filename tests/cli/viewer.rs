@@ -110,7 +110,12 @@ fn compose_png(dir: &Path, registry: Option<&Path>, name: &str) -> Vec<[f64; 3]>
         cmd.arg("--registry").arg(r);
     }
     ok(&mut cmd);
-    let p = read_png_planes(&out);
+    png_pixels(&out)
+}
+
+/// A PNG's RGB per pixel, rows top to bottom.
+fn png_pixels(path: &Path) -> Vec<[f64; 3]> {
+    let p = read_png_planes(path);
     (0..p.width * p.height)
         .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
         .collect()
@@ -392,10 +397,7 @@ fn a_second_frame_with_a_float_mask_gives_composes_pixels() {
     cmd.arg("compose");
     files(&mut cmd, "0002");
     ok(cmd.args(["--dither", "none", "-o"]).arg(&out));
-    let p = read_png_planes(&out);
-    let want: Vec<[f64; 3]> = (0..p.width * p.height)
-        .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
-        .collect();
+    let want = png_pixels(&out);
 
     let mut cmd = glassdb();
     cmd.arg("view");
@@ -482,10 +484,7 @@ fn a_cube_view_on_the_page_gives_composes_pixels_through_it() {
         .arg("-o")
         .arg(&out);
     ok(&mut cmd);
-    let p = read_png_planes(&out);
-    let want: Vec<[f64; 3]> = (0..p.width * p.height)
-        .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
-        .collect();
+    let want = png_pixels(&out);
     let standard = compose_png(dir.path(), None, "standard.png");
     assert!(
         psnr(&want, &standard) < 40.0,

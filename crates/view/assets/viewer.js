@@ -416,7 +416,8 @@ void main() {
 
     const params = new URLSearchParams(location.search);
     const state = {
-      sets: { A: slots.map((id) => products.findIndex((p) => p.id === id)), B: null },
+      // Slot i is product i's id (scene.slots): each glass starts with its own product.
+      sets: { A: slots.map((_, i) => i), B: null },
       ev: Number(params.get('ev') ?? scene.initial_ev ?? 0),
       ab: params.get('ab') || 'A',
       split: Number(params.get('split') ?? 0.5),
@@ -454,11 +455,15 @@ void main() {
       gl.uniform1f(u('uSplitX'), state.split * W);
       gl.viewport(0, 0, W, H);
       gl.drawArrays(gl.TRIANGLES, 0, 3);
-      // Wait for the frame: reading a pixel back finishes the drawing.
-      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
       state.drawn += 1;
       canvas.dataset.drawn = String(state.drawn);
       window.glassdbFrameDrawn = state.drawn;
+    }
+
+    // Waits for the frame drawn (reading a pixel back finishes the drawing): only where a time
+    // is taken, so that the exposure slider and the split drag do not stall on the GPU.
+    function finish() {
+      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
     }
 
     async function loadFrame(i) {
@@ -475,6 +480,7 @@ void main() {
       state.data = data;
       renderGlasses();
       draw();
+      finish();
       state.lastFrameLoadMs = performance.now() - t0;
     }
 
@@ -487,6 +493,7 @@ void main() {
       state.sets[set][slot] = p;
       uploadSlot(set, slot);
       draw();
+      finish();
       state.lastSwapMs = performance.now() - t0;
       renderGlasses();
       renderProducts();

@@ -28,6 +28,8 @@ pub const LUT_ROWS_PER_SLOT: usize = 4 * LUT_ROWS_PER_CURVE;
 pub const LUT_FINE_OFFSET: usize = 256;
 /// Offset of the normal-incidence entry in a curve.
 pub const LUT_NORMAL_OFFSET: usize = 256 + FINE_STEPS + 1;
+/// Bytes of one product's table ([`lut_bytes`]): its rows of `f32` RGBA texels.
+pub const LUT_BYTES: usize = LUT_ROWS_PER_SLOT * LUT_WIDTH * 4 * 4;
 
 /// How the mask's third channel holds cos θ, which the shader follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -60,8 +62,9 @@ impl MaskMode {
     }
 }
 
-/// A product's table for one glass: both sides, r and t, in the texture layout.
-pub fn lut_bytes(sides: &[GlassSideLut; 2]) -> Vec<u8> {
+/// A product's table for one glass: both sides (front, back), r and t, in the texture layout
+/// ([`LUT_BYTES`] bytes).
+pub fn lut_bytes(sides: [&GlassSideLut; 2]) -> Vec<u8> {
     let curve_len = LUT_ROWS_PER_CURVE * LUT_WIDTH * 4;
     let mut texels = vec![0f32; 4 * curve_len];
     let picks: [fn(&RtTriple) -> [f32; 3]; 2] = [|e| e.r, |e| e.t];
@@ -166,10 +169,10 @@ mod tests {
         let g = &reg.default_table().glasses[3];
         let lut = GlassLut::from_records(&[(1, g)]);
         let sides = [
-            lut.side(1, glassdb_registry::Side::Front).unwrap().clone(),
-            lut.side(1, glassdb_registry::Side::Back).unwrap().clone(),
+            lut.side(1, glassdb_registry::Side::Front).unwrap(),
+            lut.side(1, glassdb_registry::Side::Back).unwrap(),
         ];
-        let bytes = lut_bytes(&sides);
+        let bytes = lut_bytes(sides);
         let texel = |curve: usize, e: usize, c: usize| {
             let at = ((curve * LUT_ROWS_PER_CURVE * LUT_WIDTH) + e) * 4 + c;
             f32::from_le_bytes(bytes[at * 4..at * 4 + 4].try_into().unwrap())
@@ -182,5 +185,6 @@ mod tests {
         );
         assert_eq!(texel(2, LUT_NORMAL_OFFSET, 0), g.r0_back[0] as f32);
         assert_eq!(bytes.len(), 4 * LUT_ROWS_PER_CURVE * LUT_WIDTH * 16);
+        assert_eq!(bytes.len(), LUT_BYTES);
     }
 }

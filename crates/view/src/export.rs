@@ -5,9 +5,10 @@
 //! passes and mask in base64), beside `index.html`, `viewer.js` and `viewer.css`. Every file
 //! lands together or not at all (`glassdb_io::StagedOutput`).
 
+use std::io::Write;
 use std::path::Path;
 
-use base64::Engine;
+use base64::display::Base64Display;
 use base64::engine::general_purpose::STANDARD;
 use glassdb_io::StagedOutput;
 use serde_json::json;
@@ -46,38 +47,45 @@ pub fn write_export(
     scene["initial_glass"] = json!(viewer.choices_param(choices));
     scene["initial_ev"] = json!(ev);
     scene["export_available"] = json!(false);
-    let luts: Vec<String> = (0..viewer.products().len())
-        .map(|i| {
-            viewer
-                .product_lut(i)
-                .map(|b| STANDARD.encode(b.as_slice()))
-                .unwrap_or_default()
-        })
-        .collect();
-    let views: Vec<String> = (0..viewer.view_count())
-        .map(|i| {
-            viewer
-                .view_data(i)
-                .map(|b| STANDARD.encode(b))
-                .unwrap_or_default()
-        })
-        .collect();
-    let data = format!(
-        "window.GLASSDB_EXPORT = {{\"scene\": {scene}, \"luts\": {}, \"views\": {}, \"frames\": {{}}}};\n",
-        json!(luts),
-        json!(views)
-    );
-    staged.write_bytes(&dir.join("data.js"), data.as_bytes())?;
+    staged.write(&dir.join("data.js"), |w| {
+        write!(
+            w,
+            "window.GLASSDB_EXPORT = {{\"scene\": {scene}, \"luts\": "
+        )?;
+        let luts = (0..viewer.products().len()).filter_map(|i| viewer.product_lut(i));
+        write_base64_array(w, luts)?;
+        w.write_all(b", \"views\": ")?;
+        let views = (0..viewer.view_count()).filter_map(|i| viewer.view_data(i));
+        write_base64_array(w, views.map(|v| &v[..]))?;
+        w.write_all(b", \"frames\": {}};\n")
+    })?;
     for i in 0..frames {
         let frame = viewer.frame(i)?;
-        let script = format!(
-            "window.GLASSDB_EXPORT.frames[{i}] = {{\"info\": {}, \"passes\": \"{}\", \"mask\": \"{}\"}};\n",
-            frame.info,
-            STANDARD.encode(&frame.passes),
-            STANDARD.encode(&frame.mask)
-        );
-        staged.write_bytes(&dir.join(frame_file(i)), script.as_bytes())?;
+        staged.write(&dir.join(frame_file(i)), |w| {
+            writeln!(
+                w,
+                "window.GLASSDB_EXPORT.frames[{i}] = {{\"info\": {}, \"passes\": \"{}\", \"mask\": \"{}\"}};",
+                frame.info,
+                Base64Display::new(&frame.passes, &STANDARD),
+                Base64Display::new(&frame.mask, &STANDARD)
+            )
+        })?;
     }
     staged.commit()?;
     Ok(())
+}
+
+/// A JSON array of base64 strings, one per item, as `serde_json` writes it.
+fn write_base64_array<'a>(
+    w: &mut impl Write,
+    items: impl Iterator<Item = &'a [u8]>,
+) -> std::io::Result<()> {
+    w.write_all(b"[")?;
+    for (k, bytes) in items.enumerate() {
+        if k > 0 {
+            w.write_all(b",")?;
+        }
+        write!(w, "\"{}\"", Base64Display::new(bytes, &STANDARD))?;
+    }
+    w.write_all(b"]")
 }

@@ -10,7 +10,8 @@
 //!
 //! - [`scene`]: the frames, the candidate products and their tables, the binary data the page
 //!   uploads ([`data`] says how it is laid out).
-//! - [`server`]: the small HTTP server (tiny_http, one thread, 127.0.0.1 by default).
+//! - [`server`]: the small HTTP server (tiny_http, [`server::WORKERS`] threads, 127.0.0.1 by
+//!   default).
 //! - [`export`]: the self-contained folder that works from `file://`.
 
 pub mod data;

@@ -2,8 +2,9 @@
 //! products (every record of the registry's table in the passes' space) and their lookup
 //! tables, and the choice of a product per glass id.
 
-use std::path::PathBuf;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::collections::HashMap;
+use std::ops::Range;
+use std::sync::{Arc, Mutex};
 
 use glassdb_colour::RgbSpace;
 use glassdb_compose::colour::RegistryLuts;
@@ -54,8 +55,13 @@ pub struct Viewer {
     budget: MemoryBudget,
     /// The candidate products: the records of the table the frames composite with.
     products: Vec<GlassRecord>,
-    /// Each product's table in the page's layout, built when first asked for.
-    product_luts: Vec<OnceLock<Arc<Vec<u8>>>>,
+    /// The glass slot of each product id: its first product's index.
+    slots: HashMap<u16, usize>,
+    /// Every product's table in the page's layout, one after the other, [`data::LUT_BYTES`]
+    /// each ([`product_tables`]).
+    product_luts: Arc<[u8]>,
+    /// Each `.cube` view's tables as the page uploads them ([`data::view_bytes`]).
+    view_tables: Vec<Arc<[u8]>>,
     scene: Value,
     mask_mode: MaskMode,
     /// The last frame decoded.
@@ -82,9 +88,10 @@ impl Viewer {
             .table(table.basis)
             .map(|t| t.glasses.clone())
             .unwrap_or_default();
+        let slots = slot_map(&products);
+        let product_luts = product_tables(&products, &slots, first.lut);
         // Kept for the page's first request.
-        let first_data = Arc::new(frame_data(&first, &first_job, &products));
-        let first_ids = first.id_counts.clone();
+        let first_data = Arc::new(frame_data(&first, &first_job, &slots));
         drop(first);
         let display_matrix = (space.space != RgbSpace::Srgb).then(|| {
             let m = glassdb_colour::rgb_to_rgb(space.space, RgbSpace::Srgb);
@@ -121,16 +128,21 @@ impl Viewer {
             },
             "slots": products.iter().map(|g| g.id).collect::<Vec<_>>(),
             "products": products.iter().enumerate().map(|(i, g)| product_json(i, g)).collect::<Vec<_>>(),
-            "first_frame_ids": first_ids,
             "views": inputs.views.iter().map(view_json).collect::<Vec<_>>(),
         });
-        let product_luts = products.iter().map(|_| OnceLock::new()).collect();
+        let view_tables = inputs
+            .views
+            .iter()
+            .map(|v| data::view_bytes(v).into())
+            .collect();
         Ok(Viewer {
             inputs,
             luts,
             budget,
             products,
+            slots,
             product_luts,
+            view_tables,
             scene,
             mask_mode,
             cache: Mutex::new(Some((0, first_data))),
@@ -152,42 +164,33 @@ impl Viewer {
         self.inputs.frames.len().max(1)
     }
 
-    /// Product `index`'s lookup table in the page's layout ([`data::lut_bytes`]): the table
-    /// the compositor builds for a mask id whose record is this product's.
-    pub fn product_lut(&self, index: usize) -> Option<Arc<Vec<u8>>> {
-        let record = self.products.get(index)?;
-        let cell = self.product_luts.get(index)?;
-        if let Some(bytes) = cell.get() {
-            return Some(bytes.clone());
-        }
-        let lut = GlassLut::from_records(&[(record.id, record)]);
-        let sides = [
-            lut.side(record.id, Side::Front)?.clone(),
-            lut.side(record.id, Side::Back)?.clone(),
-        ];
-        Some(
-            cell.get_or_init(|| Arc::new(data::lut_bytes(&sides)))
-                .clone(),
-        )
+    /// Where product `index`'s lookup table lies in [`Viewer::all_product_luts`]: the table
+    /// the compositor builds for a mask id whose record is this product's, in the page's
+    /// layout ([`data::lut_bytes`]).
+    pub fn product_lut_range(&self, index: usize) -> Option<Range<usize>> {
+        (index < self.products.len())
+            .then(|| index * data::LUT_BYTES..(index + 1) * data::LUT_BYTES)
     }
 
-    /// View `index`'s tables as the page uploads them ([`data::view_bytes`]).
-    pub fn view_data(&self, index: usize) -> Option<Vec<u8>> {
-        self.inputs.views.get(index).map(data::view_bytes)
-    }
-
-    /// How many `.cube` views there are.
-    pub fn view_count(&self) -> usize {
-        self.inputs.views.len()
+    /// Product `index`'s lookup table (see [`Viewer::product_lut_range`]).
+    pub fn product_lut(&self, index: usize) -> Option<&[u8]> {
+        self.product_luts.get(self.product_lut_range(index)?)
     }
 
     /// Every product's table, one after the other (the page loads them in one request, so a
     /// later swap needs none).
-    pub fn all_product_luts(&self) -> Vec<u8> {
-        (0..self.products.len())
-            .filter_map(|i| self.product_lut(i))
-            .flat_map(|b| b.as_ref().clone())
-            .collect()
+    pub fn all_product_luts(&self) -> &Arc<[u8]> {
+        &self.product_luts
+    }
+
+    /// View `index`'s tables as the page uploads them ([`data::view_bytes`]).
+    pub fn view_data(&self, index: usize) -> Option<&Arc<[u8]>> {
+        self.view_tables.get(index)
+    }
+
+    /// How many `.cube` views there are.
+    pub fn view_count(&self) -> usize {
+        self.view_tables.len()
     }
 
     /// Frame `index` (0-based), decoded and checked as `compose` does; the last one is kept.
@@ -217,7 +220,7 @@ impl Viewer {
                 first: self.mask_mode.name(),
             });
         }
-        let data = Arc::new(frame_data(&frame, &job, &self.products));
+        let data = Arc::new(frame_data(&frame, &job, &self.slots));
         drop(frame);
         *cache = Some((index, data.clone()));
         Ok(data)
@@ -300,23 +303,57 @@ impl Viewer {
             .collect::<Vec<_>>()
             .join(",")
     }
-
-    /// The path of frame `index`'s transmission pass (messages).
-    pub fn frame_label(&self, index: usize) -> PathBuf {
-        job_of(&self.inputs, index)
-            .map(|j| j.trans)
-            .unwrap_or_else(|_| self.inputs.job.trans.clone())
-    }
 }
 
-/// A decoded frame as the page uploads it; `products` give the glass slots.
-fn frame_data(frame: &DecodedFrame<'_>, job: &ComposeJob, products: &[GlassRecord]) -> FrameData {
-    let slot_of = |id: u16| products.iter().position(|g| g.id == id);
+/// A decoded frame as the page uploads it; `slots` gives each mask id's glass slot.
+fn frame_data(
+    frame: &DecodedFrame<'_>,
+    job: &ComposeJob,
+    slots: &HashMap<u16, usize>,
+) -> FrameData {
     FrameData {
         info: json!({ "ids": frame.id_counts, "trans": job.trans.display().to_string() }),
         passes: data::pass_bytes(frame),
-        mask: data::mask_bytes(frame, slot_of),
+        mask: data::mask_bytes(frame, |id| slots.get(&id).copied()),
     }
+}
+
+/// The glass slot of each product id: the index of the first product with that id (a
+/// validated registry has one product per id).
+fn slot_map(products: &[GlassRecord]) -> HashMap<u16, usize> {
+    let mut slots = HashMap::with_capacity(products.len());
+    for (i, g) in products.iter().enumerate() {
+        slots.entry(g.id).or_insert(i);
+    }
+    slots
+}
+
+/// Every product's table in the page's layout ([`data::lut_bytes`]), one after the other:
+/// each product's entries in `lut`, the table the frames composite with, built from these
+/// very records under their own ids. A product whose id does not stand for it there (id 0, or
+/// an id an earlier product has: a registry that was not validated) gets a table of its own,
+/// as [`GlassLut::from_records`] builds it for any id.
+fn product_tables(
+    products: &[GlassRecord],
+    slots: &HashMap<u16, usize>,
+    lut: &GlassLut,
+) -> Arc<[u8]> {
+    let table_of = |lut: &GlassLut, id: u16| {
+        Some(data::lut_bytes([
+            lut.side(id, Side::Front)?,
+            lut.side(id, Side::Back)?,
+        ]))
+    };
+    let mut bytes = Vec::with_capacity(products.len() * data::LUT_BYTES);
+    for (i, g) in products.iter().enumerate() {
+        let table = (slots.get(&g.id) == Some(&i))
+            .then(|| table_of(lut, g.id))
+            .flatten()
+            .or_else(|| table_of(&GlassLut::from_records(&[(1, g)]), 1))
+            .unwrap_or_else(|| vec![0; data::LUT_BYTES]);
+        bytes.extend_from_slice(&table);
+    }
+    bytes.into()
 }
 
 /// `a:b,c:d` split at the commas that an `ID:` follows.
@@ -396,7 +433,45 @@ fn job_of(inputs: &ViewerInputs, index: usize) -> Result<ComposeJob, ViewError> 
 
 #[cfg(test)]
 mod tests {
-    use super::split_choices;
+    use super::*;
+
+    /// A product's table, built on its own as the viewer built them before it took them
+    /// from the compositor's table.
+    fn own_table(g: &GlassRecord) -> Vec<u8> {
+        let lut = GlassLut::from_records(&[(g.id, g)]);
+        data::lut_bytes([
+            lut.side(g.id, Side::Front).unwrap(),
+            lut.side(g.id, Side::Back).unwrap(),
+        ])
+    }
+
+    #[test]
+    fn product_tables_are_each_products_own_table() {
+        let reg = glassdb_registry::default_registry().unwrap();
+        for table in reg.tables() {
+            let products = &table.glasses;
+            let slots = slot_map(products);
+            let bytes = product_tables(products, &slots, &GlassLut::from_table(table));
+            assert_eq!(bytes.len(), products.len() * data::LUT_BYTES);
+            for (g, got) in products.iter().zip(bytes.chunks_exact(data::LUT_BYTES)) {
+                assert!(got == own_table(g), "{} ({})", g.name, table.basis());
+            }
+        }
+        // An id given twice, and id 0 (a registry not validated): each product still gets
+        // its own record's table.
+        let mut products = reg.default_table().glasses[..3].to_vec();
+        products[1].id = products[0].id;
+        products[2].id = 0;
+        let slots = slot_map(&products);
+        let lut = GlassLut::from_records(&[(products[0].id, &products[0])]);
+        let bytes = product_tables(&products, &slots, &lut);
+        for (g, got) in products.iter().zip(bytes.chunks_exact(data::LUT_BYTES)) {
+            let mut own = g.clone();
+            own.id = 1;
+            assert!(got == own_table(&own), "{}", g.name);
+        }
+        assert_eq!(slots[&products[0].id], 0);
+    }
 
     #[test]
     fn choices_split_only_where_an_id_follows_the_comma() {

@@ -1,6 +1,8 @@
-//! The viewer's HTTP server: tiny_http on one thread, a fixed table of routes (no file is
-//! served by its path, so no request reaches outside what the viewer holds), GET for the page
-//! and its data, POST for an export, 4xx for anything else, request bodies and URLs bounded.
+//! The viewer's HTTP server: tiny_http on [`WORKERS`] threads, a fixed table of routes (no file
+//! is served by its path, so no request reaches outside what the viewer holds), GET for the
+//! page and its data, POST for an export, 4xx for anything else, request bodies and URLs
+//! bounded. The data the viewer holds (tables, the last frame) is shared with the replies,
+//! never copied for one.
 //!
 //! | route | answer |
 //! |---|---|
@@ -13,13 +15,16 @@
 //! | `GET /api/luts` | every product's table, one after the other (the page's one request) |
 //! | `POST /api/export` | `{"glass": "1:NAME,…", "ev": 0}`: writes the export folder given at start |
 
-use std::io::Read;
+use std::io::{Cursor, Read};
+use std::ops::Range;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use glassdb_io::ErrorChain;
 use serde_json::{Value, json};
-use tiny_http::{Header, Method, Request, Response, Server};
+use tiny_http::{Header, Method, Request, Response, Server, StatusCode};
 
+use crate::scene::FrameData;
 use crate::{ViewError, Viewer, assets, export};
 
 /// Longest request URL accepted (path and query).
@@ -32,7 +37,7 @@ pub const MAX_BODY_BYTES: usize = 64 * 1024;
 /// A listening viewer.
 pub struct ViewServer {
     server: Server,
-    viewer: Arc<Viewer>,
+    viewer: Viewer,
     export_dir: Option<PathBuf>,
 }
 
@@ -50,7 +55,7 @@ impl ViewServer {
             Server::http(&address).map_err(|source| ViewError::Bind { address, source })?;
         Ok(ViewServer {
             server,
-            viewer: Arc::new(viewer),
+            viewer,
             export_dir,
         })
     }
@@ -117,20 +122,24 @@ impl ViewServer {
                 let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
                 match parts.as_slice() {
                     ["api", "frame", n, rest @ ..] => self.frame(n, rest),
-                    ["api", "luts"] => Reply::binary(v.all_product_luts()),
-                    ["api", "view", n] => match index(n, v.view_count()) {
-                        Some(i) => v
-                            .view_data(i)
-                            .map_or_else(|| Reply::error(404, "no such view"), Reply::binary),
+                    ["api", "luts"] => {
+                        let all = v.all_product_luts();
+                        Reply::binary(Body::Shared(all.clone(), 0..all.len()))
+                    }
+                    ["api", "view", n] => match index(n, v.view_count())
+                        .and_then(|i| v.view_data(i))
+                    {
+                        Some(bytes) => Reply::binary(Body::Shared(bytes.clone(), 0..bytes.len())),
                         None => Reply::error(404, "no such view"),
                     },
-                    ["api", "product", n, "lut"] => match index(n, self.viewer.products().len()) {
-                        Some(i) => match v.product_lut(i) {
-                            Some(bytes) => Reply::binary(bytes.as_ref().clone()),
+                    ["api", "product", n, "lut"] => {
+                        match index(n, v.products().len()).and_then(|i| v.product_lut_range(i)) {
+                            Some(range) => {
+                                Reply::binary(Body::Shared(v.all_product_luts().clone(), range))
+                            }
                             None => Reply::error(404, "no such product"),
-                        },
-                        None => Reply::error(404, "no such product"),
-                    },
+                        }
+                    }
                     _ => Reply::error(404, "no such resource"),
                 }
             }
@@ -143,12 +152,12 @@ impl ViewServer {
         };
         let data = match self.viewer.frame(i) {
             Ok(d) => d,
-            Err(e) => return Reply::error(500, &error_chain(&e)),
+            Err(e) => return Reply::error(500, &ErrorChain(&e).to_string()),
         };
         match rest {
             [] => Reply::json(&data.info),
-            ["passes"] => Reply::binary(data.passes.clone()),
-            ["mask"] => Reply::binary(data.mask.clone()),
+            ["passes"] => Reply::binary(Body::Frame(data, FramePart::Passes)),
+            ["mask"] => Reply::binary(Body::Frame(data, FramePart::Mask)),
             _ => Reply::error(404, "no such resource"),
         }
     }
@@ -170,11 +179,11 @@ impl ViewServer {
         }
         let choices = match self.viewer.parse_choices(glass) {
             Ok(c) => c,
-            Err(e) => return Reply::error(400, &error_chain(&e)),
+            Err(e) => return Reply::error(400, &ErrorChain(&e).to_string()),
         };
         match export::write_export(&self.viewer, dir, &choices, ev) {
             Ok(()) => Reply::json(&json!({ "path": dir.display().to_string() })),
-            Err(e) => Reply::error(500, &error_chain(&e)),
+            Err(e) => Reply::error(500, &ErrorChain(&e).to_string()),
         }
     }
 }
@@ -212,31 +221,48 @@ fn read_body(request: &mut Request) -> Result<Vec<u8>, Reply> {
 /// How much of a refused body is read and dropped.
 const DRAIN_BYTES: u64 = 16 * 1024 * 1024;
 
-/// An error with its causes, for a reply.
-fn error_chain(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut source = e.source();
-    while let Some(s) = source {
-        text.push_str(": ");
-        text.push_str(&s.to_string());
-        source = s.source();
+/// A reply's body: the bytes the viewer holds are shared with the reply, not copied.
+enum Body {
+    Static(&'static [u8]),
+    Owned(Vec<u8>),
+    /// A range of bytes held once (the products' tables, a view's tables).
+    Shared(Arc<[u8]>, Range<usize>),
+    /// A part of a decoded frame.
+    Frame(Arc<FrameData>, FramePart),
+}
+
+#[derive(Clone, Copy)]
+enum FramePart {
+    Passes,
+    Mask,
+}
+
+impl AsRef<[u8]> for Body {
+    fn as_ref(&self) -> &[u8] {
+        match self {
+            Body::Static(bytes) => bytes,
+            Body::Owned(bytes) => bytes,
+            // The ranges are made in bounds (`Viewer::product_lut_range`, a whole slice).
+            Body::Shared(bytes, range) => bytes.get(range.clone()).unwrap_or_default(),
+            Body::Frame(data, FramePart::Passes) => &data.passes,
+            Body::Frame(data, FramePart::Mask) => &data.mask,
+        }
     }
-    text
 }
 
 /// A reply before it becomes a tiny_http response.
 struct Reply {
     status: u16,
     content_type: &'static str,
-    body: Vec<u8>,
+    body: Body,
 }
 
 impl Reply {
-    fn text(body: &str, content_type: &'static str) -> Reply {
+    fn text(body: &'static str, content_type: &'static str) -> Reply {
         Reply {
             status: 200,
             content_type,
-            body: body.as_bytes().to_vec(),
+            body: Body::Static(body.as_bytes()),
         }
     }
 
@@ -244,11 +270,11 @@ impl Reply {
         Reply {
             status: 200,
             content_type: "application/json",
-            body: value.to_string().into_bytes(),
+            body: Body::Owned(value.to_string().into_bytes()),
         }
     }
 
-    fn binary(body: Vec<u8>) -> Reply {
+    fn binary(body: Body) -> Reply {
         Reply {
             status: 200,
             content_type: "application/octet-stream",
@@ -260,22 +286,27 @@ impl Reply {
         Reply {
             status,
             content_type: "application/json",
-            body: json!({ "error": message }).to_string().into_bytes(),
+            body: Body::Owned(json!({ "error": message }).to_string().into_bytes()),
         }
     }
 
-    fn into_response(self) -> Response<std::io::Cursor<Vec<u8>>> {
-        let mut response = Response::from_data(self.body).with_status_code(self.status);
-        for (name, value) in [
+    fn into_response(self) -> Response<Cursor<Body>> {
+        let headers = [
             ("Content-Type", self.content_type),
             ("Cache-Control", "no-store"),
             ("X-Content-Type-Options", "nosniff"),
-        ] {
-            if let Ok(h) = Header::from_bytes(name.as_bytes(), value.as_bytes()) {
-                response.add_header(h);
-            }
-        }
-        response
+        ]
+        .into_iter()
+        .filter_map(|(name, value)| Header::from_bytes(name.as_bytes(), value.as_bytes()).ok())
+        .collect();
+        let len = self.body.as_ref().len();
+        Response::new(
+            StatusCode(self.status),
+            headers,
+            Cursor::new(self.body),
+            Some(len),
+            None,
+        )
     }
 }
 
