@@ -187,7 +187,13 @@ pub fn render(
     let t = Instant::now();
     let scene = load_obj(&dir.join("scene.obj"))?;
     let cameras = CameraSource::open(&dir.join("camera.json"))?;
-    let first = cameras.camera(Some(info.frames[0]))?;
+    let Some(&first_frame) = info.frames.first() else {
+        return Err(BlenderError::BadRender {
+            path: dir.join("export.json"),
+            message: "no frames to render (the scene's frame range or --frames is empty)".into(),
+        });
+    };
+    let first = cameras.camera(Some(first_frame))?;
     let report = write_virtual_scenes(&MirrorRequest {
         scene: &scene,
         glass_patterns: mappings.iter().map(|m| m.pattern.clone()).collect(),
@@ -227,14 +233,25 @@ pub fn render(
 
     let mut frames = Vec::new();
     let mut script_frames = Vec::new();
-    let (mut width, mut height) = (0, 0);
+    // The first frame's size, which every frame must have.
+    let mut size = None;
     for &frame in &info.frames {
         let camera = cameras.camera(Some(frame))?;
         let mask = to_mask_image(
             rasterize(&labelled.raster, &camera, &options)?,
             CosEncoding::Float,
         );
-        (width, height) = (mask.width, mask.height);
+        let (width, height) = *size.get_or_insert((mask.width, mask.height));
+        if (mask.width, mask.height) != (width, height) {
+            return Err(BlenderError::BadRender {
+                path: dir.join("camera.json"),
+                message: format!(
+                    "frame {frame} is {}x{}, but frame {first_frame} is {width}x{height}; \
+                     every frame of a run must have one size",
+                    mask.width, mask.height
+                ),
+            });
+        }
         let bounds = plane_bounds(&mask, planes.len());
         let mask_name = frame_name("mask", frame);
         glassdb_mask::write_mask(&dir.join(&mask_name), &mask, MaskFormat::Exr)?;
@@ -271,6 +288,7 @@ pub fn render(
             composite: frame_name("composite", frame),
         });
     }
+    let (width, height) = size.unwrap_or_default();
     let mask_s = t.elapsed().as_secs_f64();
 
     // 3. Blender renders the transmission and reflection passes.
