@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use crate::util::{Planes, fails_naming, glassdb, ok, read_exr_planes, repo_path, write_file};
+use crate::util::{
+    Planes, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path, write_file,
+};
 
 /// The tiny scene, its facts, Cycles' index renders and two glassdb runs (seeds 0 and 1).
 struct Rendered {
@@ -348,11 +350,11 @@ fn compose_dir_recomposites_with_another_registry() {
     assert_eq!(first.channels, again.channels);
     // Other glasses with the same ids: glass pixels change, the rest stays the transmission.
     let registry = r.root.join("atrium.json");
-    ok(glassdb()
-        .args(["registry", "build"])
-        .arg(repo_path("fixtures/atrium/catalog.toml"))
-        .arg("-o")
-        .arg(&registry));
+    ok(&mut registry_build(
+        &repo_path("fixtures/atrium/catalog.toml"),
+        &registry,
+        &[],
+    ));
     let out = ok(glassdb()
         .args(["blender", "compose"])
         .arg(&dir)
@@ -414,9 +416,7 @@ fn render_with(blender: &Path, blend: &Path, out: &Path, extra: &[&str]) -> Comm
 
 /// A file that starts like a .blend (the stand-ins never read it).
 fn blend_stub(dir: &Path) -> PathBuf {
-    let p = dir.join("scene.blend");
-    std::fs::write(&p, b"BLENDER-v304RENDH").unwrap();
-    p
+    write_file(dir, "scene.blend", b"BLENDER-v304RENDH")
 }
 
 #[test]
