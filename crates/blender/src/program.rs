@@ -398,13 +398,23 @@ mod tests {
         assert!(after > before, "{before} -> {after}");
     }
 
-    /// A stand-in program in a fresh directory, running `body` (sh).
+    /// A stand-in program in a fresh directory, running `body` (sh). Written by a child
+    /// process: a file this process had open for writing can be inherited by a child another
+    /// test thread forks at that moment, and running it then fails (ETXTBSY).
     fn script(body: &str) -> (tempfile::TempDir, PathBuf) {
-        use std::os::unix::fs::PermissionsExt;
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("blender");
-        std::fs::write(&path, format!("#!/bin/sh\n{body}\n")).unwrap();
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let status = Command::new("sh")
+            .args([
+                "-c",
+                "printf '#!/bin/sh\\n%s\\n' \"$2\" > \"$1\" && chmod 755 \"$1\"",
+            ])
+            .arg("sh")
+            .arg(&path)
+            .arg(body)
+            .status()
+            .unwrap();
+        assert!(status.success());
         (dir, path)
     }
 
