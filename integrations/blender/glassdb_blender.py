@@ -275,10 +275,9 @@ def make_thin_pane(mat, glass, camera_sees_through):
     enable_trans = nt.nodes.new("ShaderNodeMath")
     enable_trans.operation = "MULTIPLY"
     nt.links.new(first.outputs[0], enable_trans.inputs[0])
-    pos = nt.nodes.new("ShaderNodeNewGeometry")
     dot_p = nt.nodes.new("ShaderNodeVectorMath")
     dot_p.operation = "DOT_PRODUCT"
-    nt.links.new(pos.outputs["Position"], dot_p.inputs[0])
+    nt.links.new(geo.outputs["Position"], dot_p.inputs[0])
     add_p = nt.nodes.new("ShaderNodeMath")
     add_p.operation = "ADD"
     nt.links.new(dot_p.outputs["Value"], add_p.inputs[0])
@@ -297,7 +296,7 @@ def make_thin_pane(mat, glass, camera_sees_through):
     camera.operation = "MULTIPLY"
     nt.links.new(lp.outputs["Is Camera Ray"], camera.inputs[0])
     nt.links.new(either.outputs[0], camera.inputs[1])
-    for k, node in enumerate((first, enable_trans, pos, dot_p, add_p, behind, enable_refl, either,
+    for k, node in enumerate((first, enable_trans, dot_p, add_p, behind, enable_refl, either,
                               camera)):
         node.location = (-900 + 150 * k, 700)
     clear = nt.nodes.new("ShaderNodeBsdfTransparent")

@@ -8,7 +8,6 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::{Args as ClapArgs, Subcommand};
 use glassdb_blender::{ComposeReport, RegistryChoice, RenderRequest};
-use glassdb_registry::Registry;
 
 use crate::cmd::progress::Spinner;
 
@@ -86,17 +85,10 @@ pub struct ComposeArgs {
     pub registry: Option<PathBuf>,
 }
 
+/// `--registry`, or the bundled catalog, as `glassdb compose` loads and names it.
 fn registry_choice(path: &Option<PathBuf>) -> anyhow::Result<RegistryChoice> {
-    Ok(match path {
-        Some(p) => RegistryChoice {
-            registry: Registry::from_json_file(p).map_err(anyhow::Error::new)?,
-            label: p.display().to_string(),
-        },
-        None => RegistryChoice {
-            registry: glassdb_registry::default_registry()?,
-            label: "the bundled catalog".into(),
-        },
-    })
+    let (registry, label) = crate::cmd::compose::load_registry(path.as_deref())?;
+    Ok(RegistryChoice { registry, label })
 }
 
 fn parse_resolution(text: &str) -> anyhow::Result<(u32, u32)> {

@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use crate::util::{Planes, fails_naming, glassdb, ok, read_exr_planes, repo_path};
+use crate::util::{
+    Planes, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path, write_file,
+};
 
 /// The tiny scene, its facts, Cycles' index renders and two glassdb runs (seeds 0 and 1).
 struct Rendered {
@@ -348,11 +350,11 @@ fn compose_dir_recomposites_with_another_registry() {
     assert_eq!(first.channels, again.channels);
     // Other glasses with the same ids: glass pixels change, the rest stays the transmission.
     let registry = r.root.join("atrium.json");
-    ok(glassdb()
-        .args(["registry", "build"])
-        .arg(repo_path("fixtures/atrium/catalog.toml"))
-        .arg("-o")
-        .arg(&registry));
+    ok(&mut registry_build(
+        &repo_path("fixtures/atrium/catalog.toml"),
+        &registry,
+        &[],
+    ));
     let out = ok(glassdb()
         .args(["blender", "compose"])
         .arg(&dir)
@@ -414,9 +416,7 @@ fn render_with(blender: &Path, blend: &Path, out: &Path, extra: &[&str]) -> Comm
 
 /// A file that starts like a .blend (the stand-ins never read it).
 fn blend_stub(dir: &Path) -> PathBuf {
-    let p = dir.join("scene.blend");
-    std::fs::write(&p, b"BLENDER-v304RENDH").unwrap();
-    p
+    write_file(dir, "scene.blend", b"BLENDER-v304RENDH")
 }
 
 #[test]
@@ -516,6 +516,83 @@ fn bad_scene_files_and_output_dirs_are_refused() {
     fails_naming(
         &mut render_with(&fake, &blend, &file.join("out"), &[]),
         &["cannot create the output directory", "a-file"],
+    );
+}
+
+/// A stand-in `blender` in `dir` whose export writes the room of fixtures/scene with `camera`
+/// as camera.json and `frames` in export.json; its render does nothing.
+fn exporting_blender(dir: &Path, camera: &serde_json::Value, frames: &[u32]) -> PathBuf {
+    let files = dir.join("export");
+    std::fs::create_dir_all(&files).unwrap();
+    let obj = std::fs::read_to_string(repo_path("fixtures/scene/room.obj")).unwrap();
+    write_file(
+        &files,
+        "scene.obj",
+        obj.replace("mtllib room.mtl", "mtllib scene.mtl")
+            .as_bytes(),
+    );
+    std::fs::copy(
+        repo_path("fixtures/scene/room.mtl"),
+        files.join("scene.mtl"),
+    )
+    .unwrap();
+    write_file(&files, "camera.json", camera.to_string().as_bytes());
+    let export = serde_json::json!({
+        "blender": "3.4.1",
+        "frames": frames,
+        "materials": ["Clear_6mm", "Tinted_Grey", "Concrete", "Wood"],
+    });
+    write_file(&files, "export.json", export.to_string().as_bytes());
+    fake_blender(
+        dir,
+        "3.4.1",
+        &format!(
+            "out=; prev=\nfor a in \"$@\"; do [ \"$prev\" = --out ] && out=$a; prev=$a; done\n\
+             if [ -n \"$out\" ]; then mkdir -p \"$out\" && cp '{}'/* \"$out\"/; fi",
+            files.display()
+        ),
+    )
+}
+
+#[test]
+fn exports_without_frames_or_with_frames_of_two_sizes_are_refused() {
+    let t = tempfile::tempdir().unwrap();
+    let blend = blend_stub(t.path());
+    let cam = json(&repo_path("fixtures/scene/camera.json"));
+    let mut small = cam.clone();
+    (small["width"], small["height"]) = (80.into(), 60.into());
+    let camera = serde_json::json!({ "frames": { "1": cam, "2": small } });
+    let render = |blender: &Path, out: &str| {
+        let mut cmd = glassdb();
+        cmd.args(["blender", "render"])
+            .arg(&blend)
+            .args(["--glass", "Clear*=1", "--out-dir"])
+            .arg(t.path().join(out))
+            .arg("--blender")
+            .arg(blender);
+        cmd
+    };
+    let dir = t.path().join("none");
+    std::fs::create_dir(&dir).unwrap();
+    let none = exporting_blender(&dir, &camera, &[]);
+    fails_naming(
+        &mut render(&none, "out-none"),
+        &["export.json", "no frames"],
+    );
+    let dir = t.path().join("two");
+    std::fs::create_dir(&dir).unwrap();
+    let two = exporting_blender(&dir, &camera, &[1, 2]);
+    fails_naming(
+        &mut render(&two, "out-two"),
+        &["camera.json", "frame 2 is 80x60, but frame 1 is 160x120"],
+    );
+    // The first frame alone is fine up to the passes, which the stand-in does not render.
+    let dir = t.path().join("one");
+    std::fs::create_dir(&dir).unwrap();
+    let one = exporting_blender(&dir, &camera, &[1]);
+    fails_naming(
+        &mut render(&one, "out-one"),
+        &["trans.0001.exr", "Blender did not write this pass"],
     );
 }
 

@@ -592,7 +592,11 @@ fn bounds_rectangles(path: &Path, frame: Option<u32>) -> Vec<(u16, [i64; 4], u64
     let b = json(path);
     assert_eq!(b["format"], "glassdb-plane-bounds/1");
     assert_eq!(b["frame"], serde_json::json!(frame));
-    let (w, h) = (b["width"].as_f64().unwrap(), b["height"].as_f64().unwrap());
+    let (w, h) = (b["width"].as_i64().unwrap(), b["height"].as_i64().unwrap());
+    // Blender's edge rule: `int(fraction · size)`, the fraction stored and multiplied in float32.
+    let blender_edge = |fraction: &serde_json::Value, size: i64| -> i64 {
+        ((fraction.as_f64().unwrap() as f32) * size as f32) as i64
+    };
     b["planes"]
         .as_array()
         .unwrap()
@@ -605,12 +609,13 @@ fn bounds_rectangles(path: &Path, frame: Option<u32>) -> Vec<(u16, [i64; 4], u64
                 .map(|v| v.as_i64().unwrap())
                 .collect();
             let border = &p["blender_border"];
-            // Blender's border is y-up, in fractions of the frame, on the rectangle's edges.
+            // Blender's border is y-up, in fractions of the frame; truncated as Blender does,
+            // it gives exactly the rectangle.
             let edges = [
-                (border["min_x"].as_f64().unwrap() * w).round() as i64,
-                (h - border["max_y"].as_f64().unwrap() * h).round() as i64,
-                (border["max_x"].as_f64().unwrap() * w).round() as i64 - 1,
-                (h - border["min_y"].as_f64().unwrap() * h).round() as i64 - 1,
+                blender_edge(&border["min_x"], w),
+                h - blender_edge(&border["max_y"], h),
+                blender_edge(&border["max_x"], w) - 1,
+                h - blender_edge(&border["min_y"], h) - 1,
             ];
             assert_eq!(edges.to_vec(), r, "{}", path.display());
             (

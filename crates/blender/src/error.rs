@@ -1,6 +1,6 @@
 //! The errors of `glassdb blender`: one variant per failure a user can act on.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Why a Blender run or its composite failed.
 #[derive(Debug, thiserror::Error)]
@@ -17,6 +17,9 @@ pub enum BlenderError {
     /// `blender --version` did not say which Blender it is.
     #[error("{path} did not print a Blender version when asked for it (it printed {printed:?})")]
     VersionUnreadable { path: PathBuf, printed: String },
+    /// `blender --version` (or the `bpy` probe) did not finish in time and was stopped.
+    #[error("{path} did not answer within {seconds} s when asked for its Blender version")]
+    VersionTimedOut { path: PathBuf, seconds: u64 },
     /// A Blender older than the oldest one supported.
     #[error(
         "{path} is Blender {found}; glassdb blender needs Blender {}.{} or newer",
@@ -95,4 +98,16 @@ pub enum BlenderError {
     Input(#[from] glassdb_io::InputError),
     #[error(transparent)]
     Registry(#[from] glassdb_registry::RegistryError),
+}
+
+impl BlenderError {
+    /// [`BlenderError::Io`] for `action` on `path`, as a `map_err` argument.
+    pub(crate) fn io(action: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> Self {
+        let path = path.to_path_buf();
+        move |source| BlenderError::Io {
+            action,
+            path,
+            source,
+        }
+    }
 }

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use glassdb_image::PixelWindow;
 use glassdb_registry::Side;
 use serde::{Deserialize, Serialize};
 
@@ -49,15 +50,16 @@ pub struct ScriptPlane {
     /// Distance within which glass counts as on the plane (planes.json's tolerance).
     pub tolerance: f64,
     /// Blender's render border `[min_x, max_x, min_y, max_y]`, fractions of the frame with y
-    /// up, chosen so that Blender's truncation gives exactly the plane's pixel rectangle.
+    /// up, chosen so that Blender's truncation gives exactly the plane's pixel rectangle
+    /// (`glassdb_mask::PlaneBounds::blender_border`).
     pub border: [f64; 4],
     pub output: PathBuf,
 }
 
-/// What the script's `export` mode says besides the scene and cameras (`export.json`).
+/// What the script's `export` mode says besides the scene and cameras (`export.json`; its
+/// other fields, such as the Blender version, are not read).
 #[derive(Debug, Clone, Deserialize)]
 pub struct ExportInfo {
-    pub blender: String,
     pub frames: Vec<u32>,
     pub materials: Vec<String>,
 }
@@ -71,21 +73,15 @@ pub struct PixelBounds {
     pub height: u32,
 }
 
-impl PixelBounds {
-    /// Blender's render border for these pixels of a `width × height` frame. Blender takes
-    /// `int(fraction · size)` for each edge (render_init_from_main), so each edge is given
-    /// half a pixel inside, which truncates to the pixel edge whatever the float rounding.
-    pub fn blender_border(&self, width: u32, height: u32) -> [f64; 4] {
-        let (w, h) = (f64::from(width), f64::from(height));
-        let frac = |edge: u32, size: f64| ((f64::from(edge) + 0.5) / size).min(1.0);
-        let y_min = height - (self.y + self.height);
-        let y_max = height - self.y;
-        [
-            frac(self.x, w),
-            frac(self.x + self.width, w),
-            frac(y_min, h),
-            frac(y_max, h),
-        ]
+impl From<PixelWindow> for PixelBounds {
+    /// A window inside a frame (coordinates not negative, as a mask's plane rectangles are).
+    fn from(w: PixelWindow) -> PixelBounds {
+        PixelBounds {
+            x: w.x.max(0) as u32,
+            y: w.y.max(0) as u32,
+            width: w.width as u32,
+            height: w.height as u32,
+        }
     }
 }
 
@@ -164,28 +160,34 @@ fn is_plain_name(name: &str) -> bool {
 mod tests {
     use super::*;
 
-    /// Blender's own edge rule (`int(fraction · size)`, in float32 as it stores the border)
-    /// gives back the bounds.
     #[test]
-    fn borders_truncate_to_the_bounds() {
-        for (w, h) in [(64u32, 48u32), (320, 240), (1920, 1080), (7, 5)] {
-            for (x, y, bw, bh) in [
-                (0, 0, w, h),
-                (1, 2, 3, 1),
-                (w - 1, h - 1, 1, 1),
-                (0, h / 2, w / 2, h / 2),
-            ] {
-                let b = PixelBounds {
-                    x,
-                    y,
-                    width: bw,
-                    height: bh,
-                };
-                let [x0, x1, y0, y1] = b.blender_border(w, h);
-                let px = |f: f64, size: u32| ((f as f32) * size as f32) as u32;
-                assert_eq!((px(x0, w), px(x1, w)), (x, x + bw));
-                assert_eq!((px(y0, h), px(y1, h)), (h - y - bh, h - y));
+    fn export_info_reads_the_scripts_fields_and_ignores_the_others() {
+        let info: ExportInfo = serde_json::from_str(
+            r#"{"blender": "3.4.1", "frames": [1, 2], "materials": ["Glass"], "new": 1}"#,
+        )
+        .unwrap();
+        assert_eq!(
+            (info.frames, info.materials),
+            (vec![1, 2], vec!["Glass".into()])
+        );
+    }
+
+    #[test]
+    fn pixel_bounds_of_a_window() {
+        let w = PixelWindow {
+            x: 3,
+            y: 4,
+            width: 5,
+            height: 6,
+        };
+        assert_eq!(
+            PixelBounds::from(w),
+            PixelBounds {
+                x: 3,
+                y: 4,
+                width: 5,
+                height: 6
             }
-        }
+        );
     }
 }

@@ -12,7 +12,7 @@ use glassdb_image::{
     ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, PixelWindow, PlaneSamples,
 };
 use glassdb_io::Progress;
-use glassdb_mask::{GlassMapping, MaskFormat};
+use glassdb_mask::{GlassMapping, MaskFormat, PlaneBounds};
 use glassdb_registry::{ColourBasis, Registry, Side};
 use glassdb_scene::{
     CameraSource, CosEncoding, CosMode, MirrorRequest, PlaneSource, PlaneTolerance, RasterOptions,
@@ -96,15 +96,6 @@ pub struct ComposeReport {
     pub seconds: f64,
 }
 
-fn io_error(action: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> BlenderError {
-    let path = path.to_path_buf();
-    move |source| BlenderError::Io {
-        action,
-        path,
-        source,
-    }
-}
-
 /// Pattern names of the frame's files.
 fn frame_name(stem: &str, frame: u32) -> String {
     format!("{stem}.{frame:04}.exr")
@@ -137,13 +128,13 @@ pub fn render(
         None => Blender::find(request.blender.as_deref())?,
     };
     let dir = &request.out_dir;
-    std::fs::create_dir_all(dir).map_err(io_error("create the output directory", dir))?;
+    std::fs::create_dir_all(dir).map_err(BlenderError::io("create the output directory", dir))?;
     let log = dir.join(LOG_NAME);
-    std::fs::write(&log, "").map_err(io_error("write", &log))?;
+    std::fs::write(&log, "").map_err(BlenderError::io("write", &log))?;
     let staging = dir.join(STAGING);
-    std::fs::create_dir_all(&staging).map_err(io_error("create", &staging))?;
+    std::fs::create_dir_all(&staging).map_err(BlenderError::io("create", &staging))?;
     let script = staging.join("glassdb_blender.py");
-    std::fs::write(&script, SCRIPT).map_err(io_error("write", &script))?;
+    std::fs::write(&script, SCRIPT).map_err(BlenderError::io("write", &script))?;
     let run = |step: &'static str, args: Vec<String>| {
         blender.run(&BlenderRun {
             step,
@@ -170,7 +161,7 @@ pub fn render(
     run("export", args)?;
     for name in ["scene.obj", "scene.mtl", "camera.json", "export.json"] {
         let from = export_dir.join(name);
-        std::fs::rename(&from, dir.join(name)).map_err(io_error("move", &from))?;
+        std::fs::rename(&from, dir.join(name)).map_err(BlenderError::io("move", &from))?;
     }
     let info: ExportInfo = {
         let path = dir.join("export.json");
@@ -187,7 +178,13 @@ pub fn render(
     let t = Instant::now();
     let scene = load_obj(&dir.join("scene.obj"))?;
     let cameras = CameraSource::open(&dir.join("camera.json"))?;
-    let first = cameras.camera(Some(info.frames[0]))?;
+    let Some(&first_frame) = info.frames.first() else {
+        return Err(BlenderError::BadRender {
+            path: dir.join("export.json"),
+            message: "no frames to render (the scene's frame range or --frames is empty)".into(),
+        });
+    };
+    let first = cameras.camera(Some(first_frame))?;
     let report = write_virtual_scenes(&MirrorRequest {
         scene: &scene,
         glass_patterns: mappings.iter().map(|m| m.pattern.clone()).collect(),
@@ -227,30 +224,46 @@ pub fn render(
 
     let mut frames = Vec::new();
     let mut script_frames = Vec::new();
-    let (mut width, mut height) = (0, 0);
+    // Each frame's plane rectangles, where its crops go.
+    let mut crops = Vec::new();
+    // The first frame's size, which every frame must have.
+    let mut size = None;
     for &frame in &info.frames {
         let camera = cameras.camera(Some(frame))?;
         let mask = to_mask_image(
             rasterize(&labelled.raster, &camera, &options)?,
             CosEncoding::Float,
         );
-        (width, height) = (mask.width, mask.height);
-        let bounds = plane_bounds(&mask, planes.len());
+        let (width, height) = *size.get_or_insert((mask.width, mask.height));
+        if (mask.width, mask.height) != (width, height) {
+            return Err(BlenderError::BadRender {
+                path: dir.join("camera.json"),
+                message: format!(
+                    "frame {frame} is {}x{}, but frame {first_frame} is {width}x{height}; \
+                     every frame of a run must have one size",
+                    mask.width, mask.height
+                ),
+            });
+        }
+        let rectangles = plane_rectangles(&mask, planes.len());
         let mask_name = frame_name("mask", frame);
         glassdb_mask::write_mask(&dir.join(&mask_name), &mask, MaskFormat::Exr)?;
+        let refl: Vec<String> = (0..planes.len())
+            .map(|k| frame_name(&format!("refl_{k}"), frame))
+            .collect();
         let mut sides = Vec::new();
         let mut script_planes = Vec::new();
         for (k, plane) in planes.iter().enumerate() {
             let front = plane.signed_distance(camera.origin) >= 0.0;
             sides.push(if front { Side::Front } else { Side::Back });
             let facing = if front { *plane } else { plane.flipped() };
-            if let Some(b) = bounds[k] {
+            if let Some(r) = rectangles[k] {
                 script_planes.push(ScriptPlane {
                     index: k,
                     equation: facing.equation(),
                     tolerance: report.planes.tolerance.distance,
-                    border: b.blender_border(width, height),
-                    output: staging.join(frame_name(&format!("refl_{k}"), frame)),
+                    border: r.blender_border(width, height),
+                    output: staging.join(&refl[k]),
                 });
             }
         }
@@ -259,18 +272,20 @@ pub fn render(
             trans: staging.join(frame_name("trans", frame)),
             planes: script_planes,
         });
+        let windows: Vec<Option<PixelWindow>> =
+            rectangles.iter().map(|r| r.map(|r| r.window())).collect();
         frames.push(FrameRecord {
             frame,
             trans: frame_name("trans", frame),
             mask: mask_name,
-            refl: (0..planes.len())
-                .map(|k| frame_name(&format!("refl_{k}"), frame))
-                .collect(),
+            refl,
             sides,
-            bounds,
+            bounds: windows.iter().map(|w| w.map(PixelBounds::from)).collect(),
             composite: frame_name("composite", frame),
         });
+        crops.push(windows);
     }
+    let (width, height) = size.unwrap_or_default();
     let mask_s = t.elapsed().as_secs_f64();
 
     // 3. Blender renders the transmission and reflection passes.
@@ -287,15 +302,12 @@ pub fn render(
         frames: script_frames,
     };
     run_job(&run, &staging.join("job.json"), "render", &job)?;
-    for (f, script) in frames.iter().zip(&job.frames) {
+    for ((f, script), windows) in frames.iter().zip(&job.frames).zip(&crops) {
         rename(&script.trans, &dir.join(&f.trans))?;
-        for (k, bounds) in f.bounds.iter().enumerate() {
-            let target = dir.join(&f.refl[k]);
-            match bounds {
-                Some(b) => {
-                    let from = staging.join(&f.refl[k]);
-                    place_crop(&from, &target, *b, width, height)?;
-                }
+        for (refl, window) in f.refl.iter().zip(windows) {
+            let target = dir.join(refl);
+            match window {
+                Some(w) => place_crop(&staging.join(refl), &target, *w, width, height)?,
                 None => write_unused_pass(&target, width, height)?,
             }
         }
@@ -350,7 +362,7 @@ pub fn render(
     // 4. The composites.
     progress.stage("composite");
     let compose = compose_record(dir, &record, registry)?;
-    std::fs::remove_dir_all(&staging).map_err(io_error("remove", &staging))?;
+    std::fs::remove_dir_all(&staging).map_err(BlenderError::io("remove", &staging))?;
     Ok(RenderReport {
         blender,
         record,
@@ -382,18 +394,25 @@ fn run_job(
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    std::fs::write(path, text).map_err(io_error("write", path))?;
+    std::fs::write(path, text).map_err(BlenderError::io("write", path))?;
     run(step, vec!["render".into(), "--job".into(), path_arg(path)])
 }
 
-fn rename(from: &Path, to: &Path) -> Result<(), BlenderError> {
-    if !from.is_file() {
-        return Err(BlenderError::BadRender {
-            path: from.to_path_buf(),
+/// Refuses a pass that Blender did not write.
+fn check_written(pass: &Path) -> Result<(), BlenderError> {
+    if pass.is_file() {
+        Ok(())
+    } else {
+        Err(BlenderError::BadRender {
+            path: pass.to_path_buf(),
             message: "Blender did not write this pass".into(),
-        });
+        })
     }
-    std::fs::rename(from, to).map_err(io_error("move", from))
+}
+
+fn rename(from: &Path, to: &Path) -> Result<(), BlenderError> {
+    check_written(from)?;
+    std::fs::rename(from, to).map_err(BlenderError::io("move", from))
 }
 
 fn path_arg(p: &Path) -> String {
@@ -423,35 +442,26 @@ fn glass_of_materials(
 
 /// Each plane's glass rectangle from the mask (glassdb-mask's `plane_bounds`), `None` where a
 /// plane has no glass in the frame.
-fn plane_bounds(mask: &glassdb_mask::MaskImage, planes: usize) -> Vec<Option<PixelBounds>> {
+fn plane_rectangles(mask: &glassdb_mask::MaskImage, planes: usize) -> Vec<Option<PlaneBounds>> {
     let found = mask.plane_bounds();
     (0..planes)
-        .map(|k| {
-            let b = u16::try_from(k).ok().and_then(|k| found.get(&k))?;
-            Some(PixelBounds {
-                x: b.x_min as u32,
-                y: b.y_min as u32,
-                width: (b.x_max - b.x_min + 1) as u32,
-                height: (b.y_max - b.y_min + 1) as u32,
-            })
-        })
+        .map(|k| u16::try_from(k).ok().and_then(|k| found.get(&k)).copied())
         .collect()
 }
 
-fn exr_options() -> Result<ExrWriteOptions, BlenderError> {
-    Ok(ExrWriteOptions {
-        storage: ExrStorage::Half,
-        compression: glassdb_compose::io::parse_exr_compression("zip")?,
-        zip_level: None,
-    })
-}
+/// The passes are written as compose writes by default: half float, ZIP.
+const EXR_OPTIONS: ExrWriteOptions = ExrWriteOptions {
+    storage: ExrStorage::Half,
+    compression: glassdb_compose::io::DEFAULT_EXR_COMPRESSION,
+    zip_level: None,
+};
 
 /// Writes Blender's cropped render `from` (its window reset to the origin, docs/compose.md)
-/// to `to` with its data window at `bounds` in the `width × height` frame, samples unchanged.
+/// to `to` with its data window at `window` in the `width × height` frame, samples unchanged.
 fn place_crop(
     from: &Path,
     to: &Path,
-    bounds: PixelBounds,
+    window: PixelWindow,
     width: u32,
     height: u32,
 ) -> Result<(), BlenderError> {
@@ -459,38 +469,32 @@ fn place_crop(
         path: from.to_path_buf(),
         message,
     };
-    if !from.is_file() {
-        return Err(bad("Blender did not write this pass".into()));
-    }
+    check_written(from)?;
     let bytes = glassdb_io::read_input(from, glassdb_io::limits::IMAGE)?;
     let exact = glassdb_image::read_exr_exact(&bytes, glassdb_image::DEFAULT_MAX_PIXELS)?;
-    let [part] = &exact.parts[..] else {
-        return Err(bad(format!("{} parts, expected one", exact.parts.len())));
+    let parts = exact.parts.len();
+    let Ok([part]) = <[_; 1]>::try_from(exact.parts) else {
+        return Err(bad(format!("{parts} parts, expected one")));
     };
     let got = (part.data_window.width, part.data_window.height);
-    if got != (bounds.width as usize, bounds.height as usize) {
+    if got != (window.width, window.height) {
         return Err(bad(format!(
             "the render is {}x{}, but the border asked for {}x{}",
-            got.0, got.1, bounds.width, bounds.height
+            got.0, got.1, window.width, window.height
         )));
     }
     let image = ExrImageOut {
         display_window: PixelWindow::at_origin(width as usize, height as usize),
-        attributes: exact.attributes.clone(),
+        attributes: exact.attributes,
         parts: vec![ExrPartOut {
-            data_window: PixelWindow {
-                x: bounds.x as i32,
-                y: bounds.y as i32,
-                width: bounds.width as usize,
-                height: bounds.height as usize,
-            },
-            attributes: part.attributes.clone(),
+            data_window: window,
+            attributes: part.attributes,
             planes: part
                 .channels
-                .iter()
+                .into_iter()
                 .map(|(name, samples)| ExrPlane {
-                    name: name.clone(),
-                    samples: PlaneSamples::Exact(samples.clone()),
+                    name,
+                    samples: PlaneSamples::Exact(samples),
                     linear: false,
                 })
                 .collect(),
@@ -500,9 +504,8 @@ fn place_crop(
 }
 
 fn write_exr(to: &Path, image: ExrImageOut) -> Result<(), BlenderError> {
-    let options = exr_options()?;
     glassdb_io::write_atomic(to, |w| {
-        glassdb_image::write_exr_image(w, image, options)
+        glassdb_image::write_exr_image(w, image, EXR_OPTIONS)
             .map(|_| ())
             .map_err(std::io::Error::other)
     })?;

@@ -2,9 +2,10 @@
 //! its output captured in a log file.
 
 use std::fs::{File, OpenOptions};
-use std::io::{Read, Seek, SeekFrom, Write};
+use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitStatus, Stdio};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use crate::BlenderError;
@@ -68,8 +69,6 @@ pub struct Blender {
     pub launcher: Launcher,
     /// As Blender prints it (`3.4.1`).
     pub version: String,
-    /// Major and minor version.
-    pub version_number: (u32, u32),
 }
 
 /// One headless run: the scene, the script and its arguments, the log and the time limit.
@@ -116,34 +115,7 @@ impl Blender {
     }
 
     fn find_with(path: PathBuf, launcher: Launcher) -> Result<Blender, BlenderError> {
-        let mut command = Command::new(&path);
-        match launcher {
-            Launcher::Executable => command.args(["-b", "--factory-startup", "--version"]),
-            Launcher::BpyModule => command.args(["-c", BPY_VERSION]),
-        };
-        let mut child = command
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .map_err(|source| BlenderError::NotFound {
-                path: path.clone(),
-                source,
-            })?;
-        let mut printed = String::new();
-        if let Some(mut out) = child.stdout.take() {
-            // Bounded: a version line is short; a program printing without end is stopped.
-            let _ = (&mut out).take(1 << 20).read_to_string(&mut printed);
-        }
-        let started = Instant::now();
-        while child.try_wait().ok().flatten().is_none() {
-            if started.elapsed() > VERSION_TIMEOUT {
-                let _ = child.kill();
-                let _ = child.wait();
-                break;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
+        let printed = Self::ask_version(&path, launcher, VERSION_TIMEOUT)?;
         if launcher == Launcher::BpyModule
             && let Some(said) = printed.lines().find_map(|l| l.strip_prefix("no bpy: "))
         {
@@ -169,21 +141,61 @@ impl Blender {
             path,
             launcher,
             version,
-            version_number: number,
         })
+    }
+
+    /// What `path` prints on stdout when asked for its version (at most 1 MiB, lossily decoded);
+    /// stopped, and refused, when it takes longer than `limit`.
+    fn ask_version(
+        path: &Path,
+        launcher: Launcher,
+        limit: Duration,
+    ) -> Result<String, BlenderError> {
+        let mut command = Command::new(path);
+        match launcher {
+            Launcher::Executable => command.args(["-b", "--factory-startup", "--version"]),
+            Launcher::BpyModule => command.args(["-c", BPY_VERSION]),
+        };
+        let mut child = command
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .map_err(|source| BlenderError::NotFound {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        let started = Instant::now();
+        // Read on a thread, so that the time limit holds while the program says nothing;
+        // bounded, so that a program printing without end is stopped by the limit too.
+        let (sender, said) = mpsc::channel();
+        if let Some(out) = child.stdout.take() {
+            std::thread::spawn(move || {
+                let mut bytes = Vec::new();
+                let _ = out.take(1 << 20).read_to_end(&mut bytes);
+                let _ = sender.send(bytes);
+            });
+        }
+        let timed_out = || BlenderError::VersionTimedOut {
+            path: path.to_path_buf(),
+            seconds: limit.as_secs(),
+        };
+        wait_with_timeout(&mut child, limit, Duration::from_millis(20))
+            .map_err(BlenderError::io("wait for", path))?
+            .ok_or_else(timed_out)?;
+        // The program has exited; a process it started may still hold its output open.
+        let bytes = match said.recv_timeout(limit.saturating_sub(started.elapsed())) {
+            Ok(bytes) => bytes,
+            Err(mpsc::RecvTimeoutError::Timeout) => return Err(timed_out()),
+            Err(mpsc::RecvTimeoutError::Disconnected) => Vec::new(),
+        };
+        Ok(String::from_utf8_lossy(&bytes).into_owned())
     }
 
     /// Runs `blender -b BLEND --factory-startup -noaudio --python-exit-code 1 -P SCRIPT -- ARGS`
     /// (or the same through a `bpy` interpreter), its output appended to the log, stopped after the time limit.
     pub fn run(&self, run: &BlenderRun<'_>) -> Result<(), BlenderError> {
-        let io = |action: &'static str, path: &Path| {
-            let path = path.to_path_buf();
-            move |source| BlenderError::Io {
-                action,
-                path,
-                source,
-            }
-        };
+        let io = BlenderError::io;
         let mut log = OpenOptions::new()
             .create(true)
             .append(true)
@@ -223,25 +235,15 @@ impl Blender {
                 path: self.path.clone(),
                 source,
             })?;
-        let started = Instant::now();
-        let status = loop {
-            match child
-                .try_wait()
-                .map_err(io("wait for Blender", &self.path))?
-            {
-                Some(status) => break status,
-                None if started.elapsed() > run.timeout => {
-                    let _ = child.kill();
-                    let _ = child.wait();
-                    return Err(BlenderError::TimedOut {
-                        step: run.step,
-                        blend: run.blend.to_path_buf(),
-                        seconds: run.timeout.as_secs(),
-                        log: run.log.to_path_buf(),
-                    });
-                }
-                None => std::thread::sleep(Duration::from_millis(50)),
-            }
+        let Some(status) = wait_with_timeout(&mut child, run.timeout, Duration::from_millis(50))
+            .map_err(io("wait for Blender", &self.path))?
+        else {
+            return Err(BlenderError::TimedOut {
+                step: run.step,
+                blend: run.blend.to_path_buf(),
+                seconds: run.timeout.as_secs(),
+                log: run.log.to_path_buf(),
+            });
         };
         if status.success() {
             return Ok(());
@@ -267,6 +269,27 @@ impl Blender {
             log: run.log.to_path_buf(),
             tail: last_bytes(&tail, LOG_TAIL_BYTES as usize),
         })
+    }
+}
+
+/// Waits for `child` to exit, looking every `poll`; past `limit` it is killed (and reaped) and
+/// the answer is `None`.
+pub(crate) fn wait_with_timeout(
+    child: &mut Child,
+    limit: Duration,
+    poll: Duration,
+) -> io::Result<Option<ExitStatus>> {
+    let started = Instant::now();
+    loop {
+        match child.try_wait() {
+            Ok(Some(status)) => return Ok(Some(status)),
+            Ok(None) if started.elapsed() <= limit => std::thread::sleep(poll),
+            waited => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return waited.map(|_| None);
+            }
+        }
     }
 }
 
@@ -373,6 +396,74 @@ mod tests {
         assert!(status.success());
         let after = children_cpu_seconds().unwrap();
         assert!(after > before, "{before} -> {after}");
+    }
+
+    /// A stand-in program in a fresh directory, running `body` (sh). Written by a child
+    /// process: a file this process had open for writing can be inherited by a child another
+    /// test thread forks at that moment, and running it then fails (ETXTBSY).
+    fn script(body: &str) -> (tempfile::TempDir, PathBuf) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("blender");
+        let status = Command::new("sh")
+            .args([
+                "-c",
+                "printf '#!/bin/sh\\n%s\\n' \"$2\" > \"$1\" && chmod 755 \"$1\"",
+            ])
+            .arg("sh")
+            .arg(&path)
+            .arg(body)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        (dir, path)
+    }
+
+    #[test]
+    fn a_version_probe_that_hangs_is_stopped() {
+        // Silent, or silent after its version: stopped at the limit.
+        for body in ["sleep 30", "echo Blender 3.4.1; exec sleep 30"] {
+            let (_dir, path) = script(body);
+            let started = Instant::now();
+            let err = Blender::ask_version(&path, Launcher::Executable, Duration::from_secs(1))
+                .map(|printed| printed.len())
+                .unwrap_err();
+            assert!(
+                matches!(&err, BlenderError::VersionTimedOut { path: p, seconds: 1 } if *p == path),
+                "{body}: {err}"
+            );
+            assert!(started.elapsed() < Duration::from_secs(10), "{body}");
+        }
+        // Printing without end: read up to 1 MiB, then the pipe closes on it.
+        let (_dir, path) = script("exec yes");
+        let printed =
+            Blender::ask_version(&path, Launcher::Executable, Duration::from_secs(30)).unwrap();
+        assert_eq!(printed.len(), 1 << 20);
+        let (_dir, path) = script("echo Blender 3.4.1");
+        let printed =
+            Blender::ask_version(&path, Launcher::Executable, Duration::from_secs(10)).unwrap();
+        assert_eq!(parse_version(&printed), Some(("3.4.1".into(), (3, 4))));
+    }
+
+    #[test]
+    fn waiting_kills_past_the_limit() {
+        let mut child = Command::new("sleep").arg("30").spawn().unwrap();
+        let started = Instant::now();
+        let waited = wait_with_timeout(
+            &mut child,
+            Duration::from_millis(200),
+            Duration::from_millis(10),
+        );
+        assert!(waited.unwrap().is_none());
+        assert!(started.elapsed() < Duration::from_secs(5));
+        // Killed and reaped.
+        assert!(child.try_wait().unwrap().is_some());
+        let mut quick = Command::new("true").spawn().unwrap();
+        let status = wait_with_timeout(
+            &mut quick,
+            Duration::from_secs(10),
+            Duration::from_millis(10),
+        );
+        assert!(status.unwrap().unwrap().success());
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! A registry glass as the thin-pane shader of the Blender-side script: r (front and back) and
 //! t per RGB channel tabulated at [`STOPS`] values of cos θ, for its Color Ramp nodes.
 
-use glassdb_registry::GlassRecord;
+use glassdb_registry::{GlassRecord, Side};
 use serde::Serialize;
 
 /// Stops of a Blender Color Ramp (its maximum is 32).
@@ -33,51 +33,60 @@ pub fn stop_cosines() -> Vec<f64> {
 
 impl ThinPane {
     /// The tables of `glass` (r = r0·C_r(cos θ), t = t0·C_t(cos θ), as the compositor
-    /// evaluates them), clamped to 0–1.
+    /// evaluates them: [`GlassRecord::eval_raw`]), each clamped to 0–1.
     pub fn of(material: &str, glass: &GlassRecord) -> ThinPane {
         let cos = stop_cosines();
-        let table = |v0: &[f64; 3], curves: &[glassdb_registry::AngleCurve; 3]| -> Vec<[f64; 3]> {
+        // `pick` takes r or t from eval_raw's (r, t).
+        let table = |side: Side, pick: fn(RAndT) -> [f64; 3]| -> Vec<[f64; 3]> {
             cos.iter()
-                .map(|&c| std::array::from_fn(|ch| (v0[ch] * curves[ch].eval(c)).clamp(0.0, 1.0)))
+                .map(|&c| pick(glass.eval_raw(side, c)).map(unit))
                 .collect()
         };
         ThinPane {
             material: material.to_string(),
             id: glass.id,
-            r_front: table(&glass.r0, &glass.c_r),
-            r_back: table(&glass.r0_back, &glass.c_r_back),
-            t: table(&glass.t0, &glass.c_t),
+            r_front: table(Side::Front, |(r, _)| r),
+            r_back: table(Side::Back, |(r, _)| r),
+            t: table(Side::Front, |(_, t)| t),
             cos,
         }
     }
+}
+
+/// r and t per channel, as [`GlassRecord::eval_raw`] gives them.
+type RAndT = ([f64; 3], [f64; 3]);
+
+/// `v` clamped to 0–1.
+fn unit(v: f64) -> f64 {
+    v.clamp(0.0, 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
 
     /// The largest difference, over `samples` cos θ in 0–1 and every channel, between the
-    /// ramp's piecewise-linear r or t and the curve itself (what the ramp costs).
-    pub fn ramp_error(&self, glass: &GlassRecord, samples: usize) -> f64 {
+    /// ramp's piecewise-linear r (front) or t and the curve itself (what the ramp costs).
+    fn ramp_error(pane: &ThinPane, glass: &GlassRecord, samples: usize) -> f64 {
         let lerp = |tab: &[[f64; 3]], c: f64, ch: usize| {
-            let k = self.cos.partition_point(|&x| x <= c).clamp(1, STOPS - 1);
-            let (c0, c1) = (self.cos[k - 1], self.cos[k]);
+            let k = pane.cos.partition_point(|&x| x <= c).clamp(1, STOPS - 1);
+            let (c0, c1) = (pane.cos[k - 1], pane.cos[k]);
             let w = ((c - c0) / (c1 - c0)).clamp(0.0, 1.0);
             tab[k - 1][ch] * (1.0 - w) + tab[k][ch] * w
         };
         let mut worst: f64 = 0.0;
         for s in 0..=samples {
             let c = s as f64 / samples as f64;
+            let (r, t) = glass.eval_raw(Side::Front, c);
+            let (r, t) = (r.map(unit), t.map(unit));
             for ch in 0..3 {
-                let r = (glass.r0[ch] * glass.c_r[ch].eval(c)).clamp(0.0, 1.0);
-                let t = (glass.t0[ch] * glass.c_t[ch].eval(c)).clamp(0.0, 1.0);
                 worst = worst
-                    .max((lerp(&self.r_front, c, ch) - r).abs())
-                    .max((lerp(&self.t, c, ch) - t).abs());
+                    .max((lerp(&pane.r_front, c, ch) - r[ch]).abs())
+                    .max((lerp(&pane.t, c, ch) - t[ch]).abs());
             }
         }
         worst
     }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
 
     #[test]
     fn stops_span_zero_to_one_ascending() {
@@ -85,6 +94,24 @@ mod tests {
         assert_eq!(c.len(), STOPS);
         assert_eq!((c[0], c[STOPS - 1]), (0.0, 1.0));
         assert!(c.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    #[test]
+    fn the_tables_are_r0_c_r_and_t0_c_t_clamped() {
+        let registry = glassdb_registry::default_registry().unwrap();
+        for glass in &registry.default_table().glasses {
+            let pane = ThinPane::of("m", glass);
+            for (k, &c) in pane.cos.iter().enumerate() {
+                for ch in 0..3 {
+                    let by_hand = |v0: &[f64; 3], curves: &[glassdb_registry::AngleCurve; 3]| {
+                        (v0[ch] * curves[ch].eval(c)).clamp(0.0, 1.0)
+                    };
+                    assert_eq!(pane.r_front[k][ch], by_hand(&glass.r0, &glass.c_r));
+                    assert_eq!(pane.r_back[k][ch], by_hand(&glass.r0_back, &glass.c_r_back));
+                    assert_eq!(pane.t[k][ch], by_hand(&glass.t0, &glass.c_t));
+                }
+            }
+        }
     }
 
     #[test]
@@ -97,7 +124,7 @@ mod tests {
                 pane.t[STOPS - 1][1],
                 (glass.t0[1] * glass.c_t[1].eval(1.0)).clamp(0.0, 1.0)
             );
-            let err = pane.ramp_error(glass, 2000);
+            let err = ramp_error(&pane, glass, 2000);
             // Measured: 9.3e-4 (id 1), 8.9e-4 (id 5), absolute, in r or t.
             assert!(err < 0.002, "glass {}: ramp error {err}", glass.id);
         }

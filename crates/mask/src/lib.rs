@@ -109,6 +109,26 @@ impl PlaneBounds {
             height: (self.y_max - self.y_min) as usize + 1,
         }
     }
+
+    /// The rectangle as Blender's render border in a `width × height` frame:
+    /// `[min_x, max_x, min_y, max_y]` (`render.border_min_x` …), fractions of the frame with y
+    /// **up**. Blender takes `int(fraction · size)` for each edge, in float32
+    /// (`render_init_from_main`), and an exact edge such as 13/22 can truncate one pixel short;
+    /// so each edge is given half a pixel on, at the centre of the pixel that starts there,
+    /// `(edge + 0.5) / size` (at most 1), which truncates to the edge whatever the rounding:
+    /// columns `x_min..=x_max`, rows `y_min..=y_max` counted from the top, exactly.
+    pub fn blender_border(&self, width: u32, height: u32) -> [f64; 4] {
+        let frac = |edge: i64, size: u32| ((edge as f64 + 0.5) / f64::from(size)).clamp(0.0, 1.0);
+        let (x_min, x_max) = (i64::from(self.x_min), i64::from(self.x_max));
+        let (y_min, y_max) = (i64::from(self.y_min), i64::from(self.y_max));
+        let h = i64::from(height);
+        [
+            frac(x_min, width),
+            frac(x_max + 1, width),
+            frac(h - 1 - y_max, height),
+            frac(h - y_min, height),
+        ]
+    }
 }
 
 /// cos θ as the mask stores it: quantised codes ([`CosCode`]) are kept as codes so that

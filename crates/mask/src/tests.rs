@@ -524,7 +524,91 @@ fn plane_bounds_are_the_glass_rectangles_per_plane() {
     assert_eq!((b[&2].x_max, b[&2].y_max), (2, 0));
 }
 
+/// Blender's own edge rule, `int(fraction · size)` with the fraction stored as float32
+/// (DNA's `rctf border`) and multiplied in float32 (render_init_from_main).
+fn blender_edge(fraction: f64, size: u32) -> i64 {
+    ((fraction as f32) * size as f32) as i64
+}
+
+/// The edges Blender takes from a border: `[x_min, y_min, x_max, y_max]` inclusive, row 0 at
+/// the top, as the rectangle states them.
+fn blender_rectangle(border: [f64; 4], width: u32, height: u32) -> [i64; 4] {
+    let [x0, x1, y0, y1] = border;
+    let h = i64::from(height);
+    [
+        blender_edge(x0, width),
+        h - blender_edge(y1, height),
+        blender_edge(x1, width) - 1,
+        h - blender_edge(y0, height) - 1,
+    ]
+}
+
+#[test]
+fn blender_borders_truncate_to_the_rectangle() {
+    // 13/22 in float32 times 22 is 12.999999: an exact edge would lose a pixel there.
+    assert_eq!(blender_edge(13.0 / 22.0, 22), 12);
+    for (w, h) in [
+        (1u32, 1u32),
+        (22, 22),
+        (22, 7),
+        (7, 5),
+        (64, 48),
+        (99, 101),
+        (320, 240),
+        (1920, 1080),
+        (4097, 2161),
+        (16383, 9),
+    ] {
+        // Every edge of the frame, as a one-pixel rectangle's left and right, top and bottom.
+        for e in 0..w.max(h) as i32 {
+            let (x, y) = (e.min(w as i32 - 1), e.min(h as i32 - 1));
+            let b = PlaneBounds {
+                x_min: x,
+                y_min: y,
+                x_max: x,
+                y_max: y,
+                glass_pixels: 1,
+            };
+            let want = [x, y, x, y].map(i64::from);
+            assert_eq!(
+                blender_rectangle(b.blender_border(w, h), w, h),
+                want,
+                "{w}x{h}"
+            );
+        }
+        let whole = PlaneBounds {
+            x_min: 0,
+            y_min: 0,
+            x_max: w as i32 - 1,
+            y_max: h as i32 - 1,
+            glass_pixels: 0,
+        };
+        let b = whole.blender_border(w, h);
+        assert_eq!(
+            blender_rectangle(b, w, h),
+            [0, 0, w as i64 - 1, h as i64 - 1]
+        );
+        assert!(b.iter().all(|f| (0.0..=1.0).contains(f)), "{b:?}");
+    }
+}
+
 proptest! {
+    /// Blender's truncation of the border gives back the rectangle, in any frame.
+    #[test]
+    fn blender_borders_truncate_to_any_rectangle(
+        (w, h, x0, x1, y0, y1) in (1u32..5000, 1u32..5000).prop_flat_map(|(w, h)| {
+            (Just(w), Just(h), 0..w, 0..w, 0..h, 0..h)
+        })
+    ) {
+        let (x0, x1) = (x0.min(x1) as i32, x0.max(x1) as i32);
+        let (y0, y1) = (y0.min(y1) as i32, y0.max(y1) as i32);
+        let b = PlaneBounds { x_min: x0, y_min: y0, x_max: x1, y_max: y1, glass_pixels: 1 };
+        prop_assert_eq!(
+            blender_rectangle(b.blender_border(w, h), w, h),
+            [x0, y0, x1, y1].map(i64::from)
+        );
+    }
+
     /// Every glass pixel lies in its plane's rectangle, and every side of the rectangle touches
     /// a glass pixel of that plane (brute force over the pixels).
     #[test]

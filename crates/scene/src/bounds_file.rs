@@ -41,8 +41,9 @@ pub struct PlaneBoundsEntry {
     /// Glass pixels of the plane inside the rectangle.
     pub glass_pixels: u64,
     /// The same rectangle as Blender's render border (`render.border_min_x` …): fractions of
-    /// the frame with y from the **bottom**, on exact pixel edges (`x_min / width`,
-    /// `(x_max + 1) / width`, `(height − 1 − y_max) / height`, `(height − y_min) / height`).
+    /// the frame with y from the **bottom**, each edge half a pixel on so that Blender's
+    /// float32 truncation `int(fraction · size)` gives exactly the data window
+    /// (`glassdb_mask::PlaneBounds::blender_border`).
     pub blender_border: BlenderBorder,
 }
 
@@ -59,20 +60,22 @@ pub struct BlenderBorder {
 impl PlaneBoundsFile {
     /// The rectangles of `mask` (a whole frame at the origin, as `glassdb mask` writes it).
     pub fn from_mask(mask: &MaskImage, frame: Option<u32>, mask_name: &str) -> PlaneBoundsFile {
-        let (w, h) = (f64::from(mask.width), f64::from(mask.height));
         let planes = mask
             .plane_bounds()
             .into_iter()
-            .map(|(plane, b)| PlaneBoundsEntry {
-                plane,
-                data_window: [b.x_min, b.y_min, b.x_max, b.y_max],
-                glass_pixels: b.glass_pixels,
-                blender_border: BlenderBorder {
-                    min_x: f64::from(b.x_min) / w,
-                    max_x: f64::from(b.x_max + 1) / w,
-                    min_y: (h - 1.0 - f64::from(b.y_max)) / h,
-                    max_y: (h - f64::from(b.y_min)) / h,
-                },
+            .map(|(plane, b)| {
+                let [min_x, max_x, min_y, max_y] = b.blender_border(mask.width, mask.height);
+                PlaneBoundsEntry {
+                    plane,
+                    data_window: [b.x_min, b.y_min, b.x_max, b.y_max],
+                    glass_pixels: b.glass_pixels,
+                    blender_border: BlenderBorder {
+                        min_x,
+                        max_x,
+                        min_y,
+                        max_y,
+                    },
+                }
             })
             .collect();
         PlaneBoundsFile {
@@ -135,36 +138,75 @@ mod tests {
 
     use super::*;
 
+    /// Blender's edge rule: `int(fraction · size)`, the fraction stored and multiplied in
+    /// float32.
+    fn blender_edge(fraction: f64, size: u32) -> i64 {
+        ((fraction as f32) * size as f32) as i64
+    }
+
     #[test]
-    fn the_blender_border_is_the_data_window_on_pixel_edges_with_y_up() {
-        // 4×2 frame; plane 3 glass at column 1..=2 of the bottom row.
-        let mask = MaskImage {
-            width: 4,
-            height: 2,
-            id: vec![0, 0, 0, 0, 0, 5, 5, 0],
-            cos_theta: CosTheta::Normal,
-            plane: vec![0, 0, 0, 0, 0, 3, 3, 0],
-            coverage: None,
-        };
-        let f = PlaneBoundsFile::from_mask(&mask, Some(7), "m.exr");
-        assert_eq!(f.planes.len(), 1);
-        let p = &f.planes[0];
-        assert_eq!(
-            (p.plane, p.data_window, p.glass_pixels),
-            (3, [1, 1, 2, 1], 2)
-        );
-        assert_eq!(
-            p.blender_border,
-            BlenderBorder {
-                min_x: 0.25,
-                max_x: 0.75,
-                min_y: 0.0,
-                max_y: 0.5
+    fn the_blender_border_truncates_to_the_data_window_with_y_up() {
+        // Exact edges can truncate short in float32: 13/22 gives 12.
+        assert_eq!(blender_edge(13.0 / 22.0, 22), 12);
+        // W×H frames; plane 3's glass fills a rectangle `[x_min, y_min, x_max, y_max]` (row 0
+        // at the top) with such edges (13 of 22, 27 of 49, 7, 27 and 31 of 99), plane 0 is the
+        // bottom left pixel.
+        for (w, h, rect) in [
+            (4u32, 2u32, [1, 1, 2, 1]),
+            (22, 22, [1, 9, 12, 21]),
+            (49, 22, [27, 0, 48, 8]),
+            (99, 49, [7, 22, 30, 48]),
+            (7, 5, [1, 1, 5, 3]),
+        ] {
+            let n = (w * h) as usize;
+            let (mut id, mut plane) = (vec![0u16; n], vec![0u16; n]);
+            for y in rect[1]..=rect[3] {
+                for x in rect[0]..=rect[2] {
+                    let i = (y * w as i32 + x) as usize;
+                    (id[i], plane[i]) = (5, 3);
+                }
             }
-        );
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("b.json");
-        f.write(&path).unwrap();
-        assert_eq!(PlaneBoundsFile::load(&path).unwrap(), f);
+            id[((h - 1) * w) as usize] = 5;
+            let mask = MaskImage {
+                width: w,
+                height: h,
+                id,
+                cos_theta: CosTheta::Normal,
+                plane,
+                coverage: None,
+            };
+            let f = PlaneBoundsFile::from_mask(&mask, Some(7), "m.exr");
+            let pixels = ((rect[2] - rect[0] + 1) * (rect[3] - rect[1] + 1)) as u64;
+            let bottom_left = [0, h as i32 - 1, 0, h as i32 - 1];
+            let got: Vec<_> = f
+                .planes
+                .iter()
+                .map(|p| (p.plane, p.data_window, p.glass_pixels))
+                .collect();
+            assert_eq!(got, [(0, bottom_left, 1), (3, rect, pixels)], "{w}x{h}");
+            for p in &f.planes {
+                let b = p.blender_border;
+                let [x0, y0, x1, y1] = p.data_window.map(i64::from);
+                let h = i64::from(h);
+                // y up: the bottom edge is the rows below y_max.
+                assert_eq!(
+                    [
+                        blender_edge(b.min_x, w),
+                        blender_edge(b.max_x, w),
+                        blender_edge(b.min_y, h as u32),
+                        blender_edge(b.max_y, h as u32),
+                    ],
+                    [x0, x1 + 1, h - 1 - y1, h - y0],
+                    "{w}x{h} plane {}",
+                    p.plane
+                );
+                let fractions = [b.min_x, b.max_x, b.min_y, b.max_y];
+                assert!(fractions.iter().all(|f| (0.0..=1.0).contains(f)));
+            }
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("b.json");
+            f.write(&path).unwrap();
+            assert_eq!(PlaneBoundsFile::load(&path).unwrap(), f);
+        }
     }
 }
