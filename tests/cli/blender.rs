@@ -10,7 +10,8 @@ use std::process::Command;
 use std::sync::OnceLock;
 
 use crate::util::{
-    Planes, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path, write_file,
+    Planes, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path,
+    write_executable, write_file,
 };
 
 /// The tiny scene, its facts, Cycles' index renders and two glassdb runs (seeds 0 and 1).
@@ -389,17 +390,13 @@ fn copy_dir(from: &Path, to: &Path) {
 
 /// A stand-in `blender`: prints `version` for --version, else runs `body` (sh).
 fn fake_blender(dir: &Path, version: &str, body: &str) -> PathBuf {
-    use std::os::unix::fs::PermissionsExt;
-    let path = dir.join("blender");
-    std::fs::write(
-        &path,
-        format!(
+    write_executable(
+        dir,
+        "blender",
+        &format!(
             "#!/bin/sh\ncase \"$*\" in *--version*) echo \"Blender {version}\"; exit 0;; esac\n{body}\n"
         ),
     )
-    .unwrap();
-    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
-    path
 }
 
 fn render_with(blender: &Path, blend: &Path, out: &Path, extra: &[&str]) -> Command {
@@ -433,10 +430,7 @@ fn missing_and_old_blender_are_refused() {
         &mut render_with(&old, &blend, &out, &[]),
         &["Blender 2.93.18", "needs Blender 3.4 or newer"],
     );
-    let not_blender = t.path().join("not-blender");
-    std::fs::write(&not_blender, "#!/bin/sh\necho hello\n").unwrap();
-    use std::os::unix::fs::PermissionsExt;
-    std::fs::set_permissions(&not_blender, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let not_blender = write_executable(t.path(), "not-blender", "#!/bin/sh\necho hello\n");
     fails_naming(
         &mut render_with(&not_blender, &blend, &out, &[]),
         &["did not print a Blender version", "hello"],

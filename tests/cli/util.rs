@@ -107,6 +107,22 @@ pub fn write_file(dir: &Path, name: &str, contents: &[u8]) -> PathBuf {
     p
 }
 
+/// Writes the shell script `text` as the executable `dir/name`. A child process writes it: a
+/// file this process had open for writing can be inherited by a child another test thread
+/// forks at that moment, and running the script then fails with ETXTBSY.
+pub fn write_executable(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    let status = Command::new("sh")
+        .args(["-c", "printf '%s' \"$2\" > \"$1\" && chmod 755 \"$1\""])
+        .arg("sh")
+        .arg(&p)
+        .arg(text)
+        .status()
+        .expect("run sh to write a test script");
+    assert!(status.success(), "writing {}", p.display());
+    p
+}
+
 /// The Python interpreter that has the pinned oracles (colour-science, pywincalc, mpmath).
 /// `scripts/test-all` (the README's test command, and CI) sets `GLASSDB_PYTHON`; failing to
 /// find it is a test failure, never a skip, so an oracle comparison cannot silently vanish.
