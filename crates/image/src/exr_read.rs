@@ -4,6 +4,7 @@
 //! decoder on a corrupt block becomes an `Internal` error. Used for masks and for passes.
 
 use std::io::{Cursor, Read, Seek, SeekFrom};
+use std::sync::Mutex;
 
 use exr::block::UncompressedBlock;
 use exr::block::chunk::Chunk;
@@ -324,16 +325,15 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
             }
         }
     };
+    // Blocks are read one at a time, as decoders ask for them, so that only the blocks being
+    // decoded are in memory, and reading overlaps decoding.
     let chunks = guarded(|| {
-        reader
-            .filter_chunks(false, |_, tile, block| {
-                block.layer == part
-                    && tile.level_index == Vec2(0, 0)
-                    && (first_band..end_band).contains(&tile.tile_index.y())
-            })?
-            .collect::<exr::error::Result<Vec<Chunk>>>()
+        reader.filter_chunks(false, |_, tile, block| {
+            block.layer == part
+                && tile.level_index == Vec2(0, 0)
+                && (first_band..end_band).contains(&tile.tile_index.y())
+        })
     })?;
-    let band_chunks = chunks_by_band(chunks, &header, first_band, end_band)?;
     let layout = BandLayout {
         width: info.width,
         height: info.height,
@@ -347,19 +347,27 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
         info.data_window.height = decoded_rows;
         info.height = decoded_rows;
     }
-    // A channel asked for twice is decoded once and copied.
+    // A channel asked for twice is decoded once and copied; the buffers are otherwise moved
+    // into the order asked for (R, G, B is the reverse of the file's B, G, R).
     let mut unique: Vec<usize> = channels.to_vec();
     unique.sort_unstable();
     unique.dedup();
-    let decoded = decode_bands(&meta, &header, &info, &unique, band_chunks, &layout)?;
-    if unique.as_slice() == channels {
-        return Ok((info, decoded));
-    }
+    let mut decoded = decode_bands(&meta, &header, &info, &unique, chunks, &layout)?;
     let outputs = channels
         .iter()
-        .map(|c| {
+        .enumerate()
+        .map(|(j, c)| {
             let k = unique.binary_search(c).unwrap_or_default();
-            decoded.get(k).cloned().unwrap_or_default()
+            let buffer = decoded.get_mut(k).map(std::mem::take).unwrap_or_default();
+            if channels[j + 1..].contains(c) {
+                let copy = buffer.clone();
+                if let Some(slot) = decoded.get_mut(k) {
+                    *slot = buffer;
+                }
+                copy
+            } else {
+                buffer
+            }
         })
         .collect();
     Ok((info, outputs))
@@ -404,31 +412,6 @@ pub fn check_exr_readable(
     Ok(())
 }
 
-/// Sorts the part's compressed chunks into bands of rows (one band per block row).
-fn chunks_by_band(
-    chunks: Vec<Chunk>,
-    header: &Header,
-    first_band: usize,
-    end_band: usize,
-) -> Result<Vec<Vec<Chunk>>, ImageError> {
-    let mut bands: Vec<Vec<Chunk>> = (first_band..end_band).map(|_| Vec::new()).collect();
-    for chunk in chunks {
-        let tile = guarded(|| header.get_block_data_indices(&chunk.compressed_block))?;
-        if tile.level_index != Vec2(0, 0) {
-            continue;
-        }
-        let index = tile.tile_index.y().wrapping_sub(first_band);
-        let band = bands.get_mut(index).ok_or_else(|| {
-            incomplete(format!(
-                "block row {} is outside the image",
-                tile.tile_index.y()
-            ))
-        })?;
-        band.push(chunk);
-    }
-    Ok(bands)
-}
-
 /// The image size, its division into bands of `band_height` rows, and the bands decoded
 /// (`first_band..end_band`).
 struct BandLayout {
@@ -453,14 +436,15 @@ impl BandLayout {
     }
 }
 
-/// Decompresses every band in parallel straight into one output buffer per selected channel,
-/// checking that each band's rows are fully covered.
+/// Decompresses the blocks `chunks` yields in parallel, each straight into the output buffers
+/// of its band (one buffer per selected channel), checking that each band's rows are fully
+/// covered.
 fn decode_bands(
     meta: &exr::meta::MetaData,
     header: &Header,
     info: &ExrPart,
     channels: &[usize],
-    band_chunks: Vec<Vec<Chunk>>,
+    chunks: impl Iterator<Item = exr::error::Result<Chunk>> + Send,
     layout: &BandLayout,
 ) -> Result<Vec<Vec<f32>>, ImageError> {
     let BandLayout {
@@ -468,9 +452,8 @@ fn decode_bands(
         height,
         band_height,
         first_band,
-        ..
+        end_band,
     } = *layout;
-    let decoded_rows = layout.decoded_rows();
     // Which output buffer each channel of the part goes to.
     let mut target: Vec<Option<usize>> = vec![None; info.channels.len()];
     for (k, &c) in channels.iter().enumerate() {
@@ -482,55 +465,96 @@ fn decode_bands(
 
     let mut outputs: Vec<Vec<f32>> = channels
         .iter()
-        .map(|_| vec![0f32; width * decoded_rows])
+        .map(|_| vec![0f32; width * layout.decoded_rows()])
         .collect();
-    let mut band_slices: Vec<Vec<&mut [f32]>> = band_chunks
-        .iter()
-        .map(|_| Vec::with_capacity(channels.len()))
+    let mut band_slices: Vec<BandTarget<'_>> = (first_band..end_band)
+        .map(|_| BandTarget {
+            slices: Vec::with_capacity(channels.len()),
+            written: 0,
+        })
         .collect();
     for buffer in outputs.iter_mut() {
         for (band, slice) in band_slices
             .iter_mut()
             .zip(buffer.chunks_mut(width * band_height))
         {
-            band.push(slice);
+            band.slices.push(slice);
         }
     }
+    let bands: Vec<Mutex<BandTarget<'_>>> = band_slices.into_iter().map(Mutex::new).collect();
 
-    band_slices
-        .into_par_iter()
-        .zip(band_chunks.into_par_iter())
-        .enumerate()
-        .try_for_each(|(band, (mut slices, chunks))| -> Result<(), ImageError> {
-            let y0 = (first_band + band) * band_height;
+    guarded_chunks(chunks)
+        .par_bridge()
+        .try_for_each(|chunk| -> Result<(), ImageError> {
+            let chunk = chunk?;
+            let tile = guarded(|| header.get_block_data_indices(&chunk.compressed_block))?;
+            let index = tile.tile_index.y().wrapping_sub(first_band);
+            let band = bands.get(index).ok_or_else(|| {
+                incomplete(format!(
+                    "block row {} is outside the image",
+                    tile.tile_index.y()
+                ))
+            })?;
+            let block = guarded(|| UncompressedBlock::decompress_chunk(chunk, meta, false))?;
+            let y0 = (first_band + index) * band_height;
             let rows = band_height.min(height - y0);
-            let mut written = 0usize;
-            for chunk in chunks {
-                let block = guarded(|| UncompressedBlock::decompress_chunk(chunk, meta, false))?;
-                written += catch_codec_panic(Codec::Exr, || {
-                    scatter_block(
-                        &block,
-                        header,
-                        &target,
-                        &sample_types,
-                        &mut slices,
-                        y0,
-                        rows,
-                        width,
-                    )
-                })??;
-            }
-            let expected = rows * width * channels.len();
-            if written != expected {
-                return Err(incomplete(format!(
-                    "rows {}..{}: {written} of {expected} samples present",
+            let mut band = band
+                .lock()
+                .map_err(|_| incomplete("a band's decoder stopped".into()))?;
+            let BandTarget { slices, written } = &mut *band;
+            *written += catch_codec_panic(Codec::Exr, || {
+                scatter_block(
+                    &block,
+                    header,
+                    &target,
+                    &sample_types,
+                    slices,
                     y0,
-                    y0 + rows
-                )));
-            }
+                    rows,
+                    width,
+                )
+            })??;
             Ok(())
         })?;
+    for (index, band) in bands.into_iter().enumerate() {
+        let written = band.into_inner().map(|b| b.written).unwrap_or_default();
+        let y0 = (first_band + index) * band_height;
+        let rows = band_height.min(height - y0);
+        let expected = rows * width * channels.len();
+        if written != expected {
+            return Err(incomplete(format!(
+                "rows {}..{}: {written} of {expected} samples present",
+                y0,
+                y0 + rows
+            )));
+        }
+    }
     Ok(outputs)
+}
+
+/// One band's slice of every output buffer, and the samples written into them so far.
+struct BandTarget<'a> {
+    slices: Vec<&'a mut [f32]>,
+    written: usize,
+}
+
+/// The blocks of a chunk reader, with a panic in the reader on a corrupt file turned into an
+/// error; nothing more is read after an error.
+fn guarded_chunks(
+    mut chunks: impl Iterator<Item = exr::error::Result<Chunk>> + Send,
+) -> impl Iterator<Item = Result<Chunk, ImageError>> + Send {
+    let mut failed = false;
+    std::iter::from_fn(move || {
+        if failed {
+            return None;
+        }
+        let next = match catch_codec_panic(Codec::Exr, || chunks.next()) {
+            Ok(next) => next?.map_err(ImageError::ExrDecode),
+            Err(panic) => Err(panic),
+        };
+        failed = next.is_err();
+        Some(next)
+    })
 }
 
 /// Copies the selected channels' lines of one decompressed block into the band's buffers;

@@ -111,7 +111,7 @@ const HALF_MAX: f32 = 65504.0;
 
 /// Writes `planes` as one scan-line part covering `width × height` at the origin (channels
 /// sorted by name, as EXR requires).
-pub fn write_exr_planes<W: Write + Seek>(
+pub fn write_exr_planes<W: Write + Seek + Send>(
     out: W,
     width: usize,
     height: usize,
@@ -132,7 +132,7 @@ pub fn write_exr_planes<W: Write + Seek>(
 }
 
 /// Writes a whole file: every part as scan lines with the options' compression.
-pub fn write_exr_image<W: Write + Seek>(
+pub fn write_exr_image<W: Write + Seek + Send>(
     out: W,
     image: ExrImageOut,
     options: ExrWriteOptions,

@@ -8,10 +8,12 @@
 //! offset table and chunk layout stay `exr`'s own (`exr::block::write`), so the file is what
 //! `exr` would write with a different deflate stream; any EXR reader decodes it.
 
+use std::collections::BTreeMap;
 use std::io::{Seek, Write};
+use std::sync::{Condvar, Mutex, mpsc};
 
 use exr::block::chunk::{Chunk, CompressedBlock, CompressedScanLineBlock};
-use exr::block::writer::ChunksWriter;
+use exr::block::writer::{ChunkWriter, ChunksWriter};
 use exr::compression::Compression;
 use exr::image::write::layers::WritableLayers;
 use exr::meta::header::ImageAttributes;
@@ -31,8 +33,9 @@ pub fn zip_block_lines(compression: Compression) -> Option<usize> {
 }
 
 /// Writes scan-line layers (one part each) whose encoding is ZIP or ZIPS, deflating at
-/// `level` (0–9). Blocks are compressed in parallel, a batch at a time, and written in order.
-pub fn write_zip_layers<W: Write + Seek>(
+/// `level` (0–9). Blocks are compressed in parallel while a writer thread writes them in order,
+/// with at most a window of blocks (four per thread) compressed ahead of the file.
+pub fn write_zip_layers<W: Write + Seek + Send>(
     attributes: &ImageAttributes,
     layers: &[Layer<AnyChannels<FlatSamples>>],
     level: u32,
@@ -55,67 +58,150 @@ pub fn write_zip_layers<W: Write + Seek>(
     })
 }
 
-/// Compresses and writes the blocks of one layer.
-fn write_layer_blocks(
+/// Compresses the blocks of one layer on the rayon pool and writes them, in order, from a
+/// scoped thread: the file's writing overlaps the compression instead of stopping it.
+fn write_layer_blocks<W: Write + Seek + Send>(
     layer_index: usize,
     layer: &Layer<AnyChannels<FlatSamples>>,
     level: u32,
-    writer: &mut impl ChunksWriter,
+    writer: &mut ChunkWriter<W>,
 ) -> exr::error::UnitResult {
     let lines_per_block = zip_block_lines(layer.encoding.compression).unwrap_or(16);
-    let width = layer.size.width();
     let height = layer.size.height();
-    let y_origin = layer.attributes.layer_position.y();
-    let channels = &layer.channel_data.list;
     let blocks = height.div_ceil(lines_per_block);
-    // A batch of blocks per round keeps both cores busy and the compressed bytes of only one
-    // batch in memory.
-    let batch = (rayon::current_num_threads() * 4).max(1);
-    for first in (0..blocks).step_by(batch) {
-        let last = (first + batch).min(blocks);
-        let chunks: Vec<Chunk> = (first..last)
-            .into_par_iter()
-            .map(|block| {
-                let y0 = block * lines_per_block;
-                let y1 = (y0 + lines_per_block).min(height);
-                let raw = block_bytes_le(channels, width, y0..y1);
-                let packed = deflate_block(&raw, level)?;
-                Ok(Chunk {
-                    layer_index,
-                    compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
-                        y_coordinate: y_origin + y0 as i32,
-                        // OpenEXR stores a block raw when deflate does not make it smaller.
-                        compressed_pixels_le: if packed.len() < raw.len() {
-                            packed
-                        } else {
-                            raw
-                        },
-                    }),
-                })
-            })
-            .collect::<exr::error::Result<_>>()?;
-        for (offset, chunk) in chunks.into_iter().enumerate() {
-            writer.write_chunk(first + offset, chunk)?;
+    let window = BlockWindow::new((rayon::current_num_threads() * 4).max(2));
+    let (sender, receiver) = mpsc::channel::<(usize, exr::error::Result<Chunk>)>();
+    std::thread::scope(|scope| {
+        let writing = scope.spawn(|| {
+            let result = write_in_order(writer, receiver, blocks, &window);
+            // Whatever happened, no compressor may wait for this writer any longer.
+            window.stop();
+            result
+        });
+        window
+            .indices(blocks)
+            .par_bridge()
+            .for_each_with(sender, |sender, block| {
+                let chunk = compress_block(layer_index, layer, lines_per_block, block, level);
+                // A closed channel means the writer has stopped on an error it reports.
+                let _ = sender.send((block, chunk));
+            });
+        writing.join().unwrap_or_else(|_| {
+            Err(exr::error::Error::Io(std::io::Error::other(
+                "the EXR block writer stopped unexpectedly",
+            )))
+        })
+    })
+}
+
+/// Receives compressed blocks in any order and writes them in increasing order.
+fn write_in_order<W: Write + Seek>(
+    writer: &mut ChunkWriter<W>,
+    receiver: mpsc::Receiver<(usize, exr::error::Result<Chunk>)>,
+    blocks: usize,
+    window: &BlockWindow,
+) -> exr::error::UnitResult {
+    let mut pending = BTreeMap::new();
+    let mut next = 0;
+    while next < blocks {
+        let (block, chunk) = receiver.recv().map_err(|_| {
+            exr::error::Error::Io(std::io::Error::other("a block compressor stopped"))
+        })?;
+        pending.insert(block, chunk?);
+        while let Some(chunk) = pending.remove(&next) {
+            writer.write_chunk(next, chunk)?;
+            next += 1;
+            window.written(next);
         }
     }
     Ok(())
 }
 
-/// The uncompressed bytes of lines `lines`: per line, per channel (sorted by name, as in the
-/// header), the samples in little-endian order.
+/// How far the writer has come, so that compression runs at most `ahead` blocks before it.
+struct BlockWindow {
+    /// Blocks written, and whether the writer has stopped.
+    state: Mutex<(usize, bool)>,
+    advanced: Condvar,
+    ahead: usize,
+}
+
+impl BlockWindow {
+    fn new(ahead: usize) -> Self {
+        Self {
+            state: Mutex::new((0, false)),
+            advanced: Condvar::new(),
+            ahead,
+        }
+    }
+
+    fn written(&self, count: usize) {
+        if let Ok(mut state) = self.state.lock() {
+            state.0 = count;
+        }
+        self.advanced.notify_all();
+    }
+
+    fn stop(&self) {
+        if let Ok(mut state) = self.state.lock() {
+            state.1 = true;
+        }
+        self.advanced.notify_all();
+    }
+
+    /// Block indices `0..blocks`, each handed out once it is within the window; none once
+    /// the writer has stopped.
+    fn indices(&self, blocks: usize) -> impl Iterator<Item = usize> + Send + '_ {
+        (0..blocks).map_while(move |block| {
+            let mut state = self.state.lock().ok()?;
+            while !state.1 && block >= state.0 + self.ahead {
+                state = self.advanced.wait(state).ok()?;
+            }
+            (!state.1).then_some(block)
+        })
+    }
+}
+
+/// One block of a layer as a chunk: its lines' bytes, OpenEXR's ZIP transform, deflated.
+fn compress_block(
+    layer_index: usize,
+    layer: &Layer<AnyChannels<FlatSamples>>,
+    lines_per_block: usize,
+    block: usize,
+    level: u32,
+) -> exr::error::Result<Chunk> {
+    let (width, height) = (layer.size.width(), layer.size.height());
+    let y0 = block * lines_per_block;
+    let y1 = (y0 + lines_per_block).min(height);
+    let compressed_pixels_le = SCRATCH.with(|cell| {
+        let scratch = &mut *cell.borrow_mut();
+        block_bytes_le(&layer.channel_data.list, width, y0..y1, &mut scratch.raw);
+        let raw_len = scratch.raw.len();
+        let packed = deflate_block(scratch, level)?;
+        // OpenEXR stores a block raw when deflate does not make it smaller.
+        Ok::<_, exr::error::Error>(if packed.len() < raw_len {
+            packed.to_vec()
+        } else {
+            scratch.raw.clone()
+        })
+    })?;
+    Ok(Chunk {
+        layer_index,
+        compressed_block: CompressedBlock::ScanLine(CompressedScanLineBlock {
+            y_coordinate: layer.attributes.layer_position.y() + y0 as i32,
+            compressed_pixels_le,
+        }),
+    })
+}
+
+/// The uncompressed bytes of lines `lines` into `out`: per line, per channel (sorted by name,
+/// as in the header), the samples in little-endian order.
 fn block_bytes_le(
     channels: &[exr::prelude::AnyChannel<FlatSamples>],
     width: usize,
     lines: std::ops::Range<usize>,
-) -> Vec<u8> {
-    let bytes_per_pixel: usize = channels
-        .iter()
-        .map(|c| match c.sample_data {
-            FlatSamples::F16(_) => 2,
-            FlatSamples::F32(_) | FlatSamples::U32(_) => 4,
-        })
-        .sum();
-    let mut out = Vec::with_capacity(bytes_per_pixel * width * lines.len());
+    out: &mut Vec<u8>,
+) {
+    out.clear();
     for y in lines {
         let row = y * width..(y + 1) * width;
         for c in channels {
@@ -138,57 +224,60 @@ fn block_bytes_le(
             }
         }
     }
-    out
 }
 
-/// OpenEXR's ZIP transform of one block: even bytes then odd bytes, a byte-delta predictor
-/// (`d[i] = s[i] − s[i−1] + 128`), then a zlib stream at `level` (libdeflate).
-fn deflate_block(raw: &[u8], level: u32) -> exr::error::Result<Vec<u8>> {
+/// OpenEXR's ZIP transform of `scratch.raw`: even bytes then odd bytes, a byte-delta
+/// predictor (`d[i] = s[i] − s[i−1] + 128`), then a zlib stream at `level` (libdeflate).
+/// Returns the stream, in `scratch.packed`.
+fn deflate_block(scratch: &mut BlockScratch, level: u32) -> exr::error::Result<&[u8]> {
+    let BlockScratch {
+        raw,
+        split,
+        packed,
+        compressor,
+    } = scratch;
     let half = raw.len().div_ceil(2);
-    let mut split = vec![0u8; raw.len()];
-    let (evens, odds) = split.split_at_mut(half);
-    for ((pair, e), o) in raw
-        .chunks_exact(2)
-        .zip(evens.iter_mut())
-        .zip(odds.iter_mut())
-    {
-        *e = pair[0];
-        *o = pair[1];
-    }
-    if raw.len() % 2 == 1 {
-        evens[half - 1] = raw[raw.len() - 1];
-    }
+    split.clear();
+    split.extend(raw.iter().step_by(2));
+    split.extend(raw.iter().skip(1).step_by(2));
+    debug_assert_eq!(split.len() - split.len() / 2, half);
     let mut previous = split.first().copied().unwrap_or(0);
     for b in split.iter_mut().skip(1) {
         let current = *b;
         *b = current.wrapping_sub(previous).wrapping_add(128);
         previous = current;
     }
-    COMPRESSOR.with(|cell| {
-        let mut slot = cell.borrow_mut();
-        let compressor = match slot.as_mut() {
-            Some((l, c)) if *l == level => c,
-            _ => {
-                let lvl = libdeflater::CompressionLvl::new(level as i32).map_err(|_| {
-                    exr::error::Error::NotSupported(format!("zip level {level}").into())
-                })?;
-                &mut slot.insert((level, libdeflater::Compressor::new(lvl))).1
-            }
-        };
-        let mut out = vec![0u8; compressor.zlib_compress_bound(split.len())];
-        let n = compressor
-            .zlib_compress(&split, &mut out)
-            .map_err(|e| exr::error::Error::Io(std::io::Error::other(e.to_string())))?;
-        out.truncate(n);
-        Ok(out)
-    })
+    let compressor = match compressor {
+        Some((l, c)) if *l == level => c,
+        _ => {
+            let lvl = libdeflater::CompressionLvl::new(level as i32).map_err(|_| {
+                exr::error::Error::NotSupported(format!("zip level {level}").into())
+            })?;
+            &mut compressor
+                .insert((level, libdeflater::Compressor::new(lvl)))
+                .1
+        }
+    };
+    packed.resize(compressor.zlib_compress_bound(split.len()), 0);
+    let n = compressor
+        .zlib_compress(split, packed)
+        .map_err(|e| exr::error::Error::Io(std::io::Error::other(e.to_string())))?;
+    Ok(&packed[..n])
+}
+
+/// One thread's buffers for compressing blocks, reused from block to block.
+#[derive(Default)]
+struct BlockScratch {
+    raw: Vec<u8>,
+    split: Vec<u8>,
+    packed: Vec<u8>,
+    /// The libdeflate compressor (with its level): about 1 MB of tables, too much to
+    /// allocate per block.
+    compressor: Option<(u32, libdeflater::Compressor)>,
 }
 
 thread_local! {
-    /// One libdeflate compressor per thread (with its level): it holds about 1 MB of tables,
-    /// too much to allocate per block.
-    static COMPRESSOR: std::cell::RefCell<Option<(u32, libdeflater::Compressor)>> =
-        const { std::cell::RefCell::new(None) };
+    static SCRATCH: std::cell::RefCell<BlockScratch> = std::cell::RefCell::new(BlockScratch::default());
 }
 
 #[cfg(test)]
@@ -206,7 +295,7 @@ mod tests {
 
     /// Writes a single-layer scan-line image whose encoding is ZIP or ZIPS, deflating at `level`
     /// (0–9); see [`write_zip_layers`].
-    pub fn write_zip_image<W: Write + Seek>(
+    pub fn write_zip_image<W: Write + Seek + Send>(
         image: &Image<Layer<AnyChannels<FlatSamples>>>,
         level: u32,
         out: W,
@@ -321,6 +410,45 @@ mod tests {
                 img.write().to_buffered(&mut theirs).unwrap();
                 assert_eq!(decode(theirs.into_inner()), expected);
             }
+        }
+    }
+
+    /// A file that takes `room` bytes, then fails every write.
+    struct FullDisk {
+        written: Cursor<Vec<u8>>,
+        room: usize,
+    }
+
+    impl Write for FullDisk {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            if self.written.get_ref().len() + buf.len() > self.room {
+                return Err(std::io::Error::other("no space left on device"));
+            }
+            self.written.write(buf)
+        }
+
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    impl Seek for FullDisk {
+        fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+            self.written.seek(pos)
+        }
+    }
+
+    #[test]
+    fn a_failing_write_stops_every_compressor_and_is_reported() {
+        // 300 one-line blocks: far more than the window compressed ahead of the writer.
+        let img = image(64, 300, false, false, Compression::ZIP1, true);
+        for room in [0, 2_000, 40_000] {
+            let out = FullDisk {
+                written: Cursor::new(Vec::new()),
+                room,
+            };
+            let err = write_zip_image(&img, 1, out).unwrap_err();
+            assert!(err.to_string().contains("no space left"), "{room}: {err}");
         }
     }
 

@@ -21,6 +21,8 @@ mod write;
 
 use std::collections::BTreeMap;
 
+use rayon::prelude::*;
+
 pub use cos_code::CosCode;
 pub use cryptomatte::{
     AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, PlaneSource, cryptomatte_layers,
@@ -63,6 +65,30 @@ pub struct PlacedMask {
     pub has_coordinates: bool,
 }
 
+/// Pixels per parallel task of the whole-mask scans.
+const SCAN_CHUNK: usize = 1 << 16;
+
+/// Smallest and largest of `value(v)` over the glass pixels (id ≠ 0), scanned in parallel;
+/// NaN values are passed over, as `f64::min` and `f64::max` do.
+fn glass_range<T: Sync>(
+    ids: &[u16],
+    values: &[T],
+    value: impl Fn(&T) -> f64 + Sync,
+) -> Option<(f64, f64)> {
+    ids.par_chunks(SCAN_CHUNK)
+        .zip(values.par_chunks(SCAN_CHUNK))
+        .filter_map(|(ids, values)| {
+            ids.iter()
+                .zip(values)
+                .filter(|(id, _)| **id != 0)
+                .map(|(_, v)| value(v))
+                .fold(None, |range, c| {
+                    Some(range.map_or((c, c), |(lo, hi): (f64, f64)| (lo.min(c), hi.max(c))))
+                })
+        })
+        .reduce_with(|(a_lo, a_hi), (b_lo, b_hi)| (a_lo.min(b_lo), a_hi.max(b_hi)))
+}
+
 impl MaskImage {
     /// The mask over window `to` of the frame, from a mask holding window `from`: pixels of
     /// `to` outside `from` have no glass (id 0).
@@ -100,6 +126,15 @@ pub struct PlaneBounds {
 }
 
 impl PlaneBounds {
+    /// Grows the rectangle to hold `other` too, and adds its glass pixels.
+    fn include(&mut self, other: &PlaneBounds) {
+        self.x_min = self.x_min.min(other.x_min);
+        self.y_min = self.y_min.min(other.y_min);
+        self.x_max = self.x_max.max(other.x_max);
+        self.y_max = self.y_max.max(other.y_max);
+        self.glass_pixels += other.glass_pixels;
+    }
+
     /// The rectangle as a [`PixelWindow`] (top-left pixel and size).
     pub fn window(&self) -> PixelWindow {
         PixelWindow {
@@ -154,10 +189,23 @@ impl MaskImage {
     /// Glass pixels per id (id 0, "no glass", is not counted). Used to list unknown ids with
     /// their pixel counts and by `glassdb registry build --mask`.
     pub fn id_pixel_counts(&self) -> BTreeMap<u16, u64> {
-        let mut counts = vec![0u64; 65536];
-        for &id in &self.id {
-            counts[id as usize] += 1;
-        }
+        let counts = self
+            .id
+            .par_chunks(SCAN_CHUNK)
+            .fold(
+                || vec![0u64; 1 << 16],
+                |mut counts, ids| {
+                    for &id in ids {
+                        counts[usize::from(id)] += 1;
+                    }
+                    counts
+                },
+            )
+            .reduce_with(|mut a, b| {
+                a.iter_mut().zip(&b).for_each(|(a, b)| *a += b);
+                a
+            })
+            .unwrap_or_default();
         counts
             .iter()
             .enumerate()
@@ -181,17 +229,12 @@ impl MaskImage {
 
     /// Smallest and largest cos θ over glass pixels (id ≠ 0); `None` without glass.
     pub fn cos_theta_range(&self) -> Option<(f64, f64)> {
-        let mut range: Option<(f64, f64)> = None;
-        for (i, &id) in self.id.iter().enumerate() {
-            if id != 0 {
-                let c = self.cos_theta_at(i);
-                range = Some(match range {
-                    None => (c, c),
-                    Some((lo, hi)) => (lo.min(c), hi.max(c)),
-                });
-            }
+        match &self.cos_theta {
+            CosTheta::Quantized8(c) => glass_range(&self.id, c, |&c| CosCode::decode8(c)),
+            CosTheta::Quantized16(c) => glass_range(&self.id, c, |&c| CosCode::Bits16.decode(c)),
+            CosTheta::Float(c) => glass_range(&self.id, c, |&c| f64::from(c)),
+            CosTheta::Normal => self.id.iter().any(|&id| id != 0).then_some((1.0, 1.0)),
         }
-        range
     }
 
     /// Each plane's screen rectangle: the smallest window holding every glass pixel (id ≠ 0)
@@ -200,36 +243,60 @@ impl MaskImage {
     /// must cover for that plane's reflection pass (docs/scene.md, "Plane bounds").
     pub fn plane_bounds(&self) -> BTreeMap<u16, PlaneBounds> {
         let width = self.width as usize;
-        let mut out: BTreeMap<u16, PlaneBounds> = BTreeMap::new();
         if width == 0 {
-            return out;
+            return BTreeMap::new();
         }
-        for (row, (ids, planes)) in self
-            .id
-            .chunks_exact(width)
-            .zip(self.plane.chunks_exact(width))
+        let rows_per_task = (SCAN_CHUNK / width).max(1);
+        self.id
+            .par_chunks(width * rows_per_task)
+            .zip(self.plane.par_chunks(width * rows_per_task))
             .enumerate()
-        {
-            for (col, (&id, &plane)) in ids.iter().zip(planes).enumerate() {
-                if id == 0 {
-                    continue;
+            .map(|(task, (ids, planes))| {
+                let mut bounds: BTreeMap<u16, PlaneBounds> = BTreeMap::new();
+                let rows = ids.chunks_exact(width).zip(planes.chunks_exact(width));
+                for (row, (ids, planes)) in rows.enumerate() {
+                    let y = (task * rows_per_task + row) as i32;
+                    // Runs of one plane along the row: one map lookup per run.
+                    let mut col = 0;
+                    while col < width {
+                        if ids[col] == 0 {
+                            col += 1;
+                            continue;
+                        }
+                        let plane = planes[col];
+                        let start = col;
+                        let mut glass = 0u64;
+                        let mut last = col;
+                        while col < width && (ids[col] == 0 || planes[col] == plane) {
+                            if ids[col] != 0 {
+                                glass += 1;
+                                last = col;
+                            }
+                            col += 1;
+                        }
+                        let run = PlaneBounds {
+                            x_min: start as i32,
+                            y_min: y,
+                            x_max: last as i32,
+                            y_max: y,
+                            glass_pixels: glass,
+                        };
+                        bounds
+                            .entry(plane)
+                            .and_modify(|b| b.include(&run))
+                            .or_insert(run);
+                    }
                 }
-                let (x, y) = (col as i32, row as i32);
-                let b = out.entry(plane).or_insert(PlaneBounds {
-                    x_min: x,
-                    y_min: y,
-                    x_max: x,
-                    y_max: y,
-                    glass_pixels: 0,
-                });
-                b.x_min = b.x_min.min(x);
-                b.y_min = b.y_min.min(y);
-                b.x_max = b.x_max.max(x);
-                b.y_max = b.y_max.max(y);
-                b.glass_pixels += 1;
-            }
-        }
-        out
+                bounds
+            })
+            .reduce(BTreeMap::new, |mut a, b| {
+                for (plane, run) in b {
+                    a.entry(plane)
+                        .and_modify(|b| b.include(&run))
+                        .or_insert(run);
+                }
+                a
+            })
     }
 
     /// Largest plane index over glass pixels (0 without glass).

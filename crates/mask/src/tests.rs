@@ -644,3 +644,64 @@ proptest! {
         }
     }
 }
+
+/// The whole-mask scans run in parallel over many tasks (a 301 × 700 mask is four or more);
+/// their merged results equal one pass over the pixels in order.
+#[test]
+fn parallel_scans_equal_a_serial_pass() {
+    let (w, h) = (301usize, 700usize);
+    let hash = |i: usize| (i as u32).wrapping_mul(0x9e37_79b9).rotate_left(11);
+    let id: Vec<u16> = (0..w * h)
+        .map(|i| {
+            if hash(i) % 5 < 2 {
+                0
+            } else {
+                (hash(i) >> 8) as u16 % 4
+            }
+        })
+        .collect();
+    // Planes in vertical and horizontal bands, so that runs along a row change plane.
+    let plane: Vec<u16> = (0..w * h)
+        .map(|i| ((i % w) / 70 + (i / w) / 150) as u16 % 6)
+        .collect();
+    let codes: Vec<u8> = (0..w * h).map(|i| (hash(i) >> 16) as u8).collect();
+    for cos_theta in [
+        CosTheta::Quantized8(codes.clone()),
+        CosTheta::Float(codes.iter().map(|&c| f32::from(c) / 300.0).collect()),
+    ] {
+        let mask = MaskImage {
+            width: w as u32,
+            height: h as u32,
+            id: id.clone(),
+            cos_theta,
+            plane: plane.clone(),
+            coverage: None,
+        };
+        let mut counts = BTreeMap::new();
+        let mut bounds: BTreeMap<u16, PlaneBounds> = BTreeMap::new();
+        let mut range: Option<(f64, f64)> = None;
+        for i in (0..w * h).filter(|&i| id[i] != 0) {
+            *counts.entry(id[i]).or_insert(0u64) += 1;
+            let (x, y) = ((i % w) as i32, (i / w) as i32);
+            let b = bounds.entry(plane[i]).or_insert(PlaneBounds {
+                x_min: x,
+                y_min: y,
+                x_max: x,
+                y_max: y,
+                glass_pixels: 0,
+            });
+            (b.x_min, b.y_min) = (b.x_min.min(x), b.y_min.min(y));
+            (b.x_max, b.y_max) = (b.x_max.max(x), b.y_max.max(y));
+            b.glass_pixels += 1;
+            let c = mask.cos_theta_at(i);
+            range = Some(range.map_or((c, c), |(lo, hi)| (lo.min(c), hi.max(c))));
+        }
+        assert_eq!(mask.id_pixel_counts(), counts);
+        assert_eq!(mask.plane_bounds(), bounds);
+        assert_eq!(mask.cos_theta_range(), range);
+        assert!(
+            bounds.len() == 6 && counts.len() == 3,
+            "{bounds:?} {counts:?}"
+        );
+    }
+}
