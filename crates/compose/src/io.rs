@@ -556,34 +556,133 @@ impl OutputFrame {
             });
         };
         let parts = glassdb_image::read_exr_headers(bytes).map_err(|s| decode_err(path, s))?;
-        let exr = if carries_whole_file(&parts, channel_names, (keep_channels, beside)) {
-            let file = glassdb_image::read_exr_exact(bytes, max_pixels).map_err(|source| {
-                ComposeError::KeepChannels {
-                    path: path.to_path_buf(),
-                    source,
-                }
-            })?;
-            ExrCarried::Whole {
+        if !carries_whole_file(&parts, channel_names, (keep_channels, beside)) {
+            return Self::with_attributes(pass, &parts, bytes, path, keep_channels);
+        }
+        let file = glassdb_image::read_exr_exact(bytes, max_pixels).map_err(|source| {
+            ComposeError::KeepChannels {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
+        Ok(OutputFrame {
+            windows: pass.windows,
+            exr: Some(ExrCarried::Whole {
                 file,
                 part: *part,
                 channel_names: channel_names.clone(),
-            }
-        } else {
-            let (image, part) = glassdb_image::read_exr_attributes(bytes, *part)
-                .map_err(|s| decode_err(path, s))?;
-            ExrCarried::Attributes {
-                image: Box::new(image),
-                part: Box::new(part),
-                names: (keep_channels && only_the_layer(&parts, channel_names))
-                    .then(|| channel_names.clone()),
-            }
-        };
-        Ok(OutputFrame {
-            windows: pass.windows,
-            exr: Some(exr),
+            }),
             tag_space: None,
         })
     }
+
+    /// The frame of an EXR transmission pass (`parts`, the file's headers) of which only the
+    /// attributes are carried over, read from `header` (the file from its start: only its
+    /// headers are read).
+    fn with_attributes(
+        pass: &Pass,
+        parts: &[ExrPart],
+        header: impl std::io::Read,
+        path: &Path,
+        keep_channels: bool,
+    ) -> Result<OutputFrame, ComposeError> {
+        let (part, channel_names) = match &pass.source {
+            PassSource::Exr {
+                part,
+                channel_names,
+                ..
+            } => (*part, channel_names),
+            PassSource::Png { .. } => {
+                return Ok(OutputFrame {
+                    windows: pass.windows,
+                    exr: None,
+                    tag_space: None,
+                });
+            }
+        };
+        let (image, part) =
+            glassdb_image::read_exr_attributes(header, part).map_err(|s| decode_err(path, s))?;
+        Ok(OutputFrame {
+            windows: pass.windows,
+            exr: Some(ExrCarried::Attributes {
+                image: Box::new(image),
+                part: Box::new(part),
+                names: (keep_channels && only_the_layer(parts, channel_names))
+                    .then(|| channel_names.clone()),
+            }),
+            tag_space: None,
+        })
+    }
+}
+
+/// Reads the transmission pass and what the output carries over from it, from one open file
+/// (a file replaced meanwhile cannot mix two versions): an EXR whose other channels are not
+/// carried is decoded by seeking (its blocks are read as they are decoded, never the whole
+/// file at once), then its headers again for the attributes; otherwise the whole file is read.
+pub fn read_transmission(
+    path: &Path,
+    opts: &PassReadOptions,
+    keep: (bool, bool),
+    max_pixels: u64,
+) -> Result<(Pass, OutputFrame), ComposeError> {
+    use std::io::{Read, Seek, SeekFrom};
+    let read_err = |cause| ComposeError::Read {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let limit = glassdb_io::limits::IMAGE;
+    let (file, len) = glassdb_io::open_input(path, limit).map_err(read_err)?;
+    let mut file = std::io::BufReader::with_capacity(1 << 16, file.into_inner());
+    let header = glassdb_image::read_image_header(&mut file, opts.max_pixels)
+        .map_err(|source| decode_err(path, source))?;
+    let rewind = |file: &mut std::io::BufReader<std::fs::File>| {
+        file.seek(SeekFrom::Start(0))
+            .map(drop)
+            .map_err(|e| read_err(glassdb_io::InputError::from(e)))
+    };
+    if let ImageHeader::Exr(headers) = &header {
+        let chosen = choose_layer(&headers.parts, opts.layer.as_deref(), path)?;
+        let names: Vec<String> = headers.parts.get(chosen.part).map_or_else(Vec::new, |p| {
+            layer_channels(&chosen)
+                .iter()
+                .filter_map(|&c| p.channels.get(c).map(|c| c.name.clone()))
+                .collect()
+        });
+        if !carries_whole_file(&headers.parts, &names, keep) {
+            let pass = read_exr_pass(&headers.parts, path, opts, |part, channels| {
+                glassdb_image::read_exr_channel_rows_from(
+                    &mut file,
+                    &headers.parts,
+                    part,
+                    channels,
+                    opts.max_pixels,
+                    None,
+                )
+            })?;
+            rewind(&mut file)?;
+            let frame = OutputFrame::with_attributes(&pass, &headers.parts, file, path, keep.0)?;
+            return Ok((pass, frame));
+        }
+    }
+    rewind(&mut file)?;
+    let mut bytes = Vec::new();
+    bytes
+        .try_reserve_exact(usize::try_from(len).unwrap_or(usize::MAX))
+        .map_err(|_| ComposeError::TooLarge {
+            path: path.to_path_buf(),
+        })?;
+    file.take(limit.bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| read_err(glassdb_io::InputError::from(e)))?;
+    if bytes.len() as u64 > limit.bytes {
+        return Err(read_err(glassdb_io::InputError::TooLarge {
+            size: None,
+            limit,
+        }));
+    }
+    let pass = read_pass_bytes(&bytes, path, opts)?;
+    let frame = OutputFrame::of_transmission(&pass, &bytes, path, keep, max_pixels)?;
+    Ok((pass, frame))
 }
 
 /// What was written.

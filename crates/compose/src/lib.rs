@@ -250,16 +250,7 @@ fn decode_inputs(
 ) -> Result<DecodedInputs, ComposeError> {
     let read_trans = || -> Result<(Pass, OutputFrame), ComposeError> {
         let opts = settings.pass_options(Some(&settings.layers.trans));
-        let bytes = io::read_file(&job.trans)?;
-        let pass = io::read_pass_bytes(&bytes, &job.trans, &opts)?;
-        let frame = OutputFrame::of_transmission(
-            &pass,
-            &bytes,
-            &job.trans,
-            (keep, beside),
-            settings.pass.max_pixels,
-        )?;
-        Ok((pass, frame))
+        io::read_transmission(&job.trans, &opts, (keep, beside), settings.pass.max_pixels)
     };
     // The reflection passes a few at a time (as many as there are threads): each holds its
     // compressed blocks (read from its file by seeking) only while it is decoded, so that many

@@ -8,8 +8,10 @@
 //!   planes, cos θ and coverage), and what a read holds only while it runs for the
 //!   transmission pass, the mask and as many reflection passes as are decoded at once
 //!   ([`decoding_at_once`], the largest counted): the transmission pass's and the mask's file,
-//!   read whole, and an EXR's compressed blocks copied out of it, or a PNG's decoding buffer;
-//!   a reflection EXR is read by seeking, so only its compressed blocks (at most its file);
+//!   read whole, and an EXR's compressed blocks copied out of it, or a PNG's decoding buffer
+//!   (an upper bound for a transmission EXR whose other channels are not carried: it is read
+//!   by seeking, one block per decoding thread at a time); a reflection EXR is read by
+//!   seeking, counted as its compressed blocks (at most its file);
 //!   the transmission file's other channels in their own sample types when they are carried
 //!   over. A reflection pass counts the planes of its whole data window (a crop: its
 //!   rectangle), an upper bound: decoding keeps only the blocks of its plane's glass rows,
@@ -17,7 +19,7 @@
 //! - compositing: the decoded inputs, and the mask placed in the frame when its data window
 //!   differs from the transmission pass's;
 //! - encoding: the composite and the carried channels, a half-float copy of one plane (half
-//!   EXR), the compressor's batch of blocks, or the PNG samples and file.
+//!   EXR), the compressor's window of blocks, or the PNG samples and file.
 //!
 //! The frame's estimate is the largest of the three stages, plus an eighth for what the
 //! allocator keeps and [`PROCESS_OVERHEAD`] for the program itself ([`with_overhead`]).

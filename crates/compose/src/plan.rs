@@ -128,7 +128,7 @@ fn estimate(
     let carried_bpp = carried / pixels.max(1);
     let output = match format {
         OutputFormat::Exr => {
-            // A half copy of one plane at a time; the compressor's batch of blocks (raw, split
+            // A half copy of one plane at a time; the compressor's window of blocks (raw, split
             // and deflated: three copies of 16 rows of every channel, four blocks per thread).
             let half = match io::output_data_type(&trans.source, &settings.output) {
                 ExrDataType::Half => pixels.saturating_mul(2),

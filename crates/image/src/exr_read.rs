@@ -626,14 +626,14 @@ fn convert_samples(bytes: &[u8], ty: ExrSampleType, dst: &mut [f32]) -> Result<(
     Ok(())
 }
 
-/// The attributes of an EXR held in memory, as the `exr` crate models them: those shared by
+/// The attributes of an EXR (`file` from its start; only its headers are read), as the `exr` crate models them: those shared by
 /// every part (display window, chromaticities, pixel aspect, custom ones) and part `part`'s own
 /// (name, view, renderer attributes). No pixel data is touched.
 pub fn read_exr_attributes(
-    bytes: &[u8],
+    file: impl Read,
     part: usize,
 ) -> Result<(ImageAttributes, LayerAttributes), ImageError> {
-    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false))?;
+    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(file, false))?;
     let header = meta
         .headers
         .get(part)
