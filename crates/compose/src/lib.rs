@@ -706,8 +706,9 @@ pub(crate) fn compose_frame_within(
     let cos_range = mask.cos_theta_range();
     let (width, height) = (trans.image.width, trans.image.height);
     drop(placed);
-    drop(refl);
-    drop(mask);
+    // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
+    // another thread does it while the encoder keeps both cores busy.
+    std::thread::spawn(move || drop((refl, mask)));
     let compose = t1.elapsed();
 
     progress.stage(encode_stage);

@@ -11,6 +11,7 @@
 
 use glassdb_mask::CosCode;
 use glassdb_registry::{GlassRecord, RegistryTable, Side};
+use rayon::prelude::*;
 
 /// Intervals of the fine table over cos θ ∈ [0, 1].
 pub const FINE_STEPS: usize = 4096;
@@ -93,54 +94,61 @@ impl GlassLut {
     /// and `normal(id, side)` the normal-incidence values.
     pub fn from_fn(
         ids: &[u16],
-        eval: impl Fn(u16, Side, f64) -> ([f64; 3], [f64; 3]),
-        normal: impl Fn(u16, Side) -> ([f64; 3], [f64; 3]),
+        eval: impl Fn(u16, Side, f64) -> ([f64; 3], [f64; 3]) + Sync,
+        normal: impl Fn(u16, Side) -> ([f64; 3], [f64; 3]) + Sync,
     ) -> GlassLut {
         let to_triple = |(r, t): ([f64; 3], [f64; 3])| RtTriple {
             r: r.map(|v| v as f32),
             t: t.map(|v| v as f32),
         };
         let mut index = vec![NONE; 65536];
-        let mut slots = Vec::new();
-        let mut worst: f64 = 0.0;
+        // Each id once, in the order given (the first wins); slot k is unique[k]'s.
+        let mut unique = Vec::new();
         for &id in ids {
-            if id == 0 || index[id as usize] != NONE {
-                continue;
+            if id != 0 && index[id as usize] == NONE {
+                index[id as usize] = unique.len() as u32;
+                unique.push(id);
             }
-            let make = |side: Side| -> (GlassSideLut, f64) {
-                let q8 = Box::new(std::array::from_fn(|code| {
-                    to_triple(eval(id, side, CosCode::decode8(code as u8)))
-                }));
-                let fine = Box::new(std::array::from_fn(|i| {
-                    to_triple(eval(id, side, i as f64 / FINE_STEPS as f64))
-                }));
-                let lut = GlassSideLut {
-                    q8,
-                    fine,
-                    normal: to_triple(normal(id, side)),
-                };
-                let mut err: f64 = 0.0;
-                for i in 0..FINE_STEPS {
-                    let cos = (i as f64 + 0.5) / FINE_STEPS as f64;
-                    let (r, t) = eval(id, side, cos);
-                    let got = lut.at_cos(cos as f32);
-                    for c in 0..3 {
-                        err = err
-                            .max((f64::from(got.r[c]) - r[c]).abs())
-                            .max((f64::from(got.t[c]) - t[c]).abs());
-                    }
-                }
-                (lut, err)
-            };
-            let (front, e1) = make(Side::Front);
-            let (back, e2) = make(Side::Back);
-            worst = worst.max(e1).max(e2);
-            index[id as usize] = slots.len() as u32;
-            slots.push([front, back]);
         }
+        let make = |id: u16, side: Side| -> (GlassSideLut, f64) {
+            let q8 = Box::new(std::array::from_fn(|code| {
+                to_triple(eval(id, side, CosCode::decode8(code as u8)))
+            }));
+            let fine = Box::new(std::array::from_fn(|i| {
+                to_triple(eval(id, side, i as f64 / FINE_STEPS as f64))
+            }));
+            let lut = GlassSideLut {
+                q8,
+                fine,
+                normal: to_triple(normal(id, side)),
+            };
+            let mut err: f64 = 0.0;
+            for i in 0..FINE_STEPS {
+                let cos = (i as f64 + 0.5) / FINE_STEPS as f64;
+                let (r, t) = eval(id, side, cos);
+                let got = lut.at_cos(cos as f32);
+                for c in 0..3 {
+                    err = err
+                        .max((f64::from(got.r[c]) - r[c]).abs())
+                        .max((f64::from(got.t[c]) - t[c]).abs());
+                }
+            }
+            (lut, err)
+        };
+        // The glasses' tables in parallel: a catalog's hundreds of glasses would otherwise
+        // hold up every frame's start on one core.
+        let built: Vec<([GlassSideLut; 2], f64)> = unique
+            .par_iter()
+            .map(|&id| {
+                let (front, e1) = make(id, Side::Front);
+                let (back, e2) = make(id, Side::Back);
+                ([front, back], e1.max(e2))
+            })
+            .collect();
+        let worst = built.iter().map(|b| b.1).fold(0.0, f64::max);
         GlassLut {
             index,
-            slots,
+            slots: built.into_iter().map(|b| b.0).collect(),
             fine_table_error: worst,
         }
     }

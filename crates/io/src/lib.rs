@@ -23,7 +23,8 @@ pub use input::{
 };
 pub use kind::FileKind;
 pub use output::{
-    OutputError, StagedOutput, refuse_input_as_output, write_atomic, write_bytes_atomic,
+    OutputError, StagedOutput, SyncingFile, refuse_input_as_output, write_atomic,
+    write_bytes_atomic,
 };
 pub use registry::{TEMP_PREFIX, exit_removing_temporaries, protect_inputs};
 pub mod progress;

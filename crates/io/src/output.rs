@@ -119,7 +119,7 @@ struct StagedFile {
 /// Writes `produce`'s content to a temporary file beside `path`'s target, flushed and synced.
 fn stage<F>(path: &Path, produce: F) -> Result<StagedFile, OutputError>
 where
-    F: FnOnce(&mut BufWriter<&mut File>) -> std::io::Result<()>,
+    F: FnOnce(&mut BufWriter<SyncingFile<'_>>) -> std::io::Result<()>,
 {
     let target = resolve_target(path)?;
     refuse_input_as_output(path, [])?;
@@ -158,7 +158,7 @@ where
         source,
     };
     {
-        let mut w = BufWriter::new(&mut file);
+        let mut w = BufWriter::new(SyncingFile::new(&mut file));
         produce(&mut w).map_err(write_err)?;
         w.flush().map_err(write_err)?;
     }
@@ -170,6 +170,46 @@ where
     })
 }
 
+/// An output's temporary file that starts writing its data to disk as it goes: after every
+/// [`SyncingFile::SYNC_EVERY`] bytes it waits for them to reach the disk (`sync_data`), so
+/// that the `fsync` before the rename, which nothing else overlaps, has only the last few
+/// megabytes left to write (a 93 MB frame: 35 ms of idle cores at the end otherwise).
+pub struct SyncingFile<'a> {
+    file: &'a mut File,
+    unsynced: u64,
+}
+
+impl<'a> SyncingFile<'a> {
+    /// Bytes written between two `sync_data` calls.
+    pub const SYNC_EVERY: u64 = 16 << 20;
+
+    fn new(file: &'a mut File) -> Self {
+        Self { file, unsynced: 0 }
+    }
+}
+
+impl Write for SyncingFile<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.file.write(buf)?;
+        self.unsynced += n as u64;
+        if self.unsynced >= Self::SYNC_EVERY {
+            self.file.sync_data()?;
+            self.unsynced = 0;
+        }
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.flush()
+    }
+}
+
+impl std::io::Seek for SyncingFile<'_> {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.file.seek(pos)
+    }
+}
+
 /// Writes a file atomically: `produce` writes into a buffered temporary file beside `path`,
 /// which is flushed, synced and renamed over `path` only if `produce` returns `Ok`.
 /// On any error the temporary file is removed and `path` is left as it was. The checks of the
@@ -177,7 +217,7 @@ where
 /// through), and not a file this process read ([`crate::protect_inputs`]).
 pub fn write_atomic<F>(path: &Path, produce: F) -> Result<(), OutputError>
 where
-    F: FnOnce(&mut BufWriter<&mut File>) -> std::io::Result<()>,
+    F: FnOnce(&mut BufWriter<SyncingFile<'_>>) -> std::io::Result<()>,
 {
     let staged = stage(path, produce)?;
     staged
@@ -213,7 +253,7 @@ impl StagedOutput {
     /// Writes the content of `path` to its temporary file (see [`write_atomic`]).
     pub fn write<F>(&mut self, path: &Path, produce: F) -> Result<(), OutputError>
     where
-        F: FnOnce(&mut BufWriter<&mut File>) -> std::io::Result<()>,
+        F: FnOnce(&mut BufWriter<SyncingFile<'_>>) -> std::io::Result<()>,
     {
         self.files.push(stage(path, produce)?);
         Ok(())
@@ -334,6 +374,26 @@ where
 mod tests {
     use super::*;
     use crate::ErrorChain;
+
+    /// A file larger than [`SyncingFile::SYNC_EVERY`], with a seek back over written bytes
+    /// (as an EXR's offset table is written last), lands exactly as written.
+    #[test]
+    fn a_large_file_written_with_syncs_and_a_seek_back_is_exact() {
+        use std::io::{Seek, SeekFrom};
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.bin");
+        let len = SyncingFile::SYNC_EVERY as usize * 2 + 12_345;
+        let expected: Vec<u8> = (0..len).map(|i| (i * 7 % 251) as u8).collect();
+        write_atomic(&path, |w| {
+            w.write_all(&[0; 8])?;
+            w.write_all(&expected[8..])?;
+            w.seek(SeekFrom::Start(0))?;
+            w.write_all(&expected[..8])
+        })
+        .unwrap();
+        assert!(std::fs::read(&path).unwrap() == expected);
+        assert_eq!(names(dir.path()), ["big.bin"]);
+    }
 
     /// The names in `dir`, sorted.
     fn names(dir: &Path) -> Vec<String> {
