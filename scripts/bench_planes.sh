@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Cost follows the glass, not the planes (docs/performance.md, "Many planes, cropped passes"):
 # times `compose` on a frame with PLANES glass windows (one plane each) whose reflection passes
-# are full frames, cropped to each plane's window (EXR data windows, one file per plane), or
-# every crop in one multi-part file (parts plane0, plane1, …), against one plane carrying the
-# same glass with one full-frame pass, and against oiiotool doing the same composite (the crops
-# summed over the frame, `--add`, then the compositor's own tables as colormaps, as in
-# scripts/bench_compose_vs_oiiotool.sh).
+# are full frames (one file per plane), cropped to each plane's window (EXR data windows, one
+# file per plane), or every crop in one multi-part file (parts plane0, plane1, …), against one
+# plane carrying the same glass with one full-frame pass, and against oiiotool doing the same
+# composite (the crops summed over the frame, `--add`, then the compositor's own tables as
+# colormaps, as in scripts/bench_compose_vs_oiiotool.sh).
 #
 # Paired whole-process runs: every repetition runs each command once, in a fixed order, so all
 # see the same machine state; medians of REPEATS, wall clock and peak RSS from /usr/bin/time -v.
@@ -56,10 +56,13 @@ for size in $SIZES; do
         for r in "${rects[@]}"; do
             read -r k x y cw ch <<<"$r"
             oiiotool "$d/refl.exr" --crop "${cw}x${ch}+${x}+${y}" -d "$type" --compression zip -o "$d/crop_$k.exr"
-            full+=(--refl "$d/refl.exr")
+            # One file per plane, as renders are: a file named twice would be decoded once by
+            # oiiotool's image cache, a saving no real frame offers.
+            cp "$d/refl.exr" "$d/refl_$k.exr"
+            full+=(--refl "$d/refl_$k.exr")
             crop+=(--refl "$d/crop_$k.exr")
             parts+=("$d/crop_$k.exr" --attrib oiio:subimagename "plane$k")
-            oiio_full+=("$d/refl.exr" --crop "${cw}x${ch}+${x}+${y}")
+            oiio_full+=("$d/refl_$k.exr" --crop "${cw}x${ch}+${x}+${y}")
             oiio_crop+=("$d/crop_$k.exr")
             [ "$k" = 0 ] || { oiio_full+=(--add); oiio_crop+=(--add); }
         done
