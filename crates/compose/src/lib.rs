@@ -708,7 +708,10 @@ pub(crate) fn compose_frame_within(
     drop(placed);
     // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
     // another thread does it while the encoder keeps both cores busy.
-    std::thread::spawn(move || drop((refl, mask)));
+    // Where no thread can be started, the closure, and so the passes, are dropped here.
+    let _ = std::thread::Builder::new()
+        .name("glassdb-free".into())
+        .spawn(move || drop((refl, mask)));
     let compose = t1.elapsed();
 
     progress.stage(encode_stage);

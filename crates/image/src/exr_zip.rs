@@ -73,10 +73,9 @@ fn write_layer_blocks<W: Write + Seek + Send>(
     let (sender, receiver) = mpsc::channel::<(usize, exr::error::Result<Chunk>)>();
     std::thread::scope(|scope| {
         let writing = scope.spawn(|| {
-            let result = write_in_order(writer, receiver, blocks, &window);
-            // Whatever happened, no compressor may wait for this writer any longer.
-            window.stop();
-            result
+            // Whatever happens, even a panic, no compressor may wait for this writer afterwards.
+            let _stop = StopOnDrop(&window);
+            write_in_order(writer, receiver, blocks, &window)
         });
         window
             .indices(blocks)
@@ -158,6 +157,15 @@ impl BlockWindow {
             }
             (!state.1).then_some(block)
         })
+    }
+}
+
+/// Stops a [`BlockWindow`] when dropped.
+struct StopOnDrop<'a>(&'a BlockWindow);
+
+impl Drop for StopOnDrop<'_> {
+    fn drop(&mut self) {
+        self.0.stop();
     }
 }
 
