@@ -2,6 +2,8 @@
 //! into samples), choosing a pass's RGB layer, and writing the result through glassdb-image's
 //! EXR and PNG encoders, atomically.
 
+use std::fs::File;
+use std::io::{BufReader, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use glassdb_image::{
@@ -93,14 +95,7 @@ pub struct PassHeader {
 /// the header alone; `None` for a PNG or an EXR without such layers. Planes must be numbered
 /// from 0 without gaps.
 pub fn plane_layers_of(path: &Path, max_pixels: u64) -> Result<Option<Vec<String>>, ComposeError> {
-    let (file, _) = glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(|cause| {
-        ComposeError::Read {
-            path: path.to_path_buf(),
-            cause,
-        }
-    })?;
-    let header = glassdb_image::read_image_header(std::io::BufReader::new(file), max_pixels)
-        .map_err(|source| decode_err(path, source))?;
+    let (_, header, _) = open_seekable(path, max_pixels)?;
     let ImageHeader::Exr(headers) = header else {
         return Ok(None);
     };
@@ -146,14 +141,7 @@ fn pass_header(
     opts: &PassReadOptions,
     seeking: bool,
 ) -> Result<PassHeader, ComposeError> {
-    let read_err = |cause| ComposeError::Read {
-        path: path.to_path_buf(),
-        cause,
-    };
-    let (file, file_len) =
-        glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(read_err)?;
-    let header = glassdb_image::read_image_header(std::io::BufReader::new(file), opts.max_pixels)
-        .map_err(|source| decode_err(path, source))?;
+    let (_, header, file_len) = open_seekable(path, opts.max_pixels)?;
     match header {
         ImageHeader::Png(h) => {
             let planes = 3 + u64::from(h.channels == 2 || h.channels == 4);
@@ -239,21 +227,12 @@ pub fn read_pass_rows(
     opts: &PassReadOptions,
     rows: (i64, i64),
 ) -> Result<Pass, ComposeError> {
-    use std::io::{Seek, SeekFrom};
-    let read_err = |cause| ComposeError::Read {
-        path: path.to_path_buf(),
-        cause,
-    };
-    let (file, _) = glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(read_err)?;
-    // The size limit was checked from the metadata as opened; the file is read by seeking.
-    let mut file = std::io::BufReader::with_capacity(1 << 16, file.into_inner());
-    let header = glassdb_image::read_image_header(&mut file, opts.max_pixels)
-        .map_err(|source| decode_err(path, source))?;
+    let (file, header, len) = open_seekable(path, opts.max_pixels)?;
     let ImageHeader::Exr(headers) = header else {
-        return read_pass(path, opts);
+        let bytes = glassdb_io::read_open_input(file, len, glassdb_io::limits::IMAGE)
+            .map_err(|cause| read_err(path, cause))?;
+        return read_pass_bytes(&bytes, path, opts);
     };
-    file.seek(SeekFrom::Start(0))
-        .map_err(|e| read_err(glassdb_io::InputError::from(e)))?;
     read_exr_pass(&headers.parts, path, opts, |part, channels| {
         let max = opts.max_pixels;
         glassdb_image::read_exr_channel_rows_from(
@@ -267,12 +246,37 @@ pub fn read_pass_rows(
     })
 }
 
-/// The bytes of an input image, of at most [`glassdb_io::limits::IMAGE`].
-pub fn read_file(path: &Path) -> Result<Vec<u8>, ComposeError> {
-    glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|cause| ComposeError::Read {
+/// An input image opened to be read by seeking (or for its header alone): the file, back at its
+/// start, its header and its size (the size limit was checked from the metadata as opened).
+fn open_seekable(
+    path: &Path,
+    max_pixels: u64,
+) -> Result<(BufReader<File>, ImageHeader, u64), ComposeError> {
+    let (file, len) = glassdb_io::open_input(path, glassdb_io::limits::IMAGE)
+        .map_err(|cause| read_err(path, cause))?;
+    let mut file = BufReader::with_capacity(1 << 16, file.into_inner());
+    let header = glassdb_image::read_image_header(&mut file, max_pixels)
+        .map_err(|source| decode_err(path, source))?;
+    rewind(&mut file, path)?;
+    Ok((file, header, len))
+}
+
+fn rewind(file: &mut BufReader<File>, path: &Path) -> Result<(), ComposeError> {
+    file.seek(SeekFrom::Start(0))
+        .map(drop)
+        .map_err(|e| read_err(path, glassdb_io::InputError::from(e)))
+}
+
+fn read_err(path: &Path, cause: glassdb_io::InputError) -> ComposeError {
+    ComposeError::Read {
         path: path.to_path_buf(),
         cause,
-    })
+    }
+}
+
+/// The bytes of an input image, of at most [`glassdb_io::limits::IMAGE`].
+pub fn read_file(path: &Path) -> Result<Vec<u8>, ComposeError> {
+    glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|cause| read_err(path, cause))
 }
 
 /// Reads a pass from bytes in memory; `path` names it in errors.
@@ -376,11 +380,16 @@ fn exr_source(info: &ExrPart, layer: glassdb_image::RgbLayer, channels: &[usize]
         compression: info.compression,
         layer: layer.name,
         part: layer.part,
-        channel_names: channels
-            .iter()
-            .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))
-            .collect(),
+        channel_names: channel_names(info, channels),
     }
+}
+
+/// The names of `channels` (indices) of part `info`, as stored.
+fn channel_names(info: &ExrPart, channels: &[usize]) -> Vec<String> {
+    channels
+        .iter()
+        .filter_map(|&c| info.channels.get(c).map(|c| c.name.clone()))
+        .collect()
 }
 
 /// EXR sample type of the output.
@@ -625,29 +634,13 @@ pub fn read_transmission(
     keep: (bool, bool),
     max_pixels: u64,
 ) -> Result<(Pass, OutputFrame), ComposeError> {
-    use std::io::{Read, Seek, SeekFrom};
-    let read_err = |cause| ComposeError::Read {
-        path: path.to_path_buf(),
-        cause,
-    };
-    let limit = glassdb_io::limits::IMAGE;
-    let (file, len) = glassdb_io::open_input(path, limit).map_err(read_err)?;
-    let mut file = std::io::BufReader::with_capacity(1 << 16, file.into_inner());
-    let header = glassdb_image::read_image_header(&mut file, opts.max_pixels)
-        .map_err(|source| decode_err(path, source))?;
-    let rewind = |file: &mut std::io::BufReader<std::fs::File>| {
-        file.seek(SeekFrom::Start(0))
-            .map(drop)
-            .map_err(|e| read_err(glassdb_io::InputError::from(e)))
-    };
+    let (mut file, header, len) = open_seekable(path, opts.max_pixels)?;
     if let ImageHeader::Exr(headers) = &header {
         let chosen = choose_layer(&headers.parts, opts.layer.as_deref(), path)?;
-        let names: Vec<String> = headers.parts.get(chosen.part).map_or_else(Vec::new, |p| {
-            layer_channels(&chosen)
-                .iter()
-                .filter_map(|&c| p.channels.get(c).map(|c| c.name.clone()))
-                .collect()
-        });
+        let names = headers
+            .parts
+            .get(chosen.part)
+            .map_or_else(Vec::new, |p| channel_names(p, &layer_channels(&chosen)));
         if !carries_whole_file(&headers.parts, &names, keep) {
             let pass = read_exr_pass(&headers.parts, path, opts, |part, channels| {
                 glassdb_image::read_exr_channel_rows_from(
@@ -659,27 +652,13 @@ pub fn read_transmission(
                     None,
                 )
             })?;
-            rewind(&mut file)?;
+            rewind(&mut file, path)?;
             let frame = OutputFrame::with_attributes(&pass, &headers.parts, file, path, keep.0)?;
             return Ok((pass, frame));
         }
     }
-    rewind(&mut file)?;
-    let mut bytes = Vec::new();
-    bytes
-        .try_reserve_exact(usize::try_from(len).unwrap_or(usize::MAX))
-        .map_err(|_| ComposeError::TooLarge {
-            path: path.to_path_buf(),
-        })?;
-    file.take(limit.bytes + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| read_err(glassdb_io::InputError::from(e)))?;
-    if bytes.len() as u64 > limit.bytes {
-        return Err(read_err(glassdb_io::InputError::TooLarge {
-            size: None,
-            limit,
-        }));
-    }
+    let bytes = glassdb_io::read_open_input(file, len, glassdb_io::limits::IMAGE)
+        .map_err(|cause| read_err(path, cause))?;
     let pass = read_pass_bytes(&bytes, path, opts)?;
     let frame = OutputFrame::of_transmission(&pass, &bytes, path, keep, max_pixels)?;
     Ok((pass, frame))
@@ -1107,8 +1086,8 @@ impl<W: std::io::Write> std::io::Write for CountingWriter<W> {
     }
 }
 
-impl<W: std::io::Seek> std::io::Seek for CountingWriter<W> {
-    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+impl<W: Seek> Seek for CountingWriter<W> {
+    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
         self.pos = self.inner.seek(pos)?;
         Ok(self.pos)
     }

@@ -386,62 +386,19 @@ fn glass_outside_passes(
     lut: &GlassLut,
     windows: &[PixelWindow],
 ) -> BTreeMap<usize, (u64, PixelWindow)> {
-    let width = mask.width as usize;
-    let frame = PixelWindow::at_origin(width, mask.height as usize);
-    if width == 0 || windows.iter().all(|w| w.contains_window(&frame)) {
+    let frame = PixelWindow::at_origin(mask.width as usize, mask.height as usize);
+    if windows.iter().all(|w| w.contains_window(&frame)) {
         return BTreeMap::new();
     }
-    // Rows in parallel, each task with its own counts, merged at the end.
-    let rows_per_task = ((1 << 16) / width).max(1);
-    let out: BTreeMap<usize, (u64, [i64; 4])> = mask
-        .id
-        .par_chunks(width * rows_per_task)
-        .zip(mask.plane.par_chunks(width * rows_per_task))
-        .enumerate()
-        .map(|(task, (ids, planes))| {
-            let first = task * rows_per_task * width;
-            let mut out: BTreeMap<usize, (u64, [i64; 4])> = BTreeMap::new();
-            for (i, (&id, &plane)) in ids.iter().zip(planes).enumerate() {
-                if id == 0 || !lut.contains(id) {
-                    continue;
-                }
-                let k = usize::from(plane);
-                let Some(w) = windows.get(k) else { continue };
-                let i = first + i;
-                let (x, y) = ((i % width) as i64, (i / width) as i64);
-                if w.contains(x, y) {
-                    continue;
-                }
-                let e = out.entry(k).or_insert((0, [x, y, x, y]));
-                e.0 += 1;
-                e.1 = [e.1[0].min(x), e.1[1].min(y), e.1[2].max(x), e.1[3].max(y)];
-            }
-            out
-        })
-        .reduce(BTreeMap::new, |mut a, b| {
-            for (k, (n, r)) in b {
-                let e = a.entry(k).or_insert((0, r));
-                e.0 += n;
-                e.1 = [
-                    e.1[0].min(r[0]),
-                    e.1[1].min(r[1]),
-                    e.1[2].max(r[2]),
-                    e.1[3].max(r[3]),
-                ];
-            }
-            a
-        });
-    out.into_iter()
-        .map(|(k, (n, b))| {
-            let window = PixelWindow {
-                x: b[0] as i32,
-                y: b[1] as i32,
-                width: (b[2] - b[0] + 1) as usize,
-                height: (b[3] - b[1] + 1) as usize,
-            };
-            (k, (n, window))
-        })
-        .collect()
+    mask.plane_bounds_of(|x, y, id, plane| {
+        lut.contains(id)
+            && windows
+                .get(usize::from(plane))
+                .is_some_and(|w| !w.contains(i64::from(x), i64::from(y)))
+    })
+    .into_iter()
+    .map(|(plane, b)| (usize::from(plane), (b.glass_pixels, b.window())))
+    .collect()
 }
 
 /// The windows of an input in the frame `display`: an image without coordinates (a PNG) of the

@@ -358,15 +358,11 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
         .enumerate()
         .map(|(j, c)| {
             let k = unique.binary_search(c).unwrap_or_default();
-            let buffer = decoded.get_mut(k).map(std::mem::take).unwrap_or_default();
+            let slot = decoded.get_mut(k);
             if channels[j + 1..].contains(c) {
-                let copy = buffer.clone();
-                if let Some(slot) = decoded.get_mut(k) {
-                    *slot = buffer;
-                }
-                copy
+                slot.map(|b| b.clone()).unwrap_or_default()
             } else {
-                buffer
+                slot.map(std::mem::take).unwrap_or_default()
             }
         })
         .collect();
@@ -626,9 +622,10 @@ fn convert_samples(bytes: &[u8], ty: ExrSampleType, dst: &mut [f32]) -> Result<(
     Ok(())
 }
 
-/// The attributes of an EXR (`file` from its start; only its headers are read), as the `exr` crate models them: those shared by
-/// every part (display window, chromaticities, pixel aspect, custom ones) and part `part`'s own
-/// (name, view, renderer attributes). No pixel data is touched.
+/// The attributes of an EXR (`file` from its start; only its headers are read), as the `exr`
+/// crate models them: those shared by every part (display window, chromaticities, pixel
+/// aspect, custom ones) and part `part`'s own (name, view, renderer attributes). No pixel data
+/// is touched.
 pub fn read_exr_attributes(
     file: impl Read,
     part: usize,

@@ -177,7 +177,7 @@ fn open(path: &Path) -> std::io::Result<File> {
 /// is recorded as an input that no output of this process may replace.
 pub fn read_input(path: &Path, limit: InputLimit) -> Result<Vec<u8>, InputError> {
     let (file, len) = open_checked(path, limit)?;
-    read_all(file, len, limit)
+    read_open_input(file, len, limit)
 }
 
 /// Reads an earlier output of the command, with the checks of [`read_input`], to see whether
@@ -185,11 +185,17 @@ pub fn read_input(path: &Path, limit: InputLimit) -> Result<Vec<u8>, InputError>
 /// command may still replace it.
 pub fn read_previous_output(path: &Path, limit: InputLimit) -> Result<Vec<u8>, InputError> {
     let (file, meta) = open_unrecorded(path, limit)?;
-    read_all(file, meta.len(), limit)
+    read_open_input(file, meta.len(), limit)
 }
 
-/// Reads at most `limit.bytes` of `file` (of `len` bytes by its metadata), refusing more.
-fn read_all(file: File, len: u64, limit: InputLimit) -> Result<Vec<u8>, InputError> {
+/// Reads at most `limit.bytes` of `file` (of `len` bytes by its metadata), refusing more: the
+/// rest of an input opened with [`open_input`] (from where it stands) when the whole file turns
+/// out to be needed.
+pub fn read_open_input(
+    file: impl Read,
+    len: u64,
+    limit: InputLimit,
+) -> Result<Vec<u8>, InputError> {
     let mut bytes = Vec::new();
     let expected = usize::try_from(len).unwrap_or(usize::MAX);
     bytes.try_reserve_exact(expected).map_err(|_| {

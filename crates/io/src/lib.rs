@@ -19,7 +19,8 @@ mod registry;
 
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
 pub use input::{
-    InputError, InputLimit, limits, open_input, read_input, read_input_string, read_previous_output,
+    InputError, InputLimit, limits, open_input, read_input, read_input_string, read_open_input,
+    read_previous_output,
 };
 pub use kind::FileKind;
 pub use output::{

@@ -242,6 +242,15 @@ impl MaskImage {
     /// count. Planes without glass in view are absent. What a renderer's border (crop) region
     /// must cover for that plane's reflection pass (docs/scene.md, "Plane bounds").
     pub fn plane_bounds(&self) -> BTreeMap<u16, PlaneBounds> {
+        self.plane_bounds_of(|_, _, _, _| true)
+    }
+
+    /// [`MaskImage::plane_bounds`] of the glass pixels `(x, y, id, plane)` that `select` keeps
+    /// (e.g. those outside their plane's pass). Rows are scanned in parallel.
+    pub fn plane_bounds_of(
+        &self,
+        select: impl Fn(i32, i32, u16, u16) -> bool + Sync,
+    ) -> BTreeMap<u16, PlaneBounds> {
         let width = self.width as usize;
         if width == 0 {
             return BTreeMap::new();
@@ -256,19 +265,22 @@ impl MaskImage {
                 let rows = ids.chunks_exact(width).zip(planes.chunks_exact(width));
                 for (row, (ids, planes)) in rows.enumerate() {
                     let y = (task * rows_per_task + row) as i32;
+                    let kept =
+                        |col: usize| ids[col] != 0 && select(col as i32, y, ids[col], planes[col]);
                     // Runs of one plane along the row: one map lookup per run.
                     let mut col = 0;
                     while col < width {
-                        if ids[col] == 0 {
+                        if !kept(col) {
                             col += 1;
                             continue;
                         }
                         let plane = planes[col];
-                        let start = col;
-                        let mut glass = 0u64;
-                        let mut last = col;
-                        while col < width && (ids[col] == 0 || planes[col] == plane) {
-                            if ids[col] != 0 {
+                        let (start, mut last, mut glass) = (col, col, 0u64);
+                        while col < width {
+                            if kept(col) {
+                                if planes[col] != plane {
+                                    break;
+                                }
                                 glass += 1;
                                 last = col;
                             }

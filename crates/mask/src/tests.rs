@@ -677,27 +677,38 @@ fn parallel_scans_equal_a_serial_pass() {
             plane: plane.clone(),
             coverage: None,
         };
+        // Pixel by pixel, in order: the bounds of the glass pixels `keep` selects.
+        let serial_bounds = |keep: &dyn Fn(usize) -> bool| {
+            let mut bounds: BTreeMap<u16, PlaneBounds> = BTreeMap::new();
+            for i in (0..w * h).filter(|&i| id[i] != 0 && keep(i)) {
+                let (x, y) = ((i % w) as i32, (i / w) as i32);
+                let b = bounds.entry(plane[i]).or_insert(PlaneBounds {
+                    x_min: x,
+                    y_min: y,
+                    x_max: x,
+                    y_max: y,
+                    glass_pixels: 0,
+                });
+                (b.x_min, b.y_min) = (b.x_min.min(x), b.y_min.min(y));
+                (b.x_max, b.y_max) = (b.x_max.max(x), b.y_max.max(y));
+                b.glass_pixels += 1;
+            }
+            bounds
+        };
         let mut counts = BTreeMap::new();
-        let mut bounds: BTreeMap<u16, PlaneBounds> = BTreeMap::new();
         let mut range: Option<(f64, f64)> = None;
         for i in (0..w * h).filter(|&i| id[i] != 0) {
             *counts.entry(id[i]).or_insert(0u64) += 1;
-            let (x, y) = ((i % w) as i32, (i / w) as i32);
-            let b = bounds.entry(plane[i]).or_insert(PlaneBounds {
-                x_min: x,
-                y_min: y,
-                x_max: x,
-                y_max: y,
-                glass_pixels: 0,
-            });
-            (b.x_min, b.y_min) = (b.x_min.min(x), b.y_min.min(y));
-            (b.x_max, b.y_max) = (b.x_max.max(x), b.y_max.max(y));
-            b.glass_pixels += 1;
             let c = mask.cos_theta_at(i);
             range = Some(range.map_or((c, c), |(lo, hi)| (lo.min(c), hi.max(c))));
         }
+        let bounds = serial_bounds(&|_| true);
         assert_eq!(mask.id_pixel_counts(), counts);
         assert_eq!(mask.plane_bounds(), bounds);
+        // A selection of the glass pixels (odd columns of ids 1 and 2) against the same pass.
+        let select = |x: i32, id: u16| x % 2 == 1 && id < 3;
+        let selected = serial_bounds(&|i| select((i % w) as i32, id[i]));
+        assert_eq!(mask.plane_bounds_of(|x, _, id, _| select(x, id)), selected);
         assert_eq!(mask.cos_theta_range(), range);
         assert!(
             bounds.len() == 6 && counts.len() == 3,
