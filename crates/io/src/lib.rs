@@ -10,6 +10,7 @@
 //!   temporary files (docs/reliability.md).
 //! - [`frames`]: frame patterns and frame lists of animations.
 //! - [`progress`]: the observer through which libraries report the progress of long work.
+//! - [`quoted`]: a value from an input quoted in a message, cut to a bounded length.
 
 pub mod frames;
 pub mod input;
@@ -29,7 +30,9 @@ pub use output::{
 };
 pub use registry::{TEMP_PREFIX, exit_removing_temporaries, protect_inputs};
 pub mod progress;
+mod quote;
 pub use progress::{NoProgress, Progress, StageLog};
+pub use quote::{MAX_QUOTED_CHARS, Quoted, quoted};
 
 /// Displays an error with its causes as `outer: cause: root`, as `anyhow`'s `{:#}` does, for
 /// messages that are printed or written without going through `anyhow`.
