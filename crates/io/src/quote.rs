@@ -9,27 +9,62 @@ use std::fmt;
 /// ellipsis and its full length.
 pub const MAX_QUOTED_CHARS: usize = 80;
 
-/// A value from an input, displayed as a quoted string (as `{:?}` writes it, escapes and all)
-/// of at most [`MAX_QUOTED_CHARS`] characters: `"abc"`, or `"abcd…" (204800 bytes)` when
-/// it is longer.
+/// A value from an input, displayed quoted, of at most [`MAX_QUOTED_CHARS`] characters:
+/// `"abc"` (escapes and all, as `{:?}` writes it), or `"abcd…" (204800 bytes)` when it is
+/// longer; [`backticked`] writes `` `abc` `` instead, as is.
 #[derive(Debug, Clone, Copy)]
-pub struct Quoted<'a>(&'a str);
+pub struct Quoted<'a> {
+    text: &'a str,
+    backticks: bool,
+}
 
-/// `text` quoted for a message, bounded (see [`Quoted`]).
+/// `text` quoted for a message as `{:?}` quotes it, bounded (see [`Quoted`]).
 pub fn quoted(text: &str) -> Quoted<'_> {
-    Quoted(text)
+    Quoted {
+        text,
+        backticks: false,
+    }
+}
+
+/// `text` between backticks for a message, as it is, bounded (see [`Quoted`]).
+pub fn backticked(text: &str) -> Quoted<'_> {
+    Quoted {
+        text,
+        backticks: true,
+    }
+}
+
+/// A parser's message (which may quote its input: a TOML error shows the line, a JSON error
+/// the unknown field), cut to a bounded length on each line.
+pub fn bounded_message(message: &str) -> String {
+    message
+        .lines()
+        .map(|line| match line.char_indices().nth(4 * MAX_QUOTED_CHARS) {
+            None => line.to_string(),
+            Some((cut, _)) => format!("{}… ({} bytes)", &line[..cut], line.len()),
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 impl fmt::Display for Quoted<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.0.char_indices().nth(MAX_QUOTED_CHARS) {
-            None => write!(f, "{:?}", self.0),
-            Some((cut, _)) => {
-                let head = format!("{:?}", &self.0[..cut]);
-                let open = head.strip_suffix('"').unwrap_or(&head);
-                write!(f, "{open}…\" ({} bytes)", self.0.len())
-            }
+        let (head, cut) = match self.text.char_indices().nth(MAX_QUOTED_CHARS) {
+            None => (self.text, false),
+            Some((at, _)) => (&self.text[..at], true),
+        };
+        let ellipsis = if cut { "…" } else { "" };
+        if self.backticks {
+            write!(f, "`{head}{ellipsis}`")?;
+        } else {
+            let quoted = format!("{head:?}");
+            let open = quoted.strip_suffix('"').unwrap_or(&quoted);
+            write!(f, "{open}{ellipsis}\"")?;
         }
+        if cut {
+            write!(f, " ({} bytes)", self.text.len())?;
+        }
+        Ok(())
     }
 }
 
@@ -59,5 +94,15 @@ mod tests {
         assert!(shown.starts_with("\"\\n\\n"), "{shown}");
         assert!(shown.ends_with("…\" (1000 bytes)"), "{shown}");
         assert!(shown.len() < 2 * MAX_QUOTED_CHARS + 20, "{shown}");
+        assert_eq!(backticked("abc").to_string(), "`abc`");
+        let shown = backticked(&long).to_string();
+        assert!(shown.ends_with("…` (200000 bytes)"), "{shown}");
+        let message = format!("line 4\n4 | x = \"{}\n  | ^\nexpected", "a".repeat(400_000));
+        let bounded = bounded_message(&message);
+        assert!(bounded.len() < 1000, "{bounded}");
+        assert!(
+            bounded.ends_with("(400009 bytes)\n  | ^\nexpected"),
+            "{bounded}"
+        );
     }
 }

@@ -295,7 +295,7 @@ pub(crate) fn plan_cryptomatte(
     opts: &CryptomatteOptions,
     max_pixels: u64,
 ) -> Result<CryptomattePlan, MaskError> {
-    let parts = headers.parts.as_slice();
+    let parts = &headers.parts[..];
     let layers = cryptomatte_layers(&headers.text_attributes, path)?;
     let layer = choose_layer(&layers, opts.layer.as_deref(), path)?;
     let unmatched = opts
