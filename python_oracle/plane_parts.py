@@ -5,7 +5,8 @@ Usage:
   plane_parts.py parts --mask MASK.png --out OUT.exr REFL_0.exr REFL_1.exr ...
       A multi-part file: part `planeK` holds REFL_K's R, G, B cropped to the rectangle of plane
       K's glass pixels in MASK (8-bit packed: R plane, G id), its data window that rectangle,
-      ZIP; a plane without glass gets a 1×1 part at its top-left corner. Prints each part's
+      ZIP; a plane without glass gets a 1×1 part at its top-left corner. With --pad N, 1×1
+      parts of zeros follow up to N parts in all (planes no glass is on). Prints each part's
       data window as JSON.
   plane_parts.py layers [--first K] --out OUT.exr REFL_0.exr REFL_1.exr ...
       One part, full frame, channels planeK.R, planeK.G, planeK.B (K counted from --first, 0).
@@ -53,6 +54,17 @@ def cmd_parts(args):
         }
         parts.append(OpenEXR.Part(header, crop, f"plane{k}"))
         windows.append([x0, y0, x1, y1])
+    display = header["displayWindow"]
+    for k in range(len(parts), args.pad):
+        header = {
+            "compression": OpenEXR.ZIP_COMPRESSION,
+            "type": OpenEXR.scanlineimage,
+            "dataWindow": _window(0, 0, 0, 0),
+            "displayWindow": display,
+        }
+        zeros = {c: np.zeros((1, 1), dtype=np.float16) for c in ("R", "G", "B")}
+        parts.append(OpenEXR.Part(header, zeros, f"plane{k}"))
+        windows.append([0, 0, 0, 0])
     with OpenEXR.File(parts) as f:
         f.write(args.out)
     json.dump(windows, sys.stdout)
@@ -82,6 +94,7 @@ def main():
     a = sub.add_parser("parts")
     a.add_argument("--mask", required=True)
     a.add_argument("--out", required=True)
+    a.add_argument("--pad", type=int, default=0)
     a.add_argument("refl", nargs="+")
     b = sub.add_parser("layers")
     b.add_argument("--out", required=True)

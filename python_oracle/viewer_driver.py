@@ -10,6 +10,16 @@
         Times product choices through the page's automation hook: from the choice to the new
         frame drawn (a 1-pixel read-back finishes the drawing), and the page's load time.
 
+    viewer_driver.py rebind URL --name NAME
+        A page of another site against the viewer at URL: Chromium resolves NAME to the
+        viewer's address (as after DNS rebinding) and opens http://NAME:PORT/. Prints JSON: the
+        text that page got, the status of its own fetch of /api/scene, and whether its
+        cross-site text/plain POST of an export to URL was answered (an opaque reply says
+        nothing, so the caller checks the export folder).
+
+    viewer_driver.py export URL
+        Opens the page, clicks its export button and prints JSON: the status line it shows.
+
 Chromium runs as Debian ships it (/usr/bin/chromium, /usr/bin/chromedriver), WebGL2 on
 SwiftShader when there is no GPU.
 """
@@ -19,6 +29,7 @@ import base64
 import json
 import sys
 import time
+import urllib.parse
 
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
@@ -29,7 +40,7 @@ CHROMIUM = "/usr/bin/chromium"
 CHROMEDRIVER = "/usr/bin/chromedriver"
 
 
-def browser(gpu):
+def browser(gpu, extra=()):
     options = webdriver.ChromeOptions()
     options.binary_location = CHROMIUM
     for flag in ["--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
@@ -38,6 +49,8 @@ def browser(gpu):
     if not gpu:
         for flag in ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]:
             options.add_argument(flag)
+    for flag in extra:
+        options.add_argument(flag)
     return webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
 
 
@@ -139,6 +152,42 @@ def bench(args):
         driver.quit()
 
 
+def rebind(args):
+    viewer = urllib.parse.urlsplit(args.url)
+    evil = f"http://{args.name}:{viewer.port}/"
+    driver = browser(args.gpu, [f"--host-resolver-rules=MAP {args.name} {viewer.hostname}"])
+    try:
+        driver.set_script_timeout(args.timeout)
+        driver.get(evil)
+        page_text = driver.find_element(By.TAG_NAME, "body").text
+        scene_status = driver.execute_async_script(
+            "const done = arguments[arguments.length - 1];"
+            "fetch('/api/scene').then(r => done(r.status), e => done(String(e)));")
+        post = driver.execute_async_script(
+            "const done = arguments[arguments.length - 1];"
+            "fetch(arguments[0] + 'api/export', {method: 'POST', mode: 'no-cors',"
+            " headers: {'Content-Type': 'text/plain'}, body: JSON.stringify({glass: '', ev: 0})})"
+            ".then(r => done(r.type), e => done('failed: ' + e));", args.url)
+        print(json.dumps({"page": page_text, "scene_status": scene_status, "post": post,
+                          "origin": driver.execute_script("return location.origin")}))
+    finally:
+        driver.quit()
+
+
+def export(args):
+    driver = browser(args.gpu)
+    try:
+        driver.get(args.url)
+        wait_ready(driver, args.timeout)
+        driver.find_element(By.ID, "export").click()
+        WebDriverWait(driver, args.timeout).until(
+            lambda d: d.find_element(By.ID, "status").text.startswith(("exported", "export failed")))
+        print(json.dumps({"status": driver.find_element(By.ID, "status").text,
+                          "errors": driver.execute_script("return window.glassdbErrors")}))
+    finally:
+        driver.quit()
+
+
 def main():
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -151,11 +200,16 @@ def main():
     b.add_argument("--id", type=int, required=True)
     b.add_argument("--products", required=True, help="product names separated by |")
     b.add_argument("--repeat", type=int, default=5)
-    for p in (c, b):
+    r = sub.add_parser("rebind")
+    r.add_argument("url")
+    r.add_argument("--name", required=True)
+    e = sub.add_parser("export")
+    e.add_argument("url")
+    for p in (c, b, r, e):
         p.add_argument("--timeout", type=float, default=60)
         p.add_argument("--gpu", action="store_true", help="use the machine's GPU, not SwiftShader")
     args = ap.parse_args()
-    {"check": check, "bench": bench}[args.cmd](args)
+    {"check": check, "bench": bench, "rebind": rebind, "export": export}[args.cmd](args)
 
 
 if __name__ == "__main__":

@@ -296,9 +296,27 @@ fn view_hint(e: &ViewError) -> Option<String> {
             Some("choose a layer with FILE.exr:LAYER or --layer".into())
         }
         ViewError::Compose(c) => compose_hint(c),
-        ViewError::Bind { .. } => Some(
-            "another program may be listening there; --port 0 picks a free port, --bind the address"
+        ViewError::Bind { source, .. } => match source.kind() {
+            std::io::ErrorKind::AddrInUse => Some(
+                "another program may be listening there; --port 0 picks a free port".into(),
+            ),
+            std::io::ErrorKind::AddrNotAvailable => Some(
+                "--bind takes an address of this machine (127.0.0.1, the default, serves this \
+                 machine only)"
+                    .into(),
+            ),
+            std::io::ErrorKind::PermissionDenied => {
+                Some("ports below 1024 need privileges; --port 0 picks a free port".into())
+            }
+            _ => None,
+        },
+        ViewError::Resolve { .. } => Some(
+            "--bind takes an IP address or a name of this machine (127.0.0.1, the default, \
+             serves this machine only)"
                 .into(),
+        ),
+        ViewError::ExportFolderInUse { .. } => Some(
+            "choose a new or empty folder, or pass --force to write into this one".into(),
         ),
         ViewError::UnknownProduct { .. } | ViewError::AmbiguousProduct { .. } => Some(
             "--glass takes ID:PRODUCT with a product's name, a part only it has, or its registry id"
@@ -310,6 +328,8 @@ fn view_hint(e: &ViewError) -> Option<String> {
         ViewError::GlassSpec { .. }
         | ViewError::UnknownGlassId { .. }
         | ViewError::ExportDir { .. }
+        | ViewError::ExportNotAFolder { .. }
+        | ViewError::SessionToken { .. }
         | ViewError::Output(_) => None,
     }
 }

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use glassdb_compose::view::CubeLut;
 use glassdb_compose::{OutsidePolicy, UnknownIds};
+use glassdb_view::export::ExportFolder;
 use glassdb_view::server::ViewServer;
 use glassdb_view::{Viewer, ViewerInputs};
 
@@ -42,6 +43,11 @@ pub struct Args {
     /// Folder the page's "export" button writes into (without it the button is disabled).
     #[arg(long, value_name = "DIR")]
     pub export_dir: Option<PathBuf>,
+    /// Let --export / --export-dir write into a folder that holds things other than a previous
+    /// export (the export's own file names in it are replaced; links are replaced, never
+    /// followed).
+    #[arg(long)]
+    pub force: bool,
     /// The export's first products, `ID:PRODUCT,…` (a product's name, a unique part of it, or
     /// its registry id); the served page takes them as its `glass` URL parameter.
     #[arg(long, value_name = "ID:PRODUCT,...")]
@@ -95,12 +101,33 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         Some(spec) => viewer.parse_choices(spec).context("--glass")?,
         None => Vec::new(),
     };
+    let folder = |dir: &PathBuf| ExportFolder {
+        dir: dir.clone(),
+        force: args.force,
+    };
     if let Some(dir) = &args.export {
-        glassdb_view::export::write_export(&viewer, dir, &choices, args.ev)?;
+        glassdb_view::export::write_export(&viewer, &folder(dir), &choices, args.ev)?;
         outln!("wrote {}", dir.join("index.html").display());
         return Ok(ExitCode::SUCCESS);
     }
-    let server = ViewServer::bind(viewer, &args.bind, args.port, args.export_dir.clone())?;
+    let export = args.export_dir.as_ref().map(folder);
+    if let Some(export) = &export {
+        export.check().context("--export-dir")?;
+    }
+    let server = ViewServer::bind(viewer, &args.bind, args.port, export)?;
+    if server.reachable_from_other_machines() {
+        eprintln!(
+            "warning: --bind {} can be reached from other machines: anyone who reaches this \
+             port sees the frames and the paths of the inputs{}. Serve 127.0.0.1 (the default) \
+             unless this network is trusted.",
+            args.bind,
+            if args.export_dir.is_some() {
+                ", and with the page's token can write the export folder"
+            } else {
+                ""
+            }
+        );
+    }
     let query = if choices.is_empty() {
         String::new()
     } else {

@@ -10,7 +10,7 @@ use std::process::Command;
 use std::sync::OnceLock;
 
 use crate::util::{
-    Planes, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path,
+    Planes, fails, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path,
     write_executable, write_file,
 };
 
@@ -483,6 +483,121 @@ fn crashing_and_hanging_blender_are_reported() {
         &["took longer than 1 s", "was stopped"],
     );
     assert!(started.elapsed().as_secs() < 20);
+}
+
+/// Whether process `pid` runs (a zombie no one has reaped yet counts as stopped).
+fn running(pid: &str) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|stat| {
+        stat.rfind(')')
+            .is_some_and(|end| !stat[end + 1..].trim_start().starts_with('Z'))
+    })
+}
+
+/// Waits up to 20 s for `path` to hold a process id.
+fn pid_in(path: &Path) -> String {
+    let started = std::time::Instant::now();
+    loop {
+        if let Ok(text) = std::fs::read_to_string(path)
+            && text.ends_with('\n')
+        {
+            return text.trim().to_string();
+        }
+        assert!(started.elapsed().as_secs() < 20, "no {}", path.display());
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+/// Asserts that the processes `pids` stop within 5 s.
+fn assert_stop(pids: &[String], what: &str) {
+    let started = std::time::Instant::now();
+    while pids.iter().any(|p| running(p)) {
+        assert!(
+            started.elapsed().as_secs() < 5,
+            "{what}: still running: {:?}",
+            pids.iter().filter(|p| running(p)).collect::<Vec<_>>()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+/// A render timed out, or glassdb stopped by SIGTERM or SIGINT, leaves nothing of Blender
+/// running: not the stand-in, not the child it started (killed as a process group).
+#[cfg(unix)]
+#[test]
+fn a_stopped_or_timed_out_render_leaves_no_blender_running() {
+    let t = tempfile::tempdir().unwrap();
+    let blend = blend_stub(t.path());
+    let pids = t.path().join("pids");
+    let blender = fake_blender(
+        t.path(),
+        "3.4.1",
+        &format!("sleep 300 &\necho \"$! $$\" > {}\nwait", pids.display()),
+    );
+    let started = std::time::Instant::now();
+    fails_naming(
+        &mut render_with(
+            &blender,
+            &blend,
+            &t.path().join("out"),
+            &["--timeout-s", "1"],
+        ),
+        &["took longer than 1 s"],
+    );
+    assert!(started.elapsed().as_secs() < 20);
+    let both: Vec<String> = pid_in(&pids).split(' ').map(str::to_string).collect();
+    assert_stop(&both, "--timeout-s");
+
+    for (signal, code) in [("TERM", 143), ("INT", 130)] {
+        std::fs::remove_file(&pids).unwrap();
+        let mut child = render_with(&blender, &blend, &t.path().join("out"), &[])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let both: Vec<String> = pid_in(&pids).split(' ').map(str::to_string).collect();
+        assert!(both.iter().all(|p| running(p)), "{both:?}");
+        let sent = Command::new("kill")
+            .arg(format!("-{signal}"))
+            .arg(child.id().to_string())
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        assert_eq!(child.wait().unwrap().code(), Some(code), "SIG{signal}");
+        assert_stop(&both, &format!("SIG{signal}"));
+    }
+}
+
+/// A scene whose name starts with `-` reaches Blender as a file (`./-dash.blend`), never as
+/// an option: Blender 3.4 reads an argument after `-b` that starts with `-` as an option when
+/// it is one (`-P`, `-t`), and warns of the others.
+#[test]
+fn a_scene_named_like_an_option_reaches_blender_as_a_file() {
+    let t = tempfile::tempdir().unwrap();
+    let seen = t.path().join("args");
+    blend_stub(t.path());
+    std::fs::rename(t.path().join("scene.blend"), t.path().join("-P")).unwrap();
+    let blender = fake_blender(
+        t.path(),
+        "3.4.1",
+        &format!("printf '%s\\n' \"$@\" > {}\nexit 1", seen.display()),
+    );
+    let mut cmd = glassdb();
+    cmd.current_dir(t.path())
+        .args([
+            "blender",
+            "render",
+            "--glass",
+            "Glass*=1",
+            "--out-dir",
+            "out",
+            "--blender",
+        ])
+        .arg(&blender)
+        .args(["--", "-P"]);
+    fails(&mut cmd);
+    let args = std::fs::read_to_string(&seen).unwrap();
+    let args: Vec<&str> = args.lines().collect();
+    assert_eq!(&args[..2], ["-b", "./-P"], "{args:?}");
 }
 
 #[test]

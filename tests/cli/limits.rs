@@ -10,7 +10,7 @@
 
 use std::path::PathBuf;
 
-use crate::util::{compose, fails, fails_naming, ok, repo_path};
+use crate::util::{compose, fails, fails_naming, ok, read_exr_planes, repo_path, run_oracle};
 
 /// CRC-32 (ISO-HDLC, PNG's chunk checksum).
 fn crc32(bytes: &[u8]) -> u32 {
@@ -301,4 +301,66 @@ fn frames_of_a_sequence_share_the_limit_and_one_over_it_fails_alone() {
     assert!(f.path("o.0002.exr").exists() && f.path("o.0003.exr").exists());
     let estimates: Vec<&str> = stdout.lines().filter(|l| l.starts_with("memory")).collect();
     assert_eq!(estimates.len(), 3, "{stdout}");
+}
+
+/// A multi-part `--refl` of many planes (written by OpenEXR: the atrium's three passes, then
+/// 1×1 parts up to `parts`), in `dir`.
+fn padded_planes_file(dir: &std::path::Path, parts: usize) -> PathBuf {
+    let a = |f: &str| repo_path("fixtures/atrium").join(f);
+    let out = dir.join(format!("planes{parts}.exr"));
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "parts".into(),
+        "--mask".into(),
+        a("mask.png").into(),
+        "--out".into(),
+        out.clone().into(),
+        "--pad".into(),
+        parts.to_string().into(),
+    ];
+    args.extend((0..3).map(|k| a(&format!("refl_{k}.exr")).into_os_string()));
+    let refs: Vec<&std::ffi::OsStr> = args.iter().map(|s| s.as_os_str()).collect();
+    run_oracle("plane_parts.py", &refs);
+    out
+}
+
+/// 300 parts compose as their three real planes do (each pass's headers parsed once for the
+/// file, not once per plane: 3.5 s before, docs/performance.md); more than
+/// glassdb_image::MAX_EXR_PARTS is refused from the headers.
+#[test]
+fn a_refl_file_of_many_parts_composes_and_one_of_too_many_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = |f: &str| repo_path("fixtures/atrium").join(f);
+    let many = padded_planes_file(dir.path(), 300);
+    let base = |cmd: &mut std::process::Command| {
+        cmd.arg("--trans")
+            .arg(a("trans.exr"))
+            .arg("--mask")
+            .arg(a("mask.png"));
+    };
+    let from_parts = dir.path().join("parts.exr");
+    let mut cmd = compose();
+    base(&mut cmd);
+    ok(cmd.arg("--refl").arg(&many).arg("-o").arg(&from_parts));
+    let separate = dir.path().join("separate.exr");
+    let mut cmd = compose();
+    base(&mut cmd);
+    for k in 0..3 {
+        cmd.arg("--refl").arg(a(&format!("refl_{k}.exr")));
+    }
+    ok(cmd.arg("-o").arg(&separate));
+    let (got, want) = (read_exr_planes(&from_parts), read_exr_planes(&separate));
+    assert_eq!(got.channels, want.channels);
+
+    let too_many = padded_planes_file(dir.path(), glassdb_image::MAX_EXR_PARTS + 1);
+    let mut cmd = compose();
+    base(&mut cmd);
+    let said = fails_naming(
+        cmd.arg("--refl")
+            .arg(&too_many)
+            .arg("-o")
+            .arg(dir.path().join("no.exr")),
+        &["planes1025.exr", "more than 1024 parts"],
+    );
+    assert!(said.len() < 1000, "{said}");
+    assert!(!dir.path().join("no.exr").exists());
 }

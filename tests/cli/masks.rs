@@ -454,43 +454,15 @@ fn the_cryptomatte_mask_agrees_with_glassdb_mask_and_so_do_the_composites() {
     }
 }
 
-#[test]
-fn a_manifest_side_file_names_the_ids_like_the_header_manifest() {
-    // The same render with its manifest moved out of the header into `manif_file` (the
-    // specification's side file, relative to the image).
-    use exr::meta::attribute::{AttributeValue, Text};
-    let dir = tempfile::tempdir().unwrap();
+/// The Blender 3.4 render `fixtures/blender/b34/multilayer.exr` written again into `path`
+/// (float, ZIP) after `edit` changed its attributes or samples, as the `exr` crate reads them
+/// exactly.
+fn rewritten_render(path: &Path, edit: impl FnOnce(&mut glassdb_image::ExactExr)) {
     let render = repo_path("fixtures/blender/b34/multilayer.exr");
     let bytes = std::fs::read(&render).unwrap();
     let mut exact = glassdb_image::read_exr_exact(&bytes, 1 << 24).unwrap();
     let headers = glassdb_image::read_exr_headers(&bytes).unwrap();
-    let mut manifests = Vec::new();
-    let mut move_out = |other: &mut std::collections::HashMap<Text, AttributeValue>| {
-        let keys: Vec<Text> = other
-            .keys()
-            .filter(|k| k.to_string().ends_with("/manifest"))
-            .cloned()
-            .collect();
-        for key in keys {
-            if let Some(AttributeValue::Text(json)) = other.remove(&key) {
-                let file = format!("manifest{}.json", manifests.len());
-                manifests.push((file.clone(), json.to_string()));
-                let side = key.to_string().replace("/manifest", "/manif_file");
-                other.insert(
-                    Text::from(side.as_str()),
-                    AttributeValue::Text(Text::from(file.as_str())),
-                );
-            }
-        }
-    };
-    move_out(&mut exact.attributes.other);
-    for part in &mut exact.parts {
-        move_out(&mut part.attributes.other);
-    }
-    assert_eq!(manifests.len(), 2, "material and object manifests");
-    for (file, json) in &manifests {
-        std::fs::write(dir.path().join(file), json).unwrap();
-    }
+    edit(&mut exact);
     let image = glassdb_image::ExrImageOut {
         display_window: headers[0].display_window,
         attributes: exact.attributes,
@@ -512,7 +484,6 @@ fn a_manifest_side_file_names_the_ids_like_the_header_manifest() {
             })
             .collect(),
     };
-    let copy = dir.path().join("side.exr");
     let mut out = std::io::Cursor::new(Vec::new());
     let options = glassdb_image::ExrWriteOptions {
         storage: glassdb_image::ExrStorage::Float,
@@ -520,7 +491,56 @@ fn a_manifest_side_file_names_the_ids_like_the_header_manifest() {
         zip_level: None,
     };
     glassdb_image::write_exr_image(&mut out, image, options).unwrap();
-    std::fs::write(&copy, out.into_inner()).unwrap();
+    std::fs::write(path, out.into_inner()).unwrap();
+}
+
+/// Every text attribute map of `exact` (the shared one and each part's).
+fn attribute_maps(
+    exact: &mut glassdb_image::ExactExr,
+) -> Vec<
+    &mut std::collections::HashMap<
+        exr::meta::attribute::Text,
+        exr::meta::attribute::AttributeValue,
+    >,
+> {
+    let mut maps = vec![&mut exact.attributes.other];
+    maps.extend(exact.parts.iter_mut().map(|p| &mut p.attributes.other));
+    maps
+}
+
+#[test]
+fn a_manifest_side_file_names_the_ids_like_the_header_manifest() {
+    // The same render with its manifest moved out of the header into `manif_file` (the
+    // specification's side file, relative to the image).
+    use exr::meta::attribute::{AttributeValue, Text};
+    let dir = tempfile::tempdir().unwrap();
+    let render = repo_path("fixtures/blender/b34/multilayer.exr");
+    let mut manifests = Vec::new();
+    let copy = dir.path().join("side.exr");
+    rewritten_render(&copy, |exact| {
+        for other in attribute_maps(exact) {
+            let keys: Vec<Text> = other
+                .keys()
+                .filter(|k| k.to_string().ends_with("/manifest"))
+                .cloned()
+                .collect();
+            for key in keys {
+                if let Some(AttributeValue::Text(json)) = other.remove(&key) {
+                    let file = format!("manifest{}.json", manifests.len());
+                    manifests.push((file.clone(), json.to_string()));
+                    let side = key.to_string().replace("/manifest", "/manif_file");
+                    other.insert(
+                        Text::from(side.as_str()),
+                        AttributeValue::Text(Text::from(file.as_str())),
+                    );
+                }
+            }
+        }
+    });
+    assert_eq!(manifests.len(), 2, "material and object manifests");
+    for (file, json) in &manifests {
+        std::fs::write(dir.path().join(file), json).unwrap();
+    }
     let options = crypto(facing(), None, AovWeighting::EveryMaterial);
     let from_header = read_placed_mask(&render, &options).unwrap();
     let from_side = read_placed_mask(&copy, &options).unwrap();
@@ -530,4 +550,151 @@ fn a_manifest_side_file_names_the_ids_like_the_header_manifest() {
     std::fs::remove_file(dir.path().join(&manifests[1].0)).unwrap();
     let err = read_placed_mask(&copy, &options).unwrap_err().to_string();
     assert!(err.contains("manifest"), "{err}");
+}
+
+/// Blender 3.4's own manifests (material and object) give every name the MurmurHash3_32 the
+/// specification says, as stored in pixels (exponent fix-up); no entry of those renders needs
+/// the fix-up, which the hash's unit vectors check.
+#[test]
+fn blender_manifests_hold_the_murmur3_of_each_name() {
+    let render = repo_path("fixtures/blender/b34/multilayer.exr");
+    let attributes =
+        glassdb_image::read_exr_text_attributes(&std::fs::read(&render).unwrap()).unwrap();
+    let layers = glassdb_mask::cryptomatte_layers(&attributes, &render).unwrap();
+    assert_eq!(layers.len(), 2);
+    let mut entries = 0;
+    for layer in &layers {
+        for (name, &hash) in &layer.manifest {
+            let want = glassdb_mask::murmur3_32(name.as_bytes(), 0);
+            assert_eq!(hash, glassdb_mask::float_encoded(want), "{name}");
+            entries += 1;
+        }
+    }
+    assert_eq!(entries, 14);
+    // Reference values of MurmurHash3_x86_32 (Appleby's SMHasher) and the fix-up.
+    assert_eq!(glassdb_mask::murmur3_32(b"", 0), 0);
+    assert_eq!(glassdb_mask::murmur3_32(b"", 1), 0x514e_28b7);
+    assert_eq!(glassdb_mask::murmur3_32(b"hello", 0), 0x248b_fa47);
+    assert_eq!(
+        glassdb_mask::murmur3_32(b"The quick brown fox jumps over the lazy dog", 0),
+        0x2e4f_f723
+    );
+    assert_eq!(glassdb_mask::float_encoded(0x0012_3456), 0x0092_3456);
+    assert_eq!(glassdb_mask::float_encoded(0xff80_0001), 0xff00_0001);
+    assert_eq!(glassdb_mask::float_encoded(0x3f80_0000), 0x3f80_0000);
+}
+
+/// A manifest that gives a glass another object's hash (the floor would turn into glass) is
+/// refused naming the entry; a coverage that is NaN, above 1 or negative is refused naming
+/// the pixel, the value and the name.
+#[test]
+fn a_corrupt_manifest_or_coverage_is_refused_naming_it() {
+    use exr::meta::attribute::{AttributeValue, Text};
+    let dir = tempfile::tempdir().unwrap();
+    let options = crypto(facing(), None, AovWeighting::EveryMaterial);
+    let swapped = dir.path().join("swapped.exr");
+    rewritten_render(&swapped, |exact| {
+        for other in attribute_maps(exact) {
+            for value in other.values_mut() {
+                if let AttributeValue::Text(json) = value
+                    && json.to_string().contains("\"Glass_clear\":\"ee9bb9e0\"")
+                {
+                    let text = json.to_string().replace(
+                        "\"Glass_clear\":\"ee9bb9e0\"",
+                        "\"Glass_clear\":\"6a2fb16e\"",
+                    );
+                    *value = AttributeValue::Text(Text::from(text.as_str()));
+                }
+            }
+        }
+    });
+    let err = read_placed_mask(&swapped, &options)
+        .unwrap_err()
+        .to_string();
+    for part in [
+        "swapped.exr",
+        "\"Glass_clear\"",
+        "6a2fb16e",
+        "ee9bb9e0",
+        "corrupt",
+    ] {
+        assert!(err.contains(part), "lacks {part}: {err}");
+    }
+
+    for (value, shown) in [(f32::NAN, "NaN"), (5.0, "5"), (-3.0, "-3")] {
+        let bad = dir.path().join("coverage.exr");
+        let mut at = None;
+        rewritten_render(&bad, |exact| {
+            for part in &mut exact.parts {
+                let width = part.data_window.width;
+                let ids: Vec<f32> = match part
+                    .channels
+                    .iter()
+                    .find(|(n, _)| n.ends_with("CryptoMaterial00.r"))
+                {
+                    Some((_, exr::prelude::FlatSamples::F32(v))) => v.clone(),
+                    _ => continue,
+                };
+                if let Some((_, exr::prelude::FlatSamples::F32(cov))) = part
+                    .channels
+                    .iter_mut()
+                    .find(|(n, _)| n.ends_with("CryptoMaterial00.g"))
+                {
+                    // A pixel whose first rank is a named id (not empty).
+                    let i = ids.iter().position(|&id| id != 0.0).unwrap();
+                    cov[i] = value;
+                    at = Some((i % width, i / width));
+                }
+            }
+        });
+        let (x, y) = at.expect("a CryptoMaterial00.g channel");
+        let err = read_placed_mask(&bad, &options).unwrap_err().to_string();
+        for part in [
+            format!("pixel (x {x}, y {y})"),
+            format!("coverage {shown},"),
+            "rank 0 gives \"".to_string(),
+        ] {
+            assert!(err.contains(&part), "lacks {part}: {err}");
+        }
+    }
+}
+
+/// Blender 3.4 writes a name's raw MurmurHash3_32 in the manifest and the bits with the
+/// exponent fix-up in the pixels (fixtures/blender/cryptomatte_fixup): both names of that
+/// render (exponents all ones and all zeros) are found in its pixels.
+#[test]
+fn names_whose_hash_needs_the_exponent_fix_up_are_found() {
+    let render = repo_path("fixtures/blender/cryptomatte_fixup/fixup.exr");
+    let glass = GlassNames::new(&[
+        GlassMapping::parse("Glass_42=1").unwrap(),
+        GlassMapping::parse("Glass_339=2").unwrap(),
+    ])
+    .unwrap();
+    let options = MaskReadOptions {
+        cryptomatte: Some(CryptomatteOptions {
+            layer: None,
+            glass,
+            cos: CosSource::Geometry {
+                normal: "Normal".into(),
+                position: "Position".into(),
+                camera_origin: [0.0, 0.0, 5.0],
+            },
+            planes: PlaneSource::Single,
+            weighting: AovWeighting::EveryMaterial,
+        }),
+        ..MaskReadOptions::default()
+    };
+    let mask = read_placed_mask(&render, &options);
+    let mask = match mask {
+        Ok(m) => m,
+        Err(e) => panic!("{e}"),
+    };
+    for id in [1, 2] {
+        let n = mask.image.id.iter().filter(|&&g| g == id).count();
+        assert!(
+            n >= 8,
+            "glass {id} on {n} of {} pixels",
+            mask.image.id.len()
+        );
+    }
 }

@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::util::{assert_names, compose, glassdb, ok, registry_build, repo_path, write_file};
+use crate::util::{
+    assert_names, compose, fails, glassdb, ok, registry_build, repo_path, write_file,
+};
 
 /// Runs `cmd` (no standard input) and returns its output, failing the test if it runs longer
 /// than `limit`: an input read without end or a FIFO opened for writing would hang it.
@@ -607,4 +609,54 @@ fn a_stopped_compose_leaves_no_temporary_file_and_no_output() {
         assert!(!out.exists(), "SIG{signal}: the unfinished output landed");
         assert_no_temporaries(d);
     }
+}
+
+/// Error lines quote what they read bounded: a 200 kB CSV field (`glassdb fit`), a 400 kB
+/// catalog line (`glassdb registry build`) and a 200 kB spectral unit are cut with an
+/// ellipsis and their length (glassdb_io::quoted).
+#[test]
+fn errors_quote_huge_input_values_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = write_file(
+        dir.path(),
+        "big.csv",
+        format!(
+            "angle_deg,T,R\n0,{},0.1\n10,0.8,0.1\n",
+            "9x".repeat(100_000)
+        )
+        .as_bytes(),
+    );
+    let said = fails(glassdb().arg("fit").arg(&csv));
+    assert!(said.len() < 1000, "{} bytes: {:.300}", said.len(), said);
+    assert!(
+        said.contains("9x9x9x") && said.contains("…` (200000 bytes) is not a number"),
+        "{said}"
+    );
+
+    let toml = write_file(
+        dir.path(),
+        "big.toml",
+        format!(
+            "[[glass]]\nname = \"x\"\nid = 1\nspectral = \"{}\n",
+            "a".repeat(400_000)
+        )
+        .as_bytes(),
+    );
+    let said = fails(
+        glassdb()
+            .args(["registry", "build"])
+            .arg(&toml)
+            .arg("-o")
+            .arg(dir.path().join("r.json")),
+    );
+    assert!(said.len() < 2000, "{} bytes: {:.300}", said.len(), said);
+    assert!(said.contains("line 4") && said.contains("bytes)"), "{said}");
+
+    let spectral = write_file(
+        dir.path(),
+        "big.units.csv",
+        format!("wavelength ({}),T\n500,0.5\n", "q".repeat(200_000)).as_bytes(),
+    );
+    let said = fails(glassdb().arg("spectral").arg(&spectral));
+    assert!(said.len() < 1000, "{} bytes: {:.300}", said.len(), said);
 }

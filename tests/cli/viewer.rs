@@ -227,33 +227,82 @@ fn a_product_swapped_on_the_page_gives_composes_pixels_and_the_export_the_same()
     assert!(db >= 50.0, "exported page vs compose: {db:.1} dB");
 }
 
-/// One raw HTTP/1.1 request; the status code.
-fn status(url: &str, request: &[u8]) -> u16 {
-    let host = url.trim_start_matches("http://").trim_end_matches('/');
-    let mut s = TcpStream::connect(host).unwrap();
+/// The `host:port` a served URL names.
+fn host_of(url: &str) -> &str {
+    url.trim_start_matches("http://").trim_end_matches('/')
+}
+
+/// One raw HTTP request; the status code and the body.
+fn exchange(url: &str, request: &[u8]) -> (u16, String) {
+    let mut s = TcpStream::connect(host_of(url)).unwrap();
     s.write_all(request).unwrap();
     let mut reply = Vec::new();
     let _ = s.read_to_end(&mut reply);
-    let text = String::from_utf8_lossy(&reply);
-    text.split_whitespace()
+    let text = String::from_utf8_lossy(&reply).into_owned();
+    let code = text
+        .split_whitespace()
         .nth(1)
         .and_then(|c| c.parse().ok())
-        .unwrap_or_else(|| panic!("no status in {text:?}"))
+        .unwrap_or_else(|| panic!("no status in {text:?}"));
+    let body = text
+        .split_once("\r\n\r\n")
+        .map_or("", |(_, b)| b)
+        .to_string();
+    (code, body)
 }
 
+/// One raw HTTP/1.1 request; the status code.
+fn status(url: &str, request: &[u8]) -> u16 {
+    exchange(url, request).0
+}
+
+/// A GET of `path` with the `Host` a browser on this machine sends.
 fn get(url: &str, path: &str) -> u16 {
-    status(
+    get_as(url, path, host_of(url)).0
+}
+
+/// A GET of `path` naming `host` in its `Host` header: the status and the body.
+fn get_as(url: &str, path: &str, host: &str) -> (u16, String) {
+    exchange(
         url,
-        format!("GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n").as_bytes(),
+        format!("GET {path} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n").as_bytes(),
     )
 }
 
+/// The session token of the page the viewer serves.
+fn page_token(url: &str) -> String {
+    let (code, page) = get_as(url, "/", host_of(url));
+    assert_eq!(code, 200);
+    let start = page
+        .find("name=\"glassdb-session\" content=\"")
+        .unwrap_or_else(|| panic!("no session token in the page:\n{page}"));
+    let rest = &page[start + "name=\"glassdb-session\" content=\"".len()..];
+    rest[..rest.find('"').unwrap()].to_string()
+}
+
+/// A POST as the viewer's own page sends it: its `Origin` and session token.
 fn post(url: &str, path: &str, body: &[u8]) -> u16 {
-    let mut req = format!(
-        "POST {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\nContent-Length: {}\r\n\r\n",
-        body.len()
+    let origin = format!("http://{}", host_of(url));
+    let token = page_token(url);
+    post_with(
+        url,
+        path,
+        body,
+        &[("Origin", &origin), ("X-Glassdb-Session", &token)],
     )
-    .into_bytes();
+}
+
+/// A POST of `body` with the `Host` of `url` and the extra `headers`.
+fn post_with(url: &str, path: &str, body: &[u8], headers: &[(&str, &str)]) -> u16 {
+    let mut req = format!(
+        "POST {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\nContent-Length: {}\r\n",
+        host_of(url),
+        body.len()
+    );
+    for (name, value) in headers {
+        req += &format!("{name}: {value}\r\n");
+    }
+    let mut req = format!("{req}\r\n").into_bytes();
     req.extend_from_slice(body);
     status(url, &req)
 }
@@ -281,8 +330,11 @@ fn the_server_answers_bad_requests_with_4xx_and_serves_no_files() {
     }
     let long = format!("/{}", "a".repeat(10_000));
     assert_eq!(get(u, &long), 414);
-    let delete = b"DELETE / HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
-    assert_eq!(status(u, delete), 405);
+    let delete = format!(
+        "DELETE / HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n\r\n",
+        host_of(u)
+    );
+    assert_eq!(status(u, delete.as_bytes()), 405);
     assert_eq!(post(u, "/api/export", &vec![b' '; 100_000]), 413);
     assert_eq!(post(u, "/api/export", b"not json"), 400);
     assert_eq!(
@@ -308,6 +360,205 @@ fn the_server_answers_bad_requests_with_4xx_and_serves_no_files() {
     }
     // Still serving after all that.
     assert_eq!(get(u, "/viewer.js"), 200);
+}
+
+/// DNS rebinding and cross-site requests, at the HTTP level: only `Host` names of this machine
+/// are answered, and an export needs the page's `Origin` and session token.
+#[test]
+fn the_server_answers_only_this_machine_and_only_its_page_may_export() {
+    let dir = tempfile::tempdir().unwrap();
+    let export = dir.path().join("from-page");
+    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    let u = &served.url;
+    let port = u.rsplit(':').next().unwrap().trim_end_matches('/');
+    for host in [
+        format!("127.0.0.1:{port}"),
+        format!("localhost:{port}"),
+        "LocalHost".to_string(),
+        format!("[::1]:{port}"),
+        // A forwarded port (ssh -L) keeps the name.
+        "localhost:9".to_string(),
+    ] {
+        assert_eq!(get_as(u, "/api/scene", &host).0, 200, "Host {host}");
+    }
+    for host in [
+        format!("rebound.example:{port}"),
+        "rebound.example".to_string(),
+        format!("localhost.rebound.example:{port}"),
+        format!("127.0.0.1.rebound.example:{port}"),
+        "".to_string(),
+        "localhost:80:80".to_string(),
+        "[::1".to_string(),
+        "x".repeat(5000),
+    ] {
+        for path in ["/", "/api/scene", "/api/frame/0/passes", "/viewer.js"] {
+            let (code, body) = get_as(u, path, &host);
+            assert_eq!(code, 403, "Host {host:.40} {path}: {body:.200}");
+            assert!(body.len() < 400, "{body}");
+        }
+    }
+    let (code, body) = exchange(u, b"GET /api/scene HTTP/1.0\r\n\r\n");
+    assert_eq!(code, 400, "no Host: {body}");
+
+    // A page of another site may not read through the viewer's address either.
+    let origin = format!("http://{}", host_of(u));
+    let token = page_token(u);
+    let foreign = [("Origin", "http://rebound.example")];
+    let (code, _) = exchange(
+        u,
+        format!(
+            "GET /api/scene HTTP/1.1\r\nHost: {}\r\nOrigin: http://rebound.example\r\nConnection: close\r\n\r\n",
+            host_of(u)
+        )
+        .as_bytes(),
+    );
+    assert_eq!(code, 403);
+
+    let request = br#"{"glass": "5:Stopray", "ev": 1}"#;
+    let text_plain = ("Content-Type", "text/plain");
+    // What any page can send without asking: a cross-site text/plain POST.
+    assert_eq!(
+        post_with(u, "/api/export", request, &[foreign[0], text_plain]),
+        403
+    );
+    assert_eq!(
+        post_with(
+            u,
+            "/api/export",
+            request,
+            &[foreign[0], text_plain, ("X-Glassdb-Session", &token)]
+        ),
+        403
+    );
+    // The page's own origin, without the token or with another.
+    assert_eq!(
+        post_with(u, "/api/export", request, &[("Origin", &origin)]),
+        403
+    );
+    let wrong = "0".repeat(token.len());
+    assert_eq!(
+        post_with(
+            u,
+            "/api/export",
+            request,
+            &[("Origin", &origin), ("X-Glassdb-Session", &wrong)]
+        ),
+        403
+    );
+    // The token without an Origin, and the "null" origin of a sandboxed or local page.
+    assert_eq!(
+        post_with(u, "/api/export", request, &[("X-Glassdb-Session", &token)]),
+        403
+    );
+    assert_eq!(
+        post_with(
+            u,
+            "/api/export",
+            request,
+            &[("Origin", "null"), ("X-Glassdb-Session", &token)]
+        ),
+        403
+    );
+    assert!(!export.exists(), "a refused request wrote the export");
+    // The page's origin and token: written.
+    assert_eq!(
+        post_with(
+            u,
+            "/api/export",
+            request,
+            &[("Origin", &origin), ("X-Glassdb-Session", &token)]
+        ),
+        200
+    );
+    assert!(export.join("index.html").is_file());
+    // Each viewer draws its own token.
+    let other = serve(&[]);
+    assert_ne!(page_token(&other.url), token);
+}
+
+/// The same in Chromium: a page of another site whose name resolves to the viewer's address
+/// (DNS rebinding) gets nothing, and its cross-site POST writes nothing; the viewer's own
+/// page still exports with its button.
+#[test]
+fn in_chromium_a_rebinding_page_gets_nothing_and_the_real_page_exports() {
+    let dir = tempfile::tempdir().unwrap();
+    let export = dir.path().join("from-page");
+    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    let said = run_oracle(
+        "viewer_driver.py",
+        &[
+            "rebind".as_ref(),
+            served.url.as_ref(),
+            "--name".as_ref(),
+            "glassdb-rebound.test".as_ref(),
+        ],
+    );
+    let report: serde_json::Value = serde_json::from_str(said.trim()).unwrap();
+    assert_eq!(
+        report["origin"],
+        format!(
+            "http://glassdb-rebound.test:{}",
+            served.url.rsplit(':').next().unwrap().trim_end_matches('/')
+        ),
+        "{report}"
+    );
+    let page = report["page"].as_str().unwrap();
+    assert!(page.contains("not for Host"), "{report}");
+    assert!(!page.contains("glassdb view"), "{report}");
+    assert_eq!(report["scene_status"], 403, "{report}");
+    assert!(
+        !export.exists(),
+        "the other site's POST wrote the export: {report}"
+    );
+
+    let said = run_oracle(
+        "viewer_driver.py",
+        &["export".as_ref(), served.url.as_ref()],
+    );
+    let report: serde_json::Value = serde_json::from_str(said.trim()).unwrap();
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    let status = report["status"].as_str().unwrap();
+    assert!(status.starts_with("exported to "), "{report}");
+    for f in [
+        "index.html",
+        "data.js",
+        "frame-0000.js",
+        "glassdb-export.json",
+    ] {
+        assert!(export.join(f).is_file(), "{f}");
+    }
+}
+
+/// A viewer listening on every interface says so on its standard error; one on 127.0.0.1
+/// does not.
+#[test]
+fn a_viewer_other_machines_can_reach_warns() {
+    for (bind, warns) in [
+        ("0.0.0.0", true),
+        ("127.0.0.1", false),
+        ("localhost", false),
+    ] {
+        let mut cmd = glassdb();
+        cmd.arg("view");
+        atrium_inputs(&mut cmd)
+            .args(["--bind", bind, "--port", "0"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        let mut child = cmd.spawn().unwrap();
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut line)
+            .unwrap();
+        assert!(line.starts_with("serving http://"), "{line}");
+        let _ = child.kill();
+        let _ = child.wait();
+        let stderr = std::io::read_to_string(child.stderr.take().unwrap()).unwrap();
+        assert_eq!(
+            stderr.contains("warning: --bind") && stderr.contains("other machines"),
+            warns,
+            "--bind {bind}: {stderr:?}"
+        );
+    }
 }
 
 #[test]
@@ -346,18 +597,125 @@ fn bad_choices_and_export_paths_are_refused_naming_them() {
         ]),
         &["clear", "several products"],
     );
-    fails_naming(
+    let said = fails_naming(
         &mut view(&["--export".as_ref(), file.as_os_str()]),
-        &["a-file"],
+        &["a-file", "it is a regular file, not a folder"],
     );
+    assert!(!said.contains("os error"), "{said}");
+    assert_eq!(std::fs::read(&file).unwrap(), b"x");
     assert!(!out.exists());
-    // A port another program holds: refused, with the way out.
+    // A port another program holds: refused, with the way out, the cause said once.
     let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let port = taken.local_addr().unwrap().port().to_string();
-    fails_naming(
+    let said = fails_naming(
         &mut view(&["--port".as_ref(), port.as_ref()]),
-        &["cannot listen", &port, "--port 0"],
+        &["cannot listen", &port, "another program", "--port 0"],
     );
+    assert_eq!(said.matches("in use").count(), 1, "{said}");
+    // A name that does not resolve: said so, without the hint about another program.
+    let said = fails_naming(
+        &mut view(&["--bind".as_ref(), "no-such-host.invalid".as_ref()]),
+        &[
+            "no-such-host.invalid",
+            "--bind takes an IP address or a name",
+        ],
+    );
+    assert!(!said.contains("another program"), "{said}");
+    assert_eq!(said.matches("lookup").count(), 1, "{said}");
+}
+
+/// What `--export` does to a folder that exists (docs/reliability.md): links in it are
+/// replaced, never followed; a folder that holds other things is refused without --force; a
+/// previous export is replaced, its frames that this one lacks removed.
+#[cfg(unix)]
+#[test]
+fn an_export_never_follows_links_and_keeps_to_its_own_folders() {
+    let dir = tempfile::tempdir().unwrap();
+    let export = |target: &Path, extra: &[&str]| {
+        let mut cmd = glassdb();
+        cmd.arg("view");
+        atrium_inputs(&mut cmd)
+            .arg("--export")
+            .arg(target)
+            .args(extra);
+        cmd
+    };
+    // A folder someone else filled: refused, named, nothing written; --force writes.
+    let site = dir.path().join("site");
+    std::fs::create_dir(&site).unwrap();
+    std::fs::write(site.join("index.html"), b"my site").unwrap();
+    std::fs::write(site.join("notes.txt"), b"notes").unwrap();
+    fails_naming(
+        &mut export(&site, &[]),
+        &["site", "not empty", "index.html, notes.txt", "--force"],
+    );
+    assert_eq!(std::fs::read(site.join("index.html")).unwrap(), b"my site");
+    assert!(!site.join("data.js").exists());
+    ok(&mut export(&site, &["--force"]));
+    assert!(
+        std::fs::read_to_string(site.join("index.html"))
+            .unwrap()
+            .contains("glassdb view")
+    );
+    assert_eq!(std::fs::read(site.join("notes.txt")).unwrap(), b"notes");
+
+    // Links planted in a previous export: replaced, what they lead to untouched.
+    let outside = dir.path().join("outside.css");
+    std::fs::write(&outside, b"kept").unwrap();
+    let css = site.join("viewer.css");
+    std::fs::remove_file(&css).unwrap();
+    std::os::unix::fs::symlink(&outside, &css).unwrap();
+    let planted = dir.path().join("planted.html");
+    std::fs::remove_file(site.join("index.html")).unwrap();
+    std::os::unix::fs::symlink(&planted, site.join("index.html")).unwrap();
+    ok(&mut export(&site, &[]));
+    assert_eq!(std::fs::read(&outside).unwrap(), b"kept");
+    assert!(
+        !planted.exists(),
+        "an export created a file through a dangling link"
+    );
+    for f in ["viewer.css", "index.html"] {
+        assert!(
+            std::fs::symlink_metadata(site.join(f)).unwrap().is_file(),
+            "{f} is still a link"
+        );
+    }
+    // A previous export's frame that this one lacks is removed; its marker names its files.
+    let marker = site.join("glassdb-export.json");
+    let mut listed: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&marker).unwrap()).unwrap();
+    listed["files"].as_array_mut().unwrap().extend([
+        "frame-0007.js".into(),
+        "../outside.css".into(),
+        "notes.txt".into(),
+    ]);
+    std::fs::write(&marker, listed.to_string()).unwrap();
+    std::fs::write(site.join("frame-0007.js"), b"old frame").unwrap();
+    ok(&mut export(&site, &[]));
+    assert!(!site.join("frame-0007.js").exists());
+    assert!(site.join("frame-0000.js").is_file());
+    assert_eq!(std::fs::read(&outside).unwrap(), b"kept");
+    assert_eq!(std::fs::read(site.join("notes.txt")).unwrap(), b"notes");
+
+    // An empty folder, a new one, and a link to a folder are written.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    ok(&mut export(&empty, &[]));
+    ok(&mut export(&dir.path().join("new/deeper"), &[]));
+    let link = dir.path().join("link-to-empty");
+    let target = dir.path().join("empty-too");
+    std::fs::create_dir(&target).unwrap();
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    ok(&mut export(&link, &[]));
+    assert!(target.join("index.html").is_file());
+
+    // The page's export folder is checked when the viewer starts.
+    let mut cmd = glassdb();
+    cmd.arg("view");
+    atrium_inputs(&mut cmd)
+        .arg("--export-dir")
+        .arg(dir.path().join("new"));
+    fails_naming(&mut cmd, &["--export-dir", "not empty", "deeper"]);
 }
 
 /// Frame 2 of a two-frame sequence whose second frame has other pixels (the atrium's plane-1

@@ -4,9 +4,11 @@
 use std::fs::{File, OpenOptions};
 use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Stdio};
+use std::process::{Command, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
+
+use glassdb_io::ChildGroup;
 
 use crate::BlenderError;
 
@@ -156,20 +158,21 @@ impl Blender {
             Launcher::Executable => command.args(["-b", "--factory-startup", "--version"]),
             Launcher::BpyModule => command.args(["-c", BPY_VERSION]),
         };
-        let mut child = command
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .map_err(|source| BlenderError::NotFound {
-                path: path.to_path_buf(),
-                source,
-            })?;
+        let mut child = ChildGroup::spawn(
+            command
+                .stdin(Stdio::null())
+                .stdout(Stdio::piped())
+                .stderr(Stdio::null()),
+        )
+        .map_err(|source| BlenderError::NotFound {
+            path: path.to_path_buf(),
+            source,
+        })?;
         let started = Instant::now();
         // Read on a thread, so that the time limit holds while the program says nothing;
         // bounded, so that a program printing without end is stopped by the limit too.
         let (sender, said) = mpsc::channel();
-        if let Some(out) = child.stdout.take() {
+        if let Some(out) = child.child().stdout.take() {
             std::thread::spawn(move || {
                 let mut bytes = Vec::new();
                 let _ = out.take(1 << 20).read_to_end(&mut bytes);
@@ -214,7 +217,7 @@ impl Blender {
         let err_log = log.try_clone().map_err(io("write the log", run.log))?;
         let mut command = Command::new(&self.path);
         match self.launcher {
-            Launcher::Executable => command.arg("-b").arg(run.blend).args([
+            Launcher::Executable => command.arg("-b").arg(not_an_option(run.blend)).args([
                 "--factory-startup",
                 "-noaudio",
                 "--python-exit-code",
@@ -223,18 +226,21 @@ impl Blender {
             ]),
             Launcher::BpyModule => command.args(["-c", BPY_LAUNCHER]).arg(run.blend),
         };
-        let mut child = command
-            .arg(run.script)
-            .arg("--")
-            .args(&run.args)
-            .stdin(Stdio::null())
-            .stdout(Stdio::from(log))
-            .stderr(Stdio::from(err_log))
-            .spawn()
-            .map_err(|source| BlenderError::NotFound {
-                path: self.path.clone(),
-                source,
-            })?;
+        // In a process group of its own: on the time limit, or when glassdb is stopped, the
+        // group is killed, with whatever Blender started.
+        let mut child = ChildGroup::spawn(
+            command
+                .arg(run.script)
+                .arg("--")
+                .args(&run.args)
+                .stdin(Stdio::null())
+                .stdout(Stdio::from(log))
+                .stderr(Stdio::from(err_log)),
+        )
+        .map_err(|source| BlenderError::NotFound {
+            path: self.path.clone(),
+            source,
+        })?;
         let Some(status) = wait_with_timeout(&mut child, run.timeout, Duration::from_millis(50))
             .map_err(io("wait for Blender", &self.path))?
         else {
@@ -272,10 +278,10 @@ impl Blender {
     }
 }
 
-/// Waits for `child` to exit, looking every `poll`; past `limit` it is killed (and reaped) and
-/// the answer is `None`.
+/// Waits for `child` to exit, looking every `poll`; past `limit` its whole process group is
+/// killed (and it is reaped) and the answer is `None`.
 pub(crate) fn wait_with_timeout(
-    child: &mut Child,
+    child: &mut ChildGroup,
     limit: Duration,
     poll: Duration,
 ) -> io::Result<Option<ExitStatus>> {
@@ -285,11 +291,20 @@ pub(crate) fn wait_with_timeout(
             Ok(Some(status)) => return Ok(Some(status)),
             Ok(None) if started.elapsed() <= limit => std::thread::sleep(poll),
             waited => {
-                let _ = child.kill();
-                let _ = child.wait();
+                child.kill();
                 return waited.map(|_| None);
             }
         }
+    }
+}
+
+/// A path Blender's argument parser cannot take for an option: one that starts with `-` is
+/// given as `./-…` (Blender 3.4 reads `-dash.blend` after `-b` as an unknown option).
+fn not_an_option(path: &Path) -> PathBuf {
+    if path.as_os_str().as_encoded_bytes().starts_with(b"-") {
+        Path::new(".").join(path)
+    } else {
+        path.to_path_buf()
     }
 }
 
@@ -446,7 +461,7 @@ mod tests {
 
     #[test]
     fn waiting_kills_past_the_limit() {
-        let mut child = Command::new("sleep").arg("30").spawn().unwrap();
+        let mut child = ChildGroup::spawn(Command::new("sleep").arg("30")).unwrap();
         let started = Instant::now();
         let waited = wait_with_timeout(
             &mut child,
@@ -456,8 +471,8 @@ mod tests {
         assert!(waited.unwrap().is_none());
         assert!(started.elapsed() < Duration::from_secs(5));
         // Killed and reaped.
-        assert!(child.try_wait().unwrap().is_some());
-        let mut quick = Command::new("true").spawn().unwrap();
+        assert!(child.child().try_wait().unwrap().is_some());
+        let mut quick = ChildGroup::spawn(&mut Command::new("true")).unwrap();
         let status = wait_with_timeout(
             &mut quick,
             Duration::from_secs(10),

@@ -85,7 +85,7 @@ pub struct PassHeader {
     /// The colour attributes of the layer's part (none for a PNG).
     pub colour: ExrColourTag,
     /// An EXR's parts (none for a PNG).
-    pub parts: Vec<ExrPart>,
+    pub parts: std::sync::Arc<[ExrPart]>,
     /// Reading it: the file and the decoder's buffers while reading, the linear planes after.
     pub memory: ReadMemory,
 }
@@ -155,7 +155,7 @@ fn pass_header(
                     },
                 },
                 colour: ExrColourTag::default(),
-                parts: Vec::new(),
+                parts: Default::default(),
                 memory: ReadMemory::png(file_len, &h)
                     .keeping(h.pixel_count().saturating_mul(4 * planes)),
             })

@@ -46,7 +46,8 @@ pub enum FitError {
     },
     /// The header has a column the reader does not know.
     #[error(
-        "{path}, line {line}, column {column}: unknown column `{name}` (accepted: angle_deg/theta_deg, R/reflectance, T/transmittance, glass)"
+        "{path}, line {line}, column {column}: unknown column {} (accepted: angle_deg/theta_deg, R/reflectance, T/transmittance, glass)",
+        glassdb_io::backticked(name)
     )]
     UnknownColumn {
         path: PathBuf,
@@ -56,7 +57,8 @@ pub enum FitError {
     },
     /// Two header cells name the same quantity (e.g. `R` and `reflectance`).
     #[error(
-        "{path}, line {line}, column {column}: column `{name}` repeats a quantity already given in column {first}"
+        "{path}, line {line}, column {column}: column {} repeats a quantity already given in column {first}",
+        glassdb_io::backticked(name)
     )]
     DuplicateColumn {
         path: PathBuf,
@@ -66,7 +68,10 @@ pub enum FitError {
         name: String,
     },
     /// A cell is not a number.
-    #[error("{path}, line {line}, column {column} ({header}): `{value}` is not a number")]
+    #[error(
+        "{path}, line {line}, column {column} ({header}): {} is not a number",
+        glassdb_io::backticked(value)
+    )]
     NotANumber {
         path: PathBuf,
         line: u64,
@@ -75,7 +80,10 @@ pub enum FitError {
         value: String,
     },
     /// A cell is NaN or infinite.
-    #[error("{path}, line {line}, column {column} ({header}): `{value}` is not a finite number")]
+    #[error(
+        "{path}, line {line}, column {column} ({header}): {} is not a finite number",
+        glassdb_io::backticked(value)
+    )]
     NotFinite {
         path: PathBuf,
         line: u64,
@@ -129,7 +137,7 @@ pub enum FitError {
         column: usize,
     },
     /// The table has neither an R nor a T column, or a glass has no value in either.
-    #[error("{path}: glass `{glass}` has no R or T values")]
+    #[error("{path}: glass {} has no R or T values", glassdb_io::backticked(glass))]
     NoValues { path: PathBuf, glass: String },
     /// Samples handed to the fitter are inconsistent (different lengths, NaN, angle outside 0–90°).
     #[error("invalid samples: {0}")]

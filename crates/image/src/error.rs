@@ -9,7 +9,8 @@ pub enum ImageErrorKind {
     /// A well-formed image using a feature this crate does not read or write (deep data,
     /// subsampled channels, another file format): convert the file.
     Unsupported,
-    /// The image is larger than the configured pixel limit: raise the limit or shrink the image.
+    /// The image is larger than the configured pixel limit, or an EXR has more parts than
+    /// [`crate::MAX_EXR_PARTS`]: raise the limit or shrink the image.
     Limits,
     /// Reading or writing the underlying stream failed.
     Io,
@@ -59,6 +60,10 @@ pub enum ImageError {
         height: u64,
         max_pixels: u64,
     },
+    /// An EXR of more parts than [`crate::MAX_EXR_PARTS`] (counted from its headers, before
+    /// they are parsed).
+    #[error("the OpenEXR file has more than {max} parts")]
+    TooManyParts { max: usize },
     /// A codec panicked (a bug in it, reached by these bytes); the panic is caught, not renamed.
     #[error("the {codec} codec failed internally (it panicked: {message})")]
     CodecPanic { codec: Codec, message: String },
@@ -105,7 +110,7 @@ impl ImageError {
             ImageError::Incomplete { .. } | ImageError::SampleCount { .. } => {
                 ImageErrorKind::Invalid
             }
-            ImageError::TooLarge { .. } => ImageErrorKind::Limits,
+            ImageError::TooLarge { .. } | ImageError::TooManyParts { .. } => ImageErrorKind::Limits,
             ImageError::Read(io) => io_kind(io),
             ImageError::CodecPanic { .. } => ImageErrorKind::Internal,
         }

@@ -173,6 +173,24 @@ impl RgbLayer {
 pub fn rgb_layers(parts: &[ExrPart]) -> Vec<RgbLayer> {
     let mut out = Vec::new();
     for (p, part) in parts.iter().enumerate() {
+        part_rgb_layers(p, part, &mut out);
+    }
+    out
+}
+
+/// Whether part `part` may hold an RGB layer named `name`, judged without building its
+/// channels' names: a channel name starts with `name`, or `name` starts with the part's name.
+fn may_hold_layer(part: &ExrPart, name: &str) -> bool {
+    part.channels.iter().any(|c| c.name.starts_with(name))
+        || part
+            .layer_name
+            .as_deref()
+            .is_some_and(|l| !l.is_empty() && name.starts_with(l))
+}
+
+/// The RGB layers of part `part` (index `p`), in channel order, appended to `out`.
+fn part_rgb_layers(p: usize, part: &ExrPart, out: &mut Vec<RgbLayer>) {
+    {
         let names: Vec<String> = (0..part.channels.len())
             .filter_map(|i| part.qualified_name(i))
             .collect();
@@ -219,7 +237,6 @@ pub fn rgb_layers(parts: &[ExrPart]) -> Vec<RgbLayer> {
             });
         }
     }
-    out
 }
 
 /// The reflection passes of several glass planes in one file: the RGB layers named `plane<K>`
@@ -265,6 +282,20 @@ pub fn choose_rgb_layer(
     parts: &[ExrPart],
     wanted: Option<&str>,
 ) -> Result<RgbLayer, LayerChoiceError> {
+    // A layer's full name: the first layer of that name, found without listing every part's
+    // layers (the planes of a file of many parts each ask for their own).
+    if let Some(want) = wanted.map(|w| w.trim_end_matches('.')) {
+        let mut found = Vec::new();
+        for (p, part) in parts.iter().enumerate() {
+            if may_hold_layer(part, want) {
+                part_rgb_layers(p, part, &mut found);
+                if let Some(l) = found.iter().find(|l| l.name == want) {
+                    return Ok(l.clone());
+                }
+                found.clear();
+            }
+        }
+    }
     let layers = rgb_layers(parts);
     let labels = || layers.iter().map(RgbLayer::label).collect::<Vec<_>>();
     if layers.is_empty() {

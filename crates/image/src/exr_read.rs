@@ -4,10 +4,11 @@
 //! decoder on a corrupt block becomes an `Internal` error. Used for masks and for passes.
 
 use std::io::{Cursor, Read, Seek, SeekFrom};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use exr::block::UncompressedBlock;
 use exr::block::chunk::Chunk;
+use exr::block::chunk::TileCoordinates;
 use exr::math::Vec2;
 use exr::meta::BlockDescription;
 use exr::meta::attribute::{SampleType, Text};
@@ -202,24 +203,82 @@ impl ExrPart {
 
 /// Reads only the headers of an EXR held in memory (no pixel data is touched or allocated).
 pub fn read_exr_headers(bytes: &[u8]) -> Result<Vec<ExrPart>, ImageError> {
-    read_exr_header_info(Cursor::new(bytes)).map(|h| h.parts)
+    read_exr_header_info(Cursor::new(bytes)).map(|h| h.parts.to_vec())
 }
 
 /// What an EXR's headers say: its parts, and every text attribute as (part, name, value).
+/// Shared, not copied: the passes of the planes of one multi-part file hold one list.
 #[derive(Debug, Clone)]
 pub struct ExrHeaders {
-    pub parts: Vec<ExrPart>,
+    /// The parts, in file order.
+    pub parts: Arc<[ExrPart]>,
     /// Every text attribute, from the attributes shared by the parts and each part's own, as
     /// (part, name, value), sorted, without repeats (see [`read_exr_text_attributes`]).
-    pub text_attributes: Vec<(usize, String, String)>,
+    pub text_attributes: Arc<[(usize, String, String)]>,
 }
 
-/// Reads the headers of an EXR from `reader`, which is read only as far as the headers go: no
-/// offset table or pixel data is read (a file need not be loaded to be checked).
+/// The most parts an EXR may have. Counted from the headers before any is parsed, so a file of
+/// thousands of tiny parts is refused in the time it takes to read its headers' bytes.
+pub const MAX_EXR_PARTS: usize = 1024;
+
+/// Reads the headers of an EXR from `reader`, which is read only as far as the headers go (and
+/// a buffer beyond): no offset table or pixel data is parsed (a file need not be loaded to be
+/// checked). More than [`MAX_EXR_PARTS`] parts is refused. Headers read before (the planes of
+/// one multi-part file, read pass by pass) are recognised by their bytes and not parsed again.
 pub fn read_exr_header_info(reader: impl Read) -> Result<ExrHeaders, ImageError> {
-    let meta = guarded(|| exr::meta::MetaData::read_from_buffered(reader, false))?;
+    parsed_headers(reader).map(|h| h.info.clone())
+}
+
+/// An EXR's headers parsed, with their bytes (the file's start up to the first offset table).
+#[derive(Debug)]
+struct ParsedHeaders {
+    bytes: Vec<u8>,
+    meta: exr::meta::MetaData,
+    info: ExrHeaders,
+}
+
+/// The headers parsed most recently, newest first (a few: one multi-part file's passes are
+/// read one after the other, beside the frame's other files).
+static PARSED: Mutex<Vec<Arc<ParsedHeaders>>> = Mutex::new(Vec::new());
+/// How many [`PARSED`] keeps.
+const PARSED_KEPT: usize = 4;
+/// Headers of more bytes than this are parsed every time rather than kept.
+const PARSED_MAX_BYTES: usize = 16 << 20;
+
+/// The headers of the EXR `reader` starts with, from [`PARSED`] when their bytes were seen
+/// before, else scanned (counting the parts), parsed and kept.
+fn parsed_headers(mut reader: impl Read) -> Result<Arc<ParsedHeaders>, ImageError> {
+    let kept: Vec<Arc<ParsedHeaders>> = PARSED
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .clone();
+    let longest = kept.iter().map(|k| k.bytes.len()).max().unwrap_or(0);
+    let mut start = Vec::new();
+    (&mut reader)
+        .take(longest as u64)
+        .read_to_end(&mut start)
+        .map_err(ImageError::Read)?;
+    // Headers are self-delimiting: bytes equal to a kept header's are that header.
+    if let Some(hit) = kept.iter().find(|k| start.starts_with(&k.bytes)) {
+        return Ok(Arc::clone(hit));
+    }
+    let mut scan = HeaderScan {
+        bytes: start,
+        at: 0,
+        reader,
+    };
+    let end = scan.header_end()?;
+    let bytes = match end {
+        Some(end) => scan.bytes[..end].to_vec(),
+        None => Vec::new(),
+    };
+    #[cfg(test)]
+    tests::PARSES.with(|n| n.set(n.get() + 1));
+    let meta = guarded(|| {
+        exr::meta::MetaData::read_from_buffered(Cursor::new(&scan.bytes).chain(scan.reader), false)
+    })?;
     let multi_part = meta.headers.len() > 1;
-    Ok(ExrHeaders {
+    let info = ExrHeaders {
         parts: meta
             .headers
             .iter()
@@ -228,8 +287,104 @@ pub fn read_exr_header_info(reader: impl Read) -> Result<ExrHeaders, ImageError>
                 ..part_from_header(h)
             })
             .collect(),
-        text_attributes: text_attributes(&meta),
-    })
+        text_attributes: text_attributes(&meta).into(),
+    };
+    let parsed = Arc::new(ParsedHeaders { bytes, meta, info });
+    if end.is_some() && parsed.bytes.len() <= PARSED_MAX_BYTES {
+        let mut kept = PARSED
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        kept.insert(0, Arc::clone(&parsed));
+        kept.truncate(PARSED_KEPT);
+    }
+    Ok(parsed)
+}
+
+/// Walks the header bytes of an EXR (magic number, version, each header's attributes as
+/// name, type, size and value, up to the end of the headers) without interpreting them, to
+/// find where they end and count the parts. `bytes` holds what was read so far.
+struct HeaderScan<R> {
+    bytes: Vec<u8>,
+    at: usize,
+    reader: R,
+}
+
+impl<R: Read> HeaderScan<R> {
+    /// The next `n` bytes (read as needed); `None` at the end of the file.
+    fn take(&mut self, n: usize) -> Result<Option<&[u8]>, ImageError> {
+        let want = self.at + n;
+        if self.bytes.len() < want {
+            let missing = (want - self.bytes.len()).max(64 * 1024);
+            (&mut self.reader)
+                .take(missing as u64)
+                .read_to_end(&mut self.bytes)
+                .map_err(ImageError::Read)?;
+        }
+        if self.bytes.len() < want {
+            return Ok(None);
+        }
+        self.at = want;
+        Ok(Some(&self.bytes[want - n..want]))
+    }
+
+    /// A null-terminated name of at most 255 bytes; `None` when there is none.
+    fn name(&mut self) -> Result<Option<usize>, ImageError> {
+        for len in 0..=255 {
+            match self.take(1)? {
+                Some([0]) => return Ok(Some(len)),
+                Some(_) => {}
+                None => return Ok(None),
+            }
+        }
+        Ok(None)
+    }
+
+    /// Where the headers end (the offset tables begin); `None` when the bytes are not headers
+    /// as the scan expects (the parser then says what is wrong). Refuses more than
+    /// [`MAX_EXR_PARTS`] parts.
+    fn header_end(&mut self) -> Result<Option<usize>, ImageError> {
+        let Some(start) = self.take(8)? else {
+            return Ok(None);
+        };
+        let multi_part = start[5] & 0x10 != 0;
+        let mut parts = 0usize;
+        loop {
+            // One header: attributes until an empty name.
+            loop {
+                match self.name()? {
+                    None => return Ok(None),
+                    Some(0) => break,
+                    Some(_) => {}
+                }
+                if !matches!(self.name()?, Some(1..)) {
+                    return Ok(None);
+                }
+                let Some(size) = self.take(4)? else {
+                    return Ok(None);
+                };
+                let size = i32::from_le_bytes([size[0], size[1], size[2], size[3]]);
+                let Ok(size) = usize::try_from(size) else {
+                    return Ok(None);
+                };
+                if self.take(size)?.is_none() {
+                    return Ok(None);
+                }
+            }
+            parts += 1;
+            if parts > MAX_EXR_PARTS {
+                return Err(ImageError::TooManyParts { max: MAX_EXR_PARTS });
+            }
+            if !multi_part {
+                return Ok(Some(self.at));
+            }
+            // A multi-part file's headers end with an empty header.
+            match self.take(1)? {
+                Some([0]) => return Ok(Some(self.at)),
+                Some(_) => self.at -= 1,
+                None => return Ok(None),
+            }
+        }
+    }
 }
 
 /// Runs an `exr` call that sees file bytes: a panic becomes `CodecPanic`, an error `ExrDecode`.
@@ -291,12 +446,10 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
         .cloned()
         .ok_or_else(|| unsupported(format!("part {part} (the file has {})", parts.len())))?;
     check_exr_readable(&info, channels, max_pixels)?;
-    source
-        .seek(SeekFrom::Start(0))
-        .map_err(|e| ImageError::ExrDecode(exr::error::Error::Io(e)))?;
-
-    let reader = guarded(|| exr::block::read(source, false))?;
-    let meta = reader.meta_data().clone();
+    let io_err = |e| ImageError::ExrDecode(exr::error::Error::Io(e));
+    source.seek(SeekFrom::Start(0)).map_err(io_err)?;
+    let parsed = parsed_headers(&mut source)?;
+    let meta = &parsed.meta;
     let header = meta
         .headers
         .get(part)
@@ -327,13 +480,7 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
     };
     // Blocks are read one at a time, as decoders ask for them, so that only the blocks being
     // decoded are in memory, and reading overlaps decoding.
-    let chunks = guarded(|| {
-        reader.filter_chunks(false, |_, tile, block| {
-            block.layer == part
-                && tile.level_index == Vec2(0, 0)
-                && (first_band..end_band).contains(&tile.tile_index.y())
-        })
-    })?;
+    let chunks = part_chunks(source, &parsed, part, first_band..end_band)?;
     let layout = BandLayout {
         width: info.width,
         height: info.height,
@@ -352,7 +499,7 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
     let mut unique: Vec<usize> = channels.to_vec();
     unique.sort_unstable();
     unique.dedup();
-    let mut decoded = decode_bands(&meta, &header, &info, &unique, chunks, &layout)?;
+    let mut decoded = decode_bands(meta, &header, &info, &unique, chunks, &layout)?;
     let outputs = channels
         .iter()
         .enumerate()
@@ -367,6 +514,59 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
         })
         .collect();
     Ok((info, outputs))
+}
+
+/// The blocks of part `part` whose band (block row, level 0) is in `bands`, read one at a time
+/// as the decoders ask for them, from the file `source` whose headers are `parsed`: only that
+/// part's offset table is read (where the headers' end is known), so reading one part of a
+/// file of many costs that part, not the file's every table.
+fn part_chunks<'r, R: Read + Seek + Send + 'r>(
+    mut source: R,
+    parsed: &Arc<ParsedHeaders>,
+    part: usize,
+    bands: std::ops::Range<usize>,
+) -> Result<Box<dyn Iterator<Item = exr::error::Result<Chunk>> + Send + 'r>, ImageError> {
+    let io_err = |e| ImageError::ExrDecode(exr::error::Error::Io(e));
+    let headers = &parsed.meta.headers;
+    let wanted = |tile: TileCoordinates| {
+        tile.level_index == Vec2(0, 0) && bands.contains(&tile.tile_index.y())
+    };
+    if parsed.bytes.is_empty() {
+        // Where the headers end is unknown: the `exr` crate reads every table.
+        source.seek(SeekFrom::Start(0)).map_err(io_err)?;
+        let reader = guarded(|| exr::block::read(source, false))?;
+        let chunks = guarded(|| {
+            reader.filter_chunks(false, |_, tile, block| block.layer == part && wanted(tile))
+        })?;
+        return Ok(Box::new(chunks));
+    }
+    let before: usize = headers.iter().take(part).map(|h| h.chunk_count).sum();
+    let header = headers
+        .get(part)
+        .ok_or_else(|| unsupported(format!("part {part}")))?;
+    let table_at = (parsed.bytes.len() as u64).saturating_add((before as u64).saturating_mul(8));
+    source.seek(SeekFrom::Start(table_at)).map_err(io_err)?;
+    let mut table = vec![0u8; header.chunk_count.saturating_mul(8)];
+    source.read_exact(&mut table).map_err(io_err)?;
+    let table: Vec<u64> = table
+        .chunks_exact(8)
+        .map(|b| u64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]))
+        .collect();
+    let mut offsets = Vec::new();
+    for (index, tile) in header.blocks_increasing_y_order().enumerate() {
+        if wanted(tile.location) {
+            let offset = table
+                .get(index)
+                .ok_or_else(|| incomplete(format!("part {part}'s offset table is short")))?;
+            offsets.push(*offset);
+        }
+    }
+    offsets.sort_unstable();
+    let parsed = Arc::clone(parsed);
+    Ok(Box::new(offsets.into_iter().map(move |offset| {
+        source.seek(SeekFrom::Start(offset))?;
+        Chunk::read(&mut source, &parsed.meta)
+    })))
 }
 
 /// Refuses what [`read_exr_channels`] cannot decode, from the header alone: too many pixels,
@@ -726,7 +926,7 @@ pub fn read_exr_exact(bytes: &[u8], max_pixels: u64) -> Result<ExactExr, ImageEr
 /// each part's own, as (part, name, value); no pixel data is touched. Renderers keep metadata
 /// here (Cryptomatte's `cryptomatte/<key>/manifest`, Blender's `colorInteropID`).
 pub fn read_exr_text_attributes(bytes: &[u8]) -> Result<Vec<(usize, String, String)>, ImageError> {
-    read_exr_header_info(Cursor::new(bytes)).map(|h| h.text_attributes)
+    read_exr_header_info(Cursor::new(bytes)).map(|h| h.text_attributes.to_vec())
 }
 
 fn text_attributes(meta: &exr::meta::MetaData) -> Vec<(usize, String, String)> {
@@ -746,4 +946,104 @@ fn text_attributes(meta: &exr::meta::MetaData) -> Vec<(usize, String, String)> {
     out.sort();
     out.dedup();
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+    use std::io::Cursor;
+
+    use exr::meta::header::{ImageAttributes, LayerAttributes};
+
+    use crate::{
+        ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ImageErrorKind,
+        PixelWindow, read_exr_channel_rows_from, read_exr_header_info,
+    };
+
+    thread_local! {
+        /// Headers parsed by the `exr` crate on this thread (the others are recognised).
+        pub(super) static PARSES: Cell<usize> = const { Cell::new(0) };
+    }
+
+    /// An EXR of `n` parts `plane0`, `plane1`, …, each 2×1 pixels with R, G, B = its index,
+    /// on rows `k % 4` of a 2×4 frame.
+    fn many_parts(n: usize) -> Vec<u8> {
+        let frame = PixelWindow::at_origin(2, 4);
+        let image = ExrImageOut {
+            display_window: frame,
+            attributes: ImageAttributes::new(exr::prelude::IntegerBounds::from_dimensions((2, 4))),
+            parts: (0..n)
+                .map(|k| ExrPartOut {
+                    data_window: PixelWindow {
+                        x: 0,
+                        y: (k % 4) as i32,
+                        width: 2,
+                        height: 1,
+                    },
+                    attributes: LayerAttributes::named(format!("plane{k}").as_str()),
+                    planes: ["R", "G", "B"]
+                        .iter()
+                        .map(|c| ExrPlane::new(c, vec![k as f32; 2]))
+                        .collect(),
+                })
+                .collect(),
+        };
+        let mut out = Cursor::new(Vec::new());
+        let options = ExrWriteOptions {
+            storage: ExrStorage::Float,
+            compression: exr::compression::Compression::Uncompressed,
+            zip_level: None,
+        };
+        crate::write_exr_image(&mut out, image, options).unwrap();
+        out.into_inner()
+    }
+
+    #[test]
+    fn every_part_of_a_file_of_many_is_read_with_its_headers_parsed_once() {
+        let bytes = many_parts(300);
+        let before = PARSES.with(Cell::get);
+        let headers = read_exr_header_info(Cursor::new(&bytes)).unwrap();
+        assert_eq!(headers.parts.len(), 300);
+        for k in [0, 1, 150, 299] {
+            let (part, planes) = read_exr_channel_rows_from(
+                Cursor::new(&bytes),
+                &headers.parts,
+                k,
+                &[0, 2],
+                100,
+                None,
+            )
+            .unwrap();
+            assert_eq!(part.data_window.y, (k % 4) as i32);
+            assert_eq!(planes, vec![vec![k as f32; 2]; 2], "part {k}");
+            // Again through the header reader, as each plane's pass does.
+            assert_eq!(
+                read_exr_header_info(Cursor::new(&bytes))
+                    .unwrap()
+                    .parts
+                    .len(),
+                300
+            );
+        }
+        assert_eq!(PARSES.with(Cell::get) - before, 1);
+    }
+
+    #[test]
+    fn a_file_of_too_many_parts_is_refused_before_its_headers_are_parsed() {
+        let bytes = many_parts(crate::MAX_EXR_PARTS + 1);
+        let before = PARSES.with(Cell::get);
+        let e = read_exr_header_info(Cursor::new(&bytes)).unwrap_err();
+        assert_eq!(e.kind(), ImageErrorKind::Limits, "{e}");
+        assert!(e.to_string().contains("more than 1024 parts"), "{e}");
+        assert_eq!(PARSES.with(Cell::get), before);
+        // The limit itself is read.
+        let bytes = many_parts(crate::MAX_EXR_PARTS);
+        assert_eq!(
+            read_exr_header_info(Cursor::new(&bytes))
+                .unwrap()
+                .parts
+                .len(),
+            crate::MAX_EXR_PARTS
+        );
+    }
 }

@@ -31,9 +31,9 @@ pub use exr_layers::{
 };
 pub use exr_read::{
     ExactExr, ExactPart, ExrChannelInfo, ExrColourTag, ExrHeaders, ExrPart, ExrSampleType,
-    check_exr_readable, read_exr_attributes, read_exr_channel_rows, read_exr_channel_rows_from,
-    read_exr_channels, read_exr_exact, read_exr_header_info, read_exr_headers,
-    read_exr_text_attributes,
+    MAX_EXR_PARTS, check_exr_readable, read_exr_attributes, read_exr_channel_rows,
+    read_exr_channel_rows_from, read_exr_channels, read_exr_exact, read_exr_header_info,
+    read_exr_headers, read_exr_text_attributes,
 };
 pub use exr_write::{
     ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport, PlaneSamples,

@@ -8,15 +8,20 @@
 //! - [`protect_inputs`] and [`exit_removing_temporaries`]: the process-wide records that keep
 //!   every file read safe from the outputs and let a signal handler remove the unfinished
 //!   temporary files (docs/reliability.md).
+//! - [`ChildGroup`]: a program started in a process group of its own, stopped with everything
+//!   it started on a timeout or when the process is stopped.
 //! - [`frames`]: frame patterns and frame lists of animations.
 //! - [`progress`]: the observer through which libraries report the progress of long work.
+//! - [`quoted`]: a value from an input quoted in a message, cut to a bounded length.
 
+mod children;
 pub mod frames;
 pub mod input;
 mod kind;
 pub mod output;
 mod registry;
 
+pub use children::ChildGroup;
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
 pub use input::{
     InputError, InputLimit, limits, open_input, read_input, read_input_string, read_open_input,
@@ -29,7 +34,9 @@ pub use output::{
 };
 pub use registry::{TEMP_PREFIX, exit_removing_temporaries, protect_inputs};
 pub mod progress;
+mod quote;
 pub use progress::{NoProgress, Progress, StageLog};
+pub use quote::{MAX_QUOTED_CHARS, Quoted, backticked, bounded_message, quoted};
 
 /// Displays an error with its causes as `outer: cause: root`, as `anyhow`'s `{:#}` does, for
 /// messages that are printed or written without going through `anyhow`.

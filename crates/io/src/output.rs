@@ -106,6 +106,31 @@ fn resolve_target(path: &Path) -> Result<PathBuf, OutputError> {
     })
 }
 
+/// The regular file or new name `path` is, without following a symbolic link: a link at
+/// `path` is itself what the output replaces (for folders whose entries must not lead
+/// elsewhere, as an export's). Refuses an existing entry of any other kind.
+fn own_target(path: &Path) -> Result<PathBuf, OutputError> {
+    match std::fs::symlink_metadata(path) {
+        Err(_) => Ok(path.to_path_buf()),
+        Ok(meta) => match FileKind::of(&meta.file_type()) {
+            FileKind::Regular | FileKind::Symlink => Ok(path.to_path_buf()),
+            kind => Err(OutputError::NotAFile {
+                path: path.to_path_buf(),
+                kind,
+            }),
+        },
+    }
+}
+
+/// What an output does with a symbolic link where it is written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Links {
+    /// Writes through it: the file it leads to is replaced and the link kept.
+    Follow,
+    /// Replaces the link itself; what it leads to is never opened.
+    Replace,
+}
+
 /// A finished temporary file waiting to be renamed over its target.
 #[derive(Debug)]
 struct StagedFile {
@@ -117,12 +142,20 @@ struct StagedFile {
 }
 
 /// Writes `produce`'s content to a temporary file beside `path`'s target, flushed and synced.
-fn stage<F>(path: &Path, produce: F) -> Result<StagedFile, OutputError>
+fn stage<F>(path: &Path, links: Links, produce: F) -> Result<StagedFile, OutputError>
 where
     F: FnOnce(&mut BufWriter<SyncingFile<'_>>) -> std::io::Result<()>,
 {
-    let target = resolve_target(path)?;
-    refuse_input_as_output(path, [])?;
+    let target = match links {
+        Links::Follow => resolve_target(path)?,
+        Links::Replace => own_target(path)?,
+    };
+    // A link that is replaced leaves what it leads to alone, input or not.
+    let replaced_link = links == Links::Replace
+        && std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if !replaced_link {
+        refuse_input_as_output(path, [])?;
+    }
     let dir = registry::parent_dir(&target).to_path_buf();
     if !dir.is_dir() {
         return Err(OutputError::MissingDirectory {
@@ -132,15 +165,18 @@ where
     }
     // A replaced file keeps its mode; a new one gets what any other tool would give it
     // (0666 masked by the umask), not a temporary file's private 0600.
-    let permissions = match std::fs::metadata(&target) {
-        Ok(meta) => meta.permissions(),
+    let permissions = match std::fs::symlink_metadata(&target)
+        .ok()
+        .filter(|m| m.is_file())
+    {
+        Some(meta) => meta.permissions(),
         #[cfg(unix)]
-        Err(_) => {
+        None => {
             use std::os::unix::fs::PermissionsExt;
             std::fs::Permissions::from_mode(0o666)
         }
         #[cfg(not(unix))]
-        Err(_) => std::fs::File::open(&dir)
+        None => std::fs::File::open(&dir)
             .and_then(|f| f.metadata())
             .map(|m| m.permissions())
             .map_err(|source| OutputError::CreateTemp {
@@ -219,7 +255,7 @@ pub fn write_atomic<F>(path: &Path, produce: F) -> Result<(), OutputError>
 where
     F: FnOnce(&mut BufWriter<SyncingFile<'_>>) -> std::io::Result<()>,
 {
-    let staged = stage(path, produce)?;
+    let staged = stage(path, Links::Follow, produce)?;
     staged
         .temp
         .persist(&staged.target)
@@ -255,7 +291,28 @@ impl StagedOutput {
     where
         F: FnOnce(&mut BufWriter<SyncingFile<'_>>) -> std::io::Result<()>,
     {
-        self.files.push(stage(path, produce)?);
+        self.files.push(stage(path, Links::Follow, produce)?);
+        Ok(())
+    }
+
+    /// As [`StagedOutput::write_bytes`], but a symbolic link at `path` is replaced by the file
+    /// rather than written through: nothing outside `path`'s folder is touched, whatever links
+    /// someone placed in it (the viewer's export folder).
+    pub fn write_bytes_replacing_link(
+        &mut self,
+        path: &Path,
+        bytes: &[u8],
+    ) -> Result<(), OutputError> {
+        self.write_replacing_link(path, |w| w.write_all(bytes))
+    }
+
+    /// As [`StagedOutput::write`], but a symbolic link at `path` is replaced by the file rather
+    /// than written through (see [`StagedOutput::write_bytes_replacing_link`]).
+    pub fn write_replacing_link<F>(&mut self, path: &Path, produce: F) -> Result<(), OutputError>
+    where
+        F: FnOnce(&mut BufWriter<SyncingFile<'_>>) -> std::io::Result<()>,
+    {
+        self.files.push(stage(path, Links::Replace, produce)?);
         Ok(())
     }
 
@@ -573,6 +630,39 @@ mod tests {
             "{:?}",
             names(dir.path())
         );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_replaced_is_never_followed() {
+        let dir = tempfile::tempdir().unwrap();
+        let outside = dir.path().join("outside.txt");
+        std::fs::write(&outside, b"kept").unwrap();
+        let inside = dir.path().join("folder");
+        std::fs::create_dir(&inside).unwrap();
+        let link = inside.join("viewer.css");
+        std::os::unix::fs::symlink(&outside, &link).unwrap();
+        let dangling = inside.join("index.html");
+        std::os::unix::fs::symlink(dir.path().join("made-outside.html"), &dangling).unwrap();
+        let mut staged = StagedOutput::new();
+        staged.write_bytes_replacing_link(&link, b"css").unwrap();
+        staged
+            .write_bytes_replacing_link(&dangling, b"html")
+            .unwrap();
+        staged.commit().unwrap();
+        assert_eq!(std::fs::read(&outside).unwrap(), b"kept");
+        assert!(!dir.path().join("made-outside.html").exists());
+        for (path, bytes) in [(&link, &b"css"[..]), (&dangling, &b"html"[..])] {
+            let meta = std::fs::symlink_metadata(path).unwrap();
+            assert!(meta.is_file(), "{path:?} is still a link");
+            assert_eq!(std::fs::read(path).unwrap(), bytes);
+        }
+        // A folder in the way is still refused.
+        let mut staged = StagedOutput::new();
+        let e = staged
+            .write_bytes_replacing_link(dir.path(), b"x")
+            .unwrap_err();
+        assert!(matches!(e, OutputError::NotAFile { .. }), "{e:?}");
     }
 
     #[cfg(unix)]

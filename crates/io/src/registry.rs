@@ -58,14 +58,17 @@ impl FileId {
 }
 
 pub(crate) struct State {
-    /// A stop is under way: no temporary file may be created or renamed into place.
-    stopping: bool,
+    /// A stop is under way: no temporary file may be created or renamed into place, no
+    /// program started.
+    pub(crate) stopping: bool,
     /// The temporary files that exist now (absolute paths).
     temporaries: BTreeSet<PathBuf>,
     /// Whether the files read are recorded (see [`protect_inputs`]).
     protect_inputs: bool,
     /// The files read, by identity, with the name each was first read by.
     inputs: BTreeMap<FileId, PathBuf>,
+    /// The process groups of the programs started and not yet reaped (`crate::ChildGroup`).
+    pub(crate) child_groups: BTreeSet<u32>,
 }
 
 static STATE: Mutex<State> = Mutex::new(State {
@@ -73,6 +76,7 @@ static STATE: Mutex<State> = Mutex::new(State {
     temporaries: BTreeSet::new(),
     protect_inputs: false,
     inputs: BTreeMap::new(),
+    child_groups: BTreeSet::new(),
 });
 
 /// The lock (a panic elsewhere does not make the records unusable).
@@ -102,7 +106,7 @@ pub(crate) fn input_matching(id: &FileId) -> Option<PathBuf> {
     state().inputs.get(id).cloned()
 }
 
-fn stopping_error() -> std::io::Error {
+pub(crate) fn stopping_error() -> std::io::Error {
     std::io::Error::new(
         std::io::ErrorKind::Interrupted,
         "the process is being stopped",
@@ -180,13 +184,17 @@ impl Drop for LiveTemp {
     }
 }
 
-/// Removes every temporary file this process is writing and exits with `code` (128 + the
-/// signal number, by convention: 130 for SIGINT, 143 for SIGTERM). The lock stays held, so no
-/// other thread creates a temporary file or renames one into place after this point: the
+/// Removes every temporary file this process is writing, kills the process groups of the
+/// programs it started ([`crate::ChildGroup`]) and exits with `code` (128 + the signal number,
+/// by convention: 130 for SIGINT, 143 for SIGTERM). The lock stays held, so no other thread
+/// creates a temporary file, renames one into place or starts a program after this point: the
 /// outputs that were finished before stay, the unfinished leave nothing behind.
 pub fn exit_removing_temporaries(code: i32) -> ! {
     let mut s = state();
     s.stopping = true;
+    for group in std::mem::take(&mut s.child_groups) {
+        crate::children::kill_group(group);
+    }
     for path in std::mem::take(&mut s.temporaries) {
         let _ = std::fs::remove_file(path);
     }

@@ -279,6 +279,8 @@ fn locate_vector(
 pub(crate) struct CryptomattePlan {
     /// hash → glass id, for the glass names only.
     glass_of: HashMap<u32, u16>,
+    /// hash → name, for every manifest entry (for messages).
+    names_of: HashMap<u32, String>,
     wanted: Vec<(usize, usize)>,
     rank_count: usize,
     windows: ImageWindows,
@@ -295,7 +297,7 @@ pub(crate) fn plan_cryptomatte(
     opts: &CryptomatteOptions,
     max_pixels: u64,
 ) -> Result<CryptomattePlan, MaskError> {
-    let parts = headers.parts.as_slice();
+    let parts = &headers.parts[..];
     let layers = cryptomatte_layers(&headers.text_attributes, path)?;
     let layer = choose_layer(&layers, opts.layer.as_deref(), path)?;
     let unmatched = opts
@@ -309,10 +311,28 @@ pub(crate) fn plan_cryptomatte(
             names: layer.manifest.keys().cloned().collect(),
         });
     }
-    let glass_of: HashMap<u32, u16> = layer
+    // Every entry used as glass is checked against its name; pixels store the hash with the
+    // exponent fix-up, whichever the manifest wrote.
+    let mut glass_of: HashMap<u32, u16> = HashMap::new();
+    for (name, &hash) in &layer.manifest {
+        if let Some(id) = opts.glass.id_of(name) {
+            let expected = murmur3_32(name.as_bytes(), 0);
+            if hash != expected && hash != float_encoded(expected) {
+                return Err(MaskError::ManifestHash {
+                    path: path.to_path_buf(),
+                    layer: layer.name.clone(),
+                    name: name.clone(),
+                    manifest: hash,
+                    expected: float_encoded(expected),
+                });
+            }
+            glass_of.insert(float_encoded(expected), id);
+        }
+    }
+    let names_of: HashMap<u32, String> = layer
         .manifest
         .iter()
-        .filter_map(|(name, &hash)| opts.glass.id_of(name).map(|id| (hash, id)))
+        .map(|(name, &hash)| (float_encoded(hash), name.clone()))
         .collect();
     let ranks = rank_channels(parts, &layer.name);
     if ranks.is_empty() {
@@ -346,6 +366,7 @@ pub(crate) fn plan_cryptomatte(
     let windows = plan_channels(parts, &wanted, path, max_pixels)?;
     Ok(CryptomattePlan {
         glass_of,
+        names_of,
         wanted,
         rank_count,
         windows,
@@ -386,6 +407,7 @@ pub(crate) fn decode_cryptomatte(
 ) -> Result<PlacedMask, MaskError> {
     let CryptomattePlan {
         glass_of,
+        names_of,
         wanted,
         rank_count,
         stores_planes,
@@ -393,11 +415,11 @@ pub(crate) fn decode_cryptomatte(
     } = plan;
     let (windows, planes) = decode_channels(exr, &wanted, path)?;
     let (ranks_data, rest) = planes.split_at(rank_count);
-    let glass = dominant_glass(ranks_data, &glass_of);
     let pixel = PixelError {
         path,
         width: windows.data.width,
     };
+    let glass = dominant_glass(ranks_data, &glass_of, &names_of, &pixel)?;
     let divide = |v: f32, i: usize| match opts.weighting {
         AovWeighting::GlassOnly if glass.total[i] > 0.0 => v / glass.total[i],
         _ => v,
@@ -449,9 +471,19 @@ struct DominantGlass {
     total: Vec<f32>,
 }
 
+/// How far above 1 a rank's coverage may round.
+const COVERAGE_ROUNDING: f32 = 1e-4;
+
 /// Sums each glass's coverage over the ranks (`ranks` alternates id and coverage planes) and
-/// keeps the largest; ids that are not glass (or not in the manifest) count as no glass.
-fn dominant_glass(ranks: &[Vec<f32>], glass_of: &HashMap<u32, u16>) -> DominantGlass {
+/// keeps the largest; ids that are not glass (or not in the manifest) count as no glass. A
+/// coverage that is not a finite value in [0, 1] is refused, naming the pixel, the value and
+/// the name its id has in the manifest (`names_of`).
+fn dominant_glass(
+    ranks: &[Vec<f32>],
+    glass_of: &HashMap<u32, u16>,
+    names_of: &HashMap<u32, String>,
+    pixel: &PixelError<'_>,
+) -> Result<DominantGlass, MaskError> {
     let n = ranks.first().map_or(0, Vec::len);
     let mut out = DominantGlass {
         id: vec![0; n],
@@ -461,9 +493,22 @@ fn dominant_glass(ranks: &[Vec<f32>], glass_of: &HashMap<u32, u16>) -> DominantG
     let mut per_glass: Vec<(u16, f32)> = Vec::with_capacity(8);
     for i in 0..n {
         per_glass.clear();
-        for pair in ranks.chunks_exact(2) {
+        for (rank, pair) in ranks.chunks_exact(2).enumerate() {
             let cov = pair[1][i];
-            if !(cov.is_finite() && cov > 0.0) {
+            if !(cov.is_finite() && (0.0..=1.0 + COVERAGE_ROUNDING).contains(&cov)) {
+                let bits = pair[0][i].to_bits();
+                let name = names_of.get(&bits).map_or_else(
+                    || format!("id {bits:08x} (not in the manifest)"),
+                    |n| glassdb_io::quoted(n).to_string(),
+                );
+                return Err(pixel.at(
+                    i,
+                    format!(
+                        "Cryptomatte rank {rank} gives {name} the coverage {cov}, not a value in [0, 1]"
+                    ),
+                ));
+            }
+            if cov == 0.0 {
                 continue;
             }
             let Some(&g) = glass_of.get(&pair[0][i].to_bits()) else {
@@ -484,7 +529,47 @@ fn dominant_glass(ranks: &[Vec<f32>], glass_of: &HashMap<u32, u16>) -> DominantG
             out.coverage[i] = c.min(1.0);
         }
     }
-    out
+    Ok(out)
+}
+
+/// MurmurHash3 (x86, 32-bit) of `data` with `seed`: Cryptomatte's hash of a name (seed 0, the
+/// name's UTF-8 bytes).
+pub fn murmur3_32(data: &[u8], seed: u32) -> u32 {
+    const C1: u32 = 0xcc9e_2d51;
+    const C2: u32 = 0x1b87_3593;
+    let mix = |k: u32| k.wrapping_mul(C1).rotate_left(15).wrapping_mul(C2);
+    let mut h = seed;
+    let mut blocks = data.chunks_exact(4);
+    for b in &mut blocks {
+        h ^= mix(u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        h = h.rotate_left(13).wrapping_mul(5).wrapping_add(0xe654_6b64);
+    }
+    let tail = blocks.remainder();
+    if !tail.is_empty() {
+        let k = tail
+            .iter()
+            .rev()
+            .fold(0u32, |k, &byte| (k << 8) | u32::from(byte));
+        h ^= mix(k);
+    }
+    h ^= data.len() as u32;
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x85eb_ca6b);
+    h ^= h >> 13;
+    h = h.wrapping_mul(0xc2b2_ae35);
+    h ^ (h >> 16)
+}
+
+/// A hash as Cryptomatte stores it in a pixel (the bits of an `f32`): an exponent of all
+/// zeros or all ones (a denormal, infinite or NaN float) has its lowest bit flipped, as the
+/// specification says (Blender clamps it to 1 or 254: the same bits).
+pub fn float_encoded(hash: u32) -> u32 {
+    let exponent = (hash >> 23) & 0xff;
+    if exponent == 0 || exponent == 0xff {
+        hash ^ (1 << 23)
+    } else {
+        hash
+    }
 }
 
 /// cos θ on glass pixels from an |N·I| AOV (divided by the glass coverage when the AOV is

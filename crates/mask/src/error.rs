@@ -24,6 +24,19 @@ pub enum MaskError {
     /// The file decodes but is not laid out as any mask format (e.g. grey PNG without a glass id).
     #[error("mask {path}: {detail}")]
     Layout { path: PathBuf, detail: String },
+    /// A Cryptomatte manifest entry used as glass whose hash is not the MurmurHash3_32 of its
+    /// name (the specification's rule): a corrupt manifest would relabel other objects.
+    #[error(
+        "mask {path}: Cryptomatte {layer}: the manifest gives {} the hash {manifest:08x}, but the MurmurHash3_32 of that name is {expected:08x} (the manifest is corrupt; its ids cannot be trusted)",
+        glassdb_io::quoted(name)
+    )]
+    ManifestHash {
+        path: PathBuf,
+        layer: String,
+        name: String,
+        manifest: u32,
+        expected: u32,
+    },
     /// A binary (white-on-black) mask given as an EXR.
     #[error("mask {path}: a binary mask must be a PNG; an EXR mask carries its ids in a channel")]
     BinaryMaskNotPng { path: PathBuf },

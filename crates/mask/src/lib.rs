@@ -26,6 +26,7 @@ use rayon::prelude::*;
 pub use cos_code::CosCode;
 pub use cryptomatte::{
     AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, PlaneSource, cryptomatte_layers,
+    float_encoded, murmur3_32,
 };
 pub use error::MaskError;
 pub use glass_names::{GlassMapping, GlassNames};

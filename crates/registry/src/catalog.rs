@@ -135,7 +135,8 @@ pub enum NormalSource {
 pub fn parse_catalog(text: &str, path: &Path) -> Result<Vec<GlassSpec>, RegistryError> {
     let catalog: Catalog = toml::from_str(text).map_err(|source| RegistryError::CatalogToml {
         path: path.to_path_buf(),
-        source: Box::new(source),
+        // The parser's message shows the line it stopped on, which may be megabytes long.
+        message: glassdb_io::bounded_message(&source.to_string()),
     })?;
     if catalog.glass.is_empty() {
         return Err(RegistryError::CatalogSyntax {

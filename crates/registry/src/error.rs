@@ -156,11 +156,8 @@ pub enum RegistryError {
 
     /// The catalog TOML is malformed, has an unknown key or a value of the wrong type
     /// (the source names the key, line and column).
-    #[error("{path}: not a valid catalog")]
-    CatalogToml {
-        path: PathBuf,
-        source: Box<toml::de::Error>,
-    },
+    #[error("{path}: not a valid catalog: {message}")]
+    CatalogToml { path: PathBuf, message: String },
 
     /// The catalog is not UTF-8 text, or lists no glass.
     #[error("{path}: {message}")]

@@ -21,16 +21,30 @@ impl Plane {
                 message: format!("plane {eq:?} has a non-finite coefficient"),
             });
         }
-        let len = math::norm([eq[0], eq[1], eq[2]]);
-        if len < 1e-12 * (1.0 + eq[3].abs()) || len == 0.0 {
+        // An equation and any multiple of it are the same plane: scaled by its largest
+        // coefficient first, a normal of 1e308 (whose length overflows) and one of 1e-320 (a
+        // subnormal, whose length underflows) are judged alike, by their direction.
+        // (Coefficients whose squares neither overflow nor underflow are taken as they are.)
+        let largest = eq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let scale = if (1e-150..=1e150).contains(&largest) {
+            1.0
+        } else {
+            largest
+        };
+        let [a, b, c, d] = eq.map(|x| if scale > 0.0 { x / scale } else { x });
+        let len = math::norm([a, b, c]);
+        if len < 1e-12 * (1.0 + d.abs()) || len == 0.0 {
             return Err(SceneError::DegeneratePlane {
-                message: format!("plane {eq:?} has a zero normal (a, b, c); it has no orientation"),
+                message: format!(
+                    "plane {eq:?} has a zero normal (a, b, c), or one negligible beside d; it \
+                     has no orientation"
+                ),
             });
         }
         // `+ 0.0` turns −0 into +0, so equations print and serialise without "-0.0".
         Ok(Plane {
-            normal: [eq[0] / len + 0.0, eq[1] / len + 0.0, eq[2] / len + 0.0],
-            d: eq[3] / len + 0.0,
+            normal: [a / len + 0.0, b / len + 0.0, c / len + 0.0],
+            d: d / len + 0.0,
         })
     }
 
@@ -417,6 +431,33 @@ pub fn assign_to_planes(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_and_subnormal_equations_are_judged_by_their_direction() {
+        for k in [1e308, -1e308, 1e-320, -1e-318, 1.0] {
+            let p = Plane::from_equation([k, 0.0, 0.0, -0.5 * k]).unwrap();
+            assert_eq!(p.normal, [k.signum(), 0.0, 0.0], "{k:e}");
+            assert_eq!(p.d, -0.5 * k.signum(), "{k:e}");
+        }
+        let tiny = Plane::from_equation([0.0, 5e-324, 0.0, 0.0]).unwrap();
+        assert_eq!(tiny.normal, [0.0, 1.0, 0.0]);
+        let tilted = Plane::from_equation([1e308, 1e308, 0.0, 0.0]).unwrap();
+        assert!((tilted.normal[0] - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-15);
+        // A normal negligible beside d, at any scale, is still refused.
+        for k in [1.0, 1e300, 1e-300] {
+            assert!(
+                Plane::from_equation([1e-14 * k, 0.0, 0.0, k]).is_err(),
+                "{k:e}"
+            );
+        }
+        for bad in [
+            [0.0; 4],
+            [f64::INFINITY, 0.0, 0.0, 1.0],
+            [0.0, 0.0, 0.0, 1e-320],
+        ] {
+            assert!(Plane::from_equation(bad).is_err(), "{bad:?}");
+        }
+    }
 
     #[test]
     fn reflection_of_known_points() {

@@ -218,7 +218,7 @@ pub(crate) fn parse_number(
             source,
             place.line,
             place.column,
-            format!("{what} `{t}` is not a number"),
+            format!("{what} {} is not a number", glassdb_io::backticked(t)),
         )
     })?;
     if !v.is_finite() {
@@ -527,7 +527,8 @@ fn parse_optics_header(
                     line_no,
                     None,
                     format!(
-                        "unknown wavelength units `{value}` (expected `SI Microns` or `SI Nanometers`)"
+                        "unknown wavelength units {} (expected `SI Microns` or `SI Nanometers`)",
+                        glassdb_io::backticked(value)
                     ),
                 ));
             };

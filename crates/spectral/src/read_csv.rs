@@ -136,7 +136,10 @@ fn classify(name: &str) -> Result<Column, String> {
             None => Ok(Column::Wavelength(WavelengthUnit::FromValues)),
             Some(u) if NM.contains(&u) => Ok(Column::Wavelength(WavelengthUnit::Nanometres)),
             Some(u) if UM.contains(&u) => Ok(Column::Wavelength(WavelengthUnit::Microns)),
-            Some(u) => Err(format!("unknown wavelength unit `{u}` (expected nm or µm)")),
+            Some(u) => Err(format!(
+                "unknown wavelength unit {} (expected nm or µm)",
+                glassdb_io::backticked(u)
+            )),
         };
     }
     let slot = match base {
@@ -150,8 +153,8 @@ fn classify(name: &str) -> Result<Column, String> {
         }
         _ => {
             return Err(format!(
-                "unknown column `{}`: expected wavelength_nm or wavelength_um (or a wavelength header with its unit, e.g. `Wavelength (nm)`), then T, R (or Rf), Rb, each optionally in percent (`%T`, `T (%)`)",
-                name.trim()
+                "unknown column {}: expected wavelength_nm or wavelength_um (or a wavelength header with its unit, e.g. `Wavelength (nm)`), then T, R (or Rf), Rb, each optionally in percent (`%T`, `T (%)`)",
+                glassdb_io::backticked(name.trim())
             ));
         }
     };
@@ -160,7 +163,8 @@ fn classify(name: &str) -> Result<Column, String> {
         && !FRACTION.contains(&u)
     {
         return Err(format!(
-            "unknown unit `{u}` for {} (expected % or none)",
+            "unknown unit {} for {} (expected % or none)",
+            glassdb_io::backticked(u),
             QUANTITY_NAMES[slot]
         ));
     }

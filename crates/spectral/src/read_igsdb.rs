@@ -326,7 +326,10 @@ impl<'a> Table<'a> {
                         let t = s.trim();
                         match t.parse::<f64>() {
                             Ok(v) if v.is_finite() => Ok(v),
-                            _ => Err(err(format!("{prefix}.{key} `{t}` is not a number"))),
+                            _ => Err(err(format!(
+                                "{prefix}.{key} {} is not a number",
+                                glassdb_io::backticked(t)
+                            ))),
                         }
                     }
                     Some(other) => Err(err(format!("{prefix}.{key} is {other}, not a number"))),

@@ -692,9 +692,13 @@ void main() {
     exportButton.disabled = !scene.export_available;
     exportButton.title = scene.export_available ? 'write the self-contained folder with the current products'
       : (EXPORT ? 'this is an exported page' : 'start glassdb view with --export-dir DIR to enable');
+    // A request that changes something carries the page's session token (the server refuses
+    // it otherwise: crates/view/src/server.rs).
+    const session = document.querySelector('meta[name="glassdb-session"]');
+    const sessionFetch = (url, init) => fetch(url, { ...init, headers: { 'X-Glassdb-Session': session ? session.content : '' } });
     exportButton.onclick = async () => {
       try {
-        const r = await fetch('api/export', { method: 'POST', body: JSON.stringify({ glass: choicesParam(state.edit), ev: state.ev }) });
+        const r = await sessionFetch('api/export', { method: 'POST', body: JSON.stringify({ glass: choicesParam(state.edit), ev: state.ev }) });
         const body = await r.json();
         if (!r.ok) throw new Error(body.error);
         status('exported to ' + body.path);

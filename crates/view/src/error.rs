@@ -31,18 +31,43 @@ pub enum ViewError {
     /// The id a choice names is not a glass the registry knows.
     #[error("glass id {id} is not in the registry's table, so it has no slot to swap")]
     UnknownGlassId { id: u16 },
-    /// The server could not listen.
-    #[error("cannot listen on {address}: {source}")]
+    /// The address given to listen on does not resolve.
+    #[error("cannot find the address of {host:?} to listen on")]
+    Resolve {
+        host: String,
+        source: std::io::Error,
+    },
+    /// The server could not listen (the port is taken, the address is not this machine's, the
+    /// port needs privileges): the cause says which.
+    #[error("cannot listen on {address}")]
     Bind {
         address: String,
-        source: Box<dyn std::error::Error + Send + Sync>,
+        source: std::io::Error,
     },
-    /// The export folder could not be created or is not a directory.
+    /// No session token could be drawn from the system's random source.
+    #[error("cannot draw the page's session token from the system's random source")]
+    SessionToken { source: getrandom::Error },
+    /// The export folder could not be created or read.
     #[error("cannot write the export into {}", path.display())]
     ExportDir {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// The export folder names something that is not a folder.
+    #[error(
+        "cannot export into {}: it is {kind}, not a folder (the export writes index.html and its data into a folder, created if missing)",
+        path.display()
+    )]
+    ExportNotAFolder {
+        path: PathBuf,
+        kind: glassdb_io::FileKind,
+    },
+    /// The export folder holds things that are not a previous export.
+    #[error(
+        "{} is not empty and holds no previous export (it has {entries}); an export there would replace its index.html and other files",
+        path.display()
+    )]
+    ExportFolderInUse { path: PathBuf, entries: String },
     /// Writing an export file failed.
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),

@@ -4,9 +4,17 @@
 //! table in base64, the chosen products and exposure) and one `frame-NNNN.js` per frame (its
 //! passes and mask in base64), beside `index.html`, `viewer.js` and `viewer.css`. Every file
 //! lands together or not at all (`glassdb_io::StagedOutput`).
+//!
+//! What an export does to a folder that exists (docs/reliability.md): it writes into an empty
+//! folder, or one that holds a previous export (recognised by its [`MARKER`] file), replacing
+//! that export's files; any other folder with something in it is refused unless the user says
+//! `--force` ([`ExportFolder::force`]). A symbolic link in the folder is never followed: an
+//! export file whose name is a link replaces the link itself, so a link planted there cannot
+//! send a file elsewhere. A previous export's frame files that this one does not write are
+//! removed.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use base64::display::Base64Display;
 use base64::engine::general_purpose::STANDARD;
@@ -15,39 +23,142 @@ use serde_json::json;
 
 use crate::{GlassChoice, ViewError, Viewer, assets};
 
-/// Writes the export of `viewer` into `dir` (created if missing), starting with `choices`
-/// and exposure `ev`.
+/// The file that marks a folder as an export (JSON: what wrote it and the files it wrote), so
+/// that a later export recognises the folder as its own to replace.
+pub const MARKER: &str = "glassdb-export.json";
+
+/// What the marker's `format` says.
+const MARKER_FORMAT: &str = "glassdb view export";
+
+/// Where an export goes and whether it may write into a folder that holds other things.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ExportFolder {
+    /// The folder (created if missing; a link to a folder is taken as that folder).
+    pub dir: PathBuf,
+    /// Write into the folder even when it holds things that are not a previous export
+    /// (`--force`): the export's own file names are replaced, links among them as links.
+    pub force: bool,
+}
+
+/// How many of a refused folder's entries its message names.
+const NAMED_ENTRIES: usize = 5;
+
+impl ExportFolder {
+    /// Checks that an export may write into the folder, without writing anything: it is
+    /// missing, empty, a previous export, or [`ExportFolder::force`] is set; and it is a folder
+    /// (or a link to one). Returns the files the previous export wrote (none otherwise).
+    pub fn check(&self) -> Result<Vec<String>, ViewError> {
+        let dir = &self.dir;
+        let meta = match std::fs::metadata(dir) {
+            Ok(meta) => meta,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+            Err(source) => {
+                return Err(ViewError::ExportDir {
+                    path: dir.clone(),
+                    source,
+                });
+            }
+        };
+        if !meta.is_dir() {
+            return Err(ViewError::ExportNotAFolder {
+                path: dir.clone(),
+                kind: glassdb_io::FileKind::of(&meta.file_type()),
+            });
+        }
+        if let Some(files) = previous_export(dir) {
+            return Ok(files);
+        }
+        let entries = std::fs::read_dir(dir).map_err(|source| ViewError::ExportDir {
+            path: dir.clone(),
+            source,
+        })?;
+        let mut names: Vec<String> = entries
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .take(NAMED_ENTRIES + 1)
+            .collect();
+        if names.is_empty() || self.force {
+            return Ok(Vec::new());
+        }
+        names.sort();
+        let more = names.len() > NAMED_ENTRIES;
+        names.truncate(NAMED_ENTRIES);
+        Err(ViewError::ExportFolderInUse {
+            path: dir.clone(),
+            entries: format!("{}{}", names.join(", "), if more { ", …" } else { "" }),
+        })
+    }
+}
+
+/// The files a previous export in `dir` wrote, from its [`MARKER`] (a regular file, not a link,
+/// of bounded size); `None` when `dir` holds no export.
+fn previous_export(dir: &Path) -> Option<Vec<String>> {
+    let marker = dir.join(MARKER);
+    if !std::fs::symlink_metadata(&marker).ok()?.is_file() {
+        return None;
+    }
+    // Not recorded as an input: the export replaces it.
+    let bytes = glassdb_io::read_previous_output(&marker, glassdb_io::limits::JSON).ok()?;
+    let value: serde_json::Value = serde_json::from_slice(&bytes).ok()?;
+    if value.get("format")?.as_str()? != MARKER_FORMAT {
+        return None;
+    }
+    let files = value.get("files")?.as_array()?;
+    Some(
+        files
+            .iter()
+            .filter_map(|f| f.as_str())
+            .filter(|f| is_export_file_name(f))
+            .map(str::to_string)
+            .collect(),
+    )
+}
+
+/// Whether `name` is one an export writes (a plain name in the folder, never a path).
+fn is_export_file_name(name: &str) -> bool {
+    let frame = name
+        .strip_prefix("frame-")
+        .and_then(|n| n.strip_suffix(".js"))
+        .is_some_and(|n| n.len() >= 4 && n.bytes().all(|b| b.is_ascii_digit()));
+    frame || STATIC_FILES.contains(&name) || name == MARKER
+}
+
+/// The files every export writes, besides its frames and [`MARKER`].
+const STATIC_FILES: [&str; 4] = ["index.html", "viewer.js", "viewer.css", "data.js"];
+
+/// Writes the export of `viewer` into `folder` (created if missing; see [`ExportFolder::check`]
+/// for which existing folders are refused), starting with `choices` and exposure `ev`.
 pub fn write_export(
     viewer: &Viewer,
-    dir: &Path,
+    folder: &ExportFolder,
     choices: &[GlassChoice],
     ev: f64,
 ) -> Result<(), ViewError> {
-    let dir_error = |source| ViewError::ExportDir {
+    let dir = folder.dir.as_path();
+    let previous = folder.check()?;
+    std::fs::create_dir_all(dir).map_err(|source| ViewError::ExportDir {
         path: dir.to_path_buf(),
         source,
-    };
-    std::fs::create_dir_all(dir).map_err(dir_error)?;
-    if !std::fs::metadata(dir).map_err(dir_error)?.is_dir() {
-        return Err(dir_error(std::io::Error::other("not a directory")));
-    }
+    })?;
     let mut staged = StagedOutput::new();
     let frames = viewer.frame_count();
     let frame_file = |i: usize| format!("frame-{i:04}.js");
+    let mut written: Vec<String> = STATIC_FILES.iter().map(|f| f.to_string()).collect();
+    written.extend((0..frames).map(frame_file));
     let data_tags = format!(
         "<script>window.GLASSDB_EXPORT_FRAME_FILES = {};</script>\n<script src=\"data.js\"></script>",
         json!((0..frames).map(frame_file).collect::<Vec<_>>())
     );
     let html = assets::INDEX_HTML.replace(assets::EXPORT_DATA_MARK, &data_tags);
-    staged.write_bytes(&dir.join("index.html"), html.as_bytes())?;
-    staged.write_bytes(&dir.join("viewer.js"), assets::VIEWER_JS.as_bytes())?;
-    staged.write_bytes(&dir.join("viewer.css"), assets::VIEWER_CSS.as_bytes())?;
+    staged.write_bytes_replacing_link(&dir.join("index.html"), html.as_bytes())?;
+    staged.write_bytes_replacing_link(&dir.join("viewer.js"), assets::VIEWER_JS.as_bytes())?;
+    staged.write_bytes_replacing_link(&dir.join("viewer.css"), assets::VIEWER_CSS.as_bytes())?;
 
     let mut scene = viewer.scene().clone();
     scene["initial_glass"] = json!(viewer.choices_param(choices));
     scene["initial_ev"] = json!(ev);
     scene["export_available"] = json!(false);
-    staged.write(&dir.join("data.js"), |w| {
+    staged.write_replacing_link(&dir.join("data.js"), |w| {
         write!(
             w,
             "window.GLASSDB_EXPORT = {{\"scene\": {scene}, \"luts\": "
@@ -61,7 +172,7 @@ pub fn write_export(
     })?;
     for i in 0..frames {
         let frame = viewer.frame(i)?;
-        staged.write(&dir.join(frame_file(i)), |w| {
+        staged.write_replacing_link(&dir.join(frame_file(i)), |w| {
             writeln!(
                 w,
                 "window.GLASSDB_EXPORT.frames[{i}] = {{\"info\": {}, \"passes\": \"{}\", \"mask\": \"{}\"}};",
@@ -71,7 +182,21 @@ pub fn write_export(
             )
         })?;
     }
+    let marker = json!({
+        "format": MARKER_FORMAT,
+        "written_by": concat!("glassdb ", env!("CARGO_PKG_VERSION")),
+        "files": written,
+    });
+    staged.write_bytes_replacing_link(&dir.join(MARKER), format!("{marker:#}\n").as_bytes())?;
     staged.commit()?;
+    // The previous export's frames beyond this one's: its own files (a link among them is
+    // removed as a link), named by its marker.
+    for stale in previous
+        .iter()
+        .filter(|f| !written.contains(f) && *f != MARKER)
+    {
+        let _ = std::fs::remove_file(dir.join(stale));
+    }
     Ok(())
 }
 

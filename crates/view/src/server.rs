@@ -4,6 +4,14 @@
 //! bounded. The data the viewer holds (tables, the last frame) is shared with the replies,
 //! never copied for one.
 //!
+//! Whom it answers (docs/reliability.md, "The viewer's server"): only requests whose `Host`
+//! names this machine as a browser on it does (`localhost`, a loopback address), the name or
+//! address it was started on, or (when it listens on every interface) an IP address; any
+//! other name is what a page of another site sends after DNS rebinding, and is refused (403).
+//! A request whose `Origin` is another site's is refused; a request that changes something
+//! (the export) must also carry the page's `Origin` and the session token the served page
+//! holds ([`SESSION_HEADER`]), which no other site's page can read.
+//!
 //! | route | answer |
 //! |---|---|
 //! | `GET /`, `/viewer.js`, `/viewer.css` | the page |
@@ -16,14 +24,15 @@
 //! | `POST /api/export` | `{"glass": "1:NAME,…", "ev": 0}`: writes the export folder given at start |
 
 use std::io::{Cursor, Read};
+use std::net::{IpAddr, SocketAddr, ToSocketAddrs};
 use std::ops::Range;
-use std::path::PathBuf;
 use std::sync::Arc;
 
-use glassdb_io::ErrorChain;
+use glassdb_io::{ErrorChain, quoted};
 use serde_json::{Value, json};
 use tiny_http::{Header, Method, Request, Response, Server, StatusCode};
 
+use crate::export::ExportFolder;
 use crate::scene::FrameData;
 use crate::{ViewError, Viewer, assets, export};
 
@@ -33,30 +42,62 @@ pub const MAX_URL_BYTES: usize = 8 * 1024;
 pub const WORKERS: usize = 4;
 /// Largest request body accepted (an export request is a few hundred bytes).
 pub const MAX_BODY_BYTES: usize = 64 * 1024;
+/// The request header that carries the page's session token on a request that changes
+/// something (`POST /api/export`).
+pub const SESSION_HEADER: &str = "X-Glassdb-Session";
+/// The `name` of the `<meta>` element that carries the session token in the served page.
+pub const SESSION_META: &str = "glassdb-session";
 
 /// A listening viewer.
 pub struct ViewServer {
     server: Server,
     viewer: Viewer,
-    export_dir: Option<PathBuf>,
+    export: Option<ExportFolder>,
+    audience: Audience,
+    token: String,
+    /// The page's HTML with the session token.
+    page: Arc<[u8]>,
 }
 
 impl ViewServer {
-    /// Listens on `host:port` (port 0: a free port chosen by the system). `export_dir` is where
-    /// the page's "export" button writes (none: the button says how to enable it).
+    /// Listens on `host:port` (port 0: a free port chosen by the system; `host` an IP address
+    /// or a name of this machine). `export` is where the page's "export" button writes (none:
+    /// the button says how to enable it).
     pub fn bind(
         viewer: Viewer,
         host: &str,
         port: u16,
-        export_dir: Option<PathBuf>,
+        export: Option<ExportFolder>,
     ) -> Result<ViewServer, ViewError> {
-        let address = format!("{host}:{port}");
-        let server =
-            Server::http(&address).map_err(|source| ViewError::Bind { address, source })?;
+        let addresses = resolve(host, port)?;
+        let server = Server::http(addresses.as_slice()).map_err(|e| ViewError::Bind {
+            address: match addresses.as_slice() {
+                [one] => one.to_string(),
+                _ => format!("{host}:{port}"),
+            },
+            source: match e.downcast::<std::io::Error>() {
+                Ok(io) => *io,
+                Err(other) => std::io::Error::other(other.to_string()),
+            },
+        })?;
+        let listening = server.server_addr().to_ip();
+        let audience = Audience::new(host, listening.map(|a| a.ip()));
+        let token = session_token()?;
+        let page = assets::INDEX_HTML
+            .replacen(
+                "</head>",
+                &format!("<meta name=\"{SESSION_META}\" content=\"{token}\">\n</head>"),
+                1,
+            )
+            .into_bytes()
+            .into();
         Ok(ViewServer {
             server,
             viewer,
-            export_dir,
+            export,
+            audience,
+            token,
+            page,
         })
     }
 
@@ -66,6 +107,16 @@ impl ViewServer {
             Some(addr) => format!("http://{addr}/"),
             None => "http://127.0.0.1/".to_string(),
         }
+    }
+
+    /// Whether the server listens on an address other machines may reach (anything but a
+    /// loopback address): whoever reaches it sees the frames and the input paths, so the
+    /// binary warns.
+    pub fn reachable_from_other_machines(&self) -> bool {
+        self.server
+            .server_addr()
+            .to_ip()
+            .is_none_or(|addr| !addr.ip().is_loopback())
     }
 
     /// Answers requests until the process ends, on [`WORKERS`] threads (a frame being
@@ -83,39 +134,98 @@ impl ViewServer {
     }
 
     fn answer(&self, mut request: Request) {
-        let reply = if request.url().len() > MAX_URL_BYTES {
-            Reply::error(414, "the URL is too long")
-        } else {
-            let method = request.method().clone();
-            let path = request
-                .url()
-                .split(['?', '#'])
-                .next()
-                .unwrap_or("")
-                .to_string();
-            match method {
-                Method::Get | Method::Head => self.get(&path),
-                Method::Post => match read_body(&mut request) {
-                    Ok(body) if path == "/api/export" => self.export(&body),
-                    Ok(_) => Reply::error(404, "no such resource"),
-                    Err(reply) => reply,
-                },
-                _ => Reply::error(405, "only GET and POST are answered"),
+        let reply = match self.refusal(&request) {
+            Some(refused) => refused,
+            None if request.url().len() > MAX_URL_BYTES => Reply::error(414, "the URL is too long"),
+            None => {
+                let method = request.method().clone();
+                let path = request
+                    .url()
+                    .split(['?', '#'])
+                    .next()
+                    .unwrap_or("")
+                    .to_string();
+                match method {
+                    Method::Get | Method::Head => self.get(&path),
+                    Method::Post => match read_body(&mut request) {
+                        Ok(body) if path == "/api/export" => self.export(&body),
+                        Ok(_) => Reply::error(404, "no such resource"),
+                        Err(reply) => reply,
+                    },
+                    _ => Reply::error(405, "only GET and POST are answered"),
+                }
             }
         };
         // A client that went away is not the server's failure.
         let _ = request.respond(reply.into_response());
     }
 
+    /// Why `request` is not answered, if it is not: a `Host` that is not this machine's, an
+    /// `Origin` of another site, or a request that changes something without the page's
+    /// `Origin` and session token.
+    fn refusal(&self, request: &Request) -> Option<Reply> {
+        let Some(host) = header(request, "Host") else {
+            return Some(Reply::error(400, "the request names no Host"));
+        };
+        if !self.audience.allows_host(host) {
+            return Some(Reply::error(
+                403,
+                &format!(
+                    "this viewer answers requests for localhost, 127.0.0.1, [::1] or the \
+                     address it was started on (--bind), not for Host {}",
+                    quoted(host)
+                ),
+            ));
+        }
+        let origin = header(request, "Origin");
+        if let Some(origin) = origin
+            && !same_origin(origin, host)
+        {
+            return Some(Reply::error(
+                403,
+                &format!(
+                    "requests from pages of another site are refused (Origin {})",
+                    quoted(origin)
+                ),
+            ));
+        }
+        // The one request that changes something (other methods are answered 405).
+        if *request.method() == Method::Post {
+            if origin.is_none() {
+                return Some(Reply::error(
+                    403,
+                    "a request that changes something must come from the viewer's page (it has no Origin)",
+                ));
+            }
+            let token = header(request, SESSION_HEADER).unwrap_or("");
+            if !same_secret(token.as_bytes(), self.token.as_bytes()) {
+                return Some(Reply::error(
+                    403,
+                    "a request that changes something must carry the session token of the viewer's page",
+                ));
+            }
+        }
+        None
+    }
+
     fn get(&self, path: &str) -> Reply {
         let v = &self.viewer;
         match path {
-            "/" | "/index.html" => Reply::text(assets::INDEX_HTML, "text/html; charset=utf-8"),
-            "/viewer.js" => Reply::text(assets::VIEWER_JS, "text/javascript; charset=utf-8"),
-            "/viewer.css" => Reply::text(assets::VIEWER_CSS, "text/css; charset=utf-8"),
+            "/" | "/index.html" => Reply::text(
+                Body::Shared(self.page.clone(), 0..self.page.len()),
+                "text/html; charset=utf-8",
+            ),
+            "/viewer.js" => Reply::text(
+                Body::Static(assets::VIEWER_JS.as_bytes()),
+                "text/javascript; charset=utf-8",
+            ),
+            "/viewer.css" => Reply::text(
+                Body::Static(assets::VIEWER_CSS.as_bytes()),
+                "text/css; charset=utf-8",
+            ),
             "/api/scene" => {
                 let mut scene = v.scene().clone();
-                scene["export_available"] = json!(self.export_dir.is_some());
+                scene["export_available"] = json!(self.export.is_some());
                 Reply::json(&scene)
             }
             _ => {
@@ -163,7 +273,7 @@ impl ViewServer {
     }
 
     fn export(&self, body: &[u8]) -> Reply {
-        let Some(dir) = &self.export_dir else {
+        let Some(folder) = &self.export else {
             return Reply::error(
                 409,
                 "this viewer was started without an export folder; restart it with one",
@@ -181,11 +291,137 @@ impl ViewServer {
             Ok(c) => c,
             Err(e) => return Reply::error(400, &ErrorChain(&e).to_string()),
         };
-        match export::write_export(&self.viewer, dir, &choices, ev) {
-            Ok(()) => Reply::json(&json!({ "path": dir.display().to_string() })),
+        match export::write_export(&self.viewer, folder, &choices, ev) {
+            Ok(()) => Reply::json(&json!({ "path": folder.dir.display().to_string() })),
             Err(e) => Reply::error(500, &ErrorChain(&e).to_string()),
         }
     }
+}
+
+/// The addresses `host` names for listening on `port`: an IP address as it is (also `[::1]`),
+/// a name as the system resolves it.
+fn resolve(host: &str, port: u16) -> Result<Vec<SocketAddr>, ViewError> {
+    let bare = host
+        .strip_prefix('[')
+        .and_then(|h| h.strip_suffix(']'))
+        .unwrap_or(host);
+    if let Ok(ip) = bare.parse::<IpAddr>() {
+        return Ok(vec![SocketAddr::new(ip, port)]);
+    }
+    let found = (bare, port)
+        .to_socket_addrs()
+        .map_err(|source| ViewError::Resolve {
+            host: host.to_string(),
+            source,
+        })?;
+    Ok(found.collect())
+}
+
+/// A fresh session token: 128 random bits in hex.
+fn session_token() -> Result<String, ViewError> {
+    let mut bytes = [0u8; 16];
+    getrandom::fill(&mut bytes).map_err(|source| ViewError::SessionToken { source })?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+/// Whether two secrets are equal, in a time that does not depend on where they differ.
+fn same_secret(given: &[u8], expected: &[u8]) -> bool {
+    given.len() == expected.len()
+        && given
+            .iter()
+            .zip(expected)
+            .fold(0u8, |diff, (a, b)| diff | (a ^ b))
+            == 0
+}
+
+/// The value of `request`'s header `name` (the first, if repeated).
+fn header<'r>(request: &'r Request, name: &str) -> Option<&'r str> {
+    request
+        .headers()
+        .iter()
+        .find(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
+        .map(|h| h.value.as_str())
+}
+
+/// Whether `origin` is the origin of a page served under `host` (`http://` and the same
+/// host and port).
+fn same_origin(origin: &str, host: &str) -> bool {
+    origin
+        .strip_prefix("http://")
+        .is_some_and(|rest| rest.eq_ignore_ascii_case(host))
+}
+
+/// Whom the server answers: the `Host` names a browser on this machine uses for it, the name
+/// or address it was started on, and, when it listens on every interface, IP addresses (a
+/// browser that reached the machine by its address). A page that reached the server by DNS
+/// rebinding sends its own site's name, which none of these is.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Audience {
+    /// The `--bind` name, in lower case, without brackets.
+    bound_name: String,
+    /// The address listened on.
+    bound_ip: Option<IpAddr>,
+}
+
+impl Audience {
+    /// The audience of a server started on `host` (as given), listening on `ip`.
+    pub fn new(host: &str, ip: Option<IpAddr>) -> Audience {
+        let bare = host
+            .strip_prefix('[')
+            .and_then(|h| h.strip_suffix(']'))
+            .unwrap_or(host);
+        Audience {
+            bound_name: bare.to_ascii_lowercase(),
+            bound_ip: ip,
+        }
+    }
+
+    /// Whether a request with this `Host` header (`name`, `name:port`, `[v6]:port`) is
+    /// answered; the port is not checked (a forwarded port keeps the name).
+    pub fn allows_host(&self, host: &str) -> bool {
+        let Some(name) = host_name(host) else {
+            return false;
+        };
+        let name = name.to_ascii_lowercase();
+        if name == "localhost" || name == self.bound_name {
+            return true;
+        }
+        match name.parse::<IpAddr>() {
+            Ok(ip) => {
+                ip.is_loopback()
+                    || Some(ip) == self.bound_ip
+                    || self.bound_ip.is_some_and(|b| b.is_unspecified())
+            }
+            Err(_) => false,
+        }
+    }
+}
+
+/// The name or address of a `Host` header, without its port and an IPv6 address's brackets;
+/// `None` when it is malformed.
+fn host_name(host: &str) -> Option<&str> {
+    let (name, port) = match host.strip_prefix('[') {
+        Some(rest) => {
+            let (v6, after) = rest.split_once(']')?;
+            v6.parse::<std::net::Ipv6Addr>().ok()?;
+            if after.is_empty() {
+                (v6, None)
+            } else {
+                (v6, Some(after.strip_prefix(':')?))
+            }
+        }
+        None => match host.split_once(':') {
+            Some((name, port)) => (name, Some(port)),
+            None => (host, None),
+        },
+    };
+    let port_ok =
+        port.is_none_or(|p| !p.is_empty() && p.len() <= 5 && p.bytes().all(|b| b.is_ascii_digit()));
+    let name_ok = !name.is_empty()
+        && name
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b"-._:".contains(&b));
+    (port_ok && name_ok).then_some(name)
 }
 
 /// A path segment as an index below `len` (digits only).
@@ -258,11 +494,11 @@ struct Reply {
 }
 
 impl Reply {
-    fn text(body: &'static str, content_type: &'static str) -> Reply {
+    fn text(body: Body, content_type: &'static str) -> Reply {
         Reply {
             status: 200,
             content_type,
-            body: Body::Static(body.as_bytes()),
+            body,
         }
     }
 
@@ -295,6 +531,9 @@ impl Reply {
             ("Content-Type", self.content_type),
             ("Cache-Control", "no-store"),
             ("X-Content-Type-Options", "nosniff"),
+            // No other site's page may load a reply (as an image or a script) or frame the page.
+            ("Cross-Origin-Resource-Policy", "same-origin"),
+            ("X-Frame-Options", "DENY"),
         ]
         .into_iter()
         .filter_map(|(name, value)| Header::from_bytes(name.as_bytes(), value.as_bytes()).ok())
@@ -313,6 +552,72 @@ impl Reply {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn hosts_of_this_machine_are_answered_and_other_names_refused() {
+        let loopback = Audience::new("127.0.0.1", Some("127.0.0.1".parse().unwrap()));
+        for host in [
+            "127.0.0.1:8000",
+            "127.0.0.1",
+            "localhost:8000",
+            "LOCALHOST",
+            "[::1]:8000",
+            "[::1]",
+            "127.0.0.2:1",
+        ] {
+            assert!(loopback.allows_host(host), "{host}");
+        }
+        for host in [
+            "evil.example:8000",
+            "localhost.evil.example",
+            "127.0.0.1.evil.example:8000",
+            "10.0.0.5:8000",
+            "",
+            ":8000",
+            "localhost:",
+            "localhost:123456",
+            "localhost:80:80",
+            "[::1",
+            "[::1]x",
+            "[evil]:80",
+            "local host",
+        ] {
+            assert!(!loopback.allows_host(host), "{host:?}");
+        }
+        // Started on a name, or on every interface (any address, but still no other name).
+        let named = Audience::new("Studio.Local", Some("192.168.1.5".parse().unwrap()));
+        assert!(named.allows_host("studio.local:8000"));
+        assert!(named.allows_host("192.168.1.5:8000"));
+        assert!(!named.allows_host("192.168.1.6:8000"));
+        let every = Audience::new("0.0.0.0", Some("0.0.0.0".parse().unwrap()));
+        assert!(every.allows_host("192.168.1.6:8000"));
+        assert!(every.allows_host("[fe80::1]:8000"));
+        assert!(!every.allows_host("evil.example:8000"));
+        let v6 = Audience::new("[::]", Some("::".parse().unwrap()));
+        assert!(v6.allows_host("10.1.2.3"));
+    }
+
+    #[test]
+    fn origins_and_tokens_must_match_exactly() {
+        assert!(same_origin("http://127.0.0.1:8000", "127.0.0.1:8000"));
+        assert!(same_origin("http://LOCALHOST:8000", "localhost:8000"));
+        for origin in [
+            "https://127.0.0.1:8000",
+            "http://127.0.0.1:8001",
+            "http://127.0.0.1:8000/",
+            "null",
+            "",
+        ] {
+            assert!(!same_origin(origin, "127.0.0.1:8000"), "{origin}");
+        }
+        assert!(same_secret(b"abcd", b"abcd"));
+        assert!(!same_secret(b"abcd", b"abce"));
+        assert!(!same_secret(b"abc", b"abcd"));
+        assert!(!same_secret(b"", b"abcd"));
+        let a = session_token().unwrap();
+        assert_eq!(a.len(), 32);
+        assert_ne!(a, session_token().unwrap());
+    }
 
     #[test]
     fn indices_are_digits_below_the_length() {

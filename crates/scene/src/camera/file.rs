@@ -197,7 +197,8 @@ fn parse_camera_json(
             .flatten()
             .ok_or_else(|| {
                 bad(format!(
-                    "\"frames\" key {key:?} is not a frame number (0 to {})",
+                    "\"frames\" key {} is not a frame number (0 to {})",
+                    glassdb_io::quoted(&key),
                     u32::MAX
                 ))
             })?;

@@ -314,8 +314,22 @@ pub(super) fn view_window(
 
 /// The look-at frame: forward towards the target, right = forward × up, up = right × forward.
 fn pose_look_at(origin: Vec3, target: Vec3, up: Vec3) -> Result<Pose, String> {
-    let forward = math::normalize(math::sub(target, origin))
-        .ok_or_else(|| "origin and target are the same point: no view direction".to_string())?;
+    let towards = math::sub(target, origin);
+    let forward = math::normalize(towards).ok_or_else(|| {
+        if towards == [0.0; 3] {
+            "origin and target are the same point: no view direction".to_string()
+        } else if !math::is_finite(towards) || !math::norm(towards).is_finite() {
+            format!(
+                "origin {origin:?} and target {target:?} are too far apart: their distance \
+                 overflows double precision (give coordinates below about 1e150)"
+            )
+        } else {
+            format!(
+                "origin {origin:?} and target {target:?} are too close: their distance \
+                 underflows double precision"
+            )
+        }
+    })?;
     let up_in = math::normalize(up).ok_or_else(|| "up is the zero vector".to_string())?;
     let side = math::cross(forward, up_in);
     if math::norm(side) < 1e-9 {

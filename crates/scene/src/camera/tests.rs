@@ -445,6 +445,18 @@ fn bad_cameras_are_errors() {
     let mut s = spec();
     s.target = s.origin;
     assert!(err(&s).contains("same point"));
+    // Far apart: the distance overflows; said so, not "the same point".
+    let mut s = spec();
+    s.origin = Some([1e308, 0.0, 0.0]);
+    let e = err(&s);
+    assert!(
+        e.contains("too far apart") && !e.contains("same point"),
+        "{e}"
+    );
+    let mut s = spec();
+    s.origin = Some([-1e308, 0.0, 0.0]);
+    s.target = Some([1e308, 0.0, 0.0]);
+    assert!(err(&s).contains("too far apart"));
 }
 
 #[test]

@@ -1,21 +1,39 @@
 //! Binning of triangles into bands of rows, the unit of parallel rasterisation.
 
-use super::setup::Setup;
+use super::depth::DrawOrder;
 
-/// The triangles overlapping each band of `rows_per_band` rows, by index into the setups.
-/// A counting sort keeps each band's triangles in scene order, so ties in depth go to the
-/// earlier triangle whatever the thread schedule.
+/// The triangles overlapping each band of `rows_per_band` rows, by position in the draw order
+/// ([`DrawOrder`]): a counting sort keeps each band's triangles in that order.
 pub(super) struct BandBins {
     /// Band `b`'s triangles are `binned[start[b]..start[b + 1]]`.
     start: Vec<u32>,
     binned: Vec<u32>,
+    /// Per band: its triangles' area in it (each triangle's area times the share of its rows
+    /// in the band), and their boxes' area in it, pixels.
+    cover: Vec<BandCover>,
+}
+
+/// The triangles of one band.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct BandTriangles<'a> {
+    /// Their positions in the draw order, increasing.
+    pub(super) drawn: &'a [u32],
+    /// How much of the band they cover.
+    pub(super) cover: BandCover,
+}
+
+/// How much of a band its triangles cover: their area in it, and their boxes' area in it.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct BandCover {
+    pub(super) area: f64,
+    pub(super) boxes: f64,
 }
 
 impl BandBins {
-    pub(super) fn new(setups: &[Setup], bands: usize, rows_per_band: u32) -> BandBins {
+    pub(super) fn new(order: &DrawOrder, bands: usize, rows_per_band: u32) -> BandBins {
         let mut counts = vec![0u32; bands + 1];
-        for s in setups {
-            for b in (s.j0 / rows_per_band)..=(s.j1 / rows_per_band) {
+        for c in &order.entries {
+            for b in (c.rows.0 / rows_per_band)..=(c.rows.1 / rows_per_band) {
                 counts[b as usize + 1] += 1;
             }
         }
@@ -24,21 +42,33 @@ impl BandBins {
         }
         let mut fill = counts.clone();
         let mut binned = vec![0u32; counts[bands] as usize];
-        for (k, s) in setups.iter().enumerate() {
-            for b in (s.j0 / rows_per_band)..=(s.j1 / rows_per_band) {
+        let mut cover = vec![BandCover::default(); bands];
+        for (p, c) in order.entries.iter().enumerate() {
+            let (j0, j1) = c.rows;
+            for b in (j0 / rows_per_band)..=(j1 / rows_per_band) {
                 let slot = &mut fill[b as usize];
-                binned[*slot as usize] = k as u32;
+                binned[*slot as usize] = p as u32;
                 *slot += 1;
+                let row0 = b * rows_per_band;
+                let row1 = row0 + rows_per_band - 1;
+                let in_band = f64::from(j1.min(row1) + 1 - j0.max(row0));
+                let band = &mut cover[b as usize];
+                band.area += c.area * in_band / f64::from(j1 + 1 - j0);
+                band.boxes += f64::from(c.columns.1 + 1 - c.columns.0) * in_band;
             }
         }
         BandBins {
             start: counts,
             binned,
+            cover,
         }
     }
 
-    /// Indices of the triangles overlapping band `band`, in scene order.
-    pub(super) fn band(&self, band: usize) -> &[u32] {
-        &self.binned[self.start[band] as usize..self.start[band + 1] as usize]
+    /// The triangles overlapping band `band` and how much of it they cover.
+    pub(super) fn band(&self, band: usize) -> BandTriangles<'_> {
+        BandTriangles {
+            drawn: &self.binned[self.start[band] as usize..self.start[band + 1] as usize],
+            cover: self.cover[band],
+        }
     }
 }

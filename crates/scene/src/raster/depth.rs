@@ -2,14 +2,16 @@
 //! sample, keeping the nearest (largest `1/z`, linear in screen space, so depth is
 //! perspective-correct); ties in depth go to the triangle earlier in the scene.
 //!
+//! Every band draws its triangles nearest first ([`DrawOrder`], sorted once for the scene).
 //! Under heavy overdraw (large triangles whose area covers the band several times over, e.g.
-//! many large overlapping panes) the band draws its triangles nearest first and skips, per tile of
-//! columns, those that lie wholly behind what the tile already holds: a triangle's largest
+//! many large overlapping panes) it skips, per tile of columns, those that lie wholly behind
+//! what the tile already holds: a triangle's largest
 //! possible `1/z` ([`z_bound`], with the rounding of the edge functions accounted for)
 //! below every sample of a tile cannot win a sample there. Skipping only what cannot win, with
 //! the tie going to the earlier triangle whatever the drawing order, gives the same labels as
 //! drawing every triangle in scene order.
 
+use super::bins::{BandCover, BandTriangles};
 use super::edge::CanonicalEdge;
 use super::setup::Setup;
 
@@ -24,11 +26,64 @@ const CULL_OVERDRAW: f64 = 3.0;
 /// No triangle (in the per-sample winner buffer).
 const NONE: u32 = u32::MAX;
 
+/// The triangles of the scene as the bands see them: each triangle's box and area and the
+/// largest `1/z` it can reach ([`z_bound`]), computed once (not once per band), in the order
+/// the bands draw them: under heavy overdraw nearest first by that bound, scene order among
+/// equals (otherwise scene order). A band reads
+/// the entries of its triangles in that order, one after the other: no band sorts, and
+/// skipping a hidden triangle never fetches its setup.
+pub(super) struct DrawOrder {
+    /// Entry `p` is the `p`-th triangle drawn.
+    pub(super) entries: Vec<Candidate>,
+}
+
+/// A triangle as the skipping test sees it.
+pub(super) struct Candidate {
+    /// Its index in the setups.
+    pub(super) k: u32,
+    /// Its box's columns and rows.
+    pub(super) columns: (u32, u32),
+    pub(super) rows: (u32, u32),
+    /// Its area, pixels.
+    pub(super) area: f64,
+    /// Its largest possible `1/z` ([`z_bound`]).
+    pub(super) z_bound: f64,
+}
+
+impl DrawOrder {
+    /// The draw order of `setups` (computed in parallel) on an image of `pixels` pixels. A
+    /// scene drawn less than [`CULL_OVERDRAW`] times over keeps its own order (sorting would
+    /// cost more than it saves; any order gives the same labels).
+    pub(super) fn new(setups: &[Setup], pixels: f64) -> DrawOrder {
+        use rayon::prelude::*;
+        let mut entries: Vec<Candidate> = setups
+            .par_iter()
+            .enumerate()
+            .map(|(k, s)| Candidate {
+                k: k as u32,
+                columns: (s.i0, s.i1),
+                rows: (s.j0, s.j1),
+                area: 0.5 / s.inv_area2,
+                z_bound: z_bound(s),
+            })
+            .collect();
+        let area: f64 = entries.par_iter().map(|c| c.area).sum();
+        if area > CULL_OVERDRAW * pixels {
+            // Stable: scene order among equal bounds.
+            entries.par_sort_by(|a, b| b.z_bound.total_cmp(&a.z_bound));
+        }
+        DrawOrder { entries }
+    }
+}
+
 /// The label of the nearest triangle at every sample of rows `row0..row0 + rows` (0 where
-/// none is), `samples` per pixel, pixel-major. `triangles` index `setups`, in scene order.
+/// none is), `samples` per pixel, pixel-major. `band` holds the band's triangles as positions
+/// in `order`, increasing, and how much of the band they cover. Ties in depth go to the triangle earlier in the scene, whatever
+/// the order they are drawn in.
 pub(super) fn nearest_labels(
     setups: &[Setup],
-    triangles: &[u32],
+    order: &DrawOrder,
+    band: BandTriangles<'_>,
     row0: u32,
     rows: u32,
     width: u32,
@@ -41,47 +96,30 @@ pub(super) fn nearest_labels(
     // The setup index of the nearest triangle so far, per sample.
     let mut winner = vec![NONE; band_px * ns];
     let row1 = row0 + rows - 1;
-    // The triangles' area in the band (each triangle's area times the share of its rows in
-    // the band): how many times over the band is drawn.
-    let area: f64 = triangles
-        .iter()
-        .map(|&k| {
-            let s = &setups[k as usize];
-            let in_band = s.j1.min(row1) + 1 - s.j0.max(row0);
-            0.5 / s.inv_area2 * f64::from(in_band) / f64::from(s.j1 + 1 - s.j0)
-        })
-        .sum();
-    // Skipping needs tiles' bounds, which only triangles covering a good part of a tile
-    // recompute (see `Tiles::open_columns`): small triangles alone would only pay for it.
-    let large = area * 4.0 >= triangles.len() as f64 * (TILE as f64 * f64::from(rows));
+    // How many times over the band is drawn (`cover.area`), and by how large boxes.
+    let BandTriangles { drawn, cover } = band;
+    let BandCover { area, boxes } = cover;
+    // Skipping needs tiles' bounds, which only triangles whose box covers a good part of a
+    // tile recompute (see `Tiles::open_columns`): small triangles alone would only pay for it.
+    // Measured by their boxes, not their areas: a pane made of long thin triangles (a round
+    // window as a fan) covers tiles as a large one does.
+    let large = boxes * 4.0 >= drawn.len() as f64 * (TILE as f64 * f64::from(rows));
     let mut tiles =
         (large && area > CULL_OVERDRAW * band_px as f64).then(|| Tiles::new(w, rows as usize));
-    // Nearest first, by each triangle's bound of 1/z (the sort is stable: scene order among
-    // equals).
-    let mut sorted: Vec<(u32, f64)> = Vec::new();
-    if tiles.is_some() {
-        sorted = triangles
-            .iter()
-            .map(|&k| (k, z_bound(&setups[k as usize])))
-            .collect();
-        sorted.sort_by(|a, b| b.1.total_cmp(&a.1));
-    }
-    let order: Box<dyn Iterator<Item = (u32, f64)> + '_> = match tiles {
-        Some(_) => Box::new(sorted.iter().copied()),
-        None => Box::new(triangles.iter().map(|&k| (k, f64::INFINITY))),
-    };
-    let sorted_band = tiles.is_some();
-    for (k, z_bound) in order {
-        let s = &setups[k as usize];
-        let j0 = s.j0.max(row0);
-        let j1 = s.j1.min(row1);
+    for &p in drawn {
+        let c = &order.entries[p as usize];
+        let k = c.k;
+        let (j0, j1) = (c.rows.0.max(row0), c.rows.1.min(row1));
         let (c0, c1) = match tiles.as_mut() {
-            Some(t) => match t.open_columns(s, z_bound, (j1 - j0 + 1) as usize, &depth, ns) {
-                Some(c) => c,
-                None => continue,
-            },
-            None => (s.i0, s.i1),
+            Some(t) => {
+                match t.open_columns(c.columns, c.z_bound, (j1 - j0 + 1) as usize, &depth, ns) {
+                    Some(c) => c,
+                    None => continue,
+                }
+            }
+            None => c.columns,
         };
+        let s = &setups[k as usize];
         let edges = s.edges();
         for j in j0..=j1 {
             let rowbase = (j - row0) as usize * w;
@@ -105,10 +143,9 @@ pub(super) fn nearest_labels(
                     }
                     let z = (e0 * s.w[0] + e1 * s.w[1] + e2 * s.w[2]) * s.inv_area2;
                     let slot = (rowbase + i as usize) * ns + si;
-                    // In scene order a tie never goes to the triangle drawn later; out of it
-                    // (a sorted band) the earlier triangle is found by its index.
-                    let nearer =
-                        z > depth[slot] || (sorted_band && z == depth[slot] && k < winner[slot]);
+                    // Drawn nearest first, not in scene order: a tie goes to the earlier
+                    // triangle by its index.
+                    let nearer = z > depth[slot] || (z == depth[slot] && k < winner[slot]);
                     if nearer {
                         depth[slot] = z;
                         winner[slot] = k;
@@ -146,23 +183,22 @@ impl Tiles {
         }
     }
 
-    /// The columns of `s`'s box (`rows` of the band high) in tiles where it may win a sample
+    /// The columns of a triangle's box (`columns`, `rows` of the band high) in tiles where it may win a sample
     /// (from the first such tile to the last), marked as drawn into; `None` when it is behind
     /// every sample of every tile it overlaps.
     fn open_columns(
         &mut self,
-        s: &Setup,
+        (i0, i1): (u32, u32),
         z_bound: f64,
         rows: usize,
         depth: &[f64],
         ns: usize,
     ) -> Option<(u32, u32)> {
-        let (t0, t1) = (s.i0 as usize / TILE, s.i1 as usize / TILE);
+        let (t0, t1) = (i0 as usize / TILE, i1 as usize / TILE);
         let mut open = (t0..=t1).filter(|&t| {
             // Recomputing a tile's bound costs as much as drawing a quarter of it: only worth
             // it for a triangle that covers that much of the tile.
-            let columns =
-                (s.i1 as usize).min((t + 1) * TILE - 1) + 1 - (s.i0 as usize).max(t * TILE);
+            let columns = (i1 as usize).min((t + 1) * TILE - 1) + 1 - (i0 as usize).max(t * TILE);
             let worth = 4 * columns * rows >= TILE * self.rows;
             !self.hides(t, z_bound, worth, depth, ns)
         });
@@ -173,7 +209,7 @@ impl Tiles {
         }
         let c0 = (first * TILE) as u32;
         let c1 = ((last + 1) * TILE).min(self.width) as u32 - 1;
-        Some((s.i0.max(c0), s.i1.min(c1)))
+        Some((i0.max(c0), i1.min(c1)))
     }
 
     /// Whether every sample of tile `t` is nearer than `z_bound` (strictly: a tie could win),
@@ -339,10 +375,15 @@ mod tests {
                 }
                 setups.push(s);
             }
-            let triangles: Vec<u32> = (0..setups.len() as u32).collect();
-            let got = nearest_labels(&setups, &triangles, 0, rows, width, &offsets);
             let want = reference(&setups, rows, width, &offsets);
-            assert_eq!(got, want, "{count} triangles of size {size}");
+            // Drawn nearest first (heavy overdraw), and in scene order.
+            for pixels in [0.0, f64::INFINITY] {
+                let order = DrawOrder::new(&setups, pixels);
+                let bands = width.div_ceil(rows) as usize;
+                let bins = super::super::bins::BandBins::new(&order, bands, rows);
+                let got = nearest_labels(&setups, &order, bins.band(0), 0, rows, width, &offsets);
+                assert_eq!(got, want, "{count} triangles of size {size}, {pixels}");
+            }
             // The heavy overdraw did take the skipping path.
             let area: f64 = setups.iter().map(|s| 0.5 / s.inv_area2).sum();
             assert!(area > CULL_OVERDRAW * f64::from(rows * width), "{area}");

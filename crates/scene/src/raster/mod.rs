@@ -127,7 +127,7 @@ pub fn check_options(opts: &RasterOptions) -> Result<(), SceneError> {
 }
 
 /// Rows per band (the unit of parallel work).
-const BAND_ROWS: u32 = 8;
+const BAND_ROWS: u32 = 32;
 
 /// Rasterises the labelled scene from `cam`: vertices to camera space, triangle setup, binning
 /// into bands, Gouraud meshes, then per band (in parallel) the z-buffer and the pixels.
@@ -142,7 +142,8 @@ pub fn rasterize(
     let (cam_pos, near) = setup::camera_space(scene, cam);
     let setups = setup::triangle_setups(scene, cam, &cam_pos, near);
     let bands = h.div_ceil(BAND_ROWS) as usize;
-    let bins = BandBins::new(&setups, bands, BAND_ROWS);
+    let order = depth::DrawOrder::new(&setups, f64::from(w) * f64::from(h));
+    let bins = BandBins::new(&order, bands, BAND_ROWS);
     let meshes = gouraud::pane_meshes(scene, cam, near, opts.cos);
     let samples = SampleGrid::new(opts.samples);
     let resolver = Resolver {
@@ -171,8 +172,15 @@ pub fn rasterize(
         .for_each(|(band, (((id, plane), cos_theta), coverage))| {
             let row0 = band as u32 * BAND_ROWS;
             let rows = (h - row0).min(BAND_ROWS);
-            let winner =
-                depth::nearest_labels(&setups, bins.band(band), row0, rows, w, &samples.offsets);
+            let winner = depth::nearest_labels(
+                &setups,
+                &order,
+                bins.band(band),
+                row0,
+                rows,
+                w,
+                &samples.offsets,
+            );
             let out = BandPixels {
                 id,
                 plane,
