@@ -16,26 +16,13 @@ use std::cell::RefCell;
 
 use crate::error::SpectralError;
 
-/// Checks what every interpolator needs: equal lengths, finite numbers, strictly increasing
-/// wavelengths, enough points. Returns whether the spacing is uniform (Sprague) or not (spline).
-pub(crate) fn validate(wavelength_nm: &[f64], values: &[f64]) -> Result<bool, SpectralError> {
-    if wavelength_nm.len() != values.len() {
-        return Err(SpectralError::LengthMismatch {
-            wavelengths: wavelength_nm.len(),
-            values: values.len(),
-        });
-    }
+/// A wavelength array of finite, strictly increasing values.
+pub(crate) fn validate_grid(wavelength_nm: &[f64]) -> Result<(), SpectralError> {
     let mut previous = f64::NEG_INFINITY;
-    for (index, (&w, &v)) in wavelength_nm.iter().zip(values).enumerate() {
+    for (index, &w) in wavelength_nm.iter().enumerate() {
         if !w.is_finite() {
             return Err(SpectralError::NonFinite {
                 what: "wavelength",
-                index,
-            });
-        }
-        if !v.is_finite() {
-            return Err(SpectralError::NonFinite {
-                what: "value",
                 index,
             });
         }
@@ -48,6 +35,31 @@ pub(crate) fn validate(wavelength_nm: &[f64], values: &[f64]) -> Result<bool, Sp
         }
         previous = w;
     }
+    Ok(())
+}
+
+/// As many finite values as wavelengths.
+pub(crate) fn validate_values(wavelength_nm: &[f64], values: &[f64]) -> Result<(), SpectralError> {
+    if wavelength_nm.len() != values.len() {
+        return Err(SpectralError::LengthMismatch {
+            wavelengths: wavelength_nm.len(),
+            values: values.len(),
+        });
+    }
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(SpectralError::NonFinite {
+            what: "value",
+            index,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Checks what every interpolator needs: equal lengths, finite numbers, strictly increasing
+/// wavelengths, enough points. Returns whether the spacing is uniform (Sprague) or not (spline).
+pub(crate) fn validate(wavelength_nm: &[f64], values: &[f64]) -> Result<bool, SpectralError> {
+    validate_values(wavelength_nm, values)?;
+    validate_grid(wavelength_nm)?;
     let uniform = is_uniform(wavelength_nm);
     let (needed, interpolator) = if uniform {
         (6, "Sprague")

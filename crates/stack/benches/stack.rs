@@ -1,0 +1,2 @@
+//! Placeholder replaced below once the engine builds.
+fn main() {}
