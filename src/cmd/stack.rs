@@ -33,7 +33,7 @@ pub struct StackArgs {
     /// The gaps between layers, `MM[:GAS]` (gas air, argon, krypton, xenon): one for every
     /// gap, or one per gap in order [default: 12.7 mm air]. Gaps do not change the optics;
     /// they place the panes.
-    #[arg(long = "gap", value_name = "MM[:GAS]")]
+    #[arg(long = "gap", value_name = "MM[:GAS]", allow_hyphen_values = true)]
     pub gaps: Vec<String>,
     /// Apply each layer's angle model to its integrated channels instead of per wavelength.
     #[arg(long)]

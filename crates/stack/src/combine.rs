@@ -45,6 +45,15 @@ impl<V> Optics<V> {
     }
 }
 
+/// `1/(1 − Rb·Rf)`: the light bouncing between two layers facing each other with
+/// reflectances `rb` and `rf`. At grazing incidence both are 1 and no light reaches the gap (the
+/// transmittances are 0); the factor is then 0 rather than infinite.
+#[inline]
+fn interreflection(rb: f64, rf: f64) -> f64 {
+    let den = 1.0 - rb * rf;
+    if den > 0.0 { 1.0 / den } else { 0.0 }
+}
+
 /// T, Rf, Rb of one sample of an equivalent layer.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Rt {
@@ -59,7 +68,7 @@ impl Rt {
     /// `Rb = Rb2 + T2²·Rb1/(1 − Rb1·Rf2)`.
     #[inline]
     fn then(self, next: Rt) -> Rt {
-        let inter = 1.0 / (1.0 - self.rb * next.rf);
+        let inter = interreflection(self.rb, next.rf);
         Rt {
             t: self.t * next.t * inter,
             rf: self.rf + self.t * self.t * next.rf * inter,
@@ -161,13 +170,13 @@ fn absorptances(layers: &[Rt], abs: &mut [f64], r_behind: &mut [f64]) {
     for k in (0..n).rev() {
         let l = layers[k];
         let r = r_behind[k + 1];
-        r_behind[k] = l.rf + l.t * l.t * r / (1.0 - l.rb * r);
+        r_behind[k] = l.rf + l.t * l.t * r * interreflection(l.rb, r);
     }
     let mut down = 1.0;
     for k in 0..n {
         let l = layers[k];
         let r = r_behind[k + 1];
-        let passed = l.t / (1.0 - l.rb * r) * down;
+        let passed = l.t * interreflection(l.rb, r) * down;
         let up = r * passed;
         abs[k] = down * (1.0 - l.t - l.rf) + up * (1.0 - l.t - l.rb);
         down = passed;
@@ -183,13 +192,13 @@ fn reflectance_shares(groups: &[Rt], shares: &mut [f64], r_behind: &mut [f64]) {
     for k in (0..n).rev() {
         let g = groups[k];
         let r = r_behind[k + 1];
-        r_behind[k] = g.rf + g.t * g.t * r / (1.0 - g.rb * r);
+        r_behind[k] = g.rf + g.t * g.t * r * interreflection(g.rb, r);
     }
     let mut reach = 1.0;
     for k in 0..n {
         let g = groups[k];
         shares[k] = reach * g.rf;
-        reach *= g.t * g.t / (1.0 - g.rb * r_behind[k + 1]);
+        reach *= g.t * g.t * interreflection(g.rb, r_behind[k + 1]);
     }
 }
 

@@ -31,18 +31,22 @@ pub enum ModelChoice {
     CoatedClear,
     /// WINDOW-4 bronze curve everywhere (what pywincalc 3.3.1 applies to every coated layer).
     CoatedBronze,
+    /// WINDOW-4 bronze curve everywhere as WINDOW applies it, not renormalised to the
+    /// measured 0° values (pywincalc 3.3.1's numbers exactly; T(θ → 0°) = 1.01175·T0).
+    CoatedBronzePublished,
     /// An opaque specular surface: t0 = 0, single-surface Fresnel reflectance.
     Opaque,
 }
 
 impl ModelChoice {
     /// Every choice, in the order help texts list them.
-    pub const ALL: [ModelChoice; 6] = [
+    pub const ALL: [ModelChoice; 7] = [
         ModelChoice::Auto,
         ModelChoice::Uncoated,
         ModelChoice::Coated,
         ModelChoice::CoatedClear,
         ModelChoice::CoatedBronze,
+        ModelChoice::CoatedBronzePublished,
         ModelChoice::Opaque,
     ];
 
@@ -54,6 +58,7 @@ impl ModelChoice {
             ModelChoice::Coated => "coated",
             ModelChoice::CoatedClear => "coated-clear",
             ModelChoice::CoatedBronze => "coated-bronze",
+            ModelChoice::CoatedBronzePublished => "coated-bronze-published",
             ModelChoice::Opaque => "opaque",
         }
     }
@@ -89,6 +94,8 @@ pub enum LayerModel {
     Coated,
     /// One WINDOW-4 curve everywhere.
     CoatedFixed(CoatedCurve),
+    /// One WINDOW-4 curve everywhere, as published (not renormalised).
+    CoatedPublished(CoatedCurve),
     /// An opaque specular surface (single-surface Fresnel, T = 0).
     Opaque,
 }
@@ -101,6 +108,8 @@ impl LayerModel {
             LayerModel::Coated => "coated",
             LayerModel::CoatedFixed(CoatedCurve::Clear) => "coated-clear",
             LayerModel::CoatedFixed(CoatedCurve::Bronze) => "coated-bronze",
+            LayerModel::CoatedPublished(CoatedCurve::Clear) => "coated-clear-published",
+            LayerModel::CoatedPublished(CoatedCurve::Bronze) => "coated-bronze-published",
             LayerModel::Opaque => "opaque",
         }
     }
@@ -112,6 +121,9 @@ impl LayerModel {
             ModelChoice::Coated => Some(LayerModel::Coated),
             ModelChoice::CoatedClear => Some(LayerModel::CoatedFixed(CoatedCurve::Clear)),
             ModelChoice::CoatedBronze => Some(LayerModel::CoatedFixed(CoatedCurve::Bronze)),
+            ModelChoice::CoatedBronzePublished => {
+                Some(LayerModel::CoatedPublished(CoatedCurve::Bronze))
+            }
             ModelChoice::Opaque => Some(LayerModel::Opaque),
             ModelChoice::Auto => None,
         }
@@ -141,6 +153,11 @@ pub fn model_at(
             };
             let (rf, t) = curve.at(t0, rf0, cos_theta);
             let (rb, _) = curve.at(t0, rb0, cos_theta);
+            (rf, t, rb)
+        }
+        LayerModel::CoatedPublished(curve) => {
+            let (rf, t) = curve.at_published(t0, rf0, cos_theta);
+            let (rb, _) = curve.at_published(t0, rb0, cos_theta);
             (rf, t, rb)
         }
         LayerModel::Opaque => {

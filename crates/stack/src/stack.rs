@@ -233,10 +233,10 @@ fn common_grid(elements: &[Element]) -> Result<Grid, StackError> {
             Some(c) => {
                 let lo = c[0].max(wavelength_nm[0]);
                 let hi = c[c.len() - 1].min(wavelength_nm[wavelength_nm.len() - 1]);
-                let merged: Vec<f64> = merge_sorted(&c, wavelength_nm)
-                    .into_iter()
-                    .filter(|&w| w >= lo && w <= hi)
-                    .collect();
+                let inside = |v: &[f64]| -> Vec<f64> {
+                    v.iter().copied().filter(|&w| w >= lo && w <= hi).collect()
+                };
+                let merged = merge_sorted(&inside(&c), &inside(wavelength_nm));
                 if merged.len() < 2 {
                     return Err(StackError::NoOverlap {
                         position: i + 1,
@@ -254,36 +254,22 @@ fn common_grid(elements: &[Element]) -> Result<Grid, StackError> {
     Ok(common.map_or(Grid::Channels, Grid::Wavelengths))
 }
 
-/// The sorted union of two ascending arrays, without repeats.
+/// Wavelengths closer than this (nm) are one wavelength of the common grid: WINDOW's own
+/// wavelength tolerance (1e-6 µm). Files that store 0.345 µm as 0.344999999 would otherwise
+/// put two samples 1e-6 nm apart, which a cubic spline through the grid does not need.
+const SAME_WAVELENGTH_NM: f64 = 1e-3;
+
+/// The sorted union of two ascending arrays; a value within [`SAME_WAVELENGTH_NM`] of the one
+/// before it is left out.
 fn merge_sorted(a: &[f64], b: &[f64]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(a.len() + b.len());
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() || j < b.len() {
-        let next = match (a.get(i), b.get(j)) {
-            (Some(&x), Some(&y)) if x < y => {
-                i += 1;
-                x
-            }
-            (Some(&x), Some(&y)) if y < x => {
-                j += 1;
-                y
-            }
-            (Some(&x), Some(_)) => {
-                i += 1;
-                j += 1;
-                x
-            }
-            (Some(&x), None) => {
-                i += 1;
-                x
-            }
-            (None, Some(&y)) => {
-                j += 1;
-                y
-            }
-            (None, None) => break,
-        };
-        out.push(next);
+    let mut all: Vec<f64> = a.iter().chain(b).copied().collect();
+    all.sort_by(f64::total_cmp);
+    let mut out: Vec<f64> = Vec::with_capacity(all.len());
+    for w in all {
+        match out.last() {
+            Some(&last) if w - last < SAME_WAVELENGTH_NM => {}
+            _ => out.push(w),
+        }
     }
     out
 }
