@@ -557,3 +557,20 @@ fn bad_build_ups_in_a_catalog_name_the_line() {
         assert!(!out.exists());
     }
 }
+
+/// `glassdb plot stack` draws the unit beside its layers.
+#[test]
+fn plot_stack_draws_the_unit_and_its_layers() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("unit.png");
+    ok(glassdb()
+        .args(["plot", "stack"])
+        .arg(glazing("igsdb_product_10693.json"))
+        .arg(glazing("CLEAR_6.DAT"))
+        .args(["--gap", "12.7:argon", "-o"])
+        .arg(&out));
+    let s = glassdb_plot::inspect::summarize_png(&out).expect("a PNG");
+    // three panels side by side: the unit and its two layers, with curves drawn
+    assert_eq!((s.width, s.height), (1800, 542), "{s:?}");
+    assert!(s.inked_fraction > 0.05 && s.distinct_colours > 20, "{s:?}");
+}

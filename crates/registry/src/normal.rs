@@ -80,6 +80,7 @@ pub(crate) fn read_layer(
         product_type: data.product.product_type.clone(),
         coated_side: data.product.coated_side.clone(),
         thickness_mm: data.product.thickness_mm,
+        composition: data.product.composition.clone(),
     };
     let layer = Layer::from_spectral_data(data, &opts, &full.display().to_string()).map_err(
         |e| match e {

@@ -222,6 +222,9 @@ pub struct ProductRecord {
     pub coated_side: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness_mm: Option<f64>,
+    /// The parts an IGSDB product lists (a laminate's plies and interlayer), when it lists them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub composition: Vec<String>,
 }
 
 /// Which face of the glass the viewer sees (`front` or `back` in JSON and on the command line).
