@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use glassdb_spectral::{IntegrationSettings, Integrator};
 use glassdb_stack::LayerModel;
+use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
 use crate::angle_model::{ModelTables, read_measured_table};
@@ -153,14 +154,18 @@ pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Regist
             glasses: Vec::new(),
         })
         .collect();
-    for spec in &specs {
-        if let Some(w) = &wanted
-            && !w.contains(&spec.id)
-        {
-            continue;
-        }
-        let records = build_entry(spec, &files, &integrators, opts)?;
-        for (table, mut g) in tables.iter_mut().zip(records) {
+    let chosen: Vec<&GlassSpec> = specs
+        .iter()
+        .filter(|spec| wanted.as_ref().is_none_or(|w| w.contains(&spec.id)))
+        .collect();
+    // Glasses build independently (in parallel); the first failure in catalog order is the
+    // one reported, whichever thread met it.
+    let built: Vec<Result<Vec<GlassRecord>, RegistryError>> = chosen
+        .par_iter()
+        .map(|spec| build_entry(spec, &files, &integrators, opts))
+        .collect();
+    for records in built {
+        for (table, mut g) in tables.iter_mut().zip(records?) {
             g.provenance.catalog = Some(catalog_ref.clone());
             table.glasses.push(g);
         }

@@ -220,12 +220,17 @@ pub(crate) fn build_unit(
         application: opts.application,
         combination: Combination::PerWavelength,
     };
-    let eval = stack
-        .evaluate(&angles, integrators, true, eval_opts)
-        .map_err(|e| match e {
-            StackError::Integration { .. } => integration_error(e, &glass),
-            other => unit_err(other),
-        })?;
+    let evaluate = |angles: &[f64], integrators: &[Integrator], window: bool| {
+        stack
+            .evaluate(angles, integrators, window, eval_opts)
+            .map_err(|e| match e {
+                StackError::Integration { .. } => integration_error(e, &glass),
+                other => unit_err(other),
+            })
+    };
+    // the colours at every angle; WINDOW's values (recorded at normal incidence) at 0° only
+    let eval = evaluate(&angles, integrators, false)?;
+    let at_normal = evaluate(&[0.0], &[], true)?;
     let luminous = match stack.spectra_at(0.0).map_err(unit_err)? {
         Some(s) => {
             let lum = |v: &[f64], what: &str| {
@@ -328,7 +333,7 @@ pub(crate) fn build_unit(
                 ElementSpec::Layer(_) => {
                     let (index, (_, l, unit_layer)) = next_layer.next().expect("one per layer");
                     debug_assert_eq!(layers[index].0, i);
-                    let absorptance = eval.solar.as_ref().map(|s| Absorptance {
+                    let absorptance = at_normal.solar.as_ref().map(|s| Absorptance {
                         front: s[0].absorptance_front[index],
                         back: s[0].absorptance_back[index],
                     });
@@ -371,8 +376,8 @@ pub(crate) fn build_unit(
                 groups,
                 thickness_mm: stack.thickness_mm(),
                 combined: eval.combination.name().to_string(),
-                photopic: system(eval.photopic.as_ref()),
-                solar: system(eval.solar.as_ref()),
+                photopic: system(at_normal.photopic.as_ref()),
+                solar: system(at_normal.solar.as_ref()),
             }),
         });
     }
@@ -600,5 +605,76 @@ impl UnitBuilder {
             })
             .collect();
         Registry::new(tables)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bundled() -> UnitBuilder {
+        let catalog = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/catalog.toml");
+        UnitBuilder::new(&catalog, BuildOptions::default()).unwrap()
+    }
+
+    fn gap() -> ChosenElement {
+        ChosenElement::Gap {
+            thickness_mm: 12.7,
+            gas: Gas::Argon,
+        }
+    }
+
+    fn glass(id: u16) -> ChosenElement {
+        ChosenElement::Glass { id, flip: false }
+    }
+
+    #[test]
+    fn the_viewer_builds_a_unit_from_the_catalogs_glasses() {
+        let b = bundled();
+        assert!(b.glasses().iter().any(|&(id, _)| id == 6));
+        assert!(
+            b.glasses().iter().all(|&(id, _)| id != 11),
+            "units are not layers"
+        );
+        let choice = UnitChoice {
+            id: 300,
+            name: "R67 | argon | clear 6".into(),
+            elements: vec![glass(6), gap(), glass(2)],
+        };
+        let reg = b.build(&choice).unwrap();
+        let g = reg.default_table().glass(300).unwrap();
+        let unit = g.unit.as_ref().unwrap();
+        assert_eq!(unit.groups.len(), 2);
+        assert_eq!(unit.elements.len(), 3);
+        // the same unit in the bundled catalog (id 12) has the same optics
+        let bundled = crate::default_registry().unwrap();
+        let twelve = bundled.default_table().glass(12).unwrap();
+        assert_eq!(
+            (g.r0, g.t0, g.r0_back),
+            (twelve.r0, twelve.t0, twelve.r0_back)
+        );
+    }
+
+    #[test]
+    fn bad_choices_say_what_is_wrong() {
+        let b = bundled();
+        let build = |elements: Vec<ChosenElement>| {
+            let choice = UnitChoice {
+                id: 300,
+                name: "bad".into(),
+                elements,
+            };
+            glassdb_io::ErrorChain(&b.build(&choice).unwrap_err()).to_string()
+        };
+        let e = build(vec![glass(99)]);
+        assert!(e.contains("no glass with id 99"), "{e}");
+        let e = build(vec![glass(11)]);
+        assert!(e.contains("is a unit itself"), "{e}");
+        let e = build(vec![glass(2), gap(), gap(), glass(2)]);
+        assert!(e.contains("two gaps in a row") && !e.contains(":0:"), "{e}");
+        let e = build(vec![glass(2), gap()]);
+        assert!(e.contains("gap at the inner end"), "{e}");
+        let e = build(vec![glass(20), gap(), glass(2)]);
+        assert!(e.contains("is opaque but layer 3"), "{e}");
     }
 }

@@ -18,7 +18,7 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SpectralError;
-use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, validate};
+use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, sprague_kernel, validate};
 use crate::tables::{Table, tables};
 use glassdb_colour::{D65_XY, RgbSpace, cat02, xyz_to_rgb};
 
@@ -436,6 +436,32 @@ impl Integrator {
         self.apply(wavelength_nm, values, self.settings.extrapolate)
     }
 
+    /// This integrator fixed to one wavelength array, for integrating many spectra sampled on
+    /// it: one dot product with the array's kernel per spectrum, the same numbers as
+    /// [`Integrator::channels`] (bit for bit on irregular wavelengths, to rounding on uniform
+    /// ones, where `channels` evaluates Sprague directly). Errors as `channels` for the array
+    /// (validity, coverage).
+    pub fn on_grid(&self, wavelength_nm: &[f64]) -> Result<GridIntegrator, SpectralError> {
+        let probe = vec![0.0; wavelength_nm.len()];
+        let uniform = validate(wavelength_nm, &probe)?;
+        check_coverage(
+            wavelength_nm,
+            &self.grid_nm,
+            self.settings.extrapolate,
+            &self.description(),
+        )?;
+        let mut kernel = Vec::new();
+        if uniform {
+            sprague_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
+        } else {
+            spline_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
+        }
+        Ok(GridIntegrator {
+            wavelength_nm: wavelength_nm.to_vec(),
+            kernel,
+        })
+    }
+
     /// The settings this integrator was built from.
     pub fn settings(&self) -> &IntegrationSettings {
         &self.settings
@@ -458,6 +484,22 @@ impl Integrator {
         );
         let step = self.grid_nm.get(1).map(|s| s - first).unwrap_or(0.0);
         format!("{} on {first}–{last} nm at {step} nm", self.label)
+    }
+}
+
+/// An [`Integrator`] fixed to one wavelength array ([`Integrator::on_grid`]).
+#[derive(Debug, Clone)]
+pub struct GridIntegrator {
+    wavelength_nm: Vec<f64>,
+    /// Per sample of the array, its weight in each channel (Sprague's or the spline's).
+    kernel: Vec<[f64; 3]>,
+}
+
+impl GridIntegrator {
+    /// The channels of a spectrum on the array (as many finite values as wavelengths).
+    pub fn channels(&self, values: &[f64]) -> Result<[f64; 3], SpectralError> {
+        crate::interp::validate_values(&self.wavelength_nm, values)?;
+        Ok(dot_kernel(&self.kernel, values))
     }
 }
 

@@ -183,6 +183,78 @@ impl<'a> Sprague<'a> {
     }
 }
 
+/// The linear map from uniformly spaced values `y(x)` to `Σ_j weights[j]·Sprague(grid[j])`:
+/// per data sample, per channel, its weight ([`for_each_on_grid`]'s uniform branch with the
+/// values left symbolic: each grid value is the padded values around it times the Sprague
+/// polynomial's coefficients, and each padded end value a combination of six data values).
+pub(crate) fn sprague_kernel(
+    x: &[f64],
+    grid: &[f64],
+    weights: &[[f64; 3]],
+    kernel: &mut Vec<[f64; 3]>,
+) {
+    let n = x.len();
+    kernel.clear();
+    kernel.resize(n, [0.0; 3]);
+    // The nodes only: `Sprague::xp` does not look at the values.
+    let sp = Sprague::new(x, x);
+    let add = |kernel: &mut Vec<[f64; 3]>, i: usize, w: &[f64; 3], f: f64| {
+        let k = &mut kernel[i];
+        k[0] += w[0] * f;
+        k[1] += w[1] * f;
+        k[2] += w[2] * f;
+    };
+    // padded value j (numpy's wrap-around for j = -1) times f, onto the data samples
+    let add_padded = |kernel: &mut Vec<[f64; 3]>, j: isize, w: &[f64; 3], f: f64| {
+        let j = if j < 0 { j + n as isize + 4 } else { j } as usize;
+        let pad = match j {
+            0 => Some((0, 0)),
+            1 => Some((1, 0)),
+            _ if j < n + 2 => None,
+            _ if j == n + 2 => Some((2, n - 6)),
+            _ => Some((3, n - 6)),
+        };
+        match pad {
+            None => add(kernel, j - 2, w, f),
+            Some((k, first)) => {
+                for (q, c) in SPRAGUE_C[k].iter().enumerate() {
+                    add(kernel, first + q, w, f * c / 209.0);
+                }
+            }
+        }
+    };
+    let mut cnt = 0usize;
+    for (j, &t) in grid.iter().enumerate() {
+        let Some(w) = weights.get(j) else { break };
+        if t < x[0] {
+            add(kernel, 0, w, 1.0);
+            continue;
+        }
+        if t > x[n - 1] {
+            add(kernel, n - 1, w, 1.0);
+            continue;
+        }
+        while cnt < sp.len_padded() && sp.xp(cnt) < t {
+            cnt += 1;
+        }
+        let i = cnt.saturating_sub(1).max(1);
+        let (x0, x1) = (sp.xp(i), sp.xp(i + 1));
+        let big_x = (t - x0) / (x1 - x0);
+        let mut coefficients = [0.0f64; 6];
+        coefficients[2] = 1.0;
+        let mut power = 1.0;
+        for row in &SPRAGUE_W {
+            power *= big_x;
+            for (c, wm) in coefficients.iter_mut().zip(row) {
+                *c += wm * power / 24.0;
+            }
+        }
+        for (m, c) in coefficients.iter().enumerate() {
+            add_padded(kernel, i as isize - 2 + m as isize, w, *c);
+        }
+    }
+}
+
 /// Not-a-knot cubic spline slopes (`scipy.interpolate.CubicSpline(bc_type="not-a-knot")`, the
 /// same interpolant as `make_interp_spline(k=3)`), solved as a tridiagonal system in `O(n)`.
 /// Needs `n ≥ 4`; `slopes` and `scratch` are resized to `n`.
@@ -596,6 +668,36 @@ mod tests {
         let out = resample(&x, &y, &grid, false).unwrap();
         for (g, v) in grid.iter().zip(&out) {
             assert!((v - lag(*g)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn sprague_kernel_equals_direct_evaluation() {
+        let x: Vec<f64> = (0..120).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .map(|w| 0.5 + 0.3 * (w / 37.0).sin() * (w / 211.0).cos())
+            .collect();
+        let grid: Vec<f64> = (250..=950).map(|g| f64::from(g) + 0.3).collect();
+        let weights: Vec<[f64; 3]> = grid
+            .iter()
+            .map(|g| [1.0, (g / 50.0).sin(), 1e-3 * g])
+            .collect();
+        let mut direct = [0.0; 3];
+        for_each_on_grid(&x, &y, true, &grid, |j, v| {
+            for c in 0..3 {
+                direct[c] += weights[j][c] * v;
+            }
+        });
+        let mut kernel = Vec::new();
+        sprague_kernel(&x, &grid, &weights, &mut kernel);
+        for c in 0..3 {
+            let k: f64 = kernel.iter().zip(&y).map(|(k, v)| k[c] * v).sum();
+            assert!(
+                (k - direct[c]).abs() < 1e-10 * direct[c].abs().max(1.0),
+                "{c}: {k} vs {}",
+                direct[c]
+            );
         }
     }
 

@@ -37,8 +37,8 @@ pub use balance::{
 pub use error::{SpectralError, UnsupportedKind};
 pub use glassdb_colour::{CHROMATICITIES_TOLERANCE, RgbSpace, rgb_to_rgb, xyz_to_rgb};
 pub use integrate::{
-    Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind, Observer,
-    RgbCmf, luminous, luminous_iso9050, rgb_matrix,
+    GridIntegrator, Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind,
+    Observer, RgbCmf, luminous, luminous_iso9050, rgb_matrix,
 };
 pub use interp::resample;
 pub use read::{

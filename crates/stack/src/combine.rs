@@ -102,22 +102,15 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         share_front: vec![vec![0.0; n]; ng],
         share_back: vec![vec![0.0; n]; ng],
     };
-    let mut rt = vec![
-        Rt {
-            t: 0.0,
-            rf: 0.0,
-            rb: 0.0
-        };
-        nl
-    ];
-    let mut group_rt = vec![
-        Rt {
-            t: 0.0,
-            rf: 0.0,
-            rb: 0.0
-        };
-        ng
-    ];
+    let zero = Rt {
+        t: 0.0,
+        rf: 0.0,
+        rb: 0.0,
+    };
+    let mut rt = vec![zero; nl];
+    let mut reversed = vec![zero; nl];
+    let mut group_rt = vec![zero; ng];
+    let mut groups_reversed = vec![zero; ng];
     let mut abs = vec![0.0; nl];
     let mut shares = vec![0.0; ng];
     let mut scratch = vec![0.0; nl.max(ng) + 1];
@@ -137,7 +130,9 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         for (a, v) in out.absorptance_front.iter_mut().zip(&abs) {
             a[i] = *v;
         }
-        let reversed: Vec<Rt> = rt.iter().rev().map(|l| l.reversed()).collect();
+        for (r, l) in reversed.iter_mut().zip(rt.iter().rev()) {
+            *r = l.reversed();
+        }
         absorptances(&reversed, &mut abs, &mut scratch);
         for (a, v) in out.absorptance_back.iter_mut().rev().zip(&abs) {
             a[i] = *v;
@@ -150,8 +145,10 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         for (s, v) in out.share_front.iter_mut().zip(&shares) {
             s[i] = *v;
         }
-        let reversed: Vec<Rt> = group_rt.iter().rev().map(|g| g.reversed()).collect();
-        reflectance_shares(&reversed, &mut shares, &mut scratch);
+        for (r, g) in groups_reversed.iter_mut().zip(group_rt.iter().rev()) {
+            *r = g.reversed();
+        }
+        reflectance_shares(&groups_reversed, &mut shares, &mut scratch);
         for (s, v) in out.share_back.iter_mut().rev().zip(&shares) {
             s[i] = *v;
         }

@@ -8,6 +8,7 @@ use crate::StackError;
 use crate::combine::{Optics, combine};
 use crate::layer::{Layer, LayerData, LayerValues};
 use crate::measured::cos_deg;
+use crate::model::ModelSample;
 use crate::stack::{Grid, Stack};
 
 /// Where each layer's angle model is applied.
@@ -91,6 +92,9 @@ pub struct Spectra {
 /// as Windows-CalcEngine's `CSeries::interpolate` does it.
 #[derive(Debug, Clone)]
 struct Resampling {
+    /// The layer's samples the common grid needs (the others are not evaluated).
+    range: std::ops::Range<usize>,
+    /// Per grid point, the samples around it, relative to `range.start`.
     lower: Vec<usize>,
     upper: Vec<usize>,
     frac: Vec<f64>,
@@ -100,6 +104,7 @@ impl Resampling {
     fn new(from: &[f64], to: &[f64]) -> Resampling {
         let n = from.len();
         let mut r = Resampling {
+            range: 0..0,
             lower: Vec::with_capacity(to.len()),
             upper: Vec::with_capacity(to.len()),
             frac: Vec::with_capacity(to.len()),
@@ -123,6 +128,11 @@ impl Resampling {
             r.upper.push(hi);
             r.frac.push(f);
         }
+        let start = r.lower.iter().copied().min().unwrap_or(0);
+        let end = r.upper.iter().copied().max().map_or(0, |m| m + 1);
+        r.range = start..end;
+        r.lower.iter_mut().for_each(|i| *i -= start);
+        r.upper.iter_mut().for_each(|i| *i -= start);
         r
     }
 
@@ -137,6 +147,23 @@ impl Resampling {
                 }
             })
             .collect()
+    }
+}
+
+/// WINDOW's `method` weights on `wavelength_nm`, or none where the data do not cover the
+/// method's range (WINDOW refuses such a layer for that method; the other outputs stay).
+fn window_weights(
+    method: WindowMethod,
+    wavelength_nm: &[f64],
+    what: impl FnOnce() -> String,
+) -> Result<Option<WindowWeights>, StackError> {
+    match WindowWeights::new(method, wavelength_nm) {
+        Ok(w) => Ok(Some(w)),
+        Err(glassdb_spectral::SpectralError::WindowCoverage { .. }) => Ok(None),
+        Err(source) => Err(StackError::Integration {
+            what: what(),
+            source: Box::new(source),
+        }),
     }
 }
 
@@ -194,9 +221,10 @@ impl Stack {
             return Ok(None);
         };
         let resampling = self.resamplings(grid);
+        let prepared: Vec<Vec<ModelSample>> = self.layers().map(Layer::prepare).collect();
         Ok(Some(Spectra {
             wavelength_nm: grid.clone(),
-            optics: self.combined_spectra(&resampling, cos_deg(angle_deg)),
+            optics: self.combined_spectra(&prepared, &resampling, cos_deg(angle_deg)),
         }))
     }
 
@@ -209,12 +237,18 @@ impl Stack {
             .collect()
     }
 
-    fn combined_spectra(&self, resampling: &[Resampling], cos_theta: f64) -> Optics<Vec<f64>> {
+    fn combined_spectra(
+        &self,
+        prepared: &[Vec<ModelSample>],
+        resampling: &[Resampling],
+        cos_theta: f64,
+    ) -> Optics<Vec<f64>> {
         let values: Vec<LayerValues> = self
             .layers()
+            .zip(prepared)
             .zip(resampling)
-            .map(|(l, r)| {
-                let v = l.values_at(cos_theta);
+            .map(|((l, p), r)| {
+                let v = l.values_prepared(p, r.range.clone(), cos_theta);
                 LayerValues {
                     t: r.apply(&v.t),
                     rf: r.apply(&v.rf),
@@ -230,7 +264,8 @@ impl Stack {
     }
 
     /// The stack at `angles_deg` (each in 0–90°), integrated with each of `integrators` and,
-    /// with `window`, averaged to WINDOW's photopic and solar values.
+    /// with `window`, averaged to WINDOW's photopic and solar values (each only where every
+    /// layer has a spectrum covering the method's range, as WINDOW requires).
     pub fn evaluate(
         &self,
         angles_deg: &[f64],
@@ -244,67 +279,75 @@ impl Stack {
             (Grid::Wavelengths(_), Application::PerWavelength) => opts.combination,
             _ => Combination::PerBand,
         };
-        let window = window && all_spectral;
+        let methods: Vec<WindowMethod> = if window && all_spectral {
+            WindowMethod::ALL.to_vec()
+        } else {
+            Vec::new()
+        };
         let mut eval = Evaluation {
             angles_deg: angles_deg.to_vec(),
             combination,
             colour: vec![Vec::with_capacity(angles_deg.len()); integrators.len()],
-            photopic: window.then(|| Vec::with_capacity(angles_deg.len())),
-            solar: window.then(|| Vec::with_capacity(angles_deg.len())),
+            photopic: None,
+            solar: None,
         };
+        // per WINDOW method evaluated: its per-angle values
+        let mut averaged: Vec<(WindowMethod, Vec<Optics<f64>>)> = Vec::new();
         match (combination, self.grid()) {
             (Combination::PerWavelength, Grid::Wavelengths(grid)) => {
                 let resampling = self.resamplings(grid);
-                let weights = if window {
-                    Some(self.window_weights(grid)?)
-                } else {
-                    None
-                };
-                for &deg in angles_deg {
-                    let spectra = self.combined_spectra(&resampling, cos_deg(deg));
-                    for (out, integrator) in eval.colour.iter_mut().zip(integrators) {
-                        out.push(integrate_optics(&spectra, deg, |v| {
-                            integrator.channels(grid, v)
-                        })?);
+                let prepared: Vec<Vec<ModelSample>> = self.layers().map(Layer::prepare).collect();
+                let mut weights = Vec::new();
+                for &m in &methods {
+                    let what = || format!("{} average of the layers' common wavelengths", m.name());
+                    if let Some(w) = window_weights(m, grid, what)? {
+                        weights.push(w);
+                        averaged.push((m, Vec::with_capacity(angles_deg.len())));
                     }
-                    if let Some([photopic, solar]) = &weights {
-                        let avg =
-                            |w: &WindowWeights| integrate_optics(&spectra, deg, |v| w.average(v));
-                        let p = avg(photopic)?;
-                        let s = avg(solar)?;
-                        eval.photopic.as_mut().expect("with window").push(p);
-                        eval.solar.as_mut().expect("with window").push(s);
+                }
+                let on_grid: Vec<_> = integrators
+                    .iter()
+                    .map(|i| {
+                        i.on_grid(grid).map_err(|source| StackError::Integration {
+                            what: "the layers' common wavelengths".into(),
+                            source: Box::new(source),
+                        })
+                    })
+                    .collect::<Result<_, _>>()?;
+                for &deg in angles_deg {
+                    let spectra = self.combined_spectra(&prepared, &resampling, cos_deg(deg));
+                    for (out, integrator) in eval.colour.iter_mut().zip(&on_grid) {
+                        out.push(integrate_optics(&spectra, deg, |v| integrator.channels(v))?);
+                    }
+                    for (w, (_, out)) in weights.iter().zip(&mut averaged) {
+                        out.push(integrate_optics(&spectra, deg, |v| w.average(v))?);
                     }
                 }
             }
-            _ => self.evaluate_per_band(&mut eval, integrators, window, opts.application)?,
+            _ => {
+                averaged =
+                    self.evaluate_per_band(&mut eval, integrators, &methods, opts.application)?;
+            }
+        }
+        for (m, values) in averaged {
+            match m {
+                WindowMethod::Photopic => eval.photopic = Some(values),
+                WindowMethod::Solar => eval.solar = Some(values),
+            }
         }
         Ok(eval)
     }
 
-    /// Photopic and solar weights on `grid`.
-    fn window_weights(&self, grid: &[f64]) -> Result<[WindowWeights; 2], StackError> {
-        let weights = |m: WindowMethod| {
-            WindowWeights::new(m, grid).map_err(|source| StackError::Integration {
-                what: format!("{} average of the layers' common wavelengths", m.name()),
-                source: Box::new(source),
-            })
-        };
-        Ok([
-            weights(WindowMethod::Photopic)?,
-            weights(WindowMethod::Solar)?,
-        ])
-    }
-
     /// Each layer reduced to the output's bands (3 channels, or one averaged value) at each
-    /// angle, then the bands combined.
+    /// angle, then the bands combined; returns the WINDOW methods every layer covers, with
+    /// their values.
     fn evaluate_per_band(
         &self,
         eval: &mut Evaluation,
         integrators: &[Integrator],
-        window: bool,
+        methods: &[WindowMethod],
         application: Application,
-    ) -> Result<(), StackError> {
+    ) -> Result<Vec<(WindowMethod, Vec<Optics<f64>>)>, StackError> {
         let groups = self.group_ranges();
         let layers: Vec<&Layer> = self.layers().collect();
         let label =
@@ -315,42 +358,47 @@ impl Stack {
                 source: Box::new(source),
             }
         };
-        // Per layer, per output: the normal values reduced to the output's bands (for models
-        // applied per channel), and how to reduce a spectrum.
+        // How each output reduces a spectrum: an integrator, or a WINDOW method's weights on
+        // each layer's wavelengths (a method only when every layer covers it).
         enum Reduce<'a> {
             Colour(&'a Integrator),
-            Window(WindowWeights),
+            Window(Vec<WindowWeights>),
         }
-        let mut outputs: Vec<Vec<Reduce<'_>>> = Vec::new(); // [layer][output]
-        for l in &layers {
-            let mut per_output: Vec<Reduce<'_>> = integrators.iter().map(Reduce::Colour).collect();
-            if window && let LayerData::Spectral { wavelength_nm, .. } = &l.data {
-                for m in WindowMethod::ALL {
-                    let w = WindowWeights::new(m, wavelength_nm).map_err(integration(format!(
-                        "{} average of layer {}",
-                        m.name(),
-                        l.label
-                    )))?;
-                    per_output.push(Reduce::Window(w));
+        let mut outputs: Vec<Reduce<'_>> = integrators.iter().map(Reduce::Colour).collect();
+        let mut averaged = Vec::new();
+        for &m in methods {
+            let mut per_layer = Vec::with_capacity(layers.len());
+            for l in &layers {
+                let LayerData::Spectral { wavelength_nm, .. } = &l.data else {
+                    break;
+                };
+                let what = || format!("{} average of layer {}", m.name(), l.label);
+                match window_weights(m, wavelength_nm, what)? {
+                    Some(w) => per_layer.push(w),
+                    None => break,
                 }
             }
-            outputs.push(per_output);
+            if per_layer.len() == layers.len() {
+                outputs.push(Reduce::Window(per_layer));
+                averaged.push((m, Vec::with_capacity(eval.angles_deg.len())));
+            }
         }
         let reduce = |r: &Reduce<'_>,
+                      k: usize,
                       wl: &[f64],
                       v: &[f64]|
          -> Result<Vec<f64>, glassdb_spectral::SpectralError> {
             match r {
                 Reduce::Colour(i) => i.channels(wl, v).map(|c| c.to_vec()),
-                Reduce::Window(w) => w.average(v).map(|a| vec![a]),
+                Reduce::Window(w) => w[k].average(v).map(|a| vec![a]),
             }
         };
-        let n_outputs = integrators.len() + if window { 2 } else { 0 };
-        // Normal values per layer and output, clamped to [0, 1] as a registry stores them.
+        // Per layer and output, the normal values reduced to the output's bands and clamped
+        // to [0, 1] as a registry stores them (for models applied per channel).
         let mut normals: Vec<Vec<Option<[Vec<f64>; 3]>>> = Vec::new();
-        for (l, outs) in layers.iter().zip(&outputs) {
+        for (k, l) in layers.iter().enumerate() {
             let mut per = Vec::new();
-            for r in outs {
+            for r in &outputs {
                 per.push(match (&l.data, application) {
                     (
                         LayerData::Spectral {
@@ -362,12 +410,8 @@ impl Stack {
                         Application::PerChannel,
                     ) => {
                         let red = |v: &[f64], what: &str| {
-                            reduce(r, wavelength_nm, v)
-                                .map(|x| {
-                                    x.into_iter()
-                                        .map(|c| c.clamp(0.0, 1.0))
-                                        .collect::<Vec<f64>>()
-                                })
+                            reduce(r, k, wavelength_nm, v)
+                                .map(|x| x.into_iter().map(|c| c.clamp(0.0, 1.0)).collect())
                                 .map_err(integration(label(l, what, 0.0)))
                         };
                         Some([
@@ -381,27 +425,28 @@ impl Stack {
             }
             normals.push(per);
         }
+        let prepared: Vec<Vec<ModelSample>> = layers.iter().map(|l| l.prepare()).collect();
         for &deg in &eval.angles_deg.clone() {
             let c = cos_deg(deg);
             // per layer: its own-sample values at this angle (spectral layers under a
             // per-wavelength model)
             let own: Vec<Option<LayerValues>> = layers
                 .iter()
-                .map(|l| match (&l.data, application) {
+                .zip(&prepared)
+                .map(|(l, p)| match (&l.data, application) {
                     (LayerData::Spectral { .. }, Application::PerWavelength) => {
-                        Some(l.values_at(c))
+                        Some(l.values_prepared(p, 0..p.len(), c))
                     }
                     _ => None,
                 })
                 .collect();
-            for o in 0..n_outputs {
+            for (o, r) in outputs.iter().enumerate() {
                 let mut values = Vec::with_capacity(layers.len());
                 for (k, l) in layers.iter().enumerate() {
                     let v = match (&l.data, &own[k], &normals[k][o]) {
                         (LayerData::Spectral { wavelength_nm, .. }, Some(v), _) => {
-                            let r = &outputs[k][o];
                             let red = |x: &[f64], what: &str| {
-                                reduce(r, wavelength_nm, x)
+                                reduce(r, k, wavelength_nm, x)
                                     .map_err(integration(label(l, what, deg)))
                             };
                             LayerValues {
@@ -421,16 +466,11 @@ impl Stack {
                         .push(o_optics.try_map(|v| Ok::<_, StackError>([v[0], v[1], v[2]]))?);
                 } else {
                     let scalar = o_optics.try_map(|v| Ok::<_, StackError>(v[0]))?;
-                    let target = if o == integrators.len() {
-                        &mut eval.photopic
-                    } else {
-                        &mut eval.solar
-                    };
-                    target.as_mut().expect("with window").push(scalar);
+                    averaged[o - integrators.len()].1.push(scalar);
                 }
             }
         }
-        Ok(())
+        Ok(averaged)
     }
 
     /// Each layer alone (flipped as in the unit) at `angles_deg`: its WINDOW `method` average
@@ -453,11 +493,12 @@ impl Stack {
                     }
                 })?;
                 let avg = |v: &[f64]| w.average(v).expect("same grid");
+                let prepared = l.prepare();
                 Ok(Some(
                     angles_deg
                         .iter()
                         .map(|&a| {
-                            let v = l.values_at(cos_deg(a));
+                            let v = l.values_prepared(&prepared, 0..prepared.len(), cos_deg(a));
                             [avg(&v.t), avg(&v.rf), avg(&v.rb)]
                         })
                         .collect(),

@@ -7,7 +7,9 @@ use glassdb_spectral::{ProductInfo, SpectralData};
 
 use crate::StackError;
 use crate::measured::MeasuredRatio;
-use crate::model::{LayerModel, ModelChoice, choose_model, model_at};
+use std::ops::Range;
+
+use crate::model::{LayerModel, ModelChoice, ModelSample, choose_model};
 
 /// A layer's normal-incidence data, as given (before any flip).
 #[derive(Debug, Clone, PartialEq)]
@@ -279,8 +281,31 @@ impl Layer {
     /// (with a measured table's ratio curves for Rf and T), then T + R ≤ 1 per side as WINDOW
     /// enforces it.
     pub fn values_at(&self, cos_theta: f64) -> LayerValues {
+        let prepared = self.prepare();
+        self.values_prepared(&prepared, 0..prepared.len(), cos_theta)
+    }
+
+    /// The layer's model prepared for each of its own samples (the `ior` of G for spectra, each
+    /// channel's for channel values): computed once, used at every angle.
+    pub fn prepare(&self) -> Vec<ModelSample> {
         let (t0, rf0, rb0) = self.data.parts();
-        self.values_from(t0, rf0, rb0, cos_theta, |_| self.ior.map(|v| v[1]))
+        let per_channel = !self.is_spectral();
+        self.prepare_samples(t0, rf0, rb0, per_channel)
+    }
+
+    fn prepare_samples(
+        &self,
+        t0: &[f64],
+        rf0: &[f64],
+        rb0: &[f64],
+        per_channel: bool,
+    ) -> Vec<ModelSample> {
+        (0..t0.len())
+            .map(|k| {
+                let ior = self.ior.map(|v| v[if per_channel { k.min(2) } else { 1 }]);
+                ModelSample::new(self.model, t0[k], rf0[k], rb0[k], ior)
+            })
+            .collect()
     }
 
     /// [`Layer::values_at`] applied to given normal values instead of the layer's own: its
@@ -293,10 +318,8 @@ impl Layer {
         rb0: &[f64],
         cos_theta: f64,
     ) -> LayerValues {
-        let three = t0.len() == 3;
-        self.values_from(t0, rf0, rb0, cos_theta, |c| {
-            self.ior.map(|v| v[if three { c } else { 1 }])
-        })
+        let prepared = self.prepare_samples(t0, rf0, rb0, t0.len() == 3);
+        self.values_from(&prepared, t0, rf0, rb0, 0..t0.len(), cos_theta)
     }
 
     /// Per channel, [`Layer::values_at`] of channel data with each channel's own `ior`.
@@ -307,15 +330,28 @@ impl Layer {
         }
     }
 
+    /// [`Layer::values_at`] on the samples `range` only, with the model prepared by
+    /// [`Layer::prepare`].
+    pub fn values_prepared(
+        &self,
+        prepared: &[ModelSample],
+        range: Range<usize>,
+        cos_theta: f64,
+    ) -> LayerValues {
+        let (t0, rf0, rb0) = self.data.parts();
+        self.values_from(prepared, t0, rf0, rb0, range, cos_theta)
+    }
+
     fn values_from(
         &self,
+        prepared: &[ModelSample],
         t0: &[f64],
         rf0: &[f64],
         rb0: &[f64],
+        range: Range<usize>,
         cos_theta: f64,
-        ior: impl Fn(usize) -> Option<(f64, f64)>,
     ) -> LayerValues {
-        let n = t0.len();
+        let n = range.len();
         let mut v = LayerValues {
             t: Vec::with_capacity(n),
             rf: Vec::with_capacity(n),
@@ -327,11 +363,11 @@ impl Layer {
             (Some(m), false) => (ratio(&m.reflectance), ratio(&m.transmittance)),
             _ => (None, None),
         };
-        for k in 0..n {
+        for k in range {
             let (mut rf, mut t, rb) = if normal {
                 (rf0[k], t0[k], rb0[k])
             } else {
-                model_at(self.model, t0[k], rf0[k], rb0[k], ior(k.min(2)), cos_theta)
+                prepared[k].at(cos_theta)
             };
             if let Some(c) = c_r {
                 rf = (rf0[k] * c).clamp(0.0, 1.0);

@@ -130,6 +130,107 @@ impl LayerModel {
     }
 }
 
+/// A layer's model prepared for one sample (a wavelength or a channel): what depends only on
+/// its normal values is computed once ([`ModelSample::new`]), then [`ModelSample::at`] gives
+/// the values at any angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ModelSample {
+    /// The uncoated slabs of the two sides (the front one gives T).
+    Uncoated {
+        /// Solved from (T0, Rf0).
+        front: UncoatedSlab,
+        /// Solved from (T0, Rb0).
+        back: UncoatedSlab,
+    },
+    /// A coated curve and the normal values it scales.
+    Coated {
+        /// The curve.
+        curve: CoatedCurve,
+        /// As published (not renormalised).
+        published: bool,
+        /// Normal transmittance.
+        t0: f64,
+        /// Normal front reflectance.
+        rf0: f64,
+        /// Normal back reflectance.
+        rb0: f64,
+    },
+    /// An opaque surface.
+    Opaque {
+        /// Normal front reflectance.
+        rf0: f64,
+        /// Normal back reflectance.
+        rb0: f64,
+        /// `(n, k)` when given.
+        ior: Option<(f64, f64)>,
+    },
+}
+
+impl ModelSample {
+    /// The model `model` for a sample with normal values `t0`, `rf0`, `rb0` (and the `(n, k)`
+    /// of an opaque surface, when given).
+    pub fn new(model: LayerModel, t0: f64, rf0: f64, rb0: f64, ior: Option<(f64, f64)>) -> Self {
+        match model {
+            LayerModel::Uncoated => ModelSample::Uncoated {
+                front: UncoatedSlab::from_normal(t0, rf0),
+                back: UncoatedSlab::from_normal(t0, rb0),
+            },
+            LayerModel::Coated | LayerModel::CoatedFixed(_) | LayerModel::CoatedPublished(_) => {
+                let (curve, published) = match model {
+                    LayerModel::CoatedFixed(c) => (c, false),
+                    LayerModel::CoatedPublished(c) => (c, true),
+                    _ => (CoatedCurve::for_t0(t0), false),
+                };
+                ModelSample::Coated {
+                    curve,
+                    published,
+                    t0,
+                    rf0,
+                    rb0,
+                }
+            }
+            LayerModel::Opaque => ModelSample::Opaque { rf0, rb0, ior },
+        }
+    }
+
+    /// `(Rf, T, Rb)` at `cos θ`.
+    #[inline]
+    pub fn at(&self, cos_theta: f64) -> (f64, f64, f64) {
+        match *self {
+            ModelSample::Uncoated { front, back } => {
+                let (rf, t) = front.at(cos_theta);
+                let (rb, _) = back.at(cos_theta);
+                (rf, t, rb)
+            }
+            ModelSample::Coated {
+                curve,
+                published,
+                t0,
+                rf0,
+                rb0,
+            } => {
+                let at = |r0| {
+                    if published {
+                        curve.at_published(t0, r0, cos_theta)
+                    } else {
+                        curve.at(t0, r0, cos_theta)
+                    }
+                };
+                let (rf, t) = at(rf0);
+                let (rb, _) = at(rb0);
+                (rf, t, rb)
+            }
+            ModelSample::Opaque { rf0, rb0, ior } => {
+                let f = |r0: f64| match ior {
+                    Some(nk) => opaque_reflectance(r0, nk, cos_theta),
+                    None => fresnel_single_surface(ior_from_reflectance(r0), 0.0, cos_theta),
+                };
+                (f(rf0), 0.0, f(rb0))
+            }
+        }
+    }
+}
+
 /// `(Rf, T, Rb)` of one wavelength (or channel) at `cos θ` from its normal values `t0`, `rf0`,
 /// `rb0`; `ior` is the `(n, k)` of an opaque surface when given.
 pub fn model_at(
@@ -140,34 +241,7 @@ pub fn model_at(
     ior: Option<(f64, f64)>,
     cos_theta: f64,
 ) -> (f64, f64, f64) {
-    match model {
-        LayerModel::Uncoated => {
-            let (rf, t) = UncoatedSlab::from_normal(t0, rf0).at(cos_theta);
-            let (rb, _) = UncoatedSlab::from_normal(t0, rb0).at(cos_theta);
-            (rf, t, rb)
-        }
-        LayerModel::Coated | LayerModel::CoatedFixed(_) => {
-            let curve = match model {
-                LayerModel::CoatedFixed(c) => c,
-                _ => CoatedCurve::for_t0(t0),
-            };
-            let (rf, t) = curve.at(t0, rf0, cos_theta);
-            let (rb, _) = curve.at(t0, rb0, cos_theta);
-            (rf, t, rb)
-        }
-        LayerModel::CoatedPublished(curve) => {
-            let (rf, t) = curve.at_published(t0, rf0, cos_theta);
-            let (rb, _) = curve.at_published(t0, rb0, cos_theta);
-            (rf, t, rb)
-        }
-        LayerModel::Opaque => {
-            let f = |r0: f64| match ior {
-                Some(nk) => opaque_reflectance(r0, nk, cos_theta),
-                None => fresnel_single_surface(ior_from_reflectance(r0), 0.0, cos_theta),
-            };
-            (f(rf0), 0.0, f(rb0))
-        }
-    }
+    ModelSample::new(model, t0, rf0, rb0, ior).at(cos_theta)
 }
 
 /// Picks the physical model: the one `choice` fixes; else `opaque` with an index of
