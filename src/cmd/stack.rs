@@ -356,7 +356,12 @@ fn to_json(
         },
         "layers": layers,
         "gaps": gaps,
-        "groups": built.stack.groups(),
+        "groups": built.stack.groups().iter().map(|g| json!({
+            "layers": g.layers.clone().collect::<Vec<_>>(),
+            "thickness_mm": g.thickness_mm,
+            "depth_mm": g.depth_mm,
+            "depth_back_mm": g.depth_back_mm,
+        })).collect::<Vec<_>>(),
         "thickness_mm": built.stack.thickness_mm(),
     })
 }

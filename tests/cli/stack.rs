@@ -574,3 +574,15 @@ fn plot_stack_draws_the_unit_and_its_layers() {
     assert_eq!((s.width, s.height), (1800, 542), "{s:?}");
     assert!(s.inked_fraction > 0.05 && s.distinct_colours > 20, "{s:?}");
 }
+
+/// docs/stack.md's "Six real units" tables are what scripts/stack_table.py writes.
+#[test]
+fn docs_table_is_current() {
+    let mut cmd = std::process::Command::new(crate::util::oracle_python());
+    cmd.arg(repo_path("scripts/stack_table.py")).args([
+        "--check",
+        "--glassdb",
+        env!("CARGO_BIN_EXE_glassdb"),
+    ]);
+    ok(&mut cmd);
+}
