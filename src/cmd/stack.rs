@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use glassdb_spectral::{
-    IntegrationSettings, Integrator, Method, Observer, RgbSpace, WindowMethod, read_spectral_file,
+    IntegrationSettings, Integrator, Method, Observer, WindowMethod, read_spectral_file,
 };
 use glassdb_stack::{
     Application, Combination, Element, EvalOptions, Evaluation, Gap, Gas, Layer, LayerOptions,
@@ -226,14 +226,7 @@ pub fn colour_settings(space: SpaceArg) -> IntegrationSettings {
         method: Method::Colorimetric {
             observer: Observer::Cie1931,
             illuminant: glassdb_spectral::Illuminant::D65,
-            space: match space {
-                SpaceArg::Srgb => RgbSpace::Srgb,
-                SpaceArg::Rec2020 => RgbSpace::Rec2020,
-                SpaceArg::Acescg => RgbSpace::AcesCg,
-                SpaceArg::Aces2065_1 => RgbSpace::Aces2065_1,
-                SpaceArg::DisplayP3 => RgbSpace::DisplayP3,
-                SpaceArg::Xyz => RgbSpace::Xyz,
-            },
+            space: space.space(),
         },
         extrapolate: false,
     }
@@ -271,23 +264,25 @@ fn column<V, U>(per_angle: &[Optics<V>], f: impl Fn(&Optics<V>) -> U) -> Vec<U> 
     per_angle.iter().map(f).collect()
 }
 
-fn window_json(per_angle: Option<&Vec<Optics<f64>>>) -> Value {
-    match per_angle {
-        None => Value::Null,
-        Some(p) => json!({
-            "T": column(p, |o| o.t),
-            "Rf": column(p, |o| o.rf),
-            "Rb": column(p, |o| o.rb),
-            "absorptance": {
-                "front": column(p, |o| o.absorptance_front.clone()),
-                "back": column(p, |o| o.absorptance_back.clone()),
-            },
-            "group_shares": {
-                "front": column(p, |o| o.share_front.clone()),
-                "back": column(p, |o| o.share_back.clone()),
-            },
-        }),
+/// T, Rf, Rb and the pane groups' shares per angle (and the layers' absorptances, with
+/// `absorptance`).
+fn optics_json<V: serde::Serialize + Clone>(per_angle: &[Optics<V>], absorptance: bool) -> Value {
+    let mut v = json!({
+        "T": column(per_angle, |o| o.t.clone()),
+        "Rf": column(per_angle, |o| o.rf.clone()),
+        "Rb": column(per_angle, |o| o.rb.clone()),
+        "group_shares": {
+            "front": column(per_angle, |o| o.share_front.clone()),
+            "back": column(per_angle, |o| o.share_back.clone()),
+        },
+    });
+    if absorptance {
+        v["absorptance"] = json!({
+            "front": column(per_angle, |o| o.absorptance_front.clone()),
+            "back": column(per_angle, |o| o.absorptance_back.clone()),
+        });
     }
+    v
 }
 
 fn to_json(
@@ -296,11 +291,12 @@ fn to_json(
     layer_photopic: &[Option<Vec<[f64; 3]>>],
     settings: &IntegrationSettings,
 ) -> Value {
-    let colour = &eval.colour[0];
     let space = match settings.method {
         Method::Colorimetric { space, .. } => space.name(),
         _ => "",
     };
+    let mut rgb = optics_json(&eval.colour[0], false);
+    rgb["space"] = json!(space);
     let mut layers = Vec::new();
     for ((l, origin), own) in built
         .stack
@@ -342,18 +338,9 @@ fn to_json(
     json!({
         "angles_deg": eval.angles_deg,
         "combination": eval.combination.name(),
-        "photopic": window_json(eval.photopic.as_ref()),
-        "solar": window_json(eval.solar.as_ref()),
-        "rgb": {
-            "space": space,
-            "T": column(colour, |o| o.t),
-            "Rf": column(colour, |o| o.rf),
-            "Rb": column(colour, |o| o.rb),
-            "group_shares": {
-                "front": column(colour, |o| o.share_front.clone()),
-                "back": column(colour, |o| o.share_back.clone()),
-            },
-        },
+        "photopic": eval.photopic.as_ref().map_or(Value::Null, |p| optics_json(p, true)),
+        "solar": eval.solar.as_ref().map_or(Value::Null, |p| optics_json(p, true)),
+        "rgb": rgb,
         "layers": layers,
         "gaps": gaps,
         "groups": built.stack.groups().iter().map(|g| json!({

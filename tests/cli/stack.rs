@@ -273,7 +273,7 @@ fn read_json(path: &Path) -> Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
 
-fn glass<'a>(table: &'a Value, id: u64) -> &'a Value {
+fn glass(table: &Value, id: u64) -> &Value {
     table["glasses"]
         .as_array()
         .unwrap()

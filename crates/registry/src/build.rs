@@ -15,7 +15,7 @@ use crate::angle_model::{ModelTables, read_measured_table};
 use crate::catalog::{
     ElementSpec, GlassBuild, GlassSpec, LayerSpec, NormalSource, parse_catalog, resolve,
 };
-use crate::curves::fit_glass_curves;
+use crate::curves::{GlassCurves, fit_glass_curves};
 use crate::normal::{NormalValues, normal_values, read_layer};
 use crate::{
     AngleModelRecord, FileRef, GlassRecord, Provenance, Registry, RegistryError, RegistryTable,
@@ -290,37 +290,52 @@ pub(crate) fn build_glass(
     let mut records = Vec::with_capacity(integrators.len());
     for (normal, tables) in normals.iter().zip(&tables) {
         let curves = fit_glass_curves(normal, tables, measured.as_ref(), opts, &glass)?;
-        let mut g = GlassRecord {
-            id: spec.id,
-            name: spec.name.clone(),
-            r0: normal.r0,
-            t0: normal.t0,
-            r0_back: normal.r0_back,
-            c_r: curves.c_r,
-            c_t: curves.c_t,
-            c_r_back: curves.c_r_back,
-            luminous,
-            angle_model: angle_model_record(
-                layer.model,
-                layer.model_reason.clone(),
-                application,
-                layer_spec,
-                measured.as_ref(),
-            ),
-            provenance: Provenance {
-                catalog: None,
-                spectral: read.source.as_ref().map(|s| s.0.clone()),
-                angles: measured.as_ref().map(|m| m.file.clone()),
-                product: read.source.as_ref().map(|s| s.1.clone()),
-            },
-            unit: None,
+        let angle_model = angle_model_record(
+            layer.model,
+            layer.model_reason.clone(),
+            application,
+            layer_spec,
+            measured.as_ref(),
+        );
+        let provenance = Provenance {
+            catalog: None,
+            spectral: read.source.as_ref().map(|s| s.0.clone()),
+            angles: measured.as_ref().map(|m| m.file.clone()),
+            product: read.source.as_ref().map(|s| s.1.clone()),
         };
+        let mut g = glass_record(spec, normal, curves, luminous, angle_model, provenance);
         if layer_spec.flip {
             g.turn_round();
         }
         records.push(g);
     }
     Ok(records)
+}
+
+/// A glass record of `spec` from its normal values, curves and the records about them (a
+/// unit's record is added by the caller).
+pub(crate) fn glass_record(
+    spec: &GlassSpec,
+    normal: &NormalValues,
+    curves: GlassCurves,
+    luminous: Option<crate::LuminousRecord>,
+    angle_model: AngleModelRecord,
+    provenance: Provenance,
+) -> GlassRecord {
+    GlassRecord {
+        id: spec.id,
+        name: spec.name.clone(),
+        r0: normal.r0,
+        t0: normal.t0,
+        r0_back: normal.r0_back,
+        c_r: curves.c_r,
+        c_t: curves.c_t,
+        c_r_back: curves.c_r_back,
+        luminous,
+        angle_model,
+        provenance,
+        unit: None,
+    }
 }
 
 /// The normal values of a layer as a unit sees it (after any flip).

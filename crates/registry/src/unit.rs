@@ -15,7 +15,7 @@ use glassdb_stack::{
 
 use crate::angle_model::{ModelTables, integration_error, read_measured_table};
 use crate::build::{
-    BuildOptions, CatalogFiles, build_glass, integrators_of, load_catalog, oriented,
+    BuildOptions, CatalogFiles, build_glass, glass_record, integrators_of, load_catalog, oriented,
 };
 use crate::catalog::{ElementSpec, GlassBuild, GlassSpec, LayerSpec, NormalSource};
 use crate::curves::{fit_glass_curves, fit_share_curves};
@@ -148,18 +148,20 @@ fn grey_layer(
 /// photopic average of a spectral layer, channel G of a channel layer.
 fn broadband_model(layer: &Layer) -> Result<(Vec<f64>, Vec<f64>), StackError> {
     let angles = model_angles_deg();
-    let average: Box<dyn Fn(&[f64]) -> f64> = match &layer.data {
-        LayerData::Spectral { wavelength_nm, .. } => {
-            let w =
-                WindowWeights::new(WindowMethod::Photopic, wavelength_nm).map_err(|source| {
-                    StackError::Integration {
-                        what: format!("photopic average of layer {}", layer.label),
-                        source: Box::new(source),
-                    }
-                })?;
-            Box::new(move |v: &[f64]| w.average(v).unwrap_or(0.0))
-        }
-        LayerData::Channels { .. } => Box::new(|v: &[f64]| v[1]),
+    let weights = match &layer.data {
+        LayerData::Spectral { wavelength_nm, .. } => Some(
+            WindowWeights::new(WindowMethod::Photopic, wavelength_nm).map_err(|source| {
+                StackError::Integration {
+                    what: format!("photopic average of layer {}", layer.label),
+                    source: Box::new(source),
+                }
+            })?,
+        ),
+        LayerData::Channels { .. } => None,
+    };
+    let average = |v: &[f64]| match &weights {
+        Some(w) => w.average(v).unwrap_or(0.0),
+        None => v[1],
     };
     let (mut r, mut t) = (Vec::new(), Vec::new());
     for a in angles {
@@ -337,49 +339,46 @@ pub(crate) fn build_unit(
                         front: s[0].absorptance_front[index],
                         back: s[0].absorptance_back[index],
                     });
-                    unit_elements.push(UnitElement::Layer(layer_record(
+                    unit_elements.push(UnitElement::Layer(Box::new(layer_record(
                         l,
                         unit_layer,
                         stack.layers().nth(index).expect("layer").thickness_mm,
                         integrator,
                         absorptance,
                         &glass,
-                    )?));
+                    )?)));
                 }
             }
         }
-        records.push(GlassRecord {
-            id: spec.id,
-            name: spec.name.clone(),
-            r0: normal.r0,
-            t0: normal.t0,
-            r0_back: normal.r0_back,
-            c_r: curves.c_r,
-            c_t: curves.c_t,
-            c_r_back: curves.c_r_back,
+        let angle_model = AngleModelRecord {
+            kind: "unit".into(),
+            applied: opts.application.name().to_string(),
+            ior: None,
+            measured_max_angle_deg: None,
+            continued_by: None,
+            chosen_by: format!(
+                "{} layers combined {}",
+                layers.len(),
+                eval.combination.name()
+            ),
+        };
+        let mut record = glass_record(
+            spec,
+            &normal,
+            curves,
             luminous,
-            angle_model: AngleModelRecord {
-                kind: "unit".into(),
-                applied: opts.application.name().to_string(),
-                ior: None,
-                measured_max_angle_deg: None,
-                continued_by: None,
-                chosen_by: format!(
-                    "{} layers combined {}",
-                    layers.len(),
-                    eval.combination.name()
-                ),
-            },
-            provenance: Provenance::default(),
-            unit: Some(UnitRecord {
-                elements: unit_elements,
-                groups,
-                thickness_mm: stack.thickness_mm(),
-                combined: eval.combination.name().to_string(),
-                photopic: system(at_normal.photopic.as_ref()),
-                solar: system(at_normal.solar.as_ref()),
-            }),
+            angle_model,
+            Provenance::default(),
+        );
+        record.unit = Some(UnitRecord {
+            elements: unit_elements,
+            groups,
+            thickness_mm: stack.thickness_mm(),
+            combined: eval.combination.name().to_string(),
+            photopic: system(at_normal.photopic.as_ref()),
+            solar: system(at_normal.solar.as_ref()),
         });
+        records.push(record);
     }
     Ok(records)
 }
@@ -455,7 +454,7 @@ fn one_layer_unit(
             &glass,
         )?;
         record.unit = Some(UnitRecord {
-            elements: vec![UnitElement::Layer(layer)],
+            elements: vec![UnitElement::Layer(Box::new(layer))],
             groups: vec![PaneGroupRecord {
                 layers: vec![0],
                 thickness_mm: group.thickness_mm,

@@ -34,7 +34,7 @@ pub struct UnitRecord {
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum UnitElement {
     /// A solid layer.
-    Layer(UnitLayerRecord),
+    Layer(Box<UnitLayerRecord>),
     /// A gap.
     Gap(GapRecord),
 }

@@ -99,6 +99,25 @@ impl RegistryTable {
     }
 }
 
+/// An unphysical value of `glass` at (side, channel, angle).
+fn unphysical(
+    source_name: &str,
+    glass: &str,
+    (side, channel, angle_deg): (Side, usize, f64),
+    what: String,
+    tolerance: f64,
+) -> RegistryError {
+    RegistryError::Unphysical {
+        source_name: source_name.to_string(),
+        glass: glass.to_string(),
+        side,
+        channel: CHANNELS[channel],
+        angle_deg,
+        what,
+        tolerance,
+    }
+}
+
 /// The validation grid: `(angle_deg, cos θ)` at 0, 0.25, …, 90° (cos exactly 0 at 90°).
 fn validation_grid() -> impl Iterator<Item = (f64, f64)> {
     let steps = (90.0 / VALIDATION_STEP_DEG).round() as usize;
@@ -249,6 +268,9 @@ fn validate_unit(
         let (_, c_r) = g.r_parts(side);
         for (angle_deg, cos) in validation_grid() {
             let (r, _) = g.eval_raw(side, cos);
+            let unphysical = |c: usize, what: String, tolerance: f64| {
+                unphysical(source_name, &glass, (side, c, angle_deg), what, tolerance)
+            };
             let mut sum = [0.0; 3];
             let mut slack = [c_r[0].tolerance, c_r[1].tolerance, c_r[2].tolerance];
             for (k, gr) in unit.groups.iter().enumerate() {
@@ -261,19 +283,9 @@ fn validate_unit(
                 for c in 0..3 {
                     let tol = curves[c].tolerance + VALIDATION_EPS;
                     if !s[c].is_finite() || s[c] < -tol || s[c] > 1.0 + tol {
-                        return Err(RegistryError::Unphysical {
-                            source_name: source_name.to_string(),
-                            glass: glass.clone(),
-                            side,
-                            channel: CHANNELS[c],
-                            angle_deg,
-                            what: format!(
-                                "pane group {} reflects {:.6}, outside [0, 1]",
-                                k + 1,
-                                s[c]
-                            ),
-                            tolerance: tol,
-                        });
+                        let what =
+                            format!("pane group {} reflects {:.6}, outside [0, 1]", k + 1, s[c]);
+                        return Err(unphysical(c, what, tol));
                     }
                     sum[c] += s[c];
                     slack[c] += curves[c].tolerance;
@@ -282,18 +294,11 @@ fn validate_unit(
             for c in 0..3 {
                 let tol = slack[c] + VALIDATION_EPS;
                 if (sum[c] - r[c]).abs() > tol {
-                    return Err(RegistryError::Unphysical {
-                        source_name: source_name.to_string(),
-                        glass: glass.clone(),
-                        side,
-                        channel: CHANNELS[c],
-                        angle_deg,
-                        what: format!(
-                            "the pane groups reflect {:.6} in all but the unit {:.6}",
-                            sum[c], r[c]
-                        ),
-                        tolerance: tol,
-                    });
+                    let what = format!(
+                        "the pane groups reflect {:.6} in all but the unit {:.6}",
+                        sum[c], r[c]
+                    );
+                    return Err(unphysical(c, what, tol));
                 }
             }
         }
@@ -343,14 +348,8 @@ fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryErro
             for c in 0..3 {
                 let tol_r = c_r[c].tolerance + VALIDATION_EPS;
                 let tol_t = g.c_t[c].tolerance + VALIDATION_EPS;
-                let fail = |what: String, tolerance: f64| RegistryError::Unphysical {
-                    source_name: source_name.to_string(),
-                    glass: glass.clone(),
-                    side,
-                    channel: CHANNELS[c],
-                    angle_deg,
-                    what,
-                    tolerance,
+                let fail = |what: String, tolerance: f64| {
+                    unphysical(source_name, &glass, (side, c, angle_deg), what, tolerance)
                 };
                 if !r[c].is_finite() || !t[c].is_finite() {
                     return Err(fail("r or t is not finite".into(), 0.0));

@@ -817,8 +817,8 @@ mod tests {
         // and the kernel is the direct spline evaluation to rounding
         let mut direct = [0.0f64; 3];
         for_each_on_grid(&wl, &v, false, it.grid_nm(), |j, x| {
-            for c in 0..3 {
-                direct[c] += x * it.weights()[j][c];
+            for (d, w) in direct.iter_mut().zip(&it.weights()[j]) {
+                *d += x * w;
             }
         });
         for c in 0..3 {

@@ -671,34 +671,45 @@ mod tests {
         }
     }
 
-    #[test]
-    fn sprague_kernel_equals_direct_evaluation() {
-        let x: Vec<f64> = (0..120).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
+    /// `Σ kernel·y` against the direct evaluation of the same interpolant onto `grid`, for a
+    /// wiggly spectrum on `x` and arbitrary weights.
+    fn assert_kernel_is_direct(
+        x: &[f64],
+        grid: &[f64],
+        uniform: bool,
+        build: fn(&[f64], &[f64], &[[f64; 3]], &mut Vec<[f64; 3]>),
+        rel_tol: f64,
+    ) {
         let y: Vec<f64> = x
             .iter()
             .map(|w| 0.5 + 0.3 * (w / 37.0).sin() * (w / 211.0).cos())
             .collect();
-        let grid: Vec<f64> = (250..=950).map(|g| f64::from(g) + 0.3).collect();
         let weights: Vec<[f64; 3]> = grid
             .iter()
             .map(|g| [1.0, (g / 50.0).sin(), 1e-3 * g])
             .collect();
         let mut direct = [0.0; 3];
-        for_each_on_grid(&x, &y, true, &grid, |j, v| {
-            for c in 0..3 {
-                direct[c] += weights[j][c] * v;
+        for_each_on_grid(x, &y, uniform, grid, |j, v| {
+            for (d, w) in direct.iter_mut().zip(&weights[j]) {
+                *d += w * v;
             }
         });
         let mut kernel = Vec::new();
-        sprague_kernel(&x, &grid, &weights, &mut kernel);
-        for c in 0..3 {
+        build(x, grid, &weights, &mut kernel);
+        for (c, d) in direct.iter().enumerate() {
             let k: f64 = kernel.iter().zip(&y).map(|(k, v)| k[c] * v).sum();
             assert!(
-                (k - direct[c]).abs() < 1e-10 * direct[c].abs().max(1.0),
-                "{c}: {k} vs {}",
-                direct[c]
+                (k - d).abs() < rel_tol * d.abs().max(1.0),
+                "{c}: {k} vs {d}"
             );
         }
+    }
+
+    #[test]
+    fn sprague_kernel_equals_direct_evaluation() {
+        let x: Vec<f64> = (0..120).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
+        let grid: Vec<f64> = (250..=950).map(|g| f64::from(g) + 0.3).collect();
+        assert_kernel_is_direct(&x, &grid, true, sprague_kernel, 1e-10);
     }
 
     #[test]
@@ -706,31 +717,8 @@ mod tests {
         // Irregular grid 300–2500 nm with a wiggly spectrum; grid 360–780 plus points outside.
         let mut x: Vec<f64> = (0..60).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
         x.extend((0..=170).map(|i| 600.0 + 11.0 * f64::from(i)));
-        let y: Vec<f64> = x
-            .iter()
-            .map(|w| 0.5 + 0.3 * (w / 37.0).sin() * (w / 211.0).cos())
-            .collect();
         let grid: Vec<f64> = (250..=800).map(f64::from).collect();
-        let weights: Vec<[f64; 3]> = grid
-            .iter()
-            .map(|g| [1.0, (g / 50.0).sin(), 1e-3 * g])
-            .collect();
-        let mut direct = [0.0; 3];
-        for_each_on_grid(&x, &y, false, &grid, |j, v| {
-            for c in 0..3 {
-                direct[c] += weights[j][c] * v;
-            }
-        });
-        let mut kernel = Vec::new();
-        spline_kernel(&x, &grid, &weights, &mut kernel);
-        for c in 0..3 {
-            let k: f64 = kernel.iter().zip(&y).map(|(k, v)| k[c] * v).sum();
-            assert!(
-                (k - direct[c]).abs() < 1e-11 * direct[c].abs().max(1.0),
-                "{c}: {k} vs {}",
-                direct[c]
-            );
-        }
+        assert_kernel_is_direct(&x, &grid, false, spline_kernel, 1e-11);
     }
 
     #[test]

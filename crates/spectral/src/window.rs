@@ -184,7 +184,7 @@ impl Weighting {
             }
         }
         let total: f64 = weight.iter().sum();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return Err("the weighting integrates to zero".into());
         }
         weight.iter_mut().for_each(|w| *w /= total);
@@ -219,7 +219,8 @@ impl WindowWeights {
             [only] => (*only, *only),
             [] => (f64::NAN, f64::NAN),
         };
-        if !(first <= lo + RANGE_TOLERANCE_NM && last >= hi - RANGE_TOLERANCE_NM) {
+        let covers = first <= lo + RANGE_TOLERANCE_NM && last >= hi - RANGE_TOLERANCE_NM;
+        if !covers {
             return Err(SpectralError::WindowCoverage {
                 method: method.name(),
                 have_start_nm: first,

@@ -150,6 +150,9 @@ impl Resampling {
     }
 }
 
+/// A WINDOW method and its values per angle.
+type Averaged = (WindowMethod, Vec<Optics<f64>>);
+
 /// WINDOW's `method` weights on `wavelength_nm`, or none where the data do not cover the
 /// method's range (WINDOW refuses such a layer for that method; the other outputs stay).
 fn window_weights(
@@ -292,7 +295,7 @@ impl Stack {
             solar: None,
         };
         // per WINDOW method evaluated: its per-angle values
-        let mut averaged: Vec<(WindowMethod, Vec<Optics<f64>>)> = Vec::new();
+        let mut averaged: Vec<Averaged> = Vec::new();
         match (combination, self.grid()) {
             (Combination::PerWavelength, Grid::Wavelengths(grid)) => {
                 let resampling = self.resamplings(grid);
@@ -347,7 +350,7 @@ impl Stack {
         integrators: &[Integrator],
         methods: &[WindowMethod],
         application: Application,
-    ) -> Result<Vec<(WindowMethod, Vec<Optics<f64>>)>, StackError> {
+    ) -> Result<Vec<Averaged>, StackError> {
         let groups = self.group_ranges();
         let layers: Vec<&Layer> = self.layers().collect();
         let label =

@@ -151,7 +151,9 @@ impl Layer {
                 rb.len()
             )));
         }
-        if let Some(k) = (1..n).find(|&k| !(wavelength_nm[k] > wavelength_nm[k - 1])) {
+        if let Some(k) = (1..n).find(|&k| {
+            wavelength_nm[k].partial_cmp(&wavelength_nm[k - 1]) != Some(std::cmp::Ordering::Greater)
+        }) {
             return Err(err(format!(
                 "wavelengths not strictly increasing at {} nm",
                 wavelength_nm[k]
@@ -170,16 +172,28 @@ impl Layer {
                 label: label.to_string(),
                 source: Box::new(source),
             })?;
-        let (model, model_reason) =
-            choose_model(opts.model, opts.ior.is_some(), product_type, &t, &rf, &rb);
-        Ok(Layer {
-            label: label.to_string(),
-            data: LayerData::Spectral {
+        Ok(Layer::new(
+            label,
+            LayerData::Spectral {
                 wavelength_nm,
                 t,
                 rf,
                 rb,
             },
+            product_type,
+            opts,
+        ))
+    }
+
+    /// A layer of checked data, its model chosen by `opts.model`, else `product_type`, else
+    /// the data.
+    fn new(label: &str, data: LayerData, product_type: Option<&str>, opts: &LayerOptions) -> Layer {
+        let (t, rf, rb) = data.parts();
+        let (model, model_reason) =
+            choose_model(opts.model, opts.ior.is_some(), product_type, t, rf, rb);
+        Layer {
+            label: label.to_string(),
+            data,
             model,
             model_reason,
             ior: opts.ior,
@@ -187,7 +201,7 @@ impl Layer {
             thickness_mm: opts.thickness_mm,
             measured: None,
             product: None,
-        })
+        }
     }
 
     /// A layer from a spectral file's data: T (zero for an opaque model), Rf, Rb (Rf where
@@ -240,19 +254,7 @@ impl Layer {
         rb: [f64; 3],
         opts: &LayerOptions,
     ) -> Layer {
-        let (model, model_reason) =
-            choose_model(opts.model, opts.ior.is_some(), None, &t, &rf, &rb);
-        Layer {
-            label: label.to_string(),
-            data: LayerData::Channels { t, rf, rb },
-            model,
-            model_reason,
-            ior: opts.ior,
-            flipped: opts.flipped,
-            thickness_mm: opts.thickness_mm,
-            measured: None,
-            product: None,
-        }
+        Layer::new(label, LayerData::Channels { t, rf, rb }, None, opts)
     }
 
     /// Whether the layer transmits nothing at any wavelength (or channel).
