@@ -671,13 +671,16 @@ mod tests {
         }
     }
 
+    /// `sprague_kernel` or `spline_kernel`.
+    type KernelBuilder = fn(&[f64], &[f64], &[[f64; 3]], &mut Vec<[f64; 3]>);
+
     /// `Σ kernel·y` against the direct evaluation of the same interpolant onto `grid`, for a
     /// wiggly spectrum on `x` and arbitrary weights.
     fn assert_kernel_is_direct(
         x: &[f64],
         grid: &[f64],
         uniform: bool,
-        build: fn(&[f64], &[f64], &[[f64; 3]], &mut Vec<[f64; 3]>),
+        build: KernelBuilder,
         rel_tol: f64,
     ) {
         let y: Vec<f64> = x
