@@ -586,3 +586,83 @@ fn docs_table_is_current() {
     ]);
     ok(&mut cmd);
 }
+
+/// Layers given by a measured angle table alone (grey), by a spectrum with an angle table, and
+/// by explicit r0/t0 values: the unit follows the tables' angle dependence and the explicit
+/// layer makes it combine per channel.
+#[test]
+fn units_of_angle_table_and_explicit_layers() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = repo_path("data/angles/clear_6mm_fresnel.csv");
+    let body = format!(
+        r#"
+[[glass]]
+id = 1
+name = "two measured panes"
+layers = [
+    {{ angles = "{t}", thickness_mm = 6 }},
+    {{ gap_mm = 16, gas = "krypton" }},
+    {{ angles = "{t}", thickness_mm = 6 }},
+]
+
+[[glass]]
+id = 2
+name = "clear with its measured table | explicit grey"
+layers = [
+    {{ spectral = "GLAZING/CLEAR_6.DAT", angles = "{t}" }},
+    {{ gap_mm = 12 }},
+    {{ r0 = [0.08, 0.08, 0.08], t0 = [0.5, 0.5, 0.5], thickness_mm = 4 }},
+]
+"#,
+        t = table.display()
+    );
+    let catalog = catalog_with(dir.path(), &body);
+    let out = dir.path().join("reg.json");
+    ok(&mut registry_build(&catalog, &out, &[]));
+    let reg = read_json(&out);
+    let table_rows: Vec<(f64, f64, f64)> = std::fs::read_to_string(&table)
+        .unwrap()
+        .lines()
+        .filter(|l| l.chars().next().is_some_and(|c| c.is_ascii_digit()))
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (v[0], v[1], v[2])
+        })
+        .collect();
+    let curve = |c: &Value, cos: f64| -> f64 {
+        let p = c["powers"].as_array().unwrap();
+        let k = c["coefficients"].as_array().unwrap();
+        p.iter()
+            .zip(k)
+            .map(|(p, k)| k.as_f64().unwrap() * cos.powi(p.as_u64().unwrap() as i32))
+            .sum()
+    };
+    let g = glass(&reg["tables"][0], 1);
+    assert_eq!(g["unit"]["elements"][0]["model"], "measured");
+    assert_eq!(g["unit"]["elements"][1]["gas"], "krypton");
+    // the two-flux unit of two table panes, by hand from the table: T²/(1 − R²), R + T²R/(1 − R²)
+    for &(deg, r, t) in table_rows.iter().filter(|(a, ..)| *a <= 80.0) {
+        let cos = deg.to_radians().cos();
+        let (t_unit, r_unit) = (t * t / (1.0 - r * r), r + t * t * r / (1.0 - r * r));
+        for ch in 0..3 {
+            let tt = g["t0"][ch].as_f64().unwrap() * curve(&g["c_t"][ch], cos);
+            let rr = g["r0"][ch].as_f64().unwrap() * curve(&g["c_r"][ch], cos);
+            assert!(
+                (tt - t_unit).abs() < 0.006 && (rr - r_unit).abs() < 0.006,
+                "{deg}°: T {tt} vs {t_unit}, R {rr} vs {r_unit}"
+            );
+        }
+    }
+    let mixed = glass(&reg["tables"][0], 2);
+    assert_eq!(mixed["unit"]["combined"], "per-band");
+    assert!(
+        mixed["unit"].get("photopic").is_none(),
+        "no photopic value without spectra"
+    );
+    assert_eq!(mixed["unit"]["elements"][0]["model"], "measured");
+    // normal incidence: the explicit layer behind clear 6 mm, per channel
+    let clear_t = mixed["unit"]["elements"][0]["t0"][1].as_f64().unwrap();
+    let clear_rb = mixed["unit"]["elements"][0]["r0_back"][1].as_f64().unwrap();
+    let want = clear_t * 0.5 / (1.0 - clear_rb * 0.08);
+    assert!((mixed["t0"][1].as_f64().unwrap() - want).abs() < 1e-12);
+}

@@ -107,7 +107,7 @@ pub struct Layer {
     pub flipped: bool,
     /// Thickness in mm (from the file, or the override), when known.
     pub thickness_mm: Option<f64>,
-    /// A measured angle table's ratio curves (replacing the model for Rf and T).
+    /// A measured angle table (its curves replacing the model for Rf and T).
     pub measured: Option<MeasuredRatio>,
     /// The product as its file describes it.
     pub product: Option<ProductInfo>,
@@ -360,22 +360,16 @@ impl Layer {
             rb: Vec::with_capacity(n),
         };
         let normal = cos_theta >= 1.0;
-        let ratio = |p: &Option<glassdb_fit::CosPolynomial>| p.as_ref().map(|c| c.eval(cos_theta));
-        let (c_r, c_t) = match (&self.measured, normal) {
-            (Some(m), false) => (ratio(&m.reflectance), ratio(&m.transmittance)),
-            _ => (None, None),
-        };
+        let measured = if normal { None } else { self.measured.as_ref() };
         for k in range {
             let (mut rf, mut t, rb) = if normal {
                 (rf0[k], t0[k], rb0[k])
             } else {
                 prepared[k].at(cos_theta)
             };
-            if let Some(c) = c_r {
-                rf = (rf0[k] * c).clamp(0.0, 1.0);
-            }
-            if let Some(c) = c_t {
-                t = (t0[k] * c).clamp(0.0, 1.0);
+            if let Some(m) = measured {
+                rf = m.reflectance_at(rf0[k], cos_theta).unwrap_or(rf);
+                t = m.transmittance_at(t0[k], cos_theta).unwrap_or(t);
             }
             let (t, rf) = check_range(t, rf);
             let (t, rb) = check_range(t, rb);

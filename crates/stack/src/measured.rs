@@ -1,9 +1,9 @@
 //! Measured angle tables of a layer: the table's R and T continued beyond its last angle by the
 //! layer's physical model ([`continue_measured`], `docs/registry.md` "Measured angle table"),
-//! and, for a layer inside a unit, the continued table fitted once to ratio curves `C(θ)` with
-//! `C(0°) = 1` that multiply the layer's normal values at every wavelength
-//! ([`MeasuredRatio`], the paper's method: a measured broadband ratio times spectral normal
-//! values).
+//! and, for a layer inside a unit, the continued table fitted once to curves `R_t(θ)`, `T_t(θ)`
+//! that carry its angle dependence to every wavelength ([`MeasuredRatio`]: T as the paper's
+//! ratio, `T(λ, θ) = T0(λ)·T_t(θ)/T_t(0)`; R as the affine map that keeps R(90°) = 1 at every
+//! wavelength, `R(λ, θ) = R0(λ) + (R_t(θ) − R_t(0))·(1 − R0(λ))/(1 − R_t(0))`).
 
 use glassdb_fit::{AngleSamples, CosPolynomial, FitOptions, Quantity};
 
@@ -76,16 +76,38 @@ pub fn continue_measured(
     out
 }
 
-/// The ratio curves of a layer's measured angle table: `C_r(θ)` for the front reflectance and
-/// `C_t(θ)` for the transmittance (either may be absent: the model then gives that quantity).
+/// A layer's measured angle table, fitted: the front reflectance and the transmittance as
+/// `normal·C(cos θ)` (either may be absent: the model then gives that quantity).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasuredRatio {
-    /// `C_r(cos θ)` of the front reflectance.
-    pub reflectance: Option<CosPolynomial>,
-    /// `C_t(cos θ)` of the transmittance.
-    pub transmittance: Option<CosPolynomial>,
+    /// R_t(0) and `C_r(cos θ)` of the front reflectance.
+    pub reflectance: Option<(f64, CosPolynomial)>,
+    /// T_t(0) and `C_t(cos θ)` of the transmittance.
+    pub transmittance: Option<(f64, CosPolynomial)>,
     /// The largest measured angle.
     pub max_angle_deg: f64,
+}
+
+impl MeasuredRatio {
+    /// The front reflectance at `cos θ` of a wavelength whose normal value is `r0`: the table's
+    /// rise from its 0° value mapped onto `[r0, 1]` (none without a reflectance table).
+    pub fn reflectance_at(&self, r0: f64, cos_theta: f64) -> Option<f64> {
+        let (rt0, c) = self.reflectance.as_ref()?;
+        let rise = rt0 * c.eval(cos_theta) - rt0;
+        let r = if *rt0 < 1.0 {
+            r0 + rise * (1.0 - r0) / (1.0 - rt0)
+        } else {
+            r0
+        };
+        Some(r.clamp(0.0, 1.0))
+    }
+
+    /// The transmittance at `cos θ` of a wavelength whose normal value is `t0`: `t0·C_t(cos θ)`
+    /// (none without a transmittance table).
+    pub fn transmittance_at(&self, t0: f64, cos_theta: f64) -> Option<f64> {
+        let (_, c) = self.transmittance.as_ref()?;
+        Some((t0 * c.eval(cos_theta)).clamp(0.0, 1.0))
+    }
 }
 
 /// How tightly the continued tables are fitted (the registry's defaults).
@@ -130,7 +152,7 @@ impl MeasuredRatio {
                     fo.tol = opts.tol;
                     fo.max_degree = opts.max_degree;
                     glassdb_fit::fit_curve(&continued, &fo)
-                        .map(|f| f.polynomial)
+                        .map(|f| (f.normal, f.polynomial))
                         .map_err(|source| StackError::Fit {
                             label: label.to_string(),
                             curve,
