@@ -1,4 +1,4 @@
-//! `glassdb`: fit, spectral, registry, compose, mirror and mask in one binary.
+//! `glassdb`: fit, spectral, stack, registry, compose, mirror and mask in one binary.
 
 use std::process::ExitCode;
 
@@ -24,6 +24,8 @@ enum Command {
     Eval(cmd::fit::EvalArgs),
     /// Spectral data to per-channel and luminous values.
     Spectral(cmd::spectral::Args),
+    /// The optics of an insulated glazing unit from its layers, per wavelength and angle.
+    Stack(cmd::stack::Args),
     /// Build, show and check the id-indexed glass table of a scene.
     Registry(cmd::registry::Args),
     /// Composite reflection and transmission passes through a mask (same as the `compose` binary).
@@ -49,6 +51,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => cmd::fit::run_fit(a),
         Command::Eval(a) => cmd::fit::run_eval(a),
         Command::Spectral(a) => cmd::spectral::run(a),
+        Command::Stack(a) => cmd::stack::run(a),
         Command::Registry(a) => cmd::registry::run(a),
         Command::Compose(a) => cmd::compose::run(*a),
         Command::Mirror(a) => cmd::scene::run_mirror(a),

@@ -31,6 +31,7 @@ pub mod registry;
 pub mod report;
 pub mod scene;
 pub mod spectral;
+pub mod stack;
 pub mod view;
 
 use std::process::ExitCode;

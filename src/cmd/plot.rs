@@ -1,4 +1,4 @@
-//! `glassdb plot fit|registry|mask|spectral`: figures for reviewing fits, registries, masks and
+//! `glassdb plot fit|registry|mask|spectral|stack`: figures for reviewing fits, registries, masks and
 //! spectra. PNG or SVG by the `-o` extension (default: a PNG named after the input, in the
 //! current directory). All drawing is in `glassdb_plot`.
 
@@ -34,6 +34,17 @@ pub enum PlotCommand {
     /// τ(λ), ρ(λ) over the visible range, the method's colour-matching functions beneath and
     /// the resulting channel values marked.
     Spectral(SpectralArgs),
+    /// A unit's photopic T, Rf, Rb against angle beside each of its layers' (the build-up as
+    /// `glassdb stack` takes it).
+    Stack(StackPlotArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct StackPlotArgs {
+    #[command(flatten)]
+    pub stack: crate::cmd::stack::StackArgs,
+    #[command(flatten)]
+    pub out: OutputArgs,
 }
 
 /// Output options shared by every figure.
@@ -146,6 +157,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         PlotCommand::Registry(a) => run_registry(a),
         PlotCommand::Mask(a) => run_mask(a),
         PlotCommand::Spectral(a) => run_spectral(a),
+        PlotCommand::Stack(a) => run_stack(a),
     }
 }
 
@@ -289,4 +301,32 @@ fn run_spectral(a: SpectralArgs) -> anyhow::Result<ExitCode> {
     };
     let fig = spectral_figure(&a.file, &opts)?;
     write(&fig, &output, &[&a.file])
+}
+
+fn run_stack(a: StackPlotArgs) -> anyhow::Result<ExitCode> {
+    let first = PathBuf::from(&a.stack.layers[0]);
+    let output = output_path(&a.out, &first, "stack");
+    let built = a.stack.build()?;
+    let labels: Vec<String> = a
+        .stack
+        .layers
+        .iter()
+        .map(|l| {
+            Path::new(l)
+                .file_name()
+                .map(|f| f.to_string_lossy().into_owned())
+                .unwrap_or_else(|| l.clone())
+        })
+        .collect();
+    let title = format!("Unit: {}", labels.join(" | "));
+    let fig = glassdb_plot::plots::stack::stack_figure(&built.stack, &labels, &title)?;
+    let files: Vec<PathBuf> = a
+        .stack
+        .layers
+        .iter()
+        .enumerate()
+        .map(|(i, l)| crate::cmd::stack::parse_layer(l, i + 1).map(|p| p.file))
+        .collect::<anyhow::Result<_>>()?;
+    let inputs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
+    write(&fig, &output, &inputs)
 }

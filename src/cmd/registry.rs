@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use glassdb_registry::{
     AngleCurve, Application, BuildOptions, ColourBasis, GlassRecord, MaskIds, Registry,
-    SCHEMA_VERSION, Side,
+    SCHEMA_VERSION, Side, UnitElement, UnitRecord,
 };
 use glassdb_spectral::{
     Illuminant, IntegrationSettings, Method, MethodKind, Observer, RgbCmf, RgbSpace,
@@ -297,6 +297,9 @@ fn print_glass(g: &GlassRecord, side: Side) {
         model.push_str(&format!("; chosen by {}", m.chosen_by));
     }
     outln!("  angle model: {model}");
+    if let Some(u) = &g.unit {
+        print_unit(u, side);
+    }
     let fit_line = |label: &str, curves: &[AngleCurve; 3]| {
         let parts: Vec<String> = curves
             .iter()
@@ -322,6 +325,91 @@ fn print_glass(g: &GlassRecord, side: Side) {
     for deg in [0.0f64, 45.0, 60.0, 75.0] {
         let (r, t) = g.eval(side, deg.to_radians().cos());
         outln!("  {:>5}°  {:>22}  {:>22}", deg, rgb(&r), rgb(&t));
+    }
+}
+
+/// A unit's build-up, its layers, its WINDOW values and its pane groups.
+fn print_unit(u: &UnitRecord, side: Side) {
+    let parts: Vec<String> = u
+        .elements
+        .iter()
+        .map(|e| match e {
+            UnitElement::Gap(g) => format!("{} mm {}", g.thickness_mm, g.gas),
+            UnitElement::Layer(l) => {
+                let name = l
+                    .provenance
+                    .spectral
+                    .as_ref()
+                    .map(|f| f.path.clone())
+                    .or_else(|| l.provenance.angles.as_ref().map(|f| f.path.clone()))
+                    .unwrap_or_else(|| "r0/t0 values".into());
+                let thickness = l
+                    .thickness_mm
+                    .map(|t| format!(", {t} mm"))
+                    .unwrap_or_default();
+                let flipped = if l.flipped { ", flipped" } else { "" };
+                format!("{name} ({}{flipped}{thickness})", l.model)
+            }
+        })
+        .collect();
+    let total = u
+        .thickness_mm
+        .map(|t| format!(", {t:.2} mm"))
+        .unwrap_or_default();
+    outln!(
+        "  unit: {}{total}; combined {}",
+        parts.join(" | "),
+        u.combined
+    );
+    for (name, v) in [("photopic", &u.photopic), ("solar", &u.solar)] {
+        if let Some(v) = v {
+            outln!(
+                "  WINDOW {name} at 0°: T {:.4}  R out {:.4}  R in {:.4}",
+                v.transmittance,
+                v.reflectance,
+                v.reflectance_back
+            );
+        }
+    }
+    let layers = u.elements.iter().filter_map(|e| match e {
+        UnitElement::Layer(l) => Some(l),
+        UnitElement::Gap(_) => None,
+    });
+    for (k, l) in layers.enumerate() {
+        let absorbed = l
+            .absorptance
+            .map(|a| {
+                format!(
+                    "; absorbs (solar) {:.4} from outdoors, {:.4} from indoors",
+                    a.front, a.back
+                )
+            })
+            .unwrap_or_default();
+        outln!(
+            "  layer {}: r0 {}  t0 {}  r0_back {}{absorbed}",
+            k + 1,
+            rgb(&l.r0),
+            rgb(&l.t0),
+            rgb(&l.r0_back)
+        );
+    }
+    for (k, grp) in u.groups.iter().enumerate() {
+        let depth = match side {
+            Side::Front => grp.depth_mm,
+            Side::Back => grp.depth_back_mm,
+        };
+        let layers: Vec<String> = grp.layers.iter().map(|i| (i + 1).to_string()).collect();
+        outln!(
+            "  pane group {} (layer {}): {}share of r at 0°, 45°, 75°: {} | {} | {}",
+            k + 1,
+            layers.join(", "),
+            depth
+                .map(|d| format!("mid-plane {d:.2} mm deep, "))
+                .unwrap_or_default(),
+            rgb(&grp.eval(side, 1.0)),
+            rgb(&grp.eval(side, 45f64.to_radians().cos())),
+            rgb(&grp.eval(side, 75f64.to_radians().cos()))
+        );
     }
 }
 

@@ -66,6 +66,20 @@ pub enum SpaceArg {
     Xyz,
 }
 
+impl SpaceArg {
+    /// The library's RGB space.
+    pub fn space(self) -> RgbSpace {
+        match self {
+            SpaceArg::Srgb => RgbSpace::Srgb,
+            SpaceArg::Rec2020 => RgbSpace::Rec2020,
+            SpaceArg::Acescg => RgbSpace::AcesCg,
+            SpaceArg::Aces2065_1 => RgbSpace::Aces2065_1,
+            SpaceArg::DisplayP3 => RgbSpace::DisplayP3,
+            SpaceArg::Xyz => RgbSpace::Xyz,
+        }
+    }
+}
+
 /// How a spectral file is read and becomes three numbers: the method, its options and the
 /// input flags (shared by `glassdb spectral` and `glassdb plot spectral`).
 #[derive(Debug, clap::Args)]
@@ -154,14 +168,7 @@ impl SpectralSettingsArgs {
                         IlluminantArg::A => Illuminant::A,
                         IlluminantArg::E => Illuminant::E,
                     },
-                    space: match self.space.unwrap_or(SpaceArg::Srgb) {
-                        SpaceArg::Srgb => RgbSpace::Srgb,
-                        SpaceArg::Rec2020 => RgbSpace::Rec2020,
-                        SpaceArg::Acescg => RgbSpace::AcesCg,
-                        SpaceArg::Aces2065_1 => RgbSpace::Aces2065_1,
-                        SpaceArg::DisplayP3 => RgbSpace::DisplayP3,
-                        SpaceArg::Xyz => RgbSpace::Xyz,
-                    },
+                    space: self.space.unwrap_or(SpaceArg::Srgb).space(),
                 }
             }
             MethodArg::Luminous => {

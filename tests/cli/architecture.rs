@@ -97,6 +97,13 @@ fn crate_edges_follow_meaning() {
             .any(|d| d == "glassdb-report" || d == "glassdb-scene"),
         "the plot library depends on the report or the scene: {plot:?}"
     );
+    let stack = workspace_dependencies("stack");
+    assert!(
+        !stack
+            .iter()
+            .any(|d| d == "glassdb-registry" || d == "glassdb-io"),
+        "the stack engine depends on the registry or on files: {stack:?}"
+    );
     let mask = workspace_dependencies("mask");
     assert!(
         !mask.iter().any(|d| d == "glassdb-registry"),

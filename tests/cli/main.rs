@@ -18,6 +18,7 @@ mod reliability;
 mod scene;
 mod spectral;
 mod spectral_formats;
+mod stack;
 mod util;
 mod validation;
 mod values;

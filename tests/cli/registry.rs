@@ -237,7 +237,7 @@ fn build_show_check_and_json_round_trip() {
     let out = dir.path().join("reg.json");
     ok(&mut build(&catalog, &out, &["--method", "luminous"]));
     let reg = read_json(&out);
-    assert_eq!(reg["schema"], 3);
+    assert_eq!(reg["schema"], 4);
     assert_eq!(reg["tables"][0]["spectral"]["method"], "luminous");
     assert_eq!(glass_ids(&reg), [1, 3, 200], "glasses are sorted by id");
     let clear = glass_by_name(&reg, "Clear 3");

@@ -7,34 +7,22 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use glassdb_spectral::{IntegrationSettings, Integrator};
+use glassdb_stack::LayerModel;
+use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
-use crate::angle_model::{ModelTables, Physical, choose_model, read_measured_table};
-use crate::catalog::{GlassSpec, NormalSource, parse_catalog, resolve};
-use crate::curves::fit_glass_curves;
-use crate::normal::{normal_values, read_spectral_source};
+use crate::angle_model::{ModelTables, read_measured_table};
+use crate::catalog::{
+    ElementSpec, GlassBuild, GlassSpec, LayerSpec, NormalSource, parse_catalog, resolve,
+};
+use crate::curves::{GlassCurves, fit_glass_curves};
+use crate::normal::{NormalValues, normal_values, read_layer};
 use crate::{
     AngleModelRecord, FileRef, GlassRecord, Provenance, Registry, RegistryError, RegistryTable,
 };
 
-/// Where the angle model is applied.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Application {
-    /// To the spectrum, wavelength by wavelength, before integration (what WINDOW does).
-    #[default]
-    PerWavelength,
-    /// To the integrated per-channel values (the cheaper approximation; for comparison).
-    PerChannel,
-}
-
-impl Application {
-    pub fn name(self) -> &'static str {
-        match self {
-            Application::PerWavelength => "per-wavelength",
-            Application::PerChannel => "per-channel",
-        }
-    }
-}
+/// Where the angle model is applied (the stack engine's choice, for every layer).
+pub use glassdb_stack::Application;
 
 /// The glass ids a scene's masks use: a build restricted to them builds only these.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -76,7 +64,7 @@ impl Default for BuildOptions {
 
 /// Reads the files a catalog names, relative to the catalog.
 pub(crate) struct CatalogFiles<'a> {
-    catalog_path: &'a Path,
+    pub(crate) catalog_path: &'a Path,
 }
 
 impl CatalogFiles<'_> {
@@ -99,6 +87,7 @@ impl CatalogFiles<'_> {
     }
 }
 
+/// The hex SHA-256 of some bytes.
 pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
     let digest = Sha256::digest(bytes);
     digest.iter().map(|b| format!("{b:02x}")).collect()
@@ -115,7 +104,7 @@ fn read_catalog(catalog_path: &Path) -> Result<Vec<u8>, RegistryError> {
 }
 
 /// Parses a catalog file.
-fn load_catalog(catalog_path: &Path) -> Result<(Vec<GlassSpec>, String), RegistryError> {
+pub(crate) fn load_catalog(catalog_path: &Path) -> Result<(Vec<GlassSpec>, String), RegistryError> {
     let bytes = read_catalog(catalog_path)?;
     let catalog_sha = sha256_hex(&bytes);
     let text = String::from_utf8(bytes).map_err(|e| RegistryError::CatalogSyntax {
@@ -132,11 +121,13 @@ pub fn catalog_inputs(catalog_path: &Path) -> Result<Vec<PathBuf>, RegistryError
     let (specs, _) = load_catalog(catalog_path)?;
     let mut files = vec![catalog_path.to_path_buf()];
     for spec in &specs {
-        if let NormalSource::Spectral { path, .. } = &spec.normal {
-            files.push(resolve(catalog_path, path));
-        }
-        if let Some((path, _)) = &spec.angles {
-            files.push(resolve(catalog_path, path));
+        for layer in spec_layers(spec) {
+            if let NormalSource::Spectral { path, .. } = &layer.normal {
+                files.push(resolve(catalog_path, path));
+            }
+            if let Some((path, _)) = &layer.angles {
+                files.push(resolve(catalog_path, path));
+            }
         }
     }
     files.sort();
@@ -147,13 +138,7 @@ pub fn catalog_inputs(catalog_path: &Path) -> Result<Vec<PathBuf>, RegistryError
 /// Builds a registry from a catalog file (paths in it are relative to the catalog; the
 /// catalog's provenance records `catalog_path` as given).
 pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Registry, RegistryError> {
-    let max = glassdb_fit::MAX_CURVE_TOLERANCE;
-    if !(opts.fit_tol > 0.0 && opts.fit_tol <= max) {
-        return Err(RegistryError::FitTolerance {
-            tol: opts.fit_tol,
-            max,
-        });
-    }
+    let integrators = integrators_of(opts)?;
     let (specs, catalog_sha) = load_catalog(catalog_path)?;
     let wanted = wanted_ids(&specs, catalog_path, opts.mask_ids.as_ref())?;
     let catalog_ref = FileRef {
@@ -161,30 +146,82 @@ pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Regist
         sha256: catalog_sha,
     };
     let files = CatalogFiles { catalog_path };
-    let mut tables = Vec::with_capacity(opts.tables.len());
-    for settings in &opts.tables {
-        let integrator =
-            Integrator::new(settings).map_err(|e| RegistryError::SpectralMethod(Box::new(e)))?;
-        let mut glasses = Vec::new();
-        for spec in &specs {
-            if let Some(w) = &wanted
-                && !w.contains(&spec.id)
-            {
-                continue;
-            }
-            let mut g = build_glass(spec, &files, &integrator, opts)?;
-            g.provenance.catalog = Some(catalog_ref.clone());
-            glasses.push(g);
-        }
-        glasses.sort_by_key(|g| g.id);
-        tables.push(RegistryTable {
+    let mut tables: Vec<RegistryTable> = opts
+        .tables
+        .iter()
+        .map(|settings| RegistryTable {
             spectral: *settings,
-            glasses,
-        });
+            glasses: Vec::new(),
+        })
+        .collect();
+    let chosen: Vec<&GlassSpec> = specs
+        .iter()
+        .filter(|spec| wanted.as_ref().is_none_or(|w| w.contains(&spec.id)))
+        .collect();
+    // Glasses build independently (in parallel); the first failure in catalog order is the
+    // one reported, whichever thread met it.
+    let built: Vec<Result<Vec<GlassRecord>, RegistryError>> = chosen
+        .par_iter()
+        .map(|spec| build_entry(spec, &files, &integrators, opts))
+        .collect();
+    for records in built {
+        for (table, mut g) in tables.iter_mut().zip(records?) {
+            g.provenance.catalog = Some(catalog_ref.clone());
+            table.glasses.push(g);
+        }
+    }
+    for table in &mut tables {
+        table.glasses.sort_by_key(|g| g.id);
     }
     let registry = Registry::from_tables_unchecked(tables);
     registry.validate_named(&format!("registry built from {}", catalog_path.display()))?;
     Ok(registry)
+}
+
+/// The layers a catalog entry names (one for a single glass).
+fn spec_layers(spec: &GlassSpec) -> Vec<&LayerSpec> {
+    match &spec.build {
+        GlassBuild::Single(l) => vec![l],
+        GlassBuild::Unit(elements) => elements
+            .iter()
+            .filter_map(|e| match e {
+                ElementSpec::Layer(l) => Some(l),
+                ElementSpec::Gap { .. } => None,
+            })
+            .collect(),
+    }
+}
+
+/// One integrator per table of the build, checking the fit tolerance first.
+pub(crate) fn integrators_of(opts: &BuildOptions) -> Result<Vec<Integrator>, RegistryError> {
+    let max = glassdb_fit::MAX_CURVE_TOLERANCE;
+    if !(opts.fit_tol > 0.0 && opts.fit_tol <= max) {
+        return Err(RegistryError::FitTolerance {
+            tol: opts.fit_tol,
+            max,
+        });
+    }
+    opts.tables
+        .iter()
+        .map(|settings| {
+            Integrator::new(settings).map_err(|e| RegistryError::SpectralMethod(Box::new(e)))
+        })
+        .collect()
+}
+
+/// One catalog entry's record in each table (one per integrator).
+pub(crate) fn build_entry(
+    spec: &GlassSpec,
+    files: &CatalogFiles<'_>,
+    integrators: &[Integrator],
+    opts: &BuildOptions,
+) -> Result<Vec<GlassRecord>, RegistryError> {
+    match &spec.build {
+        GlassBuild::Single(layer) => build_glass(spec, layer, files, integrators, opts),
+        GlassBuild::Unit(elements) => {
+            crate::unit::build_unit(spec, elements, files, integrators, opts)
+        }
+    }
 }
 
 /// The ids to build (None: all); errors for mask ids missing from the catalog and for catalog
@@ -222,45 +259,70 @@ fn wanted_ids(
     Ok(Some(mask_ids.pixel_counts.keys().copied().collect()))
 }
 
-/// One glass: its spectral file (if any), normal values, physical model and its tables, any
-/// measured table, and the fitted curves.
-fn build_glass(
+/// One glass in each table: its spectral file (if any), normal values, physical model and its
+/// tables, any measured table, and the fitted curves. A flipped layer (a unit of one layer)
+/// is built as given, then turned round.
+pub(crate) fn build_glass(
     spec: &GlassSpec,
+    layer_spec: &LayerSpec,
     files: &CatalogFiles<'_>,
-    integrator: &Integrator,
+    integrators: &[Integrator],
     opts: &BuildOptions,
-) -> Result<GlassRecord, RegistryError> {
+) -> Result<Vec<GlassRecord>, RegistryError> {
     let glass = format!("{} (\"{}\")", spec.id, spec.name);
-    let source = read_spectral_source(spec, files, &glass)?;
-    let spectra = source.as_ref().map(|s| &s.spectra);
-    let (normal, luminous) = normal_values(spec, spectra, integrator, &glass)?;
-    let (model, why) = match &source {
-        Some(s) => choose_model(
-            spec,
-            s.product_type.as_deref(),
-            &s.spectra.t,
-            &s.spectra.rf,
-            &s.spectra.rb,
-        ),
-        None => choose_model(spec, None, &normal.t0, &normal.r0, &normal.r0_back),
-    };
-    let application = if spectra.is_some() {
+    let mut read = read_layer(layer_spec, files, &glass)?;
+    read.layer.flipped = false;
+    let layer = &read.layer;
+    let mut normals = Vec::with_capacity(integrators.len());
+    let mut luminous = None;
+    for integrator in integrators {
+        let (normal, lum) = normal_values(layer, integrator, &glass)?;
+        normals.push(normal);
+        luminous = lum;
+    }
+    let application = if layer.is_spectral() {
         opts.application
     } else {
         Application::PerChannel
     };
-    let tables = ModelTables::sample(
-        model,
-        spec,
-        &normal,
-        spectra,
-        application,
-        integrator,
-        &glass,
-    )?;
-    let measured = read_measured_table(spec, files, &glass)?;
-    let curves = fit_glass_curves(&normal, &tables, measured.as_ref(), opts, &glass)?;
-    Ok(GlassRecord {
+    let tables = ModelTables::sample(layer, &normals, application, integrators, &glass)?;
+    let measured = read_measured_table(layer_spec, &spec.name, files, &glass)?;
+    let mut records = Vec::with_capacity(integrators.len());
+    for (normal, tables) in normals.iter().zip(&tables) {
+        let curves = fit_glass_curves(normal, tables, measured.as_ref(), opts, &glass)?;
+        let angle_model = angle_model_record(
+            layer.model,
+            layer.model_reason.clone(),
+            application,
+            layer_spec,
+            measured.as_ref(),
+        );
+        let provenance = Provenance {
+            catalog: None,
+            spectral: read.source.as_ref().map(|s| s.0.clone()),
+            angles: measured.as_ref().map(|m| m.file.clone()),
+            product: read.source.as_ref().map(|s| s.1.clone()),
+        };
+        let mut g = glass_record(spec, normal, curves, luminous, angle_model, provenance);
+        if layer_spec.flip {
+            g.turn_round();
+        }
+        records.push(g);
+    }
+    Ok(records)
+}
+
+/// A glass record of `spec` from its normal values, curves and the records about them (a
+/// unit's record is added by the caller).
+pub(crate) fn glass_record(
+    spec: &GlassSpec,
+    normal: &NormalValues,
+    curves: GlassCurves,
+    luminous: Option<crate::LuminousRecord>,
+    angle_model: AngleModelRecord,
+    provenance: Provenance,
+) -> GlassRecord {
+    GlassRecord {
         id: spec.id,
         name: spec.name.clone(),
         r0: normal.r0,
@@ -270,22 +332,23 @@ fn build_glass(
         c_t: curves.c_t,
         c_r_back: curves.c_r_back,
         luminous,
-        angle_model: angle_model_record(model, why, application, spec, measured.as_ref()),
-        provenance: Provenance {
-            catalog: None,
-            spectral: source.as_ref().map(|s| s.file.clone()),
-            angles: measured.as_ref().map(|m| m.file.clone()),
-            product: source.map(|s| s.product),
-        },
-    })
+        angle_model,
+        provenance,
+        unit: None,
+    }
+}
+
+/// The normal values of a layer as a unit sees it (after any flip).
+pub(crate) fn oriented(normal: NormalValues, flipped: bool) -> NormalValues {
+    if flipped { normal.flipped() } else { normal }
 }
 
 /// What the registry records about the angle model of a glass.
 fn angle_model_record(
-    model: Physical,
+    model: LayerModel,
     chosen_by: String,
     application: Application,
-    spec: &GlassSpec,
+    spec: &LayerSpec,
     measured: Option<&crate::angle_model::MeasuredTable>,
 ) -> AngleModelRecord {
     AngleModelRecord {

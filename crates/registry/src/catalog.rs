@@ -1,19 +1,23 @@
-//! The catalog (`catalog.toml`): one `[[glass]]` table per product. Keys are documented in
-//! `docs/registry.md`; unknown keys and wrong types are errors naming the key, line and column.
+//! The catalog (`catalog.toml`): one `[[glass]]` table per product, a single glass or a unit
+//! built from `layers`. Keys are documented in `docs/registry.md` and `docs/stack.md`; unknown
+//! keys and wrong types are errors naming the key, line and column, and every error about a
+//! unit's layer names that layer's line.
 
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
+use toml::Spanned;
 
 use crate::RegistryError;
+pub use glassdb_stack::{Gas, ModelChoice};
 
 /// The whole catalog file.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Catalog {
-    /// The products, in file order.
+    /// The products, in file order, with where each starts in the file.
     #[serde(default)]
-    pub glass: Vec<CatalogEntry>,
+    pub glass: Vec<Spanned<CatalogEntry>>,
 }
 
 /// One `[[glass]]` table.
@@ -52,47 +56,53 @@ pub struct CatalogEntry {
     /// Refractive index for the `opaque` model: `n`, `[n, k]`, or one `[n, k]` per channel.
     #[serde(default)]
     pub ior: Option<IorValue>,
+    /// A unit: its layers and gaps, outside first (instead of the keys above).
+    #[serde(default)]
+    pub layers: Option<Vec<Spanned<LayerEntry>>>,
 }
 
-/// The `model` key.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ModelChoice {
-    /// From the data file's product type (see `docs/registry.md`).
-    #[default]
-    Auto,
-    /// WINDOW/EnergyPlus Fresnel slab model for uncoated glass.
-    Uncoated,
-    /// WINDOW-4 coated curves, clear or bronze chosen per wavelength (T0(λ) > 0.645 → clear).
-    Coated,
-    /// WINDOW-4 clear curve everywhere.
-    CoatedClear,
-    /// WINDOW-4 bronze curve everywhere.
-    CoatedBronze,
-    /// An opaque specular surface: t0 = 0, single-surface Fresnel reflectance.
-    Opaque,
-}
-
-impl ModelChoice {
-    /// The name used in catalogs and in the registry's `angle_model.kind`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ModelChoice::Auto => "auto",
-            ModelChoice::Uncoated => "uncoated",
-            ModelChoice::Coated => "coated",
-            ModelChoice::CoatedClear => "coated-clear",
-            ModelChoice::CoatedBronze => "coated-bronze",
-            ModelChoice::Opaque => "opaque",
-        }
-    }
+/// One element of a unit's `layers`: a layer (`spectral`, `angles` or `r0`/`t0`, with `model`,
+/// `ior`, `thickness_mm`, `flip`) or a gap (`gap_mm`, `gas`).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerEntry {
+    /// Spectral data file of the layer, relative to the catalog.
+    pub spectral: Option<String>,
+    /// The spectral file is in percent.
+    pub spectral_percent: Option<bool>,
+    /// Explicit front reflectance at normal incidence, R, G, B fractions.
+    pub r0: Option<Vec<f64>>,
+    /// Explicit transmittance at normal incidence, R, G, B fractions.
+    pub t0: Option<Vec<f64>>,
+    /// Explicit back reflectance at normal incidence (defaults to `r0`).
+    pub r0_back: Option<Vec<f64>>,
+    /// Measured angle table of the layer (alone: a grey layer of the table's 0° values).
+    pub angles: Option<String>,
+    /// The angle table is in percent.
+    pub angles_percent: Option<bool>,
+    /// The layer's angle model.
+    pub model: Option<ModelChoice>,
+    /// Refractive index for an `opaque` layer.
+    pub ior: Option<IorValue>,
+    /// Thickness (mm), overriding the file's.
+    pub thickness_mm: Option<f64>,
+    /// The layer faces the other way (its coating on the other surface).
+    pub flip: Option<bool>,
+    /// A gap's thickness (mm): this element is a gap.
+    pub gap_mm: Option<f64>,
+    /// A gap's gas: air (default), argon, krypton, xenon.
+    pub gas: Option<String>,
 }
 
 /// The `ior` key: a real index, a complex `[n, k]`, or one `[n, k]` per channel (metals).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(untagged)]
 pub enum IorValue {
+    /// A real index `n` (k = 0).
     Real(f64),
+    /// One complex index `[n, k]` for every channel.
     Complex([f64; 2]),
+    /// One `[n, k]` per channel R, G, B.
     PerChannel([[f64; 2]; 3]),
 }
 
@@ -110,25 +120,101 @@ impl IorValue {
 /// A validated catalog entry, ready to build.
 #[derive(Debug, Clone)]
 pub struct GlassSpec {
+    /// Registration id.
     pub id: u16,
+    /// Product name.
     pub name: String,
+    /// The 1-based line of its `[[glass]]` table in the catalog.
+    pub line: usize,
+    /// A single glass or a unit.
+    pub build: GlassBuild,
+}
+
+/// What a catalog entry is.
+#[derive(Debug, Clone)]
+pub enum GlassBuild {
+    /// One glass (the entry's own keys).
+    Single(LayerSpec),
+    /// A unit: layers and gaps, outside first.
+    Unit(Vec<ElementSpec>),
+}
+
+/// One layer: a single glass, or a layer of a unit.
+#[derive(Debug, Clone)]
+pub struct LayerSpec {
+    /// Where its normal-incidence values come from.
     pub normal: NormalSource,
+    /// A measured angle table (path relative to the catalog) and whether it is in percent.
     pub angles: Option<(String, bool)>,
+    /// The angle model.
     pub model: ModelChoice,
+    /// `(n, k)` per channel for the opaque model.
     pub ior: Option<[(f64, f64); 3]>,
+    /// Faces the other way (only in a unit).
+    pub flip: bool,
+    /// Thickness override (mm; only in a unit).
+    pub thickness_mm: Option<f64>,
+    /// The 1-based catalog line of the layer (of the entry for a single glass).
+    pub line: usize,
+}
+
+/// One element of a unit.
+#[derive(Debug, Clone)]
+pub enum ElementSpec {
+    /// A layer.
+    Layer(LayerSpec),
+    /// A gap: thickness (mm), gas and its catalog line.
+    Gap {
+        /// Thickness (mm).
+        thickness_mm: f64,
+        /// The fill.
+        gas: Gas,
+        /// The 1-based catalog line.
+        line: usize,
+    },
+}
+
+impl ElementSpec {
+    /// The element's catalog line.
+    pub fn line(&self) -> usize {
+        match self {
+            ElementSpec::Layer(l) => l.line,
+            ElementSpec::Gap { line, .. } => *line,
+        }
+    }
 }
 
 /// Where the normal-incidence values come from.
 #[derive(Debug, Clone)]
 pub enum NormalSource {
     /// A spectral file (path relative to the catalog) and whether it is in percent.
-    Spectral { path: String, percent: bool },
+    Spectral {
+        /// The file, relative to the catalog.
+        path: String,
+        /// Its values are in percent.
+        percent: bool,
+    },
     /// Explicit per-channel values.
     Explicit {
+        /// Front reflectance per channel.
         r0: [f64; 3],
+        /// Transmittance per channel.
         t0: [f64; 3],
+        /// Back reflectance per channel.
         r0_back: [f64; 3],
     },
+    /// The 0° values of the layer's measured angle table, the same at every wavelength (a grey
+    /// layer; only in a unit).
+    AngleTable,
+}
+
+/// The 1-based line of byte `offset` in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
 }
 
 /// Parses catalog text; `path` names it in errors.
@@ -146,7 +232,8 @@ pub fn parse_catalog(text: &str, path: &Path) -> Result<Vec<GlassSpec>, Registry
     }
     let mut specs: Vec<GlassSpec> = Vec::with_capacity(catalog.glass.len());
     for entry in catalog.glass {
-        let spec = validate_entry(entry, path)?;
+        let line = line_of(text, entry.span().start);
+        let spec = validate_entry(entry.into_inner(), line, text, path)?;
         if let Some(first) = specs.iter().find(|s| s.id == spec.id) {
             return Err(RegistryError::DuplicateId {
                 source_name: path.display().to_string(),
@@ -160,12 +247,12 @@ pub fn parse_catalog(text: &str, path: &Path) -> Result<Vec<GlassSpec>, Registry
     Ok(specs)
 }
 
-fn rgb(values: &[f64], key: &str, path: &Path, glass: &str) -> Result<[f64; 3], RegistryError> {
-    let err = |message: String| RegistryError::CatalogEntry {
-        path: path.to_path_buf(),
-        glass: glass.to_string(),
-        message,
-    };
+/// Three fractions `[R, G, B]` in [0, 1]; `err` builds the error from a message.
+fn rgb(
+    values: &[f64],
+    key: &str,
+    err: &dyn Fn(String) -> RegistryError,
+) -> Result<[f64; 3], RegistryError> {
     let arr: [f64; 3] = values.try_into().map_err(|_| {
         err(format!(
             "`{key}` must be an array of three fractions [R, G, B], got {} values",
@@ -188,51 +275,50 @@ fn rgb(values: &[f64], key: &str, path: &Path, glass: &str) -> Result<[f64; 3], 
     Ok(arr)
 }
 
-fn validate_entry(e: CatalogEntry, path: &Path) -> Result<GlassSpec, RegistryError> {
-    let label = format!("\"{}\" (id {})", e.name, e.id);
-    let err = |message: String| RegistryError::CatalogEntry {
-        path: path.to_path_buf(),
-        glass: label.clone(),
-        message,
-    };
-    if e.id == 0 {
-        return Err(RegistryError::IdZero {
-            source_name: path.display().to_string(),
-            name: e.name,
-        });
-    }
-    let id = u16::try_from(e.id).map_err(|_| {
-        err(format!(
-            "id {} is outside 1–65535 (1–255 for 8-bit masks)",
-            e.id
-        ))
-    })?;
-    if e.name.trim().is_empty() {
-        return Err(err("`name` is empty".into()));
-    }
-    let ior = match &e.ior {
+/// The keys that describe one layer, from a `[[glass]]` table or an element of its `layers`.
+struct LayerKeys<'a> {
+    spectral: &'a Option<String>,
+    spectral_percent: bool,
+    r0: &'a Option<Vec<f64>>,
+    t0: &'a Option<Vec<f64>>,
+    r0_back: &'a Option<Vec<f64>>,
+    angles: &'a Option<String>,
+    angles_percent: bool,
+    model: ModelChoice,
+    ior: &'a Option<IorValue>,
+    /// A layer of a unit (which may be given by its angle table alone).
+    in_unit: bool,
+}
+
+/// Validates the keys of one layer (`err` names the glass, and the layer's line in a unit).
+fn validate_layer(
+    k: LayerKeys<'_>,
+    line: usize,
+    err: &dyn Fn(String) -> RegistryError,
+) -> Result<LayerSpec, RegistryError> {
+    let ior = match k.ior {
         None => None,
         Some(v) => {
             let per = v.per_channel();
-            for (n, k) in per {
-                if !n.is_finite() || !k.is_finite() || n <= 0.0 || k < 0.0 {
+            for (n, kk) in per {
+                if !n.is_finite() || !kk.is_finite() || n <= 0.0 || kk < 0.0 {
                     return Err(err(format!(
-                        "`ior` needs n > 0 and k ≥ 0 (finite), got n = {n}, k = {k}"
+                        "`ior` needs n > 0 and k ≥ 0 (finite), got n = {n}, k = {kk}"
                     )));
                 }
             }
             Some(per)
         }
     };
-    if ior.is_some() && !matches!(e.model, ModelChoice::Opaque | ModelChoice::Auto) {
+    if ior.is_some() && !matches!(k.model, ModelChoice::Opaque | ModelChoice::Auto) {
         return Err(err(format!(
             "`ior` applies to the `opaque` model only, but model is `{}`",
-            e.model.name()
+            k.model.name()
         )));
     }
-    let explicit = e.r0.is_some() || e.t0.is_some() || e.r0_back.is_some();
-    let opaque = e.model == ModelChoice::Opaque || (e.model == ModelChoice::Auto && ior.is_some());
-    let normal = match (&e.spectral, explicit) {
+    let explicit = k.r0.is_some() || k.t0.is_some() || k.r0_back.is_some();
+    let opaque = k.model == ModelChoice::Opaque || (k.model == ModelChoice::Auto && ior.is_some());
+    let normal = match (k.spectral, explicit) {
         (Some(_), true) => {
             return Err(err(
                 "give either `spectral` or explicit `r0`/`t0`, not both".into(),
@@ -244,27 +330,35 @@ fn validate_entry(e: CatalogEntry, path: &Path) -> Result<GlassSpec, RegistryErr
             }
             NormalSource::Spectral {
                 path: p.clone(),
-                percent: e.spectral_percent,
+                percent: k.spectral_percent,
             }
         }
-        (None, _) => {
-            if e.spectral_percent {
+        (None, false) if k.in_unit && k.angles.is_some() && !opaque => {
+            if k.spectral_percent {
                 return Err(err("`spectral_percent` without `spectral`".into()));
             }
-            let t0 = match &e.t0 {
-                Some(v) => rgb(v, "t0", path, &label)?,
+            NormalSource::AngleTable
+        }
+        (None, _) => {
+            if k.spectral_percent {
+                return Err(err("`spectral_percent` without `spectral`".into()));
+            }
+            let t0 = match k.t0 {
+                Some(v) => rgb(v, "t0", err)?,
                 None if opaque => [0.0; 3],
                 None => {
-                    return Err(err(
-                        "no normal-incidence data: give `spectral` (a file) or `r0` and `t0`"
-                            .into(),
-                    ));
+                    let give = if k.in_unit {
+                        "give `spectral` (a file), `angles` (a measured table) or `r0` and `t0`"
+                    } else {
+                        "give `spectral` (a file) or `r0` and `t0`"
+                    };
+                    return Err(err(format!("no normal-incidence data: {give}")));
                 }
             };
-            let r0 = match (&e.r0, &ior) {
-                (Some(v), _) => rgb(v, "r0", path, &label)?,
+            let r0 = match (k.r0, &ior) {
+                (Some(v), _) => rgb(v, "r0", err)?,
                 (None, Some(per)) if opaque => {
-                    per.map(|(n, k)| crate::physics::fresnel_single_surface(n, k, 1.0))
+                    per.map(|(n, kk)| glassdb_stack::physics::fresnel_single_surface(n, kk, 1.0))
                 }
                 (None, _) => {
                     return Err(err(
@@ -272,8 +366,8 @@ fn validate_entry(e: CatalogEntry, path: &Path) -> Result<GlassSpec, RegistryErr
                     ));
                 }
             };
-            let r0_back = match &e.r0_back {
-                Some(v) => rgb(v, "r0_back", path, &label)?,
+            let r0_back = match k.r0_back {
+                Some(v) => rgb(v, "r0_back", err)?,
                 None => r0,
             };
             for c in 0..3 {
@@ -296,24 +390,191 @@ fn validate_entry(e: CatalogEntry, path: &Path) -> Result<GlassSpec, RegistryErr
             NormalSource::Explicit { r0, t0, r0_back }
         }
     };
-    let angles = match &e.angles {
+    let angles = match k.angles {
         Some(p) if p.trim().is_empty() => return Err(err("`angles` is an empty path".into())),
-        Some(p) => Some((p.clone(), e.angles_percent)),
+        Some(p) => Some((p.clone(), k.angles_percent)),
         None => {
-            if e.angles_percent {
+            if k.angles_percent {
                 return Err(err("`angles_percent` without `angles`".into()));
             }
             None
         }
     };
+    Ok(LayerSpec {
+        normal,
+        angles,
+        model: k.model,
+        ior,
+        flip: false,
+        thickness_mm: None,
+        line,
+    })
+}
+
+fn validate_entry(
+    e: CatalogEntry,
+    line: usize,
+    text: &str,
+    path: &Path,
+) -> Result<GlassSpec, RegistryError> {
+    let label = format!("\"{}\" (id {})", e.name, e.id);
+    let err = |message: String| RegistryError::CatalogEntry {
+        path: path.to_path_buf(),
+        glass: label.clone(),
+        message,
+    };
+    if e.id == 0 {
+        return Err(RegistryError::IdZero {
+            source_name: path.display().to_string(),
+            name: e.name,
+        });
+    }
+    let id = u16::try_from(e.id).map_err(|_| {
+        err(format!(
+            "id {} is outside 1–65535 (1–255 for 8-bit masks)",
+            e.id
+        ))
+    })?;
+    if e.name.trim().is_empty() {
+        return Err(err("`name` is empty".into()));
+    }
+    let build = match &e.layers {
+        Some(layers) => {
+            let single_keys = [
+                ("spectral", e.spectral.is_some()),
+                ("spectral_percent", e.spectral_percent),
+                ("r0", e.r0.is_some()),
+                ("t0", e.t0.is_some()),
+                ("r0_back", e.r0_back.is_some()),
+                ("angles", e.angles.is_some()),
+                ("angles_percent", e.angles_percent),
+                ("model", e.model != ModelChoice::Auto),
+                ("ior", e.ior.is_some()),
+            ];
+            if let Some((key, _)) = single_keys.iter().find(|(_, given)| *given) {
+                return Err(err(format!(
+                    "`{key}` and `layers` together: a unit's keys go in its layers"
+                )));
+            }
+            GlassBuild::Unit(
+                layers
+                    .iter()
+                    .enumerate()
+                    .map(|(i, l)| {
+                        let line = line_of(text, l.span().start);
+                        validate_element(l.get_ref(), i + 1, line, path, &label)
+                    })
+                    .collect::<Result<_, _>>()?,
+            )
+        }
+        None => GlassBuild::Single(validate_layer(
+            LayerKeys {
+                spectral: &e.spectral,
+                spectral_percent: e.spectral_percent,
+                r0: &e.r0,
+                t0: &e.t0,
+                r0_back: &e.r0_back,
+                angles: &e.angles,
+                angles_percent: e.angles_percent,
+                model: e.model,
+                ior: &e.ior,
+                in_unit: false,
+            },
+            line,
+            &err,
+        )?),
+    };
     Ok(GlassSpec {
         id,
         name: e.name,
-        normal,
-        angles,
-        model: e.model,
-        ior,
+        line,
+        build,
     })
+}
+
+/// Validates one element of a unit's `layers` (at 1-based `position`, on catalog `line`).
+fn validate_element(
+    l: &LayerEntry,
+    position: usize,
+    line: usize,
+    path: &Path,
+    glass: &str,
+) -> Result<ElementSpec, RegistryError> {
+    let err = |message: String| RegistryError::CatalogLayer {
+        path: path.to_path_buf(),
+        line,
+        glass: glass.to_string(),
+        position,
+        message,
+    };
+    let layer_keys = [
+        ("spectral", l.spectral.is_some()),
+        ("spectral_percent", l.spectral_percent.is_some()),
+        ("r0", l.r0.is_some()),
+        ("t0", l.t0.is_some()),
+        ("r0_back", l.r0_back.is_some()),
+        ("angles", l.angles.is_some()),
+        ("angles_percent", l.angles_percent.is_some()),
+        ("model", l.model.is_some()),
+        ("ior", l.ior.is_some()),
+        ("thickness_mm", l.thickness_mm.is_some()),
+        ("flip", l.flip.is_some()),
+    ];
+    let positive = |key: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(err(format!(
+                "`{key}` = {v} is not a positive number of millimetres"
+            )))
+        }
+    };
+    if let Some(gap_mm) = l.gap_mm {
+        if let Some((key, _)) = layer_keys.iter().find(|(_, given)| *given) {
+            let what = if *key == "flip" {
+                "a flip on a gap: only a layer can face the other way".to_string()
+            } else {
+                format!("`{key}` on a gap (`gap_mm`): a gap has `gap_mm` and `gas` only")
+            };
+            return Err(err(what));
+        }
+        let gas = match &l.gas {
+            None => Gas::Air,
+            Some(g) => g.parse::<Gas>().map_err(err)?,
+        };
+        return Ok(ElementSpec::Gap {
+            thickness_mm: positive("gap_mm", gap_mm)?,
+            gas,
+            line,
+        });
+    }
+    if l.gas.is_some() {
+        return Err(err(
+            "`gas` without `gap_mm`: a gap needs its thickness".into()
+        ));
+    }
+    let mut spec = validate_layer(
+        LayerKeys {
+            spectral: &l.spectral,
+            spectral_percent: l.spectral_percent.unwrap_or(false),
+            r0: &l.r0,
+            t0: &l.t0,
+            r0_back: &l.r0_back,
+            angles: &l.angles,
+            angles_percent: l.angles_percent.unwrap_or(false),
+            model: l.model.unwrap_or_default(),
+            ior: &l.ior,
+            in_unit: true,
+        },
+        line,
+        &err,
+    )?;
+    spec.flip = l.flip.unwrap_or(false);
+    spec.thickness_mm = l
+        .thickness_mm
+        .map(|v| positive("thickness_mm", v))
+        .transpose()?;
+    Ok(ElementSpec::Layer(spec))
 }
 
 /// Resolves a catalog-relative path.
@@ -337,8 +598,11 @@ mod tests {
                 .unwrap();
         assert_eq!(specs.len(), 1);
         assert_eq!(specs[0].id, 3);
-        match &specs[0].normal {
-            NormalSource::Explicit { r0_back, .. } => assert_eq!(*r0_back, [0.1; 3]),
+        match &specs[0].build {
+            GlassBuild::Single(LayerSpec {
+                normal: NormalSource::Explicit { r0_back, .. },
+                ..
+            }) => assert_eq!(*r0_back, [0.1; 3]),
             other => panic!("{other:?}"),
         }
     }
@@ -407,8 +671,11 @@ mod tests {
     fn opaque_from_ior_gets_fresnel_r0() {
         let specs = parse("[[glass]]\nid = 9\nname = \"water\"\nmodel = \"opaque\"\nior = 1.333\n")
             .unwrap();
-        match &specs[0].normal {
-            NormalSource::Explicit { r0, t0, .. } => {
+        match &specs[0].build {
+            GlassBuild::Single(LayerSpec {
+                normal: NormalSource::Explicit { r0, t0, .. },
+                ..
+            }) => {
                 let expect = ((1.333f64 - 1.0) / 2.333).powi(2);
                 assert!((r0[0] - expect).abs() < 1e-12);
                 assert_eq!(*t0, [0.0; 3]);

@@ -3,7 +3,9 @@
 
 use glassdb_fit::{AngleSamples, FitOptions, Quantity};
 
-use crate::angle_model::{MeasuredTable, ModelTables, continue_measured};
+use glassdb_stack::measured::continue_measured;
+
+use crate::angle_model::{MeasuredTable, ModelTables};
 use crate::normal::NormalValues;
 use crate::{AngleCurve, BuildOptions, CHANNELS, RegistryError};
 
@@ -46,6 +48,33 @@ fn fit_curve(
     })
 }
 
+/// Fits the three channel curves of one reflectance share (a pane group's, one side): the
+/// nominal curve where its normal value is zero.
+pub(crate) fn fit_share_curves(
+    r0: [f64; 3],
+    tables: &ModelTables,
+    table: &[[f64; 3]],
+    quantity: Quantity,
+    opts: &BuildOptions,
+    glass: &str,
+    name: &str,
+) -> Result<[AngleCurve; 3], RegistryError> {
+    let curve = |ch: usize| {
+        if r0[ch] <= ZERO_NORMAL {
+            Ok(AngleCurve::nominal_transmittance())
+        } else {
+            fit_curve(
+                &tables.samples(table, ch),
+                quantity,
+                opts,
+                glass,
+                format!("{name} channel {}", CHANNELS[ch]),
+            )
+        }
+    };
+    Ok([curve(0)?, curve(1)?, curve(2)?])
+}
+
 /// Fits every curve of a glass. A measured table's R and T curves (the ratio C(θ) of the table,
 /// continued by the model's channel G beyond its last angle) are shared by the three channels;
 /// otherwise each channel fits its model table. Zero normal values get the nominal curve.
@@ -62,9 +91,11 @@ pub(crate) fn fit_glass_curves(
     // A measured curve continued by the model `table` beyond its last angle.
     let shared = |measured: Option<&AngleSamples>, table: &[[f64; 3]], quantity, curve: &str| {
         let reflect = quantity == Quantity::Reflectance;
+        // the model's channel G continues the table
+        let model: Vec<f64> = table.iter().map(|v| v[1]).collect();
         measured
             .map(|m| {
-                let continued = continue_measured(m, &tables.angles, table, reflect);
+                let continued = continue_measured(m, &tables.angles, &model, reflect);
                 fit(&continued, quantity, curve.into())
             })
             .transpose()

@@ -22,7 +22,7 @@ pub enum RegistryError {
 
     /// The registry was written by a different, incompatible schema version.
     #[error(
-        "{source_name}: registry schema {found} is not supported (this build reads schemas 2 and {expected}); rebuild it from its catalog"
+        "{source_name}: registry schema {found} is not supported (this build reads schemas 2 to {expected}); rebuild it from its catalog"
     )]
     SchemaVersion {
         source_name: String,
@@ -31,7 +31,7 @@ pub enum RegistryError {
     },
 
     /// A registry with no table.
-    #[error("{source_name}: the registry has no table (schema 3 needs at least one in `tables`)")]
+    #[error("{source_name}: the registry has no table (`tables` needs at least one)")]
     NoTables { source_name: String },
 
     /// The registry holds no table in the colour basis asked for.
@@ -169,6 +169,47 @@ pub enum RegistryError {
         path: PathBuf,
         glass: String,
         message: String,
+    },
+
+    /// An element of a unit's `layers` says something impossible or incomplete.
+    #[error("{path}:{line}: glass {glass}: element {position} of `layers`: {message}")]
+    CatalogLayer {
+        /// The catalog.
+        path: PathBuf,
+        /// The element's 1-based line.
+        line: usize,
+        /// The glass (name and id).
+        glass: String,
+        /// The element's 1-based position in `layers`.
+        position: usize,
+        /// What is wrong.
+        message: String,
+    },
+
+    /// A unit's build-up is impossible (two gaps in a row, a gap at an end, an opaque layer
+    /// before another, spectra that do not overlap, …) or its layers cannot be combined; the
+    /// line is the element's at fault, or the glass's.
+    #[error("{path}:{line}: glass {glass}")]
+    Unit {
+        /// The catalog.
+        path: PathBuf,
+        /// The 1-based line.
+        line: usize,
+        /// The glass (id and name).
+        glass: String,
+        /// The stack engine's error.
+        source: Box<glassdb_stack::StackError>,
+    },
+
+    /// A unit chosen from a catalog's glasses ([`crate::UnitBuilder`]) cannot be built.
+    #[error("unit {glass} chosen from {path}")]
+    UnitChoice {
+        /// The catalog.
+        path: PathBuf,
+        /// The unit (id and name).
+        glass: String,
+        /// The stack engine's error.
+        source: Box<glassdb_stack::StackError>,
     },
 
     /// A file named by the catalog (spectral data or angle table) could not be read.

@@ -8,6 +8,9 @@
 //! - [`GlassRecord::eval`]: what the compositor tabulates.
 //! - [`build_registry`]: catalog → registry; [`default_registry`]: the bundled, prebuilt
 //!   `data/registry.json`.
+//! - Units: a catalog entry with `layers` is built by the stack engine (`glassdb-stack`) into
+//!   system curves plus a [`UnitRecord`] (build-up, per-layer values, pane groups' depths and
+//!   reflectance shares); [`UnitBuilder`] builds one from a catalog's glasses on demand.
 
 mod angle_model;
 mod build;
@@ -16,9 +19,14 @@ pub mod catalog;
 mod curves;
 mod error;
 mod normal;
-pub mod physics;
 mod record;
+mod unit;
+mod unit_record;
 mod validate;
+
+/// The single-layer angle models (they live in the stack engine, which both the registry's
+/// glasses and its units use).
+pub use glassdb_stack::physics;
 
 pub use build::{Application, BuildOptions, MaskIds, build_registry, catalog_inputs};
 pub use bundled::{DEFAULT_REGISTRY_JSON, DEFAULT_REGISTRY_NAME, default_registry};
@@ -27,6 +35,10 @@ pub use error::RegistryError;
 pub use glassdb_fit::MAX_CURVE_TOLERANCE;
 pub use record::{
     AngleCurve, AngleModelRecord, CHANNELS, ColourBasis, FileRef, GlassRecord, LuminousRecord,
-    ProductRecord, Provenance, Registry, RegistryTable, SCHEMA_VERSION, SCHEMA_VERSION_ONE_TABLE,
-    Side, UnknownSide,
+    ProductRecord, Provenance, Registry, RegistryTable, SCHEMA_VERSION,
+    SCHEMA_VERSION_BEFORE_UNITS, SCHEMA_VERSION_ONE_TABLE, Side, UnknownSide,
+};
+pub use unit::{ChosenElement, UnitBuilder, UnitChoice};
+pub use unit_record::{
+    Absorptance, GapRecord, PaneGroupRecord, SystemValues, UnitElement, UnitLayerRecord, UnitRecord,
 };

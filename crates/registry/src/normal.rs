@@ -1,32 +1,13 @@
-//! Normal-incidence values of a glass: its spectra read from the catalog's spectral file and
-//! integrated per channel (and to ISO 9050 luminous values), or the catalog's explicit values.
+//! A layer from the catalog: its spectral file read into a stack-engine [`Layer`] (or its
+//! explicit values), and its normal-incidence values integrated per channel (and to ISO 9050
+//! luminous values).
 
-use std::path::{Path, PathBuf};
-
-use glassdb_spectral::{Integrator, SpectralData};
+use glassdb_spectral::Integrator;
+use glassdb_stack::{Layer, LayerData, LayerOptions, StackError};
 
 use crate::build::{CatalogFiles, sha256_hex};
-use crate::catalog::{GlassSpec, ModelChoice, NormalSource};
+use crate::catalog::{LayerSpec, NormalSource};
 use crate::{FileRef, LuminousRecord, ProductRecord, RegistryError};
-
-/// Spectra of one glass at normal incidence on the file's own wavelengths.
-pub(crate) struct Spectra {
-    /// The spectral file, for messages.
-    pub path: PathBuf,
-    pub wavelength_nm: Vec<f64>,
-    pub t: Vec<f64>,
-    pub rf: Vec<f64>,
-    pub rb: Vec<f64>,
-}
-
-/// A glass's spectral file, read: the spectra, the product type the file states, and the
-/// provenance records of the file and the product.
-pub(crate) struct SpectralSource {
-    pub spectra: Spectra,
-    pub product_type: Option<String>,
-    pub file: FileRef,
-    pub product: ProductRecord,
-}
 
 /// Per-channel normal-incidence values.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,34 +17,56 @@ pub(crate) struct NormalValues {
     pub r0_back: [f64; 3],
 }
 
-/// Integrates one spectrum of a glass to three channels; `what` names it in errors.
-pub(crate) fn integrate(
-    integrator: &Integrator,
-    spectra: &Spectra,
-    values: &[f64],
-    glass: &str,
-    what: String,
-) -> Result<[f64; 3], RegistryError> {
-    integrator
-        .channels(&spectra.wavelength_nm, values)
-        .map_err(|source| RegistryError::Integration {
-            glass: glass.to_string(),
-            what,
-            source: Box::new(source),
-        })
+impl NormalValues {
+    /// The values of the layer turned round (front and back reflectance swapped).
+    pub(crate) fn flipped(self) -> NormalValues {
+        NormalValues {
+            r0: self.r0_back,
+            t0: self.t0,
+            r0_back: self.r0,
+        }
+    }
 }
 
-/// Reads the spectral file of a glass (none for explicit values).
-pub(crate) fn read_spectral_source(
-    spec: &GlassSpec,
+/// A layer read from the catalog, with the provenance of its spectral file.
+pub(crate) struct CatalogLayer {
+    pub layer: Layer,
+    /// The spectral file and the product it describes (none for explicit values).
+    pub source: Option<(FileRef, ProductRecord)>,
+}
+
+/// The layer options of a catalog layer.
+pub(crate) fn layer_options(spec: &LayerSpec) -> LayerOptions {
+    LayerOptions {
+        model: spec.model,
+        ior: spec.ior,
+        flipped: spec.flip,
+        thickness_mm: spec.thickness_mm,
+    }
+}
+
+/// Reads a catalog layer with spectral data or explicit values (a layer given by its angle
+/// table alone is read with the table, by the unit builder).
+pub(crate) fn read_layer(
+    spec: &LayerSpec,
     files: &CatalogFiles<'_>,
     glass: &str,
-) -> Result<Option<SpectralSource>, RegistryError> {
-    let NormalSource::Spectral { path, percent } = &spec.normal else {
-        return Ok(None);
+) -> Result<CatalogLayer, RegistryError> {
+    let opts = layer_options(spec);
+    let (path, percent) = match &spec.normal {
+        NormalSource::Spectral { path, percent } => (path, *percent),
+        NormalSource::Explicit { r0, t0, r0_back } => {
+            return Ok(CatalogLayer {
+                layer: Layer::from_channels("r0/t0 values", *t0, *r0, *r0_back, &opts),
+                source: None,
+            });
+        }
+        NormalSource::AngleTable => {
+            unreachable!("layers given by an angle table are read by the unit builder")
+        }
     };
     let (full, bytes) = files.read(path, glass, glassdb_io::limits::SPECTRAL)?;
-    let read_opts = glassdb_spectral::ReadOptions { percent: *percent };
+    let read_opts = glassdb_spectral::ReadOptions { percent };
     let data =
         glassdb_spectral::read_spectral_bytes(&bytes, &full.display().to_string(), &read_opts)
             .map_err(|source| RegistryError::Spectral {
@@ -71,54 +74,71 @@ pub(crate) fn read_spectral_source(
                 path: full.clone(),
                 source: Box::new(source),
             })?;
-    let product_type = data.product.product_type.clone();
     let product = ProductRecord {
         name: data.product.name.clone(),
         manufacturer: data.product.manufacturer.clone(),
         product_type: data.product.product_type.clone(),
         coated_side: data.product.coated_side.clone(),
         thickness_mm: data.product.thickness_mm,
+        composition: data.product.composition.clone(),
     };
-    Ok(Some(SpectralSource {
-        spectra: spectra_of(data, spec, glass, &full)?,
-        product_type,
-        file: FileRef {
-            path: path.clone(),
-            sha256: sha256_hex(&bytes),
+    let layer = Layer::from_spectral_data(data, &opts, &full.display().to_string()).map_err(
+        |e| match e {
+            StackError::LayerSpectrum { source, .. } => RegistryError::Spectral {
+                glass: glass.to_string(),
+                path: full.clone(),
+                source,
+            },
+            StackError::Layer { message, .. } => RegistryError::SpectralContent {
+                glass: glass.to_string(),
+                path: full.clone(),
+                detail: message,
+            },
+            other => RegistryError::SpectralContent {
+                glass: glass.to_string(),
+                path: full.clone(),
+                detail: other.to_string(),
+            },
         },
-        product,
-    }))
+    )?;
+    Ok(CatalogLayer {
+        layer,
+        source: Some((
+            FileRef {
+                path: path.clone(),
+                sha256: sha256_hex(&bytes),
+            },
+            product,
+        )),
+    })
 }
 
-/// The normal-incidence values: the catalog's explicit ones, or the spectra integrated per
-/// channel (clamped to [0, 1]; t + r ≤ 1 per channel and side,
+/// The normal-incidence values of a layer as given (before any flip): its explicit values, or
+/// its spectra integrated per channel (clamped to [0, 1]; t + r ≤ 1 per channel and side,
 /// [`glassdb_spectral::check_channel_balance`]) with their luminous values.
 pub(crate) fn normal_values(
-    spec: &GlassSpec,
-    spectra: Option<&Spectra>,
+    layer: &Layer,
     integrator: &Integrator,
     glass: &str,
 ) -> Result<(NormalValues, Option<LuminousRecord>), RegistryError> {
-    let s = match (&spec.normal, spectra) {
-        (NormalSource::Explicit { r0, t0, r0_back }, _) => {
+    let (wavelength_nm, t, rf, rb) = match &layer.data {
+        LayerData::Channels { t, rf, rb } => {
             let values = NormalValues {
-                r0: *r0,
-                t0: *t0,
-                r0_back: *r0_back,
+                r0: *rf,
+                t0: *t,
+                r0_back: *rb,
             };
             return Ok((values, None));
         }
-        (NormalSource::Spectral { .. }, Some(s)) => s,
-        (NormalSource::Spectral { path, .. }, None) => {
-            return Err(RegistryError::SpectralContent {
-                glass: glass.to_string(),
-                path: PathBuf::from(path),
-                detail: "the spectral file was not read".into(),
-            });
-        }
+        LayerData::Spectral {
+            wavelength_nm,
+            t,
+            rf,
+            rb,
+        } => (wavelength_nm, t, rf, rb),
     };
     let lum = |v: &[f64], what: &str| {
-        glassdb_spectral::luminous_iso9050(&s.wavelength_nm, v).map_err(|source| {
+        glassdb_spectral::luminous_iso9050(wavelength_nm, v).map_err(|source| {
             RegistryError::Integration {
                 glass: glass.to_string(),
                 what: format!("luminous {what}"),
@@ -127,82 +147,34 @@ pub(crate) fn normal_values(
         })
     };
     let luminous = LuminousRecord {
-        transmittance: lum(&s.t, "transmittance")?,
-        reflectance: lum(&s.rf, "reflectance")?,
-        reflectance_back: lum(&s.rb, "back reflectance")?,
+        transmittance: lum(t, "transmittance")?,
+        reflectance: lum(rf, "reflectance")?,
+        reflectance_back: lum(rb, "back reflectance")?,
     };
     let channels = |v: &[f64], what: &str| {
-        integrate(integrator, s, v, glass, what.to_string()).map(|c| c.map(|x| x.clamp(0.0, 1.0)))
+        integrator
+            .channels(wavelength_nm, v)
+            .map(|c| c.map(|x| x.clamp(0.0, 1.0)))
+            .map_err(|source| RegistryError::Integration {
+                glass: glass.to_string(),
+                what: what.to_string(),
+                source: Box::new(source),
+            })
     };
     let values = NormalValues {
-        r0: channels(&s.rf, "front reflectance")?,
-        t0: channels(&s.t, "transmittance")?,
-        r0_back: channels(&s.rb, "back reflectance")?,
+        r0: channels(rf, "front reflectance")?,
+        t0: channels(t, "transmittance")?,
+        r0_back: channels(rb, "back reflectance")?,
     };
     // the check `glassdb spectral` applies to the same integrated values
     for (r, side) in [(values.r0, "front"), (values.r0_back, "back")] {
-        glassdb_spectral::check_channel_balance(values.t0, r, side, &s.wavelength_nm).map_err(
+        glassdb_spectral::check_channel_balance(values.t0, r, side, wavelength_nm).map_err(
             |source| RegistryError::Spectral {
                 glass: glass.to_string(),
-                path: s.path.clone(),
+                path: layer.label.clone().into(),
                 source: Box::new(source),
             },
         )?;
     }
     Ok((values, Some(luminous)))
-}
-
-/// The spectra of a parsed file, checked against the glass: T (zero for opaque glass), Rf, Rb
-/// (Rf when absent), equal lengths, and T + R ≤ 1 at every wavelength
-/// ([`glassdb_spectral::check_spectrum_balance`], as `glassdb spectral` checks it).
-fn spectra_of(
-    data: SpectralData,
-    spec: &GlassSpec,
-    glass: &str,
-    path: &Path,
-) -> Result<Spectra, RegistryError> {
-    let err = |detail: String| RegistryError::SpectralContent {
-        glass: glass.to_string(),
-        path: path.to_path_buf(),
-        detail,
-    };
-    let n = data.wavelength_nm.len();
-    let opaque = spec.model == ModelChoice::Opaque || spec.ior.is_some();
-    let t = match data.transmittance {
-        Some(t) if opaque => {
-            if t.iter().any(|&v| v > 0.0) {
-                return Err(err(
-                    "model `opaque` means T = 0, but the file has a non-zero transmittance".into(),
-                ));
-            }
-            t
-        }
-        Some(t) => t,
-        None if opaque => vec![0.0; n],
-        None => return Err(err("has no transmittance column (T)".into())),
-    };
-    let rf = data
-        .reflectance_front
-        .ok_or_else(|| err("has no front reflectance column (R or Rf)".into()))?;
-    let rb = data.reflectance_back.unwrap_or_else(|| rf.clone());
-    if t.len() != n || rf.len() != n || rb.len() != n {
-        return Err(err("columns of different lengths".into()));
-    }
-    glassdb_spectral::check_spectrum_balance(
-        &data.wavelength_nm,
-        Some(&t),
-        &[Some(&rf), Some(&rb)],
-    )
-    .map_err(|source| RegistryError::Spectral {
-        glass: glass.to_string(),
-        path: path.to_path_buf(),
-        source: Box::new(source),
-    })?;
-    Ok(Spectra {
-        path: path.to_path_buf(),
-        wavelength_nm: data.wavelength_nm,
-        t,
-        rf,
-        rb,
-    })
 }

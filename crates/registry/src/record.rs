@@ -1,4 +1,4 @@
-//! The registry JSON (schema 2): types, loading, and the evaluation the compositor uses
+//! The registry JSON (schema 4): types, loading, and the evaluation the compositor uses
 //! (method.md eqs. 11–14: `r(θ) = r0·C_r(θ)`, `t(θ) = t0·C_t(θ)`, per channel).
 
 use std::fmt;
@@ -11,14 +11,18 @@ use serde::{Deserialize, Serialize};
 
 use crate::RegistryError;
 
-/// The registry schema version this crate writes. Schema 3: one table per colour basis
-/// (`tables`, each with its spectral method and its glasses); schema 2 (one table, `spectral`
-/// and `glasses` at the top) is still read, as a registry of one table. Curves are the fit
-/// crate's [`CosPolynomial`] (basis `paper` or `full`, strictly ascending powers) and
-/// [`FitSummary`]; the spectral method is [`IntegrationSettings`].
-pub const SCHEMA_VERSION: u32 = 3;
+/// The registry schema version this crate writes. Schema 4: a glass may be a unit
+/// ([`GlassRecord::unit`]: its build-up, per-layer values and per-pane-group reflectances);
+/// schema 3 (the same without units) is read as it is; schema 2 (one table, `spectral` and
+/// `glasses` at the top) is read as a registry of one table. Curves are the fit crate's
+/// [`CosPolynomial`] (basis `paper` or `full`, strictly ascending powers) and [`FitSummary`];
+/// the spectral method is [`IntegrationSettings`].
+pub const SCHEMA_VERSION: u32 = 4;
 
-/// The older schema still read (one table).
+/// The schema before units (one table per colour basis), still read.
+pub const SCHEMA_VERSION_BEFORE_UNITS: u32 = 3;
+
+/// The oldest schema still read (one table).
 pub const SCHEMA_VERSION_ONE_TABLE: u32 = 2;
 
 /// Channel names, in the order of every `[_; 3]` array in the registry.
@@ -127,6 +131,10 @@ pub struct GlassRecord {
     pub angle_model: AngleModelRecord,
     /// Input files and their sha256, and the product as the data file describes it.
     pub provenance: Provenance,
+    /// A unit's build-up, per-layer values and per-pane-group reflectances (none for a single
+    /// glass: one pane group whose reflectance is `r`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<crate::unit_record::UnitRecord>,
 }
 
 /// One angle curve: the fitted polynomial `C(cos θ)` with the summary of its fit, under the
@@ -214,6 +222,9 @@ pub struct ProductRecord {
     pub coated_side: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness_mm: Option<f64>,
+    /// The parts an IGSDB product lists (a laminate's plies and interlayer), when it lists them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub composition: Vec<String>,
 }
 
 /// Which face of the glass the viewer sees (`front` or `back` in JSON and on the command line).
@@ -327,6 +338,17 @@ impl GlassRecord {
                 chosen_by: String::new(),
             },
             provenance: Provenance::default(),
+            unit: None,
+        }
+    }
+
+    /// The glass turned round: front and back reflectance (values, curves, luminous)
+    /// swapped, as a layer flipped in a unit.
+    pub fn turn_round(&mut self) {
+        std::mem::swap(&mut self.r0, &mut self.r0_back);
+        std::mem::swap(&mut self.c_r, &mut self.c_r_back);
+        if let Some(l) = &mut self.luminous {
+            std::mem::swap(&mut l.reflectance, &mut l.reflectance_back);
         }
     }
 
@@ -368,7 +390,7 @@ impl GlassRecord {
     }
 }
 
-/// The JSON form of schema 3.
+/// The JSON form of schemas 3 and 4.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RegistryJson {
@@ -465,7 +487,7 @@ impl Registry {
         Registry::from_json_str(&text, &path.display().to_string())
     }
 
-    /// Parses and validates a registry JSON text (schema 3, or schema 2 as one table);
+    /// Parses and validates a registry JSON text (schema 4 or 3, or schema 2 as one table);
     /// `source_name` names it in errors.
     pub fn from_json_str(json: &str, source_name: &str) -> Result<Registry, RegistryError> {
         // Check the version first, so an old or future file gets a version message rather than
@@ -480,7 +502,7 @@ impl Registry {
         };
         let version: VersionOnly = serde_json::from_str(json).map_err(json_err)?;
         let tables = match version.schema {
-            SCHEMA_VERSION => {
+            SCHEMA_VERSION | SCHEMA_VERSION_BEFORE_UNITS => {
                 serde_json::from_str::<RegistryJson>(json)
                     .map_err(json_err)?
                     .tables
@@ -511,7 +533,7 @@ impl Registry {
         Ok(crate::build::sha256_hex(self.to_json_string()?.as_bytes()))
     }
 
-    /// The registry as pretty JSON text (schema 3).
+    /// The registry as pretty JSON text (schema 4).
     pub fn to_json_string(&self) -> Result<String, RegistryError> {
         #[derive(Serialize)]
         struct RegistryJsonOut<'a> {
@@ -686,10 +708,10 @@ mod tests {
             e.starts_with("x.json:") && e.matches("line 1").count() == 1,
             "{e}"
         );
-        let e = Registry::from_json_str("{\"schema\": 4}", "y.json")
+        let e = Registry::from_json_str("{\"schema\": 5}", "y.json")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("schema 4 is not supported"), "{e}");
+        assert!(e.contains("schema 5 is not supported"), "{e}");
         // A schema-1 file says what to do, without naming command-line flags (the binary adds
         // the exact command).
         let err =
@@ -699,7 +721,7 @@ mod tests {
                 err,
                 RegistryError::SchemaVersion {
                     found: 1,
-                    expected: 3,
+                    expected: 4,
                     ..
                 }
             ),
@@ -748,7 +770,7 @@ mod tests {
         );
         assert_eq!(two.table(ColourBasis::Luminous), None);
         let text = two.to_json_string().unwrap();
-        assert!(text.contains("\"schema\": 3"), "{text}");
+        assert!(text.contains("\"schema\": 4"), "{text}");
         assert_eq!(Registry::from_json_str(&text, "two.json").unwrap(), two);
 
         let e = Registry::new(vec![acescg.clone(), acescg.clone()]).unwrap_err();

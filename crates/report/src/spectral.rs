@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use glassdb_registry::catalog::{NormalSource, parse_catalog, resolve};
+use glassdb_registry::catalog::{GlassBuild, LayerSpec, NormalSource, parse_catalog, resolve};
 use glassdb_spectral::{
     IntegrationSettings, Integrator, Method, ReadOptions, RgbCmf, SpectralData, luminous_iso9050,
     read_spectral_file,
@@ -125,7 +125,11 @@ fn spectral_rows(catalog: &Path) -> Result<Vec<SpectralRow>, ReportError> {
     let (cmfs, srgb_settings) = spectral_methods();
     let mut rows = Vec::new();
     for spec in &specs {
-        let NormalSource::Spectral { path, percent } = &spec.normal else {
+        let GlassBuild::Single(LayerSpec {
+            normal: NormalSource::Spectral { path, percent },
+            ..
+        }) = &spec.build
+        else {
             continue;
         };
         let file = resolve(catalog, path);

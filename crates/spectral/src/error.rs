@@ -111,6 +111,19 @@ pub enum SpectralError {
         need_end_nm: f64,
     },
 
+    /// The spectrum does not cover the range a WINDOW average needs (WINDOW refuses such a
+    /// layer too).
+    #[error(
+        "the spectrum covers {have_start_nm}–{have_end_nm} nm but WINDOW's {method} average needs {need_start_nm}–{need_end_nm} nm"
+    )]
+    WindowCoverage {
+        method: &'static str,
+        have_start_nm: f64,
+        have_end_nm: f64,
+        need_start_nm: f64,
+        need_end_nm: f64,
+    },
+
     /// The spectrum does not overlap the integration range at all.
     #[error(
         "the spectrum ({have_start_nm}–{have_end_nm} nm) does not overlap {need_start_nm}–{need_end_nm} nm at all"

@@ -4,8 +4,9 @@
 //! Every method is a weighted sum over a fixed reference grid: the spectrum is resampled onto
 //! the grid (Sprague or not-a-knot spline, as colour-science does; see [`crate::interp`]) and
 //! dotted with weights precomputed once in [`Integrator::new`]. A call to
-//! [`Integrator::channels`] therefore costs one `O(n)` spline solve plus one pass over the grid
-//! and does not allocate once its thread has warmed up.
+//! [`Integrator::channels`] therefore costs one pass over the grid (uniform data) or one dot
+//! product with the wavelength array's cached spline kernel (irregular data), and does not
+//! allocate once its thread has warmed up.
 
 use std::cell::RefCell;
 use std::fmt;
@@ -17,7 +18,7 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SpectralError;
-use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, validate};
+use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, sprague_kernel, validate};
 use crate::tables::{Table, tables};
 use glassdb_colour::{D65_XY, RgbSpace, cat02, xyz_to_rgb};
 
@@ -365,21 +366,15 @@ impl Integrator {
             )
         };
         // Fast path: a wavelength array this thread has already validated (equality with the
-        // cached copy implies it is valid and irregular). Seen once: build its spline kernel
-        // now; kernel already built: one dot product.
+        // cached copy implies it is valid and irregular): one dot product with its kernel.
         if wavelength_nm.len() == values.len() && values.iter().all(|v| v.is_finite()) {
             let hit = KERNELS.with(|cell| {
-                let mut cache = cell.borrow_mut();
+                let cache = cell.borrow();
                 let entry = cache
                     .entries
-                    .iter_mut()
+                    .iter()
                     .find(|e| e.id == self.id && e.wavelength_nm.as_slice() == wavelength_nm)?;
-                let kernel = entry.kernel.get_or_insert_with(|| {
-                    let mut kernel = Vec::new();
-                    spline_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
-                    kernel
-                });
-                Some(dot_kernel(kernel, values))
+                Some(dot_kernel(&entry.kernel, values))
             });
             if let Some(acc) = hit {
                 check_coverage()?;
@@ -388,50 +383,83 @@ impl Integrator {
         }
         let uniform = validate(wavelength_nm, values)?;
         check_coverage()?;
-        // First sight of this wavelength array: evaluate directly (one spline solve, cheaper
-        // than building the kernel) and remember the array for next time.
-        let mut acc = [0.0f64; 3];
-        let weights = &self.weights;
-        for_each_on_grid(wavelength_nm, values, uniform, &self.grid_nm, |j, v| {
-            if let Some(w) = weights.get(j) {
-                acc[0] += v * w[0];
-                acc[1] += v * w[1];
-                acc[2] += v * w[2];
-            }
-        });
-        if !uniform {
-            KERNELS.with(|cell| {
-                let mut cache = cell.borrow_mut();
-                let entry = KernelEntry {
-                    id: self.id,
-                    wavelength_nm: wavelength_nm.to_vec(),
-                    kernel: None,
-                };
-                if cache.entries.len() < KERNEL_CACHE_SLOTS {
-                    cache.entries.push(entry);
-                } else {
-                    let slot = cache.next_slot % KERNEL_CACHE_SLOTS;
-                    cache.next_slot = slot + 1;
-                    cache.entries[slot] = entry;
+        if uniform {
+            // Sprague on the grid directly: no solve, nothing to cache.
+            let mut acc = [0.0f64; 3];
+            let weights = &self.weights;
+            for_each_on_grid(wavelength_nm, values, true, &self.grid_nm, |j, v| {
+                if let Some(w) = weights.get(j) {
+                    acc[0] += v * w[0];
+                    acc[1] += v * w[1];
+                    acc[2] += v * w[2];
                 }
             });
+            return Ok(acc);
         }
+        // First sight of this irregular wavelength array: build its spline kernel now and
+        // remember it, so that every spectrum on these wavelengths is integrated by the same
+        // arithmetic (the same spectrum gives the same bits whatever was integrated before).
+        let mut kernel = Vec::new();
+        spline_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
+        let acc = dot_kernel(&kernel, values);
+        KERNELS.with(|cell| {
+            let mut cache = cell.borrow_mut();
+            let entry = KernelEntry {
+                id: self.id,
+                wavelength_nm: wavelength_nm.to_vec(),
+                kernel,
+            };
+            if cache.entries.len() < KERNEL_CACHE_SLOTS {
+                cache.entries.push(entry);
+            } else {
+                let slot = cache.next_slot % KERNEL_CACHE_SLOTS;
+                cache.next_slot = slot + 1;
+                cache.entries[slot] = entry;
+            }
+        });
         Ok(acc)
     }
 
     /// The three channel values of a spectrum (`wavelength_nm` strictly increasing, values as
     /// fractions). For [`Method::Luminous`] all three are the luminous value.
     ///
-    /// Cost: uniform spacing evaluates Sprague on the grid directly. Irregular spacing solves
-    /// the spline directly the first time a thread sees a wavelength array, builds the spline's
-    /// linear kernel the second time (kept for the 8 most recent arrays), and from then on
-    /// another spectrum on the same wavelengths is one dot product.
+    /// Cost: uniform spacing evaluates Sprague on the grid directly. Irregular spacing builds
+    /// the spline's linear kernel the first time a thread sees a wavelength array (kept for the
+    /// 8 most recent arrays); from then on a spectrum on the same wavelengths is one dot
+    /// product. Either way the result depends only on the spectrum, not on what the thread
+    /// integrated before.
     pub fn channels(
         &self,
         wavelength_nm: &[f64],
         values: &[f64],
     ) -> Result<[f64; 3], SpectralError> {
         self.apply(wavelength_nm, values, self.settings.extrapolate)
+    }
+
+    /// This integrator fixed to one wavelength array, for integrating many spectra sampled on
+    /// it: one dot product with the array's kernel per spectrum, the same numbers as
+    /// [`Integrator::channels`] (bit for bit on irregular wavelengths, to rounding on uniform
+    /// ones, where `channels` evaluates Sprague directly). Errors as `channels` for the array
+    /// (validity, coverage).
+    pub fn on_grid(&self, wavelength_nm: &[f64]) -> Result<GridIntegrator, SpectralError> {
+        let probe = vec![0.0; wavelength_nm.len()];
+        let uniform = validate(wavelength_nm, &probe)?;
+        check_coverage(
+            wavelength_nm,
+            &self.grid_nm,
+            self.settings.extrapolate,
+            &self.description(),
+        )?;
+        let mut kernel = Vec::new();
+        if uniform {
+            sprague_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
+        } else {
+            spline_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
+        }
+        Ok(GridIntegrator {
+            wavelength_nm: wavelength_nm.to_vec(),
+            kernel,
+        })
     }
 
     /// The settings this integrator was built from.
@@ -456,6 +484,22 @@ impl Integrator {
         );
         let step = self.grid_nm.get(1).map(|s| s - first).unwrap_or(0.0);
         format!("{} on {first}–{last} nm at {step} nm", self.label)
+    }
+}
+
+/// An [`Integrator`] fixed to one wavelength array ([`Integrator::on_grid`]).
+#[derive(Debug, Clone)]
+pub struct GridIntegrator {
+    wavelength_nm: Vec<f64>,
+    /// Per sample of the array, its weight in each channel (Sprague's or the spline's).
+    kernel: Vec<[f64; 3]>,
+}
+
+impl GridIntegrator {
+    /// The channels of a spectrum on the array (as many finite values as wavelengths).
+    pub fn channels(&self, values: &[f64]) -> Result<[f64; 3], SpectralError> {
+        crate::interp::validate_values(&self.wavelength_nm, values)?;
+        Ok(dot_kernel(&self.kernel, values))
     }
 }
 
@@ -575,8 +619,8 @@ const KERNEL_CACHE_SLOTS: usize = 8;
 struct KernelEntry {
     id: u64,
     wavelength_nm: Vec<f64>,
-    /// Built on the second use of the wavelength array.
-    kernel: Option<Vec<[f64; 3]>>,
+    /// The spline's linear map from the values to the channels.
+    kernel: Vec<[f64; 3]>,
 }
 
 #[derive(Default)]
@@ -756,20 +800,29 @@ mod tests {
     }
 
     #[test]
-    fn direct_kernel_build_and_cached_kernel_paths_agree() {
-        // First call: direct spline; second: builds the kernel; third: cached kernel.
+    fn the_same_spectrum_gives_the_same_bits_whatever_came_before() {
+        // Irregular data: the first call builds the kernel, later ones reuse it; evicting it
+        // (more arrays than cache slots) and coming back rebuilds the same kernel.
         let mut wl: Vec<f64> = (0..40).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
         wl.extend((0..60).map(|i| 500.0 + 7.0 * f64::from(i)));
         let v: Vec<f64> = wl.iter().map(|w| 0.5 + 0.4 * (w / 29.0).sin()).collect();
         let it = Integrator::new(&IntegrationSettings::default()).unwrap();
-        let a = it.channels(&wl, &v).unwrap();
-        let b = it.channels(&wl, &v).unwrap();
-        let c = it.channels(&wl, &v).unwrap();
-        for k in 0..3 {
-            assert!(
-                (a[k] - b[k]).abs() < 1e-13 && (b[k] - c[k]).abs() < 1e-15,
-                "{a:?} {b:?} {c:?}"
-            );
+        let first = it.channels(&wl, &v).unwrap();
+        assert_eq!(it.channels(&wl, &v).unwrap(), first);
+        for k in 0..2 * KERNEL_CACHE_SLOTS {
+            let other: Vec<f64> = wl.iter().map(|w| w + 0.1 * (k + 1) as f64).collect();
+            it.channels(&other, &v).unwrap();
+        }
+        assert_eq!(it.channels(&wl, &v).unwrap(), first);
+        // and the kernel is the direct spline evaluation to rounding
+        let mut direct = [0.0f64; 3];
+        for_each_on_grid(&wl, &v, false, it.grid_nm(), |j, x| {
+            for (d, w) in direct.iter_mut().zip(&it.weights()[j]) {
+                *d += x * w;
+            }
+        });
+        for c in 0..3 {
+            assert!((direct[c] - first[c]).abs() < 1e-13, "{direct:?} {first:?}");
         }
     }
 

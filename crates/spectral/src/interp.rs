@@ -16,26 +16,13 @@ use std::cell::RefCell;
 
 use crate::error::SpectralError;
 
-/// Checks what every interpolator needs: equal lengths, finite numbers, strictly increasing
-/// wavelengths, enough points. Returns whether the spacing is uniform (Sprague) or not (spline).
-pub(crate) fn validate(wavelength_nm: &[f64], values: &[f64]) -> Result<bool, SpectralError> {
-    if wavelength_nm.len() != values.len() {
-        return Err(SpectralError::LengthMismatch {
-            wavelengths: wavelength_nm.len(),
-            values: values.len(),
-        });
-    }
+/// A wavelength array of finite, strictly increasing values.
+pub(crate) fn validate_grid(wavelength_nm: &[f64]) -> Result<(), SpectralError> {
     let mut previous = f64::NEG_INFINITY;
-    for (index, (&w, &v)) in wavelength_nm.iter().zip(values).enumerate() {
+    for (index, &w) in wavelength_nm.iter().enumerate() {
         if !w.is_finite() {
             return Err(SpectralError::NonFinite {
                 what: "wavelength",
-                index,
-            });
-        }
-        if !v.is_finite() {
-            return Err(SpectralError::NonFinite {
-                what: "value",
                 index,
             });
         }
@@ -48,6 +35,31 @@ pub(crate) fn validate(wavelength_nm: &[f64], values: &[f64]) -> Result<bool, Sp
         }
         previous = w;
     }
+    Ok(())
+}
+
+/// As many finite values as wavelengths.
+pub(crate) fn validate_values(wavelength_nm: &[f64], values: &[f64]) -> Result<(), SpectralError> {
+    if wavelength_nm.len() != values.len() {
+        return Err(SpectralError::LengthMismatch {
+            wavelengths: wavelength_nm.len(),
+            values: values.len(),
+        });
+    }
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(SpectralError::NonFinite {
+            what: "value",
+            index,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Checks what every interpolator needs: equal lengths, finite numbers, strictly increasing
+/// wavelengths, enough points. Returns whether the spacing is uniform (Sprague) or not (spline).
+pub(crate) fn validate(wavelength_nm: &[f64], values: &[f64]) -> Result<bool, SpectralError> {
+    validate_values(wavelength_nm, values)?;
+    validate_grid(wavelength_nm)?;
     let uniform = is_uniform(wavelength_nm);
     let (needed, interpolator) = if uniform {
         (6, "Sprague")
@@ -168,6 +180,78 @@ impl<'a> Sprague<'a> {
             y += a * power;
         }
         self.yp(ii) + y
+    }
+}
+
+/// The linear map from uniformly spaced values `y(x)` to `Σ_j weights[j]·Sprague(grid[j])`:
+/// per data sample, per channel, its weight ([`for_each_on_grid`]'s uniform branch with the
+/// values left symbolic: each grid value is the padded values around it times the Sprague
+/// polynomial's coefficients, and each padded end value a combination of six data values).
+pub(crate) fn sprague_kernel(
+    x: &[f64],
+    grid: &[f64],
+    weights: &[[f64; 3]],
+    kernel: &mut Vec<[f64; 3]>,
+) {
+    let n = x.len();
+    kernel.clear();
+    kernel.resize(n, [0.0; 3]);
+    // The nodes only: `Sprague::xp` does not look at the values.
+    let sp = Sprague::new(x, x);
+    let add = |kernel: &mut Vec<[f64; 3]>, i: usize, w: &[f64; 3], f: f64| {
+        let k = &mut kernel[i];
+        k[0] += w[0] * f;
+        k[1] += w[1] * f;
+        k[2] += w[2] * f;
+    };
+    // padded value j (numpy's wrap-around for j = -1) times f, onto the data samples
+    let add_padded = |kernel: &mut Vec<[f64; 3]>, j: isize, w: &[f64; 3], f: f64| {
+        let j = if j < 0 { j + n as isize + 4 } else { j } as usize;
+        let pad = match j {
+            0 => Some((0, 0)),
+            1 => Some((1, 0)),
+            _ if j < n + 2 => None,
+            _ if j == n + 2 => Some((2, n - 6)),
+            _ => Some((3, n - 6)),
+        };
+        match pad {
+            None => add(kernel, j - 2, w, f),
+            Some((k, first)) => {
+                for (q, c) in SPRAGUE_C[k].iter().enumerate() {
+                    add(kernel, first + q, w, f * c / 209.0);
+                }
+            }
+        }
+    };
+    let mut cnt = 0usize;
+    for (j, &t) in grid.iter().enumerate() {
+        let Some(w) = weights.get(j) else { break };
+        if t < x[0] {
+            add(kernel, 0, w, 1.0);
+            continue;
+        }
+        if t > x[n - 1] {
+            add(kernel, n - 1, w, 1.0);
+            continue;
+        }
+        while cnt < sp.len_padded() && sp.xp(cnt) < t {
+            cnt += 1;
+        }
+        let i = cnt.saturating_sub(1).max(1);
+        let (x0, x1) = (sp.xp(i), sp.xp(i + 1));
+        let big_x = (t - x0) / (x1 - x0);
+        let mut coefficients = [0.0f64; 6];
+        coefficients[2] = 1.0;
+        let mut power = 1.0;
+        for row in &SPRAGUE_W {
+            power *= big_x;
+            for (c, wm) in coefficients.iter_mut().zip(row) {
+                *c += wm * power / 24.0;
+            }
+        }
+        for (m, c) in coefficients.iter().enumerate() {
+            add_padded(kernel, i as isize - 2 + m as isize, w, *c);
+        }
     }
 }
 
@@ -587,36 +671,57 @@ mod tests {
         }
     }
 
-    #[test]
-    fn spline_kernel_equals_direct_evaluation() {
-        // Irregular grid 300–2500 nm with a wiggly spectrum; grid 360–780 plus points outside.
-        let mut x: Vec<f64> = (0..60).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
-        x.extend((0..=170).map(|i| 600.0 + 11.0 * f64::from(i)));
+    /// `sprague_kernel` or `spline_kernel`.
+    type KernelBuilder = fn(&[f64], &[f64], &[[f64; 3]], &mut Vec<[f64; 3]>);
+
+    /// `Σ kernel·y` against the direct evaluation of the same interpolant onto `grid`, for a
+    /// wiggly spectrum on `x` and arbitrary weights.
+    fn assert_kernel_is_direct(
+        x: &[f64],
+        grid: &[f64],
+        uniform: bool,
+        build: KernelBuilder,
+        rel_tol: f64,
+    ) {
         let y: Vec<f64> = x
             .iter()
             .map(|w| 0.5 + 0.3 * (w / 37.0).sin() * (w / 211.0).cos())
             .collect();
-        let grid: Vec<f64> = (250..=800).map(f64::from).collect();
         let weights: Vec<[f64; 3]> = grid
             .iter()
             .map(|g| [1.0, (g / 50.0).sin(), 1e-3 * g])
             .collect();
         let mut direct = [0.0; 3];
-        for_each_on_grid(&x, &y, false, &grid, |j, v| {
-            for c in 0..3 {
-                direct[c] += weights[j][c] * v;
+        for_each_on_grid(x, &y, uniform, grid, |j, v| {
+            for (d, w) in direct.iter_mut().zip(&weights[j]) {
+                *d += w * v;
             }
         });
         let mut kernel = Vec::new();
-        spline_kernel(&x, &grid, &weights, &mut kernel);
-        for c in 0..3 {
+        build(x, grid, &weights, &mut kernel);
+        for (c, d) in direct.iter().enumerate() {
             let k: f64 = kernel.iter().zip(&y).map(|(k, v)| k[c] * v).sum();
             assert!(
-                (k - direct[c]).abs() < 1e-11 * direct[c].abs().max(1.0),
-                "{c}: {k} vs {}",
-                direct[c]
+                (k - d).abs() < rel_tol * d.abs().max(1.0),
+                "{c}: {k} vs {d}"
             );
         }
+    }
+
+    #[test]
+    fn sprague_kernel_equals_direct_evaluation() {
+        let x: Vec<f64> = (0..120).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
+        let grid: Vec<f64> = (250..=950).map(|g| f64::from(g) + 0.3).collect();
+        assert_kernel_is_direct(&x, &grid, true, sprague_kernel, 1e-10);
+    }
+
+    #[test]
+    fn spline_kernel_equals_direct_evaluation() {
+        // Irregular grid 300–2500 nm with a wiggly spectrum; grid 360–780 plus points outside.
+        let mut x: Vec<f64> = (0..60).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
+        x.extend((0..=170).map(|i| 600.0 + 11.0 * f64::from(i)));
+        let grid: Vec<f64> = (250..=800).map(f64::from).collect();
+        assert_kernel_is_direct(&x, &grid, false, spline_kernel, 1e-11);
     }
 
     #[test]

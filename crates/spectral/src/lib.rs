@@ -9,6 +9,8 @@
 //! - [`Integrator`]: built once from [`IntegrationSettings`], then cheap per spectrum
 //!   ([`Integrator::channels`]).
 //! - [`luminous_iso9050`]: visible transmittance/reflectance, D65 × V(λ), 380–780 nm at 10 nm.
+//! - [`WindowWeights`] / [`window_average`]: WINDOW's NFRC 300-2003 photopic and solar
+//!   averages, computed as pywincalc 3.3.1 computes them (linear interpolation, trapezoids).
 //! - [`check_spectrum_balance`] / [`check_channel_balance`]: T + R ≤ 1 per wavelength and per
 //!   integrated channel, the checks every command applies to a glass's spectra.
 //!
@@ -26,6 +28,7 @@ mod read_csv;
 mod read_igsdb;
 mod sniff;
 mod tables;
+mod window;
 
 pub use balance::{
     CHANNEL_BALANCE_SLACK, SPECTRUM_BALANCE_SLACK, check_channel_balance, check_spectrum_balance,
@@ -34,11 +37,12 @@ pub use balance::{
 pub use error::{SpectralError, UnsupportedKind};
 pub use glassdb_colour::{CHROMATICITIES_TOLERANCE, RgbSpace, rgb_to_rgb, xyz_to_rgb};
 pub use integrate::{
-    Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind, Observer,
-    RgbCmf, luminous, luminous_iso9050, rgb_matrix,
+    GridIntegrator, Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind,
+    Observer, RgbCmf, luminous, luminous_iso9050, rgb_matrix,
 };
 pub use interp::resample;
 pub use read::{
     ProductInfo, ReadOptions, SpectralData, SpectralFormat, detect_format, microns_to_nm,
     read_spectral_bytes, read_spectral_file,
 };
+pub use window::{WindowMethod, WindowWeights, window_average};

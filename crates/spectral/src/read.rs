@@ -43,6 +43,10 @@ pub struct ProductInfo {
     /// angle blocks), in file order. Only the 0° spectrum is read; empty for other formats.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub other_incidence_angles_deg: Vec<f64>,
+    /// The parts an IGSDB product lists in its `composition` (a laminate's plies and
+    /// interlayer), each as "name (subtype, thickness mm)"; empty for other formats.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub composition: Vec<String>,
     pub format: SpectralFormat,
 }
 
@@ -55,6 +59,7 @@ impl ProductInfo {
             coated_side: None,
             thickness_mm: None,
             other_incidence_angles_deg: Vec::new(),
+            composition: Vec::new(),
             format,
         }
     }

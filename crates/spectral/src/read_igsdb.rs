@@ -110,6 +110,37 @@ fn product_name(product: &Value) -> Option<String> {
         .or_else(|| text(product.get("product_name")))
 }
 
+/// The parts a product lists in `composition` (v1: `{child_product: {...}}` items; v2: the
+/// product objects themselves), each "name (subtype, thickness mm)".
+fn composition(product: &Value) -> Vec<String> {
+    let Some(items) = product.get("composition").and_then(Value::as_array) else {
+        return Vec::new();
+    };
+    items
+        .iter()
+        .map(|item| {
+            let child = item.get("child_product").unwrap_or(item);
+            let name = product_name(child).unwrap_or_else(|| "unnamed part".to_owned());
+            let thickness = child
+                .pointer("/measured_data/thickness")
+                .or_else(|| child.pointer("/physical_properties/thickness"))
+                .and_then(number_of);
+            let details: Vec<String> = [
+                text(child.get("subtype")),
+                thickness.map(|t| format!("{t} mm")),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            if details.is_empty() {
+                name
+            } else {
+                format!("{name} ({})", details.join(", "))
+            }
+        })
+        .collect()
+}
+
 /// Refuses shading layers, shade materials and non-specular products by name.
 fn refuse_unsupported(product: &Value, source: &str) -> Result<(), SpectralError> {
     let name = product_name(product);
@@ -181,6 +212,7 @@ fn read_v1(
             .get("measured_data")
             .and_then(|m| m.get("thickness"))
             .and_then(Value::as_f64),
+        composition: composition(product),
         ..ProductInfo::empty(SpectralFormat::IgsdbJson)
     };
     let lines = json_array_element_lines(bytes, "spectral_data", 0);
@@ -252,6 +284,7 @@ fn read_v2(
             .and_then(|p| p.get("thickness"))
             .and_then(number_of),
         other_incidence_angles_deg: angles.iter().copied().filter(|&a| a != 0.0).collect(),
+        composition: composition(product),
         format: SpectralFormat::IgsdbJson,
     };
     let lines = json_array_element_lines(bytes, "wavelength_data", normal);
@@ -494,6 +527,40 @@ mod tests {
         assert_eq!(p.thickness_mm, Some(4.0));
         // One-product lists (API search results) are that product.
         assert_eq!(read(&format!("[{text}]")).unwrap(), d);
+    }
+
+    #[test]
+    fn a_laminates_composition_names_its_parts() {
+        // the real laminate's file, with the composition the IGSDB lists for laminates whose
+        // parts it holds (the test data's own laminates list none)
+        let real = include_str!("../../../data/glazing/igsdb_product_11148.json");
+        let plain = read_igsdb_json(real.as_bytes(), "l.json").unwrap();
+        assert_eq!(plain.product.product_type.as_deref(), Some("laminate"));
+        assert!(plain.product.composition.is_empty());
+        let with_parts = real.replacen(
+            "\"composition\":[]",
+            r#""composition": [
+              {"child_product": {"name": "SB70 on Pacifica 6mm", "subtype": "coated-glass",
+                                 "measured_data": {"thickness": 6.0}}},
+              {"child_product": {"name": "SentryGlas 0.090", "subtype": "interlayer",
+                                 "measured_data": {"thickness": 2.286}}},
+              {"child_product": {"name": "Clear 6mm", "subtype": "monolithic"}}]"#,
+            1,
+        );
+        assert_ne!(
+            with_parts, real,
+            "the file has an empty composition to fill"
+        );
+        let d = read_igsdb_json(with_parts.as_bytes(), "l.json").unwrap();
+        assert_eq!(
+            d.product.composition,
+            [
+                "SB70 on Pacifica 6mm (coated-glass, 6 mm)",
+                "SentryGlas 0.090 (interlayer, 2.286 mm)",
+                "Clear 6mm (monolithic)"
+            ]
+        );
+        assert_eq!(d.wavelength_nm, plain.wavelength_nm);
     }
 
     #[test]

@@ -1,10 +1,11 @@
-//! The four figures of `glassdb plot`: each function reads its inputs through the owning crate
+//! The figures of `glassdb plot`: each function reads its inputs through the owning crate
 //! and returns a [`Figure`](crate::Figure) to [`save`](crate::save).
 
 pub mod fit;
 pub mod mask;
 pub mod registry;
 pub mod spectral;
+pub mod stack;
 
 use glassdb_fit::cos_deg;
 

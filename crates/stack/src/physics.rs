@@ -153,6 +153,19 @@ impl CoatedCurve {
     }
 }
 
+impl CoatedCurve {
+    /// `(R, T)` at `cos θ` with the published polynomials as WINDOW applies them (LBNL
+    /// Windows-CalcEngine `CAngularPropertiesCoated`): `T = T0·τ`, `R = R0·(1 − ρ) + ρ`, each
+    /// clamped to [0, 1], without the renormalisation of [`CoatedCurve::at`] (so that T(0°) =
+    /// 1.0023·T0 for the clear curve and 1.01175·T0 for the bronze one).
+    pub fn at_published(self, t0: f64, r0: f64, cos_theta: f64) -> (f64, f64) {
+        let (tau, rho) = self.raw(cos_theta.clamp(0.0, 1.0));
+        let t = (t0 * tau).clamp(0.0, 1.0);
+        let r = (r0 * (1.0 - rho) + rho).clamp(0.0, 1.0);
+        (r, t)
+    }
+}
+
 /// A complex number, just enough for Fresnel's equations.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Complex {

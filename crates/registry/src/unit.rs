@@ -1,0 +1,679 @@
+//! Units in the registry: a catalog entry with `layers` built by the stack engine into a glass
+//! record per table (system curves, as for any glass, plus the [`UnitRecord`]: build-up,
+//! per-layer values, per-pane-group reflectance curves and depths); and [`UnitBuilder`], the
+//! entry point a front-end calls to build a unit from a catalog's glasses on demand (the
+//! viewer's "build a unit on the page").
+
+use std::path::{Path, PathBuf};
+
+use glassdb_fit::{AngleSamples, Quantity};
+use glassdb_spectral::{Integrator, WindowMethod, WindowWeights};
+use glassdb_stack::measured::{MeasuredRatio, RatioFit, cos_deg, model_angles_deg};
+use glassdb_stack::{
+    Combination, Element, EvalOptions, Gap, Gas, Layer, LayerData, Optics, Stack, StackError,
+};
+
+use crate::angle_model::{ModelTables, integration_error, read_measured_table};
+use crate::build::{
+    BuildOptions, CatalogFiles, build_glass, glass_record, integrators_of, load_catalog, oriented,
+};
+use crate::catalog::{ElementSpec, GlassBuild, GlassSpec, LayerSpec, NormalSource};
+use crate::curves::{fit_glass_curves, fit_share_curves};
+use crate::normal::{CatalogLayer, normal_values, read_layer};
+use crate::unit_record::{
+    Absorptance, GapRecord, PaneGroupRecord, SystemValues, UnitElement, UnitLayerRecord, UnitRecord,
+};
+use crate::{
+    AngleModelRecord, GlassRecord, LuminousRecord, Provenance, Registry, RegistryError,
+    RegistryTable,
+};
+
+/// Wavelengths (nm) of a grey layer (one given by its angle table alone): 300–2500 nm in 10 nm
+/// steps, the same value at each.
+const GREY_STEP_NM: f64 = 10.0;
+
+/// A layer of a unit read from the catalog, with what its record needs.
+struct UnitLayer {
+    read: CatalogLayer,
+    angles_file: Option<crate::FileRef>,
+    model_kind: String,
+}
+
+/// The glass label of a unit's element in messages.
+fn element_label(glass: &str, position: usize, line: usize) -> String {
+    if line == 0 {
+        format!("{glass}, element {position}")
+    } else {
+        format!("{glass}, element {position} of `layers` (catalog line {line})")
+    }
+}
+
+/// Reads one layer of a unit: its spectral file or explicit values, or a grey layer from its
+/// angle table alone; with a table, the table's ratio curves replace the model for Rf and T.
+fn read_unit_layer(
+    spec: &LayerSpec,
+    unit_name: &str,
+    files: &CatalogFiles<'_>,
+    label: &str,
+    opts: &BuildOptions,
+) -> Result<UnitLayer, RegistryError> {
+    let measured = read_measured_table(spec, unit_name, files, label)?;
+    let mut read = match (&spec.normal, &measured) {
+        (NormalSource::AngleTable, Some(m)) => grey_layer(spec, m, label)?,
+        _ => read_layer(spec, files, label)?,
+    };
+    let mut model_kind = read.layer.model.name().to_string();
+    if let Some(m) = &measured {
+        // the model's broadband curve continues the table beyond its last angle
+        let mut plain = read.layer.clone();
+        plain.flipped = false;
+        let (model_r, model_t) =
+            broadband_model(&plain).map_err(|e| integration_error(e, label))?;
+        let ratio = MeasuredRatio::fit(
+            m.reflectance.as_ref(),
+            m.transmittance.as_ref(),
+            &model_r,
+            &model_t,
+            RatioFit {
+                tol: opts.fit_tol,
+                max_degree: opts.max_degree,
+            },
+            label,
+        )
+        .map_err(|e| match e {
+            StackError::Fit { curve, source, .. } => RegistryError::Fit {
+                glass: label.to_string(),
+                curve: format!("measured {curve}"),
+                source,
+            },
+            other => integration_error(other, label),
+        })?;
+        read.layer.measured = Some(ratio);
+        model_kind = "measured".into();
+    }
+    Ok(UnitLayer {
+        read,
+        angles_file: measured.map(|m| m.file),
+        model_kind,
+    })
+}
+
+/// A grey layer: the table's 0° R and T at every wavelength of 300–2500 nm.
+fn grey_layer(
+    spec: &LayerSpec,
+    m: &crate::angle_model::MeasuredTable,
+    label: &str,
+) -> Result<CatalogLayer, RegistryError> {
+    let at_zero = |s: &Option<AngleSamples>, what: &str| {
+        s.as_ref()
+            .and_then(|s| {
+                s.angle_deg
+                    .iter()
+                    .position(|&a| a == 0.0)
+                    .map(|i| s.value[i])
+            })
+            .ok_or_else(|| RegistryError::AngleTableGlass {
+                glass: label.to_string(),
+                path: PathBuf::from(&m.file.path),
+                detail: format!(
+                    "a layer given by its angle table alone needs {what} at 0° (the layer's normal value)"
+                ),
+            })
+    };
+    let r0 = at_zero(&m.reflectance, "R")?;
+    let t0 = at_zero(&m.transmittance, "T")?;
+    let n = ((2500.0 - 300.0) / GREY_STEP_NM).round() as usize + 1;
+    let wavelength_nm: Vec<f64> = (0..n).map(|i| 300.0 + GREY_STEP_NM * i as f64).collect();
+    let layer = Layer::from_spectra(
+        &m.file.path,
+        wavelength_nm,
+        vec![t0; n],
+        vec![r0; n],
+        vec![r0; n],
+        None,
+        &crate::normal::layer_options(spec),
+    )
+    .map_err(|e| RegistryError::SpectralContent {
+        glass: label.to_string(),
+        path: PathBuf::from(&m.file.path),
+        detail: e.to_string(),
+    })?;
+    Ok(CatalogLayer {
+        layer,
+        source: None,
+    })
+}
+
+/// The layer's model at 0–90° (1° steps) as one broadband value of Rf and T: the WINDOW
+/// photopic average of a spectral layer, channel G of a channel layer.
+fn broadband_model(layer: &Layer) -> Result<(Vec<f64>, Vec<f64>), StackError> {
+    let angles = model_angles_deg();
+    let weights = match &layer.data {
+        LayerData::Spectral { wavelength_nm, .. } => Some(
+            WindowWeights::new(WindowMethod::Photopic, wavelength_nm).map_err(|source| {
+                StackError::Integration {
+                    what: format!("photopic average of layer {}", layer.label),
+                    source: Box::new(source),
+                }
+            })?,
+        ),
+        LayerData::Channels { .. } => None,
+    };
+    let average = |v: &[f64]| match &weights {
+        Some(w) => w.average(v).unwrap_or(0.0),
+        None => v[1],
+    };
+    let (mut r, mut t) = (Vec::new(), Vec::new());
+    for a in angles {
+        let v = layer.values_at(cos_deg(a));
+        r.push(average(&v.rf));
+        t.push(average(&v.t));
+    }
+    Ok((r, t))
+}
+
+/// The unit's records, one per integrator.
+pub(crate) fn build_unit(
+    spec: &GlassSpec,
+    elements: &[ElementSpec],
+    files: &CatalogFiles<'_>,
+    integrators: &[Integrator],
+    opts: &BuildOptions,
+) -> Result<Vec<GlassRecord>, RegistryError> {
+    let glass = format!("{} (\"{}\")", spec.id, spec.name);
+    let catalog = files.catalog_path.to_path_buf();
+    let mut layers: Vec<(usize, &LayerSpec, UnitLayer)> = Vec::new();
+    let mut stack_elements = Vec::with_capacity(elements.len());
+    for (i, e) in elements.iter().enumerate() {
+        match e {
+            ElementSpec::Layer(l) => {
+                let label = element_label(&glass, i + 1, l.line);
+                let unit_layer = read_unit_layer(l, &spec.name, files, &label, opts)?;
+                stack_elements.push(Element::Layer(Box::new(unit_layer.read.layer.clone())));
+                layers.push((i, l, unit_layer));
+            }
+            ElementSpec::Gap {
+                thickness_mm, gas, ..
+            } => stack_elements.push(Element::Gap(Gap {
+                thickness_mm: *thickness_mm,
+                gas: *gas,
+            })),
+        }
+    }
+    let unit_err = |e: StackError| {
+        let line = e
+            .position()
+            .and_then(|p| elements.get(p - 1))
+            .map_or(spec.line, ElementSpec::line);
+        RegistryError::Unit {
+            path: catalog.clone(),
+            line,
+            glass: glass.clone(),
+            source: Box::new(e),
+        }
+    };
+    let stack = Stack::new(stack_elements).map_err(unit_err)?;
+    if layers.len() == 1 {
+        let (_, l, unit_layer) = &layers[0];
+        return one_layer_unit(spec, l, unit_layer, &stack, files, integrators, opts);
+    }
+    let angles = model_angles_deg();
+    let eval_opts = EvalOptions {
+        application: opts.application,
+        combination: Combination::PerWavelength,
+    };
+    let evaluate = |angles: &[f64], integrators: &[Integrator], window: bool| {
+        stack
+            .evaluate(angles, integrators, window, eval_opts)
+            .map_err(|e| match e {
+                StackError::Integration { .. } => integration_error(e, &glass),
+                other => unit_err(other),
+            })
+    };
+    // the colours at every angle; WINDOW's values (recorded at normal incidence) at 0° only
+    let eval = evaluate(&angles, integrators, false)?;
+    let at_normal = evaluate(&[0.0], &[], true)?;
+    let luminous = match stack.spectra_at(0.0).map_err(unit_err)? {
+        Some(s) => {
+            let lum = |v: &[f64], what: &str| {
+                glassdb_spectral::luminous_iso9050(&s.wavelength_nm, v).map_err(|source| {
+                    RegistryError::Integration {
+                        glass: glass.clone(),
+                        what: format!("luminous {what}"),
+                        source: Box::new(source),
+                    }
+                })
+            };
+            Some(LuminousRecord {
+                transmittance: lum(&s.optics.t, "transmittance")?,
+                reflectance: lum(&s.optics.rf, "reflectance")?,
+                reflectance_back: lum(&s.optics.rb, "back reflectance")?,
+            })
+        }
+        None => None,
+    };
+    let system = |o: Option<&Vec<Optics<f64>>>| {
+        o.map(|v| SystemValues {
+            transmittance: v[0].t,
+            reflectance: v[0].rf,
+            reflectance_back: v[0].rb,
+        })
+    };
+    let mut records = Vec::with_capacity(integrators.len());
+    for (k, integrator) in integrators.iter().enumerate() {
+        let per_angle = &eval.colour[k];
+        let row = |f: &dyn Fn(&Optics<[f64; 3]>) -> [f64; 3]| -> Vec<[f64; 3]> {
+            per_angle.iter().map(f).collect()
+        };
+        let clamp = |v: [f64; 3]| v.map(|x| x.clamp(0.0, 1.0));
+        let normal = crate::normal::NormalValues {
+            r0: clamp(per_angle[0].rf),
+            t0: clamp(per_angle[0].t),
+            r0_back: clamp(per_angle[0].rb),
+        };
+        let mut tables = ModelTables {
+            angles: angles.clone(),
+            rf: row(&|o| o.rf),
+            t: row(&|o| o.t),
+            rb: row(&|o| o.rb),
+        };
+        tables.rf[0] = normal.r0;
+        tables.t[0] = normal.t0;
+        tables.rb[0] = normal.r0_back;
+        let curves = fit_glass_curves(&normal, &tables, None, opts, &glass)?;
+        let n_groups = stack.groups().len();
+        let mut groups = Vec::with_capacity(n_groups);
+        for (g, group) in stack.groups().iter().enumerate() {
+            let share = |front: bool| -> Result<([f64; 3], [crate::AngleCurve; 3]), RegistryError> {
+                let mut table = row(&|o| {
+                    if front {
+                        o.share_front[g]
+                    } else {
+                        o.share_back[g]
+                    }
+                });
+                table[0] = clamp(table[0]);
+                // the group facing the light reflects everything at grazing; the others nothing
+                let facing = if front { g == 0 } else { g + 1 == n_groups };
+                let quantity = if facing {
+                    Quantity::Reflectance
+                } else {
+                    Quantity::Transmittance
+                };
+                let name = format!(
+                    "reflectance share of pane group {} ({})",
+                    g + 1,
+                    if front { "front" } else { "back" }
+                );
+                let curves =
+                    fit_share_curves(table[0], &tables, &table, quantity, opts, &glass, &name)?;
+                Ok((table[0], curves))
+            };
+            let (r0, c_r) = share(true)?;
+            let (r0_back, c_r_back) = share(false)?;
+            groups.push(PaneGroupRecord {
+                layers: group.layers.clone().collect(),
+                thickness_mm: group.thickness_mm,
+                depth_mm: group.depth_mm,
+                depth_back_mm: group.depth_back_mm,
+                r0,
+                c_r,
+                r0_back,
+                c_r_back,
+            });
+        }
+        let mut unit_elements = Vec::with_capacity(elements.len());
+        let mut next_layer = layers.iter().enumerate().peekable();
+        for (i, e) in elements.iter().enumerate() {
+            match e {
+                ElementSpec::Gap {
+                    thickness_mm, gas, ..
+                } => unit_elements.push(UnitElement::Gap(GapRecord {
+                    thickness_mm: *thickness_mm,
+                    gas: *gas,
+                })),
+                ElementSpec::Layer(_) => {
+                    let (index, (_, l, unit_layer)) = next_layer.next().expect("one per layer");
+                    debug_assert_eq!(layers[index].0, i);
+                    let absorptance = at_normal.solar.as_ref().map(|s| Absorptance {
+                        front: s[0].absorptance_front[index],
+                        back: s[0].absorptance_back[index],
+                    });
+                    unit_elements.push(UnitElement::Layer(Box::new(layer_record(
+                        l,
+                        unit_layer,
+                        stack.layers().nth(index).expect("layer").thickness_mm,
+                        integrator,
+                        absorptance,
+                        &glass,
+                    )?)));
+                }
+            }
+        }
+        let angle_model = AngleModelRecord {
+            kind: "unit".into(),
+            applied: opts.application.name().to_string(),
+            ior: None,
+            measured_max_angle_deg: None,
+            continued_by: None,
+            chosen_by: format!(
+                "{} layers combined {}",
+                layers.len(),
+                eval.combination.name()
+            ),
+        };
+        let mut record = glass_record(
+            spec,
+            &normal,
+            curves,
+            luminous,
+            angle_model,
+            Provenance::default(),
+        );
+        record.unit = Some(UnitRecord {
+            elements: unit_elements,
+            groups,
+            thickness_mm: stack.thickness_mm(),
+            combined: eval.combination.name().to_string(),
+            photopic: system(at_normal.photopic.as_ref()),
+            solar: system(at_normal.solar.as_ref()),
+        });
+        records.push(record);
+    }
+    Ok(records)
+}
+
+/// One layer's record in its unit (in `integrator`'s basis, as it faces in the unit).
+fn layer_record(
+    spec: &LayerSpec,
+    unit_layer: &UnitLayer,
+    thickness_mm: Option<f64>,
+    integrator: &Integrator,
+    absorptance: Option<Absorptance>,
+    glass: &str,
+) -> Result<UnitLayerRecord, RegistryError> {
+    let layer = &unit_layer.read.layer;
+    let (normal, mut luminous) = normal_values(layer, integrator, glass)?;
+    let normal = oriented(normal, spec.flip);
+    if spec.flip
+        && let Some(l) = &mut luminous
+    {
+        std::mem::swap(&mut l.reflectance, &mut l.reflectance_back);
+    }
+    Ok(UnitLayerRecord {
+        flipped: spec.flip,
+        thickness_mm,
+        model: unit_layer.model_kind.clone(),
+        model_chosen_by: layer.model_reason.clone(),
+        r0: normal.r0,
+        t0: normal.t0,
+        r0_back: normal.r0_back,
+        luminous,
+        absorptance,
+        provenance: Provenance {
+            catalog: None,
+            spectral: unit_layer.read.source.as_ref().map(|s| s.0.clone()),
+            angles: unit_layer.angles_file.clone(),
+            product: unit_layer.read.source.as_ref().map(|s| s.1.clone()),
+        },
+    })
+}
+
+/// A unit of one layer: exactly the single glass's records (turned round when flipped), with
+/// the build-up recorded and one pane group whose shares are the glass's reflectances.
+fn one_layer_unit(
+    spec: &GlassSpec,
+    layer_spec: &LayerSpec,
+    unit_layer: &UnitLayer,
+    stack: &Stack,
+    files: &CatalogFiles<'_>,
+    integrators: &[Integrator],
+    opts: &BuildOptions,
+) -> Result<Vec<GlassRecord>, RegistryError> {
+    let mut single = layer_spec.clone();
+    if let NormalSource::AngleTable = single.normal {
+        let LayerData::Spectral { t, rf, rb, .. } = &unit_layer.read.layer.data else {
+            unreachable!("a grey layer is spectral")
+        };
+        single.normal = NormalSource::Explicit {
+            r0: [rf[0]; 3],
+            t0: [t[0]; 3],
+            r0_back: [rb[0]; 3],
+        };
+    }
+    let glass = format!("{} (\"{}\")", spec.id, spec.name);
+    let mut records = build_glass(spec, &single, files, integrators, opts)?;
+    let group = &stack.groups()[0];
+    for (record, integrator) in records.iter_mut().zip(integrators) {
+        let layer = layer_record(
+            layer_spec,
+            unit_layer,
+            stack.layers().next().and_then(|l| l.thickness_mm),
+            integrator,
+            None,
+            &glass,
+        )?;
+        record.unit = Some(UnitRecord {
+            elements: vec![UnitElement::Layer(Box::new(layer))],
+            groups: vec![PaneGroupRecord {
+                layers: vec![0],
+                thickness_mm: group.thickness_mm,
+                depth_mm: group.depth_mm,
+                depth_back_mm: group.depth_back_mm,
+                r0: record.r0,
+                c_r: record.c_r.clone(),
+                r0_back: record.r0_back,
+                c_r_back: record.c_r_back.clone(),
+            }],
+            thickness_mm: stack.thickness_mm(),
+            combined: Combination::PerWavelength.name().to_string(),
+            photopic: None,
+            solar: None,
+        });
+    }
+    Ok(records)
+}
+
+/// One element of a unit chosen from a catalog's glasses.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ChosenElement {
+    /// A single glass of the catalog, by id, turned round or not.
+    Glass {
+        /// Its catalog id.
+        id: u16,
+        /// Turned round (coating on the other surface).
+        flip: bool,
+    },
+    /// A gap.
+    Gap {
+        /// Thickness (mm).
+        thickness_mm: f64,
+        /// Its gas.
+        gas: Gas,
+    },
+}
+
+/// A unit chosen on a front-end (the viewer's picker): its id and name and its elements,
+/// outside first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnitChoice {
+    /// The id the unit gets.
+    pub id: u16,
+    /// Its name.
+    pub name: String,
+    /// Layers (the catalog's single glasses) and gaps, outside first.
+    pub elements: Vec<ChosenElement>,
+}
+
+/// A catalog loaded once, building units from its single glasses on demand: the entry point
+/// a front-end calls (`glassdb view` builds a unit on the page with it). Each build reads the
+/// chosen glasses' files, runs the stack engine and fits the curves of every table.
+#[derive(Debug)]
+pub struct UnitBuilder {
+    catalog_path: PathBuf,
+    specs: Vec<GlassSpec>,
+    integrators: Vec<Integrator>,
+    opts: BuildOptions,
+}
+
+impl UnitBuilder {
+    /// Loads the catalog and prepares the integrators of `opts.tables`.
+    pub fn new(catalog_path: &Path, opts: BuildOptions) -> Result<UnitBuilder, RegistryError> {
+        let integrators = integrators_of(&opts)?;
+        let (specs, _) = load_catalog(catalog_path)?;
+        Ok(UnitBuilder {
+            catalog_path: catalog_path.to_path_buf(),
+            specs,
+            integrators,
+            opts,
+        })
+    }
+
+    /// The catalog's single glasses (the layers a unit can be built from): id and name.
+    pub fn glasses(&self) -> Vec<(u16, &str)> {
+        self.specs
+            .iter()
+            .filter(|s| matches!(s.build, GlassBuild::Single(_)))
+            .map(|s| (s.id, s.name.as_str()))
+            .collect()
+    }
+
+    /// Builds the chosen unit: a validated registry of one glass in each table of the options.
+    pub fn build(&self, choice: &UnitChoice) -> Result<Registry, RegistryError> {
+        let bad = |message: String| RegistryError::CatalogEntry {
+            path: self.catalog_path.clone(),
+            glass: format!("\"{}\" (id {})", choice.name, choice.id),
+            message,
+        };
+        if choice.id == 0 {
+            return Err(bad("id 0 is \"no glass\" in every mask".into()));
+        }
+        let mut elements = Vec::with_capacity(choice.elements.len());
+        for (i, e) in choice.elements.iter().enumerate() {
+            elements.push(match e {
+                ChosenElement::Gap { thickness_mm, gas } => ElementSpec::Gap {
+                    thickness_mm: *thickness_mm,
+                    gas: *gas,
+                    line: 0,
+                },
+                ChosenElement::Glass { id, flip } => {
+                    let spec = self.specs.iter().find(|s| s.id == *id).ok_or_else(|| {
+                        bad(format!("element {}: the catalog has no glass with id {id}", i + 1))
+                    })?;
+                    let GlassBuild::Single(layer) = &spec.build else {
+                        return Err(bad(format!(
+                            "element {}: glass {id} (\"{}\") is a unit itself; a layer is a single glass",
+                            i + 1,
+                            spec.name
+                        )));
+                    };
+                    let mut layer = layer.clone();
+                    layer.flip = *flip;
+                    layer.line = spec.line;
+                    ElementSpec::Layer(layer)
+                }
+            });
+        }
+        let spec = GlassSpec {
+            id: choice.id,
+            name: choice.name.clone(),
+            line: 0,
+            build: GlassBuild::Unit(elements.clone()),
+        };
+        let files = CatalogFiles {
+            catalog_path: &self.catalog_path,
+        };
+        let records = build_unit(&spec, &elements, &files, &self.integrators, &self.opts).map_err(
+            |e| match e {
+                RegistryError::Unit { glass, source, .. } => RegistryError::UnitChoice {
+                    path: self.catalog_path.clone(),
+                    glass,
+                    source,
+                },
+                other => other,
+            },
+        )?;
+        let tables = self
+            .opts
+            .tables
+            .iter()
+            .zip(records)
+            .map(|(settings, g)| RegistryTable {
+                spectral: *settings,
+                glasses: vec![g],
+            })
+            .collect();
+        Registry::new(tables)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bundled() -> UnitBuilder {
+        let catalog = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/catalog.toml");
+        UnitBuilder::new(&catalog, BuildOptions::default()).unwrap()
+    }
+
+    fn gap() -> ChosenElement {
+        ChosenElement::Gap {
+            thickness_mm: 12.7,
+            gas: Gas::Argon,
+        }
+    }
+
+    fn glass(id: u16) -> ChosenElement {
+        ChosenElement::Glass { id, flip: false }
+    }
+
+    #[test]
+    fn the_viewer_builds_a_unit_from_the_catalogs_glasses() {
+        let b = bundled();
+        assert!(b.glasses().iter().any(|&(id, _)| id == 6));
+        assert!(
+            b.glasses().iter().all(|&(id, _)| id != 11),
+            "units are not layers"
+        );
+        let choice = UnitChoice {
+            id: 300,
+            name: "R67 | argon | clear 6".into(),
+            elements: vec![glass(6), gap(), glass(2)],
+        };
+        let reg = b.build(&choice).unwrap();
+        let g = reg.default_table().glass(300).unwrap();
+        let unit = g.unit.as_ref().unwrap();
+        assert_eq!(unit.groups.len(), 2);
+        assert_eq!(unit.elements.len(), 3);
+        // the same unit in the bundled catalog (id 12) has the same optics
+        let bundled = crate::default_registry().unwrap();
+        let twelve = bundled.default_table().glass(12).unwrap();
+        assert_eq!(
+            (g.r0, g.t0, g.r0_back),
+            (twelve.r0, twelve.t0, twelve.r0_back)
+        );
+    }
+
+    #[test]
+    fn bad_choices_say_what_is_wrong() {
+        let b = bundled();
+        let build = |elements: Vec<ChosenElement>| {
+            let choice = UnitChoice {
+                id: 300,
+                name: "bad".into(),
+                elements,
+            };
+            glassdb_io::ErrorChain(&b.build(&choice).unwrap_err()).to_string()
+        };
+        let e = build(vec![glass(99)]);
+        assert!(e.contains("no glass with id 99"), "{e}");
+        let e = build(vec![glass(11)]);
+        assert!(e.contains("is a unit itself"), "{e}");
+        let e = build(vec![glass(2), gap(), gap(), glass(2)]);
+        assert!(e.contains("two gaps in a row") && !e.contains(":0:"), "{e}");
+        let e = build(vec![glass(2), gap()]);
+        assert!(e.contains("gap at the inner end"), "{e}");
+        let e = build(vec![glass(20), gap(), glass(2)]);
+        assert!(e.contains("is opaque but layer 3"), "{e}");
+    }
+}
