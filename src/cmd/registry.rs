@@ -7,11 +7,11 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use glassdb_registry::{
-    AngleCurve, Application, BuildOptions, ColourBasis, GlassRecord, MaskIds, Registry,
-    SCHEMA_VERSION, Side, UnitElement, UnitRecord,
+    AngleCurve, Application, BuildOptions, ColourBasis, GlassRecord, MaskIds, NamedLight, Registry,
+    Side, UnitElement, UnitRecord,
 };
 use glassdb_spectral::{
-    Illuminant, IntegrationSettings, Method, MethodKind, Observer, RgbCmf, RgbSpace,
+    Illuminant, IntegrationSettings, Method, MethodKind, Observer, RgbCmf, RgbSpace, WhiteBalance,
 };
 
 #[derive(Debug, clap::Args)]
@@ -50,9 +50,21 @@ pub struct BuildArgs {
     /// Observer for --method colorimetric: cie1931 or cie1964.
     #[arg(long, default_value = "cie1931")]
     pub observer: String,
-    /// Illuminant for --method colorimetric: D65, A or E.
-    #[arg(long, default_value = "D65")]
-    pub illuminant: String,
+    /// Illuminant for --method colorimetric [default: D65]: D50, D55, D65, D75, A, E,
+    /// FL1–FL12, LED-B1…B5, LED-BH1, LED-RGB1, LED-V1, LED-V2, or an SPD CSV file
+    /// (wavelength_nm,power). For several lights, use --light instead.
+    #[arg(long, value_name = "NAME|FILE.csv")]
+    pub illuminant: Option<String>,
+    /// A named light, NAME=ILLUMINANT (e.g. sun=D65, warm=A, led=LED-B3, lamp=lamp.csv):
+    /// one table per space is built under each light, the first light the default; each table
+    /// names its light (the light group it is for). Repeatable.
+    #[arg(long = "light", value_name = "NAME=ILLUMINANT")]
+    pub lights: Vec<String>,
+    /// The white the camera is balanced to: `light` (each light renders white: CAT02 from the
+    /// light's own white) or a CIE illuminant (D65: every light renders in its own colour, as
+    /// lamps do in a render balanced to daylight) [default: light].
+    #[arg(long, value_name = "light|NAME")]
+    pub white_balance: Option<WhiteBalance>,
     /// RGB working space(s) for --method colorimetric, comma-separated: srgb (alias rec709),
     /// rec2020, acescg, aces2065-1, display-p3, xyz. One table per space, the first the
     /// default; compose picks the one its passes are in. Default: srgb.
@@ -83,6 +95,9 @@ pub struct ShowArgs {
     /// registry's first table).
     #[arg(long, value_name = "SPACE")]
     pub space: Option<ColourBasis>,
+    /// The light whose table to show (default: the registry's first light).
+    #[arg(long, value_name = "NAME")]
+    pub light: Option<String>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -120,13 +135,28 @@ fn table_settings(a: &BuildArgs) -> anyhow::Result<Vec<IntegrationSettings>> {
                 "--space {space}: only --method colorimetric integrates into an RGB space (--method {kind} has its own channels)"
             );
         }
+        if !a.lights.is_empty() || a.illuminant.is_some() || a.white_balance.is_some() {
+            anyhow::bail!(
+                "--light, --illuminant and --white-balance apply to --method colorimetric (--method {kind} has no illuminant)"
+            );
+        }
         return Ok(vec![with(match kind {
             MethodKind::Paper => Method::Paper(parse::<RgbCmf>(&a.cmf, "cmf")?),
             _ => Method::Luminous,
         })]);
     }
     let observer = parse::<Observer>(&a.observer, "observer")?;
-    let illuminant = parse::<Illuminant>(&a.illuminant, "illuminant")?;
+    if !a.lights.is_empty() && a.illuminant.is_some() {
+        anyhow::bail!(
+            "--illuminant with --light: give each light's illuminant in --light NAME=ILLUMINANT"
+        );
+    }
+    let illuminant = match &a.illuminant {
+        Some(text) => Illuminant::from_name_or_file(text)
+            .map_err(anyhow::Error::new)
+            .context("--illuminant")?,
+        None => Illuminant::default(),
+    };
     let mut spaces: Vec<RgbSpace> = Vec::new();
     for name in a.space.as_deref().unwrap_or("srgb").split(',') {
         let space = parse::<RgbSpace>(name.trim(), "space")?;
@@ -140,8 +170,9 @@ fn table_settings(a: &BuildArgs) -> anyhow::Result<Vec<IntegrationSettings>> {
         .map(|space| {
             with(Method::Colorimetric {
                 observer,
-                illuminant,
+                illuminant: illuminant.clone(),
                 space,
+                white_balance: a.white_balance.unwrap_or_default(),
             })
         })
         .collect())
@@ -154,12 +185,28 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     if a.max_degree == 0 || a.max_degree > 20 {
         anyhow::bail!("--max-degree must be 1–20, got {}", a.max_degree);
     }
-    // The catalog, every spectral file and angle table it names, and the masks.
+    let tables = table_settings(&a)?;
+    let lights = a
+        .lights
+        .iter()
+        .map(|arg| NamedLight::parse(arg))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(anyhow::Error::new)
+        .context("--light")?;
+    // The catalog, every spectral file and angle table it names, the masks and the lights'
+    // SPD files.
     let mut inputs = glassdb_registry::catalog_inputs(&a.catalog).map_err(anyhow::Error::new)?;
     inputs.extend(a.masks.iter().cloned());
+    inputs.extend(a.illuminant.iter().map(PathBuf::from));
+    inputs.extend(
+        a.lights
+            .iter()
+            .filter_map(|l| l.split_once('=').map(|(_, i)| PathBuf::from(i))),
+    );
     glassdb_io::refuse_input_as_output(&a.output, inputs.iter().map(PathBuf::as_path))?;
     let opts = BuildOptions {
-        tables: table_settings(&a)?,
+        tables,
+        lights,
         mask_ids: mask_ids(&a.masks)?,
         fit_tol: a.tol,
         max_degree: a.max_degree,
@@ -218,18 +265,25 @@ fn rgb(v: &[f64; 3]) -> String {
 fn show(a: ShowArgs) -> anyhow::Result<ExitCode> {
     let registry = Registry::from_json_file(&a.registry).map_err(anyhow::Error::new)?;
     let side = if a.back { Side::Back } else { Side::Front };
-    let table = registry
-        .table_or_error(a.space, &a.registry.display().to_string())
-        .map_err(anyhow::Error::new)?;
+    let source = a.registry.display().to_string();
+    let table = match &a.light {
+        Some(light) => {
+            let basis = a.space.unwrap_or_else(|| registry.default_table().basis());
+            registry.table_under(basis, light, &source)
+        }
+        None => registry.table_or_error(a.space, &source),
+    }
+    .map_err(anyhow::Error::new)?;
     outln!(
-        "{}: schema {SCHEMA_VERSION}, {}, {} glasses",
+        "{}: schema {}, {}, {} glasses",
         a.registry.display(),
+        registry.schema_version(),
         tables_text(&registry),
         table.glasses.len()
     );
     outln!(
         "showing the {} table (spectral method {}); values per channel in it",
-        table.basis(),
+        table.label(),
         method_text(&table.spectral)
     );
     if a.back {
@@ -243,30 +297,52 @@ fn show(a: ShowArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The tables a registry holds, e.g. `2 tables: srgb (default), acescg`.
+/// The tables a registry holds, e.g. `2 tables: srgb (default), acescg`, or with lights
+/// `4 tables: srgb (default), acescg × lights sun (D65, default), warm (A)`.
 fn tables_text(registry: &Registry) -> String {
     let bases: Vec<String> = registry.bases().iter().map(ToString::to_string).collect();
-    match bases.as_slice() {
-        [one] => format!("1 table: {one}"),
-        [first, rest @ ..] => format!(
-            "{} tables: {first} (default), {}",
-            bases.len(),
-            rest.join(", ")
-        ),
-        [] => "no table".to_string(),
+    let spaces = match bases.as_slice() {
+        [one] => one.clone(),
+        [first, rest @ ..] => format!("{first} (default), {}", rest.join(", ")),
+        [] => String::new(),
+    };
+    let n = registry.tables().len();
+    let tables = format!("{n} table{}", if n == 1 { "" } else { "s" });
+    if registry.default_light().is_none() {
+        return format!("{tables}: {spaces}");
     }
+    let lights: Vec<String> = registry
+        .lights()
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            let described = l.describe();
+            match (k, described.strip_suffix(')')) {
+                (0, Some(open)) => format!("{open}, default)"),
+                _ => described,
+            }
+        })
+        .collect();
+    format!("{tables}: {spaces} × lights {}", lights.join(", "))
 }
 
-/// The method and its options, e.g. `colorimetric cie1931 D65 srgb`.
+/// The method and its options, e.g. `colorimetric cie1931 D65 srgb` (and the camera's white
+/// balance when it is not the light's own).
 fn method_text(s: &IntegrationSettings) -> String {
     let kind = s.method.kind();
-    match s.method {
+    match &s.method {
         Method::Paper(cmf) => format!("{kind} {cmf}"),
         Method::Colorimetric {
             observer,
             illuminant,
             space,
-        } => format!("{kind} {observer} {illuminant} {space}"),
+            white_balance,
+        } => match white_balance {
+            WhiteBalance::Light => format!("{kind} {observer} {illuminant} {space}"),
+            WhiteBalance::Fixed(w) => {
+                format!("{kind} {observer} {illuminant} {space}, camera balanced to {w}")
+            }
+        },
         Method::Luminous => kind.to_string(),
     }
 }
@@ -418,8 +494,9 @@ fn check(a: CheckArgs) -> anyhow::Result<ExitCode> {
     for path in &a.registries {
         match Registry::from_json_file(path) {
             Ok(r) => outln!(
-                "{}: ok (schema {SCHEMA_VERSION}, {} glasses, {})",
+                "{}: ok (schema {}, {} glasses, {})",
                 path.display(),
+                r.schema_version(),
                 r.default_table().glasses.len(),
                 tables_text(&r)
             ),

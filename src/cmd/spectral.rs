@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use glassdb_spectral::{
     Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, Observer, ReadOptions,
-    RgbCmf, RgbSpace, SpectralData, luminous, read_spectral_file,
+    RgbCmf, RgbSpace, SpectralData, WhiteBalance, luminous, read_spectral_file,
 };
 use serde_json::{Value, json};
 
@@ -35,16 +35,6 @@ pub enum CmfArg {
 pub enum ObserverArg {
     Cie1931,
     Cie1964,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum IlluminantArg {
-    #[value(name = "D65", alias = "d65")]
-    D65,
-    #[value(name = "A", alias = "a")]
-    A,
-    #[value(name = "E", alias = "e")]
-    E,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -93,9 +83,17 @@ pub struct SpectralSettingsArgs {
     /// Standard observer for --method colorimetric [default: cie1931].
     #[arg(long, value_enum)]
     pub observer: Option<ObserverArg>,
-    /// Illuminant for --method colorimetric [default: D65].
-    #[arg(long, value_enum)]
-    pub illuminant: Option<IlluminantArg>,
+    /// Illuminant for --method colorimetric [default: D65]: D50, D55, D65, D75, A, E,
+    /// FL1–FL12 (alias F1–F12), LED-B1…B5, LED-BH1, LED-RGB1, LED-V1, LED-V2, or a light's
+    /// spectrum as a CSV file (wavelength_nm,power).
+    #[arg(long, value_name = "NAME|FILE.csv")]
+    pub illuminant: Option<String>,
+    /// The white the camera is balanced to, for --method colorimetric: `light` (the
+    /// illuminant's own white: it renders white; colour-science's default) or a CIE
+    /// illuminant (D65: the illuminant renders in its own colour, as a lamp does in a render
+    /// balanced to daylight) [default: light].
+    #[arg(long, value_name = "light|NAME")]
+    pub white_balance: Option<WhiteBalance>,
     /// Linear RGB working space for --method colorimetric [default: srgb].
     #[arg(long, value_enum)]
     pub space: Option<SpaceArg>,
@@ -139,13 +137,15 @@ impl SpectralSettingsArgs {
 
     /// The library's [`Method`], refusing options that do not apply to the chosen method.
     pub fn method(&self) -> anyhow::Result<Method> {
-        let colorimetric_flags =
-            self.observer.is_some() || self.illuminant.is_some() || self.space.is_some();
+        let colorimetric_flags = self.observer.is_some()
+            || self.illuminant.is_some()
+            || self.space.is_some()
+            || self.white_balance.is_some();
         Ok(match self.method {
             MethodArg::Paper => {
                 if colorimetric_flags {
                     bail!(
-                        "--observer, --illuminant and --space apply to --method colorimetric, not paper"
+                        "--observer, --illuminant, --white-balance and --space apply to --method colorimetric, not paper"
                     );
                 }
                 Method::Paper(match self.cmf.unwrap_or(CmfArg::WrightGuild1931) {
@@ -163,18 +163,20 @@ impl SpectralSettingsArgs {
                         ObserverArg::Cie1931 => Observer::Cie1931,
                         ObserverArg::Cie1964 => Observer::Cie1964,
                     },
-                    illuminant: match self.illuminant.unwrap_or(IlluminantArg::D65) {
-                        IlluminantArg::D65 => Illuminant::D65,
-                        IlluminantArg::A => Illuminant::A,
-                        IlluminantArg::E => Illuminant::E,
+                    illuminant: match &self.illuminant {
+                        Some(text) => Illuminant::from_name_or_file(text)
+                            .map_err(anyhow::Error::new)
+                            .context("--illuminant")?,
+                        None => Illuminant::default(),
                     },
                     space: self.space.unwrap_or(SpaceArg::Srgb).space(),
+                    white_balance: self.white_balance.unwrap_or_default(),
                 }
             }
             MethodArg::Luminous => {
                 if colorimetric_flags || self.cmf.is_some() {
                     bail!(
-                        "--cmf, --observer, --illuminant and --space do not apply to --method luminous"
+                        "--cmf, --observer, --illuminant, --white-balance and --space do not apply to --method luminous"
                     );
                 }
                 Method::Luminous
@@ -194,7 +196,7 @@ struct QuantityResult {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let settings = args.settings.settings()?;
-    let method = settings.method;
+    let method = settings.method.clone();
     let data = read_spectral_file(&args.file, &args.settings.read_options())
         .map_err(anyhow::Error::new)?;
     let integrator = Integrator::new(&settings)?;
@@ -281,19 +283,21 @@ fn check_channel_balance(data: &SpectralData, results: &[QuantityResult]) -> any
 }
 
 fn to_json(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> Value {
-    let (cmf, observer, illuminant, space) = match method {
-        Method::Paper(c) => (Some(c.name()), None, None, None),
+    let (cmf, observer, illuminant, space, white_balance) = match method {
+        Method::Paper(c) => (Some(c.name()), None, None, None, None),
         Method::Colorimetric {
             observer,
             illuminant,
             space,
+            white_balance,
         } => (
             None,
             Some(observer.name()),
             Some(illuminant.name()),
             Some(space.name()),
+            Some(white_balance.name()),
         ),
-        Method::Luminous => (None, None, None, None),
+        Method::Luminous => (None, None, None, None, None),
     };
     let name = method.kind().name();
     let mut obj = json!({
@@ -302,6 +306,7 @@ fn to_json(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> 
         "observer": observer,
         "illuminant": illuminant,
         "space": space,
+        "white_balance": white_balance,
         "file": data.source,
         "product": data.product,
     });

@@ -7,9 +7,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use glassdb_spectral::{
-    IntegrationSettings, Integrator, Method, Observer, WindowMethod, read_spectral_file,
-};
+use glassdb_spectral::{IntegrationSettings, Integrator, Method, WindowMethod, read_spectral_file};
 use glassdb_stack::{
     Application, Combination, Element, EvalOptions, Evaluation, Gap, Gas, Layer, LayerOptions,
     ModelChoice, Optics, Stack,
@@ -64,6 +62,14 @@ pub struct Args {
     /// The linear RGB space of the colours shown.
     #[arg(long, value_enum, default_value = "srgb")]
     pub space: SpaceArg,
+    /// The light of the colours shown: a CIE illuminant (D65, A, FL2, LED-B3, …) or an SPD
+    /// CSV file (wavelength_nm,power) [default: D65].
+    #[arg(long, value_name = "NAME|FILE.csv")]
+    pub illuminant: Option<String>,
+    /// The white the camera is balanced to: `light` (the illuminant's own) or a CIE
+    /// illuminant [default: light].
+    #[arg(long, value_name = "light|NAME")]
+    pub white_balance: Option<glassdb_spectral::WhiteBalance>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -220,22 +226,27 @@ impl StackArgs {
     }
 }
 
-/// The colorimetric integrator of a space (CIE 1931, D65).
-pub fn colour_settings(space: SpaceArg) -> IntegrationSettings {
-    IntegrationSettings {
-        method: Method::Colorimetric {
-            observer: Observer::Cie1931,
-            illuminant: glassdb_spectral::Illuminant::D65,
-            space: space.space(),
-        },
-        extrapolate: false,
+/// The colorimetric integrator of the colours shown (CIE 1931; D65 unless `--illuminant`).
+fn colour_settings(args: &Args) -> anyhow::Result<IntegrationSettings> {
+    let illuminant = match &args.illuminant {
+        Some(text) => glassdb_spectral::Illuminant::from_name_or_file(text)
+            .map_err(anyhow::Error::new)
+            .context("--illuminant")?,
+        None => Default::default(),
+    };
+    let mut settings = IntegrationSettings::colorimetric(args.space.space(), illuminant);
+    if let (Some(wb), Method::Colorimetric { white_balance, .. }) =
+        (args.white_balance, &mut settings.method)
+    {
+        *white_balance = wb;
     }
+    Ok(settings)
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let angles = crate::cmd::fit::parse_angles(&args.angles)?;
     let built = args.stack.build()?;
-    let settings = colour_settings(args.space);
+    let settings = colour_settings(&args)?;
     let integrator = Integrator::new(&settings)?;
     let eval = built
         .stack
@@ -291,12 +302,18 @@ fn to_json(
     layer_photopic: &[Option<Vec<[f64; 3]>>],
     settings: &IntegrationSettings,
 ) -> Value {
-    let space = match settings.method {
-        Method::Colorimetric { space, .. } => space.name(),
-        _ => "",
-    };
     let mut rgb = optics_json(&eval.colour[0], false);
-    rgb["space"] = json!(space);
+    if let Method::Colorimetric {
+        space,
+        illuminant,
+        white_balance,
+        ..
+    } = &settings.method
+    {
+        rgb["space"] = json!(space.name());
+        rgb["illuminant"] = json!(illuminant.name());
+        rgb["white_balance"] = json!(white_balance.name());
+    }
     let mut layers = Vec::new();
     for ((l, origin), own) in built
         .stack

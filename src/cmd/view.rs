@@ -147,10 +147,7 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
 /// each of its spaces, so that passes in any of those spaces find their table.
 fn registry_from_catalog(catalog: &std::path::Path) -> anyhow::Result<glassdb_registry::Registry> {
     let bundled = glassdb_registry::default_registry()?;
-    let opts = glassdb_registry::BuildOptions {
-        tables: bundled.tables().iter().map(|t| t.spectral).collect(),
-        ..Default::default()
-    };
+    let opts = glassdb_registry::BuildOptions::with_tables_of(&bundled);
     glassdb_registry::build_registry(catalog, &opts)
         .map_err(anyhow::Error::new)
         .with_context(|| format!("building the candidates from {}", catalog.display()))

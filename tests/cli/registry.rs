@@ -112,7 +112,7 @@ fn missing_catalog_and_non_utf8_catalog_are_errors() {
     let catalog = explicit_catalog(dir.path(), &[1]);
     let err = fails(&mut build(&catalog, &out, &["--method", "magic"]));
     assert!(err.contains("--method"), "{err}");
-    let err = fails(&mut build(&catalog, &out, &["--illuminant", "F2"]));
+    let err = fails(&mut build(&catalog, &out, &["--illuminant", "F99"]));
     assert!(err.contains("--illuminant"), "{err}");
     assert!(!out.exists());
 }

@@ -182,12 +182,11 @@ pub struct ChosenTable {
 }
 
 impl RegistryLuts {
-    /// Lookup tables for every table of `registry` (built when first used).
+    /// Lookup tables for every table of `registry`'s default light (built when first used).
     pub fn new(registry: &Registry) -> RegistryLuts {
         RegistryLuts {
             tables: registry
-                .tables()
-                .iter()
+                .default_light_tables()
                 .map(|t| (t.basis(), LazyLut::Table(t.clone(), OnceLock::new())))
                 .collect(),
         }

@@ -171,6 +171,7 @@ fn linear_registry() -> Registry {
     let lin = curve(vec![1], vec![1.0]);
     let one = curve(vec![0], vec![1.0]);
     Registry::single(RegistryTable {
+        light: None,
         spectral: IntegrationSettings {
             method: Method::Luminous,
             extrapolate: false,

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glassdb_registry::{BuildOptions, ChosenElement, UnitBuilder, UnitChoice, build_registry};
-use glassdb_spectral::{IntegrationSettings, Method, Observer, RgbSpace};
+use glassdb_spectral::{IntegrationSettings, RgbSpace};
 use glassdb_stack::Gas;
 
 fn glazing() -> PathBuf {
@@ -30,14 +30,7 @@ fn glazing() -> PathBuf {
 fn tables(spaces: &[RgbSpace]) -> Vec<IntegrationSettings> {
     spaces
         .iter()
-        .map(|&space| IntegrationSettings {
-            method: Method::Colorimetric {
-                observer: Observer::Cie1931,
-                illuminant: glassdb_spectral::Illuminant::D65,
-                space,
-            },
-            extrapolate: false,
-        })
+        .map(|&space| IntegrationSettings::colorimetric(space, Default::default()))
         .collect()
 }
 

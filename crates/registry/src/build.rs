@@ -39,6 +39,10 @@ pub struct BuildOptions {
     /// The spectral method of each table to build, the default table first (one per colour
     /// basis: e.g. colorimetric in linear Rec.709 and in ACEScg).
     pub tables: Vec<IntegrationSettings>,
+    /// Named lights: when given, every table of `tables` is built under each light (the
+    /// light's illuminant replacing the table's), light by light, the first light the default;
+    /// each table then names its light. Empty: one table per entry of `tables`, naming none.
+    pub lights: Vec<crate::NamedLight>,
     /// With the ids of a scene's masks, only those glasses are built.
     pub mask_ids: Option<MaskIds>,
     /// Fit tolerance on r and t (absolute), in (0, [`glassdb_fit::MAX_CURVE_TOLERANCE`]]: it
@@ -54,6 +58,7 @@ impl Default for BuildOptions {
     fn default() -> Self {
         BuildOptions {
             tables: vec![IntegrationSettings::default()],
+            lights: Vec::new(),
             mask_ids: None,
             fit_tol: glassdb_fit::DEFAULT_TOL,
             max_degree: 12,
@@ -138,7 +143,7 @@ pub fn catalog_inputs(catalog_path: &Path) -> Result<Vec<PathBuf>, RegistryError
 /// Builds a registry from a catalog file (paths in it are relative to the catalog; the
 /// catalog's provenance records `catalog_path` as given).
 pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Registry, RegistryError> {
-    let integrators = integrators_of(opts)?;
+    let (mut tables, integrators) = integrators_of(opts)?;
     let (specs, catalog_sha) = load_catalog(catalog_path)?;
     let wanted = wanted_ids(&specs, catalog_path, opts.mask_ids.as_ref())?;
     let catalog_ref = FileRef {
@@ -146,14 +151,6 @@ pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Regist
         sha256: catalog_sha,
     };
     let files = CatalogFiles { catalog_path };
-    let mut tables: Vec<RegistryTable> = opts
-        .tables
-        .iter()
-        .map(|settings| RegistryTable {
-            spectral: *settings,
-            glasses: Vec::new(),
-        })
-        .collect();
     let chosen: Vec<&GlassSpec> = specs
         .iter()
         .filter(|spec| wanted.as_ref().is_none_or(|w| w.contains(&spec.id)))
@@ -192,8 +189,11 @@ fn spec_layers(spec: &GlassSpec) -> Vec<&LayerSpec> {
     }
 }
 
-/// One integrator per table of the build, checking the fit tolerance first.
-pub(crate) fn integrators_of(opts: &BuildOptions) -> Result<Vec<Integrator>, RegistryError> {
+/// The empty tables of the build ([`crate::lights::planned_tables`]) and one integrator per
+/// table, checking the fit tolerance first.
+pub(crate) fn integrators_of(
+    opts: &BuildOptions,
+) -> Result<(Vec<RegistryTable>, Vec<Integrator>), RegistryError> {
     let max = glassdb_fit::MAX_CURVE_TOLERANCE;
     if !(opts.fit_tol > 0.0 && opts.fit_tol <= max) {
         return Err(RegistryError::FitTolerance {
@@ -201,12 +201,14 @@ pub(crate) fn integrators_of(opts: &BuildOptions) -> Result<Vec<Integrator>, Reg
             max,
         });
     }
-    opts.tables
+    let tables = crate::lights::planned_tables(opts)?;
+    let integrators = tables
         .iter()
-        .map(|settings| {
-            Integrator::new(settings).map_err(|e| RegistryError::SpectralMethod(Box::new(e)))
+        .map(|t| {
+            Integrator::new(&t.spectral).map_err(|e| RegistryError::SpectralMethod(Box::new(e)))
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    Ok((tables, integrators))
 }
 
 /// One catalog entry's record in each table (one per integrator).

@@ -30,6 +30,12 @@ pub enum RegistryError {
         expected: u32,
     },
 
+    /// A registry file of an older schema whose tables use lights (schema 5's).
+    #[error(
+        "{source_name}: schema {found} has no lights, but a table names a light, an SPD or a white balance (schema 5)"
+    )]
+    LightsInOldSchema { source_name: String, found: u32 },
+
     /// A registry with no table.
     #[error("{source_name}: the registry has no table (`tables` needs at least one)")]
     NoTables { source_name: String },
@@ -42,7 +48,96 @@ pub enum RegistryError {
         have: Vec<String>,
     },
 
-    /// Two tables in one colour basis: a compositor could not tell which to use.
+    /// The registry has no light of the name asked for; `have` lists its lights (empty when
+    /// its tables name none: a registry built under one unnamed illuminant).
+    #[error(
+        "{source_name} has no light `{wanted}` ({})",
+        if have.is_empty() {
+            format!("its tables name no light: they are integrated under one unnamed illuminant, {unnamed}")
+        } else {
+            format!("its lights: {}", have.join(", "))
+        }
+    )]
+    NoSuchLight {
+        source_name: String,
+        wanted: String,
+        have: Vec<String>,
+        /// The illuminant of the unnamed light (when `have` is empty).
+        unnamed: String,
+    },
+
+    /// A light's name that a compositor could not match to a light group.
+    #[error("{source_name}: light name `{name}`: {reason}")]
+    LightName {
+        source_name: String,
+        name: String,
+        reason: String,
+    },
+
+    /// Some tables name their light and others do not.
+    #[error(
+        "{source_name}: table {named} names light `{light}` but table {unnamed} names none; either every table names its light or none does"
+    )]
+    LightsMixed {
+        source_name: String,
+        named: usize,
+        light: String,
+        unnamed: usize,
+    },
+
+    /// A light lacks a table in a colour basis that another light has.
+    #[error(
+        "{source_name}: light `{light}` has no {basis} table but light `{other}` has one; every light needs a table in every space"
+    )]
+    LightMissingTable {
+        source_name: String,
+        light: String,
+        basis: String,
+        other: String,
+    },
+
+    /// Two tables of one light are integrated under different illuminants (or observers, or
+    /// white balances): a light name must mean one spectrum.
+    #[error(
+        "{source_name}: light `{light}` is {first} in one table and {second} in another; a light is one spectrum"
+    )]
+    LightInconsistent {
+        source_name: String,
+        light: String,
+        first: String,
+        second: String,
+    },
+
+    /// A named light on a table whose method has no illuminant.
+    #[error(
+        "{source_name}: light `{light}` on a table of the {method} method, which has no illuminant; lights name the illuminant of colorimetric tables"
+    )]
+    LightNotColorimetric {
+        source_name: String,
+        light: String,
+        method: String,
+    },
+
+    /// A build with lights whose spectral method has no illuminant.
+    #[error("lights apply to the colorimetric method only; the {method} method has no illuminant")]
+    LightsNeedColorimetric { method: String },
+
+    /// The same light name twice in a build.
+    #[error("light `{name}` is given twice")]
+    DuplicateLight { name: String },
+
+    /// A light given as `NAME=ILLUMINANT` that is not of that form, or whose illuminant cannot
+    /// be read; the spectral error (a bad SPD file) is the source.
+    #[error("light `{arg}`: {message}")]
+    LightSpec {
+        arg: String,
+        message: String,
+        #[source]
+        source: Option<Box<glassdb_spectral::SpectralError>>,
+    },
+
+    /// Two tables in one colour basis (under one light): a compositor could not tell which to
+    /// use.
     #[error("{source_name}: two tables in {basis}: {first} and {second}; keep one table per space")]
     DuplicateTable {
         source_name: String,

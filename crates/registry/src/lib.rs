@@ -6,6 +6,9 @@
 //!
 //! - [`Registry`]: the JSON schema, loading with validation, and atomic writing.
 //! - [`GlassRecord::eval`]: what the compositor tabulates.
+//! - Lights ([`NamedLight`], [`Registry::lights`], [`Registry::table_under`]): one table per
+//!   (colour basis, light), so that each light group of a render is composited with its own
+//!   light's table.
 //! - [`build_registry`]: catalog → registry; [`default_registry`]: the bundled, prebuilt
 //!   `data/registry.json`.
 //! - Units: a catalog entry with `layers` is built by the stack engine (`glassdb-stack`) into
@@ -18,6 +21,7 @@ mod bundled;
 pub mod catalog;
 mod curves;
 mod error;
+mod lights;
 mod normal;
 mod record;
 mod unit;
@@ -33,10 +37,12 @@ pub use bundled::{DEFAULT_REGISTRY_JSON, DEFAULT_REGISTRY_NAME, default_registry
 pub use error::RegistryError;
 /// The cap on every curve's recorded validation tolerance (shared with fit files).
 pub use glassdb_fit::MAX_CURVE_TOLERANCE;
+pub use lights::{MAX_LIGHT_NAME, NamedLight, RegistryLight, check_light_name};
 pub use record::{
     AngleCurve, AngleModelRecord, CHANNELS, ColourBasis, FileRef, GlassRecord, LuminousRecord,
     ProductRecord, Provenance, Registry, RegistryTable, SCHEMA_VERSION,
-    SCHEMA_VERSION_BEFORE_UNITS, SCHEMA_VERSION_ONE_TABLE, Side, UnknownSide,
+    SCHEMA_VERSION_BEFORE_LIGHTS, SCHEMA_VERSION_BEFORE_UNITS, SCHEMA_VERSION_ONE_TABLE, Side,
+    UnknownSide,
 };
 pub use unit::{ChosenElement, UnitBuilder, UnitChoice};
 pub use unit_record::{

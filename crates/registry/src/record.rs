@@ -1,4 +1,4 @@
-//! The registry JSON (schema 4): types, loading, and the evaluation the compositor uses
+//! The registry JSON (schema 5): types, loading, and the evaluation the compositor uses
 //! (method.md eqs. 11–14: `r(θ) = r0·C_r(θ)`, `t(θ) = t0·C_t(θ)`, per channel).
 
 use std::fmt;
@@ -11,13 +11,21 @@ use serde::{Deserialize, Serialize};
 
 use crate::RegistryError;
 
-/// The registry schema version this crate writes. Schema 4: a glass may be a unit
-/// ([`GlassRecord::unit`]: its build-up, per-layer values and per-pane-group reflectances);
-/// schema 3 (the same without units) is read as it is; schema 2 (one table, `spectral` and
-/// `glasses` at the top) is read as a registry of one table. Curves are the fit crate's
-/// [`CosPolynomial`] (basis `paper` or `full`, strictly ascending powers) and [`FitSummary`];
-/// the spectral method is [`IntegrationSettings`].
-pub const SCHEMA_VERSION: u32 = 4;
+/// The newest registry schema this crate reads and writes. Schema 5: a table may name the
+/// light it is integrated under ([`RegistryTable::light`]), its illuminant may be an SPD from a
+/// file (with the samples) and its method may fix the camera's white balance; a registry that
+/// uses none of these is written as schema 4, byte for byte as before lights
+/// ([`Registry::schema_version`]). Schema 4: a glass may be a unit ([`GlassRecord::unit`]: its
+/// build-up, per-layer values and per-pane-group reflectances); schema 3 (the same without
+/// units) is read as it is; schema 2 (one table, `spectral` and `glasses` at the top) is read
+/// as a registry of one table. Curves are the fit crate's [`CosPolynomial`] (basis `paper` or
+/// `full`, strictly ascending powers) and [`FitSummary`]; the spectral method is
+/// [`IntegrationSettings`].
+pub const SCHEMA_VERSION: u32 = 5;
+
+/// The schema before lights (one light, a CIE illuminant), still read and still written for
+/// registries without lights.
+pub const SCHEMA_VERSION_BEFORE_LIGHTS: u32 = 4;
 
 /// The schema before units (one table per colour basis), still read.
 pub const SCHEMA_VERSION_BEFORE_UNITS: u32 = 3;
@@ -37,9 +45,15 @@ pub struct Registry {
     tables: Vec<RegistryTable>,
 }
 
-/// The glasses of a registry integrated with one spectral method (one colour basis).
+/// The glasses of a registry integrated with one spectral method (one colour basis) under one
+/// light.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RegistryTable {
+    /// The light the table is integrated under, by the name a scene's light groups use
+    /// (`sun`, `warm`); `None` in a registry of one unnamed light (every registry built without
+    /// lights). Its spectrum is the method's illuminant.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light: Option<String>,
     /// The spectral method that turned spectra into per-channel values.
     pub spectral: IntegrationSettings,
     /// The glasses, sorted by id.
@@ -97,6 +111,27 @@ impl RegistryTable {
             Method::Paper(_) => ColourBasis::PaperRgb,
             Method::Luminous => ColourBasis::Luminous,
         }
+    }
+
+    /// What the table is for messages: its basis, and its light when named (`acescg, light
+    /// warm`).
+    pub fn label(&self) -> String {
+        match &self.light {
+            Some(light) => format!("{}, light {light}", self.basis()),
+            None => self.basis().to_string(),
+        }
+    }
+
+    /// Whether the table needs schema 5: a named light, an SPD illuminant or a fixed white
+    /// balance.
+    pub(crate) fn uses_lights(&self) -> bool {
+        self.light.is_some()
+            || matches!(
+                &self.spectral.method,
+                Method::Colorimetric { illuminant, white_balance, .. }
+                    if matches!(illuminant, glassdb_spectral::Illuminant::Spd(_))
+                        || *white_balance != glassdb_spectral::WhiteBalance::Light
+            )
     }
 
     /// The glass with this registration id.
@@ -390,7 +425,7 @@ impl GlassRecord {
     }
 }
 
-/// The JSON form of schemas 3 and 4.
+/// The JSON form of schemas 3, 4 and 5.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RegistryJson {
@@ -418,8 +453,8 @@ impl Registry {
     }
 
     /// A registry of several tables, the first the default; validated
-    /// ([`Registry::validate`]): at least one table, one per colour basis, the same glasses
-    /// (ids and names) in each.
+    /// ([`Registry::validate`]): at least one table, one per colour basis and light, the same
+    /// glasses (ids and names) in each.
     pub fn new(tables: Vec<RegistryTable>) -> Result<Registry, RegistryError> {
         let registry = Registry { tables };
         registry.validate()?;
@@ -448,13 +483,14 @@ impl Registry {
         &mut self.tables
     }
 
-    /// The table in this colour basis, if the registry holds one.
+    /// The default light's table in this colour basis, if the registry holds one
+    /// ([`Registry::table_under`] for another light).
     pub fn table(&self, basis: ColourBasis) -> Option<&RegistryTable> {
-        self.tables.iter().find(|t| t.basis() == basis)
+        self.default_light_tables().find(|t| t.basis() == basis)
     }
 
-    /// The table in `basis`, or the default table for `None`; an error naming the registry
-    /// and the bases it holds when it has no such table.
+    /// The default light's table in `basis`, or the default table for `None`; an error naming
+    /// the registry and the bases it holds when it has no such table.
     pub fn table_or_error(
         &self,
         basis: Option<ColourBasis>,
@@ -470,9 +506,12 @@ impl Registry {
         })
     }
 
-    /// The colour bases held, in table order.
+    /// The colour bases held (by the default light's tables, and so by every light's), in
+    /// table order.
     pub fn bases(&self) -> Vec<ColourBasis> {
-        self.tables.iter().map(RegistryTable::basis).collect()
+        self.default_light_tables()
+            .map(RegistryTable::basis)
+            .collect()
     }
 
     /// Reads and validates a registry JSON file.
@@ -502,14 +541,23 @@ impl Registry {
         };
         let version: VersionOnly = serde_json::from_str(json).map_err(json_err)?;
         let tables = match version.schema {
-            SCHEMA_VERSION | SCHEMA_VERSION_BEFORE_UNITS => {
-                serde_json::from_str::<RegistryJson>(json)
+            SCHEMA_VERSION | SCHEMA_VERSION_BEFORE_LIGHTS | SCHEMA_VERSION_BEFORE_UNITS => {
+                let tables = serde_json::from_str::<RegistryJson>(json)
                     .map_err(json_err)?
-                    .tables
+                    .tables;
+                if version.schema < SCHEMA_VERSION && tables.iter().any(RegistryTable::uses_lights)
+                {
+                    return Err(RegistryError::LightsInOldSchema {
+                        source_name: source_name.to_string(),
+                        found: version.schema,
+                    });
+                }
+                tables
             }
             SCHEMA_VERSION_ONE_TABLE => {
                 let one: OneTableJson = serde_json::from_str(json).map_err(json_err)?;
                 vec![RegistryTable {
+                    light: None,
                     spectral: one.spectral,
                     glasses: one.glasses,
                 }]
@@ -533,7 +581,18 @@ impl Registry {
         Ok(crate::build::sha256_hex(self.to_json_string()?.as_bytes()))
     }
 
-    /// The registry as pretty JSON text (schema 4).
+    /// The schema the registry is written with: 5 when a table uses lights (a named light, an
+    /// SPD illuminant or a fixed white balance), else 4, so that a registry without lights is
+    /// written exactly as before lights and older builds still read it.
+    pub fn schema_version(&self) -> u32 {
+        if self.tables.iter().any(RegistryTable::uses_lights) {
+            SCHEMA_VERSION
+        } else {
+            SCHEMA_VERSION_BEFORE_LIGHTS
+        }
+    }
+
+    /// The registry as pretty JSON text ([`Registry::schema_version`]).
     pub fn to_json_string(&self) -> Result<String, RegistryError> {
         #[derive(Serialize)]
         struct RegistryJsonOut<'a> {
@@ -541,7 +600,7 @@ impl Registry {
             tables: &'a [RegistryTable],
         }
         let json = RegistryJsonOut {
-            schema: SCHEMA_VERSION,
+            schema: self.schema_version(),
             tables: &self.tables,
         };
         let mut s = serde_json::to_string_pretty(&json).map_err(RegistryError::Serialize)?;
@@ -584,6 +643,7 @@ mod tests {
         let cr = curve(vec![0, 1, 2], vec![10.0, -18.0, 9.0]);
         let ct = curve(vec![1], vec![1.0]);
         Registry::single(RegistryTable {
+            light: None,
             spectral: IntegrationSettings::default(),
             glasses: vec![GlassRecord::with_shared_curves(
                 4,
@@ -708,10 +768,10 @@ mod tests {
             e.starts_with("x.json:") && e.matches("line 1").count() == 1,
             "{e}"
         );
-        let e = Registry::from_json_str("{\"schema\": 5}", "y.json")
+        let e = Registry::from_json_str("{\"schema\": 6}", "y.json")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("schema 5 is not supported"), "{e}");
+        assert!(e.contains("schema 6 is not supported"), "{e}");
         // A schema-1 file says what to do, without naming command-line flags (the binary adds
         // the exact command).
         let err =
@@ -721,7 +781,7 @@ mod tests {
                 err,
                 RegistryError::SchemaVersion {
                     found: 1,
-                    expected: 4,
+                    expected: 5,
                     ..
                 }
             ),
@@ -741,14 +801,7 @@ mod tests {
 
     fn in_space(reg: &Registry, space: RgbSpace) -> RegistryTable {
         let mut t = reg.default_table().clone();
-        t.spectral = IntegrationSettings {
-            method: Method::Colorimetric {
-                observer: glassdb_spectral::Observer::Cie1931,
-                illuminant: glassdb_spectral::Illuminant::D65,
-                space,
-            },
-            extrapolate: false,
-        };
+        t.spectral = IntegrationSettings::colorimetric(space, Default::default());
         t
     }
 

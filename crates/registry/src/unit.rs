@@ -512,6 +512,8 @@ pub struct UnitChoice {
 pub struct UnitBuilder {
     catalog_path: PathBuf,
     specs: Vec<GlassSpec>,
+    /// The tables a build makes, empty.
+    tables: Vec<RegistryTable>,
     integrators: Vec<Integrator>,
     opts: BuildOptions,
 }
@@ -519,11 +521,12 @@ pub struct UnitBuilder {
 impl UnitBuilder {
     /// Loads the catalog and prepares the integrators of `opts.tables`.
     pub fn new(catalog_path: &Path, opts: BuildOptions) -> Result<UnitBuilder, RegistryError> {
-        let integrators = integrators_of(&opts)?;
+        let (tables, integrators) = integrators_of(&opts)?;
         let (specs, _) = load_catalog(catalog_path)?;
         Ok(UnitBuilder {
             catalog_path: catalog_path.to_path_buf(),
             specs,
+            tables,
             integrators,
             opts,
         })
@@ -594,13 +597,12 @@ impl UnitBuilder {
             },
         )?;
         let tables = self
-            .opts
             .tables
             .iter()
             .zip(records)
-            .map(|(settings, g)| RegistryTable {
-                spectral: *settings,
+            .map(|(table, g)| RegistryTable {
                 glasses: vec![g],
+                ..table.clone()
             })
             .collect();
         Registry::new(tables)

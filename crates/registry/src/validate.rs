@@ -18,8 +18,9 @@ const VALIDATION_EPS: f64 = 1e-9;
 
 impl Registry {
     /// Validates every table ([`RegistryTable::validate_named`]) and how they fit together:
-    /// at least one table, one table per colour basis, and the same glasses (ids and names,
-    /// in order) in each.
+    /// at least one table, one table per colour basis and light, the same glasses (ids and
+    /// names, in order) in each, and the lights' rules (every table names its light or none
+    /// does; one spectrum per light; every light in every basis).
     pub fn validate(&self) -> Result<(), RegistryError> {
         self.validate_named("registry")
     }
@@ -39,15 +40,18 @@ impl Registry {
         let first_ids = ids(first);
         for (k, t) in tables.iter().enumerate() {
             let name = if several {
-                format!("{source_name} (table {}: {})", k + 1, t.basis())
+                format!("{source_name} (table {}: {})", k + 1, t.label())
             } else {
                 source_name.to_string()
             };
             t.validate_named(&name)?;
-            if let Some(earlier) = tables[..k].iter().find(|e| e.basis() == t.basis()) {
+            if let Some(earlier) = tables[..k]
+                .iter()
+                .find(|e| e.basis() == t.basis() && e.light == t.light)
+            {
                 return Err(RegistryError::DuplicateTable {
                     source_name: source_name.to_string(),
-                    basis: t.basis().to_string(),
+                    basis: t.label(),
                     first: earlier.spectral.method.to_string(),
                     second: t.spectral.method.to_string(),
                 });
@@ -55,14 +59,14 @@ impl Registry {
             if k > 0 && ids(t) != first_ids {
                 return Err(RegistryError::TablesDiffer {
                     source_name: source_name.to_string(),
-                    first: first.basis().to_string(),
-                    other: t.basis().to_string(),
+                    first: first.label(),
+                    other: t.label(),
                     first_glasses: first_ids.iter().map(label).collect(),
                     other_glasses: ids(t).iter().map(label).collect(),
                 });
             }
         }
-        Ok(())
+        self.validate_lights(source_name)
     }
 }
 

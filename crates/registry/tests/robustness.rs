@@ -67,6 +67,7 @@ proptest! {
         }
         // Validation either accepts or gives an error; it never panics.
         let reg = Registry::single(RegistryTable {
+            light: None,
             spectral: IntegrationSettings { method: Method::Luminous, extrapolate: false },
             glasses: vec![g],
         });

@@ -150,7 +150,7 @@ fn spectral_rows(catalog: &Path) -> Result<Vec<SpectralRow>, ReportError> {
                     values,
                 )?);
             }
-            let srgb = integrate(srgb_settings, &data, values)?;
+            let srgb = integrate(srgb_settings.clone(), &data, values)?;
             let luminous = luminous_iso9050(&data.wavelength_nm, values)?;
             rows.push(SpectralRow {
                 glass: format!("{} {}", spec.id, spec.name),

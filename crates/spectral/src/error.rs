@@ -156,9 +156,13 @@ pub enum SpectralError {
 
     /// The reference white of a method has a zero (or negative) channel, so no ratio exists.
     #[error(
-        "the illuminant's {channel} channel in this colour space is {value}: no per-channel ratio exists"
+        "illuminant {illuminant}: its {channel} channel in this colour space is {value}: no per-channel ratio exists (a light needs power in every channel)"
     )]
-    DegenerateWhite { channel: &'static str, value: f64 },
+    DegenerateWhite {
+        illuminant: String,
+        channel: &'static str,
+        value: f64,
+    },
 
     /// An embedded reference table failed to parse (a build defect, reported rather than panicking).
     #[error("embedded table {table} is corrupt: {message}")]

@@ -8,6 +8,9 @@
 //!   binary files are refused by name ([`UnsupportedKind`]).
 //! - [`Integrator`]: built once from [`IntegrationSettings`], then cheap per spectrum
 //!   ([`Integrator::channels`]).
+//! - [`Illuminant`]: the light, a bundled [`CieIlluminant`] (D series, A, E, FL1–FL12, the
+//!   CIE 15:2018 LED series) or an [`Spd`] read from a CSV file ([`read_spd_file`]), and
+//!   [`WhiteBalance`], the white the camera is balanced to.
 //! - [`luminous_iso9050`]: visible transmittance/reflectance, D65 × V(λ), 380–780 nm at 10 nm.
 //! - [`WindowWeights`] / [`window_average`]: WINDOW's NFRC 300-2003 photopic and solar
 //!   averages, computed as pywincalc 3.3.1 computes them (linear interpolation, trapezoids).
@@ -19,8 +22,11 @@
 //! agree with it to 1e-9 relative; the differences where colour is wrong are in
 //! `docs/spectral.md`.
 
+#[macro_use]
+mod names;
 mod balance;
 mod error;
+mod illuminant;
 mod integrate;
 mod interp;
 mod read;
@@ -36,9 +42,13 @@ pub use balance::{
 };
 pub use error::{SpectralError, UnsupportedKind};
 pub use glassdb_colour::{CHROMATICITIES_TOLERANCE, RgbSpace, rgb_to_rgb, xyz_to_rgb};
+pub use illuminant::{
+    CieIlluminant, Illuminant, LIGHT_RANGE_NM, MAX_SPD_SAMPLES, Spd, WhiteBalance, read_spd_bytes,
+    read_spd_file,
+};
 pub use integrate::{
-    GridIntegrator, Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind,
-    Observer, RgbCmf, luminous, luminous_iso9050, rgb_matrix,
+    GridIntegrator, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind, Observer,
+    RgbCmf, luminous, luminous_iso9050, rgb_matrix,
 };
 pub use interp::resample;
 pub use read::{

@@ -1,17 +1,31 @@
-//! The CIE reference tables, embedded in the binary (`data/cie/`, exported bit-exactly from
-//! colour-science 0.4.7; provenance and licences in `data/cie/README.md`).
+//! The CIE reference tables, embedded in the binary (`data/cie/` and `data/illuminants/`,
+//! exported bit-exactly from colour-science 0.4.7; provenance and licences in each folder's
+//! README).
 
 use std::sync::{Arc, OnceLock};
 
 use crate::error::SpectralError;
+use crate::illuminant::CieIlluminant;
+use crate::integrate::Observer;
 
 const CIE_1931: &str = include_str!("../../../data/cie/cie_1931_2deg_xyz_cmfs.csv");
 const CIE_1964: &str = include_str!("../../../data/cie/cie_1964_10deg_xyz_cmfs.csv");
-const D65: &str = include_str!("../../../data/cie/illuminant_d65.csv");
-const ILL_A: &str = include_str!("../../../data/cie/illuminant_a.csv");
 const WG_1931: &str = include_str!("../../../data/cie/wright_guild_1931_2deg_rgb_cmfs.csv");
 const SB_1955: &str = include_str!("../../../data/cie/stiles_burch_1955_2deg_rgb_cmfs.csv");
 const SB_1959: &str = include_str!("../../../data/cie/stiles_burch_1959_10deg_rgb_cmfs.csv");
+
+/// The bundled illuminants' files, in [`CieIlluminant::ALL`]'s order.
+macro_rules! illuminant_files {
+    ($($name:literal),+ $(,)?) => {
+        [$(($name, include_str!(concat!("../../../data/illuminants/", $name, ".csv")))),+]
+    };
+}
+const ILLUMINANTS: [(&str, &str); 27] = illuminant_files!(
+    "D50", "D55", "D65", "D75", "A", "E", "FL1", "FL2", "FL3", "FL4", "FL5", "FL6", "FL7", "FL8",
+    "FL9", "FL10", "FL11", "FL12", "LED-B1", "LED-B2", "LED-B3", "LED-B4", "LED-B5", "LED-BH1",
+    "LED-RGB1", "LED-V1", "LED-V2",
+);
+const WHITES: &str = include_str!("../../../data/illuminants/whites.csv");
 
 /// A table of one or three functions of wavelength on an ascending grid.
 #[derive(Debug, Clone)]
@@ -58,25 +72,24 @@ impl Table {
     pub fn index_of(&self, wavelength_nm: f64) -> Option<usize> {
         self.wavelength_nm.iter().position(|&w| w == wavelength_nm)
     }
+}
 
-    /// colour's `LinearInterpolator` (numpy `interp`) at `t`, end values held outside.
-    pub fn linear(&self, column: usize, t: f64) -> f64 {
-        let x = &self.wavelength_nm;
-        let y = &self.columns[column];
-        let n = x.len();
-        if t <= x[0] {
-            return y[0];
-        }
-        if t >= x[n - 1] {
-            return y[n - 1];
-        }
-        let j = x.partition_point(|&w| w <= t) - 1;
-        if x[j] == t {
-            return y[j];
-        }
-        let slope = (y[j + 1] - y[j]) / (x[j + 1] - x[j]);
-        slope * (t - x[j]) + y[j]
+/// colour's `LinearInterpolator` (numpy `interp`) of the samples `(x, y)` at `t` (`x`
+/// strictly increasing, at least one sample), end values held outside them.
+pub(crate) fn linear_at(x: &[f64], y: &[f64], t: f64) -> f64 {
+    let n = x.len();
+    if t <= x[0] {
+        return y[0];
     }
+    if t >= x[n - 1] {
+        return y[n - 1];
+    }
+    let j = x.partition_point(|&w| w <= t) - 1;
+    if x[j] == t {
+        return y[j];
+    }
+    let slope = (y[j + 1] - y[j]) / (x[j + 1] - x[j]);
+    slope * (t - x[j]) + y[j]
 }
 
 /// All embedded tables, parsed once.
@@ -84,8 +97,10 @@ impl Table {
 pub(crate) struct Tables {
     pub cie_1931: Table,
     pub cie_1964: Table,
-    pub d65: Table,
-    pub a: Table,
+    /// The bundled illuminants, in [`CieIlluminant::ALL`]'s order.
+    pub illuminants: Vec<Table>,
+    /// Each illuminant's white in CIE xy, per observer (`Observer as usize`).
+    pub whites: Vec<[[f64; 2]; 2]>,
     pub wright_guild_1931: Table,
     pub stiles_burch_1955: Table,
     pub stiles_burch_1959: Table,
@@ -100,8 +115,11 @@ pub(crate) fn tables() -> Result<&'static Tables, SpectralError> {
             Ok(Tables {
                 cie_1931: Table::parse("cie_1931_2deg_xyz_cmfs.csv", CIE_1931, 3)?,
                 cie_1964: Table::parse("cie_1964_10deg_xyz_cmfs.csv", CIE_1964, 3)?,
-                d65: Table::parse("illuminant_d65.csv", D65, 1)?,
-                a: Table::parse("illuminant_a.csv", ILL_A, 1)?,
+                illuminants: ILLUMINANTS
+                    .iter()
+                    .map(|(name, text)| Table::parse(name, text, 1))
+                    .collect::<Result<_, _>>()?,
+                whites: parse_whites()?,
                 wright_guild_1931: Table::parse("wright_guild_1931_2deg_rgb_cmfs.csv", WG_1931, 3)?,
                 stiles_burch_1955: Table::parse("stiles_burch_1955_2deg_rgb_cmfs.csv", SB_1955, 3)?,
                 stiles_burch_1959: Table::parse(
@@ -121,6 +139,30 @@ pub(crate) fn tables() -> Result<&'static Tables, SpectralError> {
         })
 }
 
+/// `whites.csv`: `illuminant,observer,x,y`, a row for every bundled illuminant and observer.
+fn parse_whites() -> Result<Vec<[[f64; 2]; 2]>, SpectralError> {
+    let corrupt = |message: String| SpectralError::EmbeddedTable {
+        table: "whites.csv",
+        message,
+    };
+    let mut whites = vec![[[f64::NAN; 2]; 2]; CieIlluminant::ALL.len()];
+    for (i, line) in WHITES.lines().enumerate().skip(1) {
+        let fields: Vec<&str> = line.split(',').collect();
+        let row = || corrupt(format!("line {}", i + 1));
+        let [name, observer, x, y] = fields.as_slice() else {
+            return Err(row());
+        };
+        let illuminant = name.parse::<CieIlluminant>().map_err(|_| row())?;
+        let observer = observer.parse::<Observer>().map_err(|_| row())?;
+        let xy = [x, y].map(|v| v.parse::<f64>().unwrap_or(f64::NAN));
+        whites[illuminant.index()][observer as usize] = xy;
+    }
+    if whites.iter().flatten().flatten().any(|v| !v.is_finite()) {
+        return Err(corrupt("an illuminant or observer has no white".into()));
+    }
+    Ok(whites)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -137,19 +179,48 @@ mod tests {
         };
         assert_eq!(shape(&t.cie_1931), (360.0, 830.0, 471));
         assert_eq!(shape(&t.cie_1964), (360.0, 830.0, 471));
-        assert_eq!(shape(&t.d65), (300.0, 780.0, 97));
-        assert_eq!(shape(&t.a), (300.0, 780.0, 97));
+        let d65 = &t.illuminants[CieIlluminant::D65.index()];
+        assert_eq!(shape(d65), (300.0, 780.0, 97));
+        assert_eq!(
+            shape(&t.illuminants[CieIlluminant::A.index()]),
+            (300.0, 780.0, 97)
+        );
+        assert_eq!(
+            shape(&t.illuminants[CieIlluminant::E.index()]),
+            (360.0, 830.0, 95)
+        );
+        for led in [
+            CieIlluminant::Fl1,
+            CieIlluminant::Fl12,
+            CieIlluminant::LedV2,
+        ] {
+            assert_eq!(shape(&t.illuminants[led.index()]), (380.0, 780.0, 81));
+        }
         assert_eq!(shape(&t.wright_guild_1931), (380.0, 780.0, 81));
         assert_eq!(shape(&t.stiles_burch_1955), (390.0, 730.0, 69));
         assert_eq!(shape(&t.stiles_burch_1959), (390.0, 830.0, 89));
         // D65 is normalised to 100 at 560 nm; ȳ peaks at 1 near 555 nm (CIE 15).
-        assert_eq!(t.d65.columns[0][t.d65.index_of(560.0).unwrap()], 100.0);
+        assert_eq!(d65.columns[0][d65.index_of(560.0).unwrap()], 100.0);
         assert_eq!(
             t.cie_1931.columns[1][t.cie_1931.index_of(555.0).unwrap()],
             1.0
         );
         // Linear interpolation: D65 at 362 nm lies 2/5 of the way from 360 to 365.
-        let (d360, d365) = (t.d65.columns[0][12], t.d65.columns[0][13]);
-        assert!((t.d65.linear(0, 362.0) - (d360 + 0.4 * (d365 - d360))).abs() < 1e-12);
+        let (d360, d365) = (d65.columns[0][12], d65.columns[0][13]);
+        assert!(
+            (linear_at(&d65.wavelength_nm, &d65.columns[0], 362.0) - (d360 + 0.4 * (d365 - d360)))
+                .abs()
+                < 1e-12
+        );
+        // Every illuminant has a white for both observers; D65's is the spaces' D65 exactly.
+        assert_eq!(t.whites.len(), CieIlluminant::ALL.len());
+        for (name, illuminant) in ILLUMINANTS.iter().map(|f| f.0).zip(CieIlluminant::ALL) {
+            assert_eq!(name, illuminant.name());
+        }
+        assert_eq!(
+            t.whites[CieIlluminant::D65.index()][Observer::Cie1931 as usize],
+            glassdb_colour::D65_XY
+        );
+        assert_eq!(t.whites[CieIlluminant::LedB3.index()][0], [0.3756, 0.3723]);
     }
 }

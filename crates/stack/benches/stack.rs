@@ -8,7 +8,7 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glassdb_spectral::{
-    IntegrationSettings, Integrator, Method, Observer, ReadOptions, RgbSpace, read_spectral_file,
+    IntegrationSettings, Integrator, ReadOptions, RgbSpace, read_spectral_file,
 };
 use glassdb_stack::{Element, Gap, Gas, Layer, LayerOptions, Stack};
 
@@ -40,14 +40,10 @@ fn bench(c: &mut Criterion) {
     let integrators: Vec<Integrator> = [RgbSpace::Srgb, RgbSpace::AcesCg, RgbSpace::Rec2020]
         .into_iter()
         .map(|space| {
-            Integrator::new(&IntegrationSettings {
-                method: Method::Colorimetric {
-                    observer: Observer::Cie1931,
-                    illuminant: glassdb_spectral::Illuminant::D65,
-                    space,
-                },
-                extrapolate: false,
-            })
+            Integrator::new(&IntegrationSettings::colorimetric(
+                space,
+                Default::default(),
+            ))
             .expect("integrator")
         })
         .collect();

@@ -14,7 +14,7 @@ use crate::figure::{Cell, GridFigure};
 use crate::plots::fit::{REFLECTANCE_COLOUR, TRANSMITTANCE_COLOUR};
 
 /// Options of the spectral figure.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct SpectralPlotOptions {
     pub settings: IntegrationSettings,
     pub read: ReadOptions,

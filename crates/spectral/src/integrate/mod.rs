@@ -10,7 +10,6 @@
 
 use std::cell::RefCell;
 use std::fmt;
-use std::str::FromStr;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 
@@ -18,9 +17,10 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SpectralError;
+use crate::illuminant::{CieIlluminant, Illuminant, WhiteBalance, xy_of};
 use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, sprague_kernel, validate};
 use crate::tables::{Table, tables};
-use glassdb_colour::{D65_XY, RgbSpace, cat02, xyz_to_rgb};
+use glassdb_colour::{RgbSpace, cat02, xyz_to_rgb};
 
 /// The RGB colour-matching functions of the paper's method (eqs. 15–20).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -47,19 +47,8 @@ pub enum Observer {
     Cie1964,
 }
 
-/// Illuminant the glass is lit by (colorimetric method).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum Illuminant {
-    /// CIE D65 daylight (CIE 15:2004, 300–780 nm at 5 nm, linearly interpolated).
-    D65,
-    /// CIE A, incandescent 2856 K.
-    A,
-    /// Equal energy.
-    E,
-}
-
 /// How a spectrum becomes three numbers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// The paper's eqs. 15–20: `∫ρ·c̄ dλ / ∫c̄ dλ` per RGB CMF channel, on the CMF's own grid.
@@ -67,13 +56,18 @@ pub enum Method {
     /// below the smallest: that is the formula, not a defect.
     Paper(RgbCmf),
     /// `RGB(value × illuminant) / RGB(illuminant)` per channel, XYZ through the observer over
-    /// 360–780 nm at 1 nm, then CAT02 from the illuminant's white to the space's white (identity
-    /// when they are equal, and for [`RgbSpace::Xyz`]) and the space's XYZ→RGB matrix
-    /// ([`rgb_matrix`]).
+    /// 360–780 nm at 1 nm, then CAT02 from the white the camera is balanced to (by default the
+    /// illuminant's own) to the space's white (identity when they are equal, and for
+    /// [`RgbSpace::Xyz`]) and the space's XYZ→RGB matrix ([`rgb_matrix`]).
     Colorimetric {
+        /// The CIE standard observer.
         observer: Observer,
+        /// The light the glass is seen under.
         illuminant: Illuminant,
+        /// The linear RGB space of the channels.
         space: RgbSpace,
+        /// The white the camera is balanced to: where the adaptation starts.
+        white_balance: WhiteBalance,
     },
     /// ISO 9050 / EN 410 luminous value (D65 × V(λ), 380–780 nm at 10 nm) in all three channels.
     Luminous,
@@ -90,7 +84,7 @@ pub enum MethodKind {
 
 impl Method {
     /// The method's kind (its name without options).
-    pub fn kind(self) -> MethodKind {
+    pub fn kind(&self) -> MethodKind {
         match self {
             Method::Paper(_) => MethodKind::Paper,
             Method::Colorimetric { .. } => MethodKind::Colorimetric,
@@ -109,19 +103,27 @@ impl fmt::Display for Method {
                 observer,
                 illuminant,
                 space,
-            } => write!(
-                f,
-                "colorimetric, {observer} observer, illuminant {illuminant}, {space} (linear)"
-            ),
+                white_balance,
+            } => {
+                write!(
+                    f,
+                    "colorimetric, {observer} observer, illuminant {illuminant}, {space} (linear)"
+                )?;
+                match white_balance {
+                    WhiteBalance::Light => Ok(()),
+                    WhiteBalance::Fixed(w) => write!(f, ", camera balanced to {w}"),
+                }
+            }
             Method::Luminous => f.write_str("luminous (ISO 9050: D65 × V(λ), 380–780 nm at 10 nm)"),
         }
     }
 }
 
 /// Everything an [`Integrator`] needs. Its JSON form is one flat object: `method` (a
-/// [`MethodKind`]), that method's options (`cmf`; `observer`, `illuminant`, `space`; absent
-/// ones take their defaults) and `extrapolate` (default false).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+/// [`MethodKind`]), that method's options (`cmf`; `observer`, `illuminant`, `space`,
+/// `white_balance`; absent ones take their defaults, and `white_balance` is written only when it
+/// is not `light`) and `extrapolate` (default false).
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(into = "SettingsJson", try_from = "SettingsJson")]
 pub struct IntegrationSettings {
     pub method: Method,
@@ -135,8 +137,25 @@ impl Default for IntegrationSettings {
         IntegrationSettings {
             method: Method::Colorimetric {
                 observer: Observer::Cie1931,
-                illuminant: Illuminant::D65,
+                illuminant: Illuminant::default(),
                 space: RgbSpace::Srgb,
+                white_balance: WhiteBalance::Light,
+            },
+            extrapolate: false,
+        }
+    }
+}
+
+impl IntegrationSettings {
+    /// The colorimetric method in `space` under `illuminant` (CIE 1931 observer, camera
+    /// balanced to the light, no extrapolation).
+    pub fn colorimetric(space: RgbSpace, illuminant: Illuminant) -> IntegrationSettings {
+        IntegrationSettings {
+            method: Method::Colorimetric {
+                observer: Observer::Cie1931,
+                illuminant,
+                space,
+                white_balance: WhiteBalance::Light,
             },
             extrapolate: false,
         }
@@ -144,7 +163,7 @@ impl Default for IntegrationSettings {
 }
 
 /// The flat JSON form of [`IntegrationSettings`].
-#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SettingsJson {
     method: MethodKind,
@@ -156,6 +175,8 @@ struct SettingsJson {
     illuminant: Option<Illuminant>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     space: Option<RgbSpace>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    white_balance: Option<WhiteBalance>,
     #[serde(default)]
     extrapolate: bool,
 }
@@ -168,6 +189,7 @@ impl From<IntegrationSettings> for SettingsJson {
             observer: None,
             illuminant: None,
             space: None,
+            white_balance: None,
             extrapolate: s.extrapolate,
         };
         match s.method {
@@ -176,10 +198,13 @@ impl From<IntegrationSettings> for SettingsJson {
                 observer,
                 illuminant,
                 space,
+                white_balance,
             } => {
                 json.observer = Some(observer);
                 json.illuminant = Some(illuminant);
                 json.space = Some(space);
+                json.white_balance =
+                    (white_balance != WhiteBalance::Light).then_some(white_balance);
             }
             Method::Luminous => {}
         }
@@ -192,11 +217,14 @@ impl TryFrom<SettingsJson> for IntegrationSettings {
 
     /// Refuses options of another method (e.g. `cmf` with `colorimetric`).
     fn try_from(j: SettingsJson) -> Result<IntegrationSettings, String> {
-        let colorimetric = j.observer.is_some() || j.illuminant.is_some() || j.space.is_some();
+        let colorimetric = j.observer.is_some()
+            || j.illuminant.is_some()
+            || j.space.is_some()
+            || j.white_balance.is_some();
         let method = match j.method {
             MethodKind::Paper if colorimetric => {
                 return Err(
-                    "observer, illuminant and space apply to method colorimetric, not paper".into(),
+                    "observer, illuminant, space and white_balance apply to method colorimetric, not paper".into(),
                 );
             }
             MethodKind::Paper => Method::Paper(j.cmf.unwrap_or(RgbCmf::WrightGuild1931)),
@@ -205,12 +233,13 @@ impl TryFrom<SettingsJson> for IntegrationSettings {
             }
             MethodKind::Colorimetric => Method::Colorimetric {
                 observer: j.observer.unwrap_or(Observer::Cie1931),
-                illuminant: j.illuminant.unwrap_or(Illuminant::D65),
+                illuminant: j.illuminant.unwrap_or_default(),
                 space: j.space.unwrap_or(RgbSpace::Srgb),
+                white_balance: j.white_balance.unwrap_or_default(),
             },
             MethodKind::Luminous if colorimetric || j.cmf.is_some() => {
                 return Err(
-                    "cmf, observer, illuminant and space do not apply to method luminous".into(),
+                    "cmf, observer, illuminant, space and white_balance do not apply to method luminous".into(),
                 );
             }
             MethodKind::Luminous => Method::Luminous,
@@ -249,9 +278,9 @@ impl Integrator {
     /// Builds the integrator: loads the embedded tables and precomputes the weights.
     pub fn new(settings: &IntegrationSettings) -> Result<Self, SpectralError> {
         let t = tables()?;
-        let (grid_nm, weights, label) = match settings.method {
+        let (grid_nm, weights, label) = match &settings.method {
             Method::Paper(cmf) => {
-                let table = match cmf {
+                let table = match *cmf {
                     RgbCmf::WrightGuild1931 => &t.wright_guild_1931,
                     RgbCmf::StilesBurch1955 => &t.stiles_burch_1955,
                     RgbCmf::StilesBurch1959 => &t.stiles_burch_1959,
@@ -270,21 +299,27 @@ impl Integrator {
                 observer,
                 illuminant,
                 space,
+                white_balance,
             } => {
-                let cmfs = match observer {
-                    Observer::Cie1931 => &t.cie_1931,
-                    Observer::Cie1964 => &t.cie_1964,
-                };
                 let grid: Vec<f64> = (360..=780).map(f64::from).collect();
-                let xyz_weights = xyz_weights(cmfs, illuminant_on(&grid, illuminant)?, &grid)?;
-                let m = rgb_matrix(observer, illuminant, space);
+                let xyz_weights = xyz_weights_of(*observer, illuminant, &grid)?;
                 let white_xyz = xyz_weights
                     .iter()
                     .fold(Vector3::zeros(), |acc, w| acc + Vector3::from(*w));
+                // The adaptation starts from the white the camera is balanced to: the light's
+                // own (tabulated for a CIE illuminant, integrated above for an SPD) or a fixed one.
+                let from_white = match (white_balance, illuminant) {
+                    (WhiteBalance::Light, Illuminant::Spd(_)) => {
+                        xy_of([white_xyz[0], white_xyz[1], white_xyz[2]])
+                    }
+                    _ => white_balance.white_xy(illuminant, *observer)?,
+                };
+                let m = rgb_matrix(from_white, *space);
                 let white_rgb = m * white_xyz;
                 for (c, name) in ["red", "green", "blue"].iter().enumerate() {
                     if white_rgb[c].is_nan() || white_rgb[c] <= 1e-12 * white_xyz[1].abs() {
                         return Err(SpectralError::DegenerateWhite {
+                            illuminant: illuminant.name().to_owned(),
                             channel: name,
                             value: white_rgb[c],
                         });
@@ -301,16 +336,13 @@ impl Integrator {
                         ]
                     })
                     .collect();
-                (
-                    grid,
-                    weights,
-                    format!(
-                        "the colorimetric method ({}, {}, {})",
-                        observer.name(),
-                        illuminant.name(),
-                        space.name()
-                    ),
-                )
+                let label = format!(
+                    "the colorimetric method ({}, {}, {})",
+                    observer.name(),
+                    illuminant.name(),
+                    space.name()
+                );
+                (grid, weights, label)
             }
             Method::Luminous => {
                 let (grid, weights) = luminous_weights(LuminousGrid::Iso9050)?;
@@ -323,7 +355,7 @@ impl Integrator {
         };
         Ok(Integrator {
             id: NEXT_INTEGRATOR_ID.fetch_add(1, Ordering::Relaxed),
-            settings: *settings,
+            settings: settings.clone(),
             grid_nm,
             weights,
             label,
@@ -503,14 +535,19 @@ impl GridIntegrator {
     }
 }
 
-/// Illuminant relative SPD on `grid` (colour's linear interpolation of the 5 nm tables; E = 100).
-fn illuminant_on(grid: &[f64], illuminant: Illuminant) -> Result<Vec<f64>, SpectralError> {
+/// `S(λ)·x̄(λ), S(λ)·ȳ(λ), S(λ)·z̄(λ)` of the light `illuminant` and the CMFs of `observer` on
+/// `grid` (every grid point a row of the CMF table).
+pub(crate) fn xyz_weights_of(
+    observer: Observer,
+    illuminant: &Illuminant,
+    grid: &[f64],
+) -> Result<Vec<[f64; 3]>, SpectralError> {
     let t = tables()?;
-    Ok(match illuminant {
-        Illuminant::D65 => grid.iter().map(|&w| t.d65.linear(0, w)).collect(),
-        Illuminant::A => grid.iter().map(|&w| t.a.linear(0, w)).collect(),
-        Illuminant::E => vec![100.0; grid.len()],
-    })
+    let cmfs = match observer {
+        Observer::Cie1931 => &t.cie_1931,
+        Observer::Cie1964 => &t.cie_1964,
+    };
+    xyz_weights(cmfs, illuminant.power_on(grid)?, grid)
 }
 
 /// `S(λ)·x̄(λ), S(λ)·ȳ(λ), S(λ)·z̄(λ)` on `grid` (every grid point must be a table row).
@@ -537,36 +574,21 @@ fn luminous_weights(grid: LuminousGrid) -> Result<(Vec<f64>, Vec<f64>), Spectral
         LuminousGrid::OneNm => 1,
     };
     let grid: Vec<f64> = (380..=780).step_by(step).map(f64::from).collect();
-    let xyz = xyz_weights(&t.cie_1931, illuminant_on(&grid, Illuminant::D65)?, &grid)?;
+    let xyz = xyz_weights(&t.cie_1931, CieIlluminant::D65.power_on(&grid)?, &grid)?;
     let total: f64 = xyz.iter().map(|w| w[1]).sum();
     Ok((grid, xyz.iter().map(|w| w[1] / total).collect()))
 }
 
-impl Illuminant {
-    /// The illuminant's white as CIE xy for `observer`, as colour's `CCS_ILLUMINANTS` holds it.
-    pub fn white_xy(self, observer: Observer) -> [f64; 2] {
-        match (self, observer) {
-            (Illuminant::D65, Observer::Cie1931) => D65_XY,
-            (Illuminant::D65, Observer::Cie1964) => [0.31382, 0.33100],
-            (Illuminant::A, Observer::Cie1931) => [0.44758, 0.40745],
-            (Illuminant::A, Observer::Cie1964) => [0.45117, 0.40594],
-            (Illuminant::E, _) => [1.0 / 3.0, 1.0 / 3.0],
-        }
-    }
-}
-
-/// XYZ (integrated with `observer` under `illuminant`) → linear RGB of `space`: what
-/// colour-science 0.4.7's `XYZ_to_RGB(XYZ, space, illuminant=CCS_ILLUMINANTS[observer]
-/// [illuminant])` does with its default `chromatic_adaptation_transform="CAT02"`, i.e.
-/// `xyz_to_rgb(space) · M_CAT02(illuminant white → space white)` (method.md eqs. 15–20 for the
-/// integration; von Kries in the CAT02 sharpened space). The adaptation is left out (exactly
-/// the identity) when the two whites are equal and for [`RgbSpace::Xyz`].
-pub fn rgb_matrix(observer: Observer, illuminant: Illuminant, space: RgbSpace) -> Matrix3<f64> {
+/// XYZ → linear RGB of `space` for a camera balanced to the white `from_white_xy`: what
+/// colour-science 0.4.7's `XYZ_to_RGB(XYZ, space, illuminant=from_white_xy)` does with its
+/// default `chromatic_adaptation_transform="CAT02"`, i.e. `xyz_to_rgb(space) · M_CAT02(from
+/// white → space white)` (method.md eqs. 15–20 for the integration; von Kries in the CAT02
+/// sharpened space). The adaptation is left out (exactly the identity) when the two whites are
+/// equal and for [`RgbSpace::Xyz`].
+pub fn rgb_matrix(from_white_xy: [f64; 2], space: RgbSpace) -> Matrix3<f64> {
     let m = xyz_to_rgb(space);
     match space.whitepoint_xy() {
-        Some(white) if white != illuminant.white_xy(observer) => {
-            m * cat02(illuminant.white_xy(observer), white)
-        }
+        Some(white) if white != from_white_xy => m * cat02(from_white_xy, white),
         _ => m,
     }
 }
@@ -633,274 +655,9 @@ thread_local! {
     static KERNELS: RefCell<KernelCache> = RefCell::new(KernelCache::default());
 }
 
-macro_rules! names {
-    ($ty:ty { $($variant:ident => $name:literal $(| $alias:literal)*),+ $(,)? }) => {
-        impl $ty {
-            /// The name used on the command line and in JSON.
-            pub fn name(self) -> &'static str {
-                match self { $(<$ty>::$variant => $name),+ }
-            }
-            /// Every value, for help texts.
-            pub const ALL: &'static [$ty] = &[$(<$ty>::$variant),+];
-        }
-        impl fmt::Display for $ty {
-            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-                f.write_str(self.name())
-            }
-        }
-        impl FromStr for $ty {
-            type Err = String;
-            fn from_str(s: &str) -> Result<Self, String> {
-                $(if s.eq_ignore_ascii_case($name) $(|| s.eq_ignore_ascii_case($alias))* {
-                    return Ok(<$ty>::$variant);
-                })+
-                Err(format!("unknown value `{s}`; expected one of: {}", [$($name),+].join(", ")))
-            }
-        }
-    };
-}
-
 names!(RgbCmf { WrightGuild1931 => "wright-guild-1931", StilesBurch1955 => "stiles-burch-1955", StilesBurch1959 => "stiles-burch-1959" });
 names!(Observer { Cie1931 => "cie1931", Cie1964 => "cie1964" });
-names!(Illuminant { D65 => "D65", A => "A", E => "E" });
 names!(MethodKind { Colorimetric => "colorimetric", Paper => "paper", Luminous => "luminous" });
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use glassdb_colour::{ACES_XY, normalised_primary_matrix};
-
-    fn flat(v: f64) -> (Vec<f64>, Vec<f64>) {
-        let wl: Vec<f64> = (0..=53).map(|i| 300.0 + 10.0 * i as f64).collect();
-        (wl.clone(), vec![v; wl.len()])
-    }
-
-    #[test]
-    fn a_flat_spectrum_gives_its_value_in_every_method() {
-        let (wl, v) = flat(0.37);
-        let mut methods: Vec<Method> = RgbCmf::ALL.iter().map(|&c| Method::Paper(c)).collect();
-        for &observer in Observer::ALL {
-            for &illuminant in Illuminant::ALL {
-                for &space in RgbSpace::ALL {
-                    methods.push(Method::Colorimetric {
-                        observer,
-                        illuminant,
-                        space,
-                    });
-                }
-            }
-        }
-        methods.push(Method::Luminous);
-        for method in methods {
-            let it = Integrator::new(&IntegrationSettings {
-                method,
-                extrapolate: false,
-            })
-            .unwrap();
-            let rgb = it.channels(&wl, &v).unwrap();
-            for c in rgb {
-                assert!((c - 0.37).abs() < 1e-13, "{method:?}: {rgb:?}");
-            }
-        }
-        assert!((luminous_iso9050(&wl, &v).unwrap() - 0.37).abs() < 1e-13);
-        assert!((luminous(&wl, &v, LuminousGrid::OneNm, false).unwrap() - 0.37).abs() < 1e-13);
-    }
-
-    #[test]
-    fn srgb_of_d65_white_is_neutral_and_acescg_matrix_matches_the_aces_spec() {
-        // The sRGB matrix maps D65 (0.3127, 0.3290) to nearly equal RGB.
-        let m = xyz_to_rgb(RgbSpace::Srgb);
-        let w = m * Vector3::new(0.3127 / 0.3290, 1.0, (1.0 - 0.3127 - 0.3290) / 0.3290);
-        assert!(
-            (w[0] - 1.0).abs() < 1e-3 && (w[1] - 1.0).abs() < 1e-3 && (w[2] - 1.0).abs() < 1e-3
-        );
-        // ACEScg XYZ→AP1 from the ACES TB-2014-004 (S-2014-004) specification, 10 decimals.
-        let aces = xyz_to_rgb(RgbSpace::AcesCg);
-        let spec = Matrix3::new(
-            1.6410233797,
-            -0.3248032942,
-            -0.2364246952,
-            -0.6636628587,
-            1.6153315917,
-            0.0167563477,
-            0.0117218943,
-            -0.0082844420,
-            0.9883948585,
-        );
-        assert!((aces - spec).abs().max() < 1e-9);
-    }
-
-    #[test]
-    fn adaptation_is_cat02_to_the_space_white_and_identity_where_the_whites_agree() {
-        // D65 spaces under 1931 D65, and XYZ under anything: no adaptation at all (bit-exact).
-        for space in [RgbSpace::Srgb, RgbSpace::Rec2020, RgbSpace::DisplayP3] {
-            assert_eq!(
-                rgb_matrix(Observer::Cie1931, Illuminant::D65, space),
-                xyz_to_rgb(space)
-            );
-        }
-        for &o in Observer::ALL {
-            for &i in Illuminant::ALL {
-                assert_eq!(rgb_matrix(o, i, RgbSpace::Xyz), Matrix3::identity());
-            }
-        }
-        // colour 0.4.7: XYZ_to_RGB(np.identity(3), "ACEScg", illuminant=D65) (columns are the
-        // images of X, Y, Z), i.e. AP1 · CAT02(D65 → ACES).
-        let colour = Matrix3::new(
-            1.658854308471041,
-            -0.31185697539741886,
-            -0.24315600712571486,
-            -0.6622832871075869,
-            1.6121995708713222,
-            0.01585912660306284,
-            0.01148056645747657,
-            -0.00923632492424387,
-            0.91668651344913,
-        );
-        let ours = rgb_matrix(Observer::Cie1931, Illuminant::D65, RgbSpace::AcesCg);
-        assert!((ours - colour).abs().max() < 1e-12, "{ours}");
-        // The adapted D65 white lands on the ACES white, i.e. on equal AP1 channels.
-        let d65 = Vector3::new(0.3127 / 0.3290, 1.0, (1.0 - 0.3127 - 0.3290) / 0.3290);
-        let w = ours * d65;
-        assert!(
-            (w[0] - 1.0).abs() < 1e-12 && (w[1] - 1.0).abs() < 1e-12 && (w[2] - 1.0).abs() < 1e-12
-        );
-        // The AP0 matrix is the published ST 2065-1 one; it nearly inverts the primaries' NPM.
-        let npm = normalised_primary_matrix([0.7347, 0.2653, 0.0, 1.0, 0.0001, -0.077], ACES_XY);
-        assert!(
-            (xyz_to_rgb(RgbSpace::Aces2065_1) * npm - Matrix3::identity())
-                .abs()
-                .max()
-                < 1e-9
-        );
-    }
-
-    #[test]
-    fn rec709_is_an_input_alias_of_srgb() {
-        assert_eq!("rec709".parse::<RgbSpace>().unwrap(), RgbSpace::Srgb);
-        assert_eq!("Rec709".parse::<RgbSpace>().unwrap(), RgbSpace::Srgb);
-        let json: RgbSpace = serde_json::from_str(r#""rec709""#).unwrap();
-        assert_eq!(json, RgbSpace::Srgb);
-        assert_eq!(serde_json::to_string(&json).unwrap(), r#""srgb""#);
-        let names: Vec<&str> = RgbSpace::ALL.iter().map(|s| s.name()).collect();
-        assert_eq!(
-            names,
-            [
-                "srgb",
-                "rec2020",
-                "acescg",
-                "aces2065-1",
-                "display-p3",
-                "xyz"
-            ]
-        );
-        for &s in RgbSpace::ALL {
-            assert_eq!(s.name().parse::<RgbSpace>().unwrap(), s);
-        }
-    }
-
-    #[test]
-    fn the_same_spectrum_gives_the_same_bits_whatever_came_before() {
-        // Irregular data: the first call builds the kernel, later ones reuse it; evicting it
-        // (more arrays than cache slots) and coming back rebuilds the same kernel.
-        let mut wl: Vec<f64> = (0..40).map(|i| 300.0 + 5.0 * f64::from(i)).collect();
-        wl.extend((0..60).map(|i| 500.0 + 7.0 * f64::from(i)));
-        let v: Vec<f64> = wl.iter().map(|w| 0.5 + 0.4 * (w / 29.0).sin()).collect();
-        let it = Integrator::new(&IntegrationSettings::default()).unwrap();
-        let first = it.channels(&wl, &v).unwrap();
-        assert_eq!(it.channels(&wl, &v).unwrap(), first);
-        for k in 0..2 * KERNEL_CACHE_SLOTS {
-            let other: Vec<f64> = wl.iter().map(|w| w + 0.1 * (k + 1) as f64).collect();
-            it.channels(&other, &v).unwrap();
-        }
-        assert_eq!(it.channels(&wl, &v).unwrap(), first);
-        // and the kernel is the direct spline evaluation to rounding
-        let mut direct = [0.0f64; 3];
-        for_each_on_grid(&wl, &v, false, it.grid_nm(), |j, x| {
-            for (d, w) in direct.iter_mut().zip(&it.weights()[j]) {
-                *d += x * w;
-            }
-        });
-        for c in 0..3 {
-            assert!((direct[c] - first[c]).abs() < 1e-13, "{direct:?} {first:?}");
-        }
-    }
-
-    #[test]
-    fn settings_json_is_flat_and_round_trips() {
-        let default = IntegrationSettings::default();
-        let text = serde_json::to_string(&default).unwrap();
-        assert_eq!(
-            text,
-            r#"{"method":"colorimetric","observer":"cie1931","illuminant":"D65","space":"srgb","extrapolate":false}"#
-        );
-        assert_eq!(
-            serde_json::from_str::<IntegrationSettings>(&text).unwrap(),
-            default
-        );
-        let paper = IntegrationSettings {
-            method: Method::Paper(RgbCmf::StilesBurch1955),
-            extrapolate: true,
-        };
-        let text = serde_json::to_string(&paper).unwrap();
-        assert_eq!(
-            text,
-            r#"{"method":"paper","cmf":"stiles-burch-1955","extrapolate":true}"#
-        );
-        assert_eq!(
-            serde_json::from_str::<IntegrationSettings>(&text).unwrap(),
-            paper
-        );
-        // Absent options take their defaults; options of another method are refused.
-        let lum: IntegrationSettings = serde_json::from_str(r#"{"method":"luminous"}"#).unwrap();
-        assert_eq!(lum.method, Method::Luminous);
-        assert!(!lum.extrapolate);
-        let col: IntegrationSettings =
-            serde_json::from_str(r#"{"method":"colorimetric","space":"acescg"}"#).unwrap();
-        assert_eq!(
-            col.method,
-            Method::Colorimetric {
-                observer: Observer::Cie1931,
-                illuminant: Illuminant::D65,
-                space: RgbSpace::AcesCg
-            }
-        );
-        for bad in [
-            r#"{"method":"paper","space":"srgb"}"#,
-            r#"{"method":"colorimetric","cmf":"stiles-burch-1955"}"#,
-            r#"{"method":"luminous","observer":"cie1931"}"#,
-            r#"{"method":"explicit"}"#,
-        ] {
-            assert!(
-                serde_json::from_str::<IntegrationSettings>(bad).is_err(),
-                "{bad}"
-            );
-        }
-        for &k in MethodKind::ALL {
-            assert_eq!(k.name().parse::<MethodKind>().unwrap(), k);
-            assert_eq!(serde_json::to_string(&k).unwrap(), format!("\"{k}\""));
-        }
-    }
-
-    /// Each value serialises to its name as a JSON string.
-    fn assert_json_names<T: Serialize>(values: &[T], name: impl Fn(&T) -> &'static str) {
-        for value in values {
-            assert_eq!(
-                serde_json::to_string(value).unwrap(),
-                format!("\"{}\"", name(value))
-            );
-        }
-    }
-
-    #[test]
-    fn names_round_trip() {
-        for &c in RgbCmf::ALL {
-            assert_eq!(c.name().parse::<RgbCmf>().unwrap(), c);
-        }
-        assert_json_names(RgbCmf::ALL, |c| c.name());
-        assert_json_names(RgbSpace::ALL, |s| s.name());
-        assert_json_names(Observer::ALL, |o| o.name());
-        assert_json_names(Illuminant::ALL, |i| i.name());
-        assert!("bogus".parse::<RgbSpace>().is_err());
-    }
-}
+mod tests;
