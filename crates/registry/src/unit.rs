@@ -282,17 +282,22 @@ pub(crate) fn build_unit(
         tables.rb[0] = normal.r0_back;
         let curves = fit_glass_curves(&normal, &tables, None, opts, &glass)?;
         let n_groups = stack.groups().len();
+        let shares_front = stored_shares(
+            (0..n_groups).map(|g| row(&|o| o.share_front[g])).collect(),
+            &tables.rf,
+        );
+        let shares_back = stored_shares(
+            (0..n_groups).map(|g| row(&|o| o.share_back[g])).collect(),
+            &tables.rb,
+        );
         let mut groups = Vec::with_capacity(n_groups);
         for (g, group) in stack.groups().iter().enumerate() {
             let share = |front: bool| -> Result<([f64; 3], [crate::AngleCurve; 3]), RegistryError> {
-                let mut table = row(&|o| {
-                    if front {
-                        o.share_front[g]
-                    } else {
-                        o.share_back[g]
-                    }
-                });
-                table[0] = clamp(table[0]);
+                let table = if front {
+                    shares_front[g].clone()
+                } else {
+                    shares_back[g].clone()
+                };
                 // the group facing the light reflects everything at grazing; the others nothing
                 let facing = if front { g == 0 } else { g + 1 == n_groups };
                 let quantity = if facing {
@@ -607,6 +612,42 @@ impl UnitBuilder {
             .collect();
         Registry::new(tables)
     }
+}
+
+/// The pane groups' reflectance shares as the registry stores them (`[group][angle]`, per
+/// channel). A channel can integrate negative: an out-of-gamut colour, e.g. a blue coating's
+/// back reflectance in sRGB's red under the narrow-band LED-RGB1. In a channel where some
+/// group's share leaves [0, 1] at some angle, every angle's shares are redrawn as the unit's
+/// reflectance there (`unit`, clamped to [0, 1] as every stored value is) split between the
+/// groups as their shares of all three channels together split it, so that the shares stay
+/// non-negative and smooth and still sum to the unit's reflectance (eq. 6). Other channels are
+/// kept bit for bit.
+fn stored_shares(mut shares: Vec<Vec<[f64; 3]>>, unit: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
+    for c in 0..3 {
+        let outside = shares
+            .iter()
+            .any(|s| s.iter().any(|v| !(0.0..=1.0).contains(&v[c])));
+        if !outside {
+            continue;
+        }
+        for (a, total) in unit.iter().enumerate() {
+            let target = total[c].clamp(0.0, 1.0);
+            let weights: Vec<f64> = shares.iter().map(|s| s[a].iter().sum()).collect();
+            let sum: f64 = weights.iter().sum();
+            let clamped: Vec<f64> = shares.iter().map(|s| s[a][c].clamp(0.0, 1.0)).collect();
+            let clamped_sum: f64 = clamped.iter().sum();
+            for (k, s) in shares.iter_mut().enumerate() {
+                s[a][c] = if sum > 0.0 && weights.iter().all(|&w| w >= 0.0) {
+                    target * weights[k] / sum
+                } else if clamped_sum > 0.0 {
+                    target * clamped[k] / clamped_sum
+                } else {
+                    0.0
+                };
+            }
+        }
+    }
+    shares
 }
 
 #[cfg(test)]

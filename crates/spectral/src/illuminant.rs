@@ -113,19 +113,7 @@ impl CieIlluminant {
     }
 }
 
-impl Serialize for CieIlluminant {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.name())
-    }
-}
-
-impl<'de> Deserialize<'de> for CieIlluminant {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        String::deserialize(d)?
-            .parse()
-            .map_err(serde::de::Error::custom)
-    }
-}
+serde_as_name!(CieIlluminant);
 
 /// The wavelengths (nm) every light must overlap: those of the colorimetric method (the CIE
 /// colour-matching functions as colour-science uses them, 360–780 nm).
@@ -540,19 +528,7 @@ impl std::str::FromStr for WhiteBalance {
     }
 }
 
-impl Serialize for WhiteBalance {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.name())
-    }
-}
-
-impl<'de> Deserialize<'de> for WhiteBalance {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        String::deserialize(d)?
-            .parse()
-            .map_err(serde::de::Error::custom)
-    }
-}
+serde_as_name!(WhiteBalance);
 
 #[cfg(test)]
 mod tests {

@@ -1,5 +1,5 @@
 //! `names!`: the command-line and JSON names of the crate's small enums (name, `ALL`,
-//! `Display`, `FromStr` with aliases, any case).
+//! `Display`, `FromStr` with aliases, any case); `serde_as_name!`: JSON as that name.
 
 macro_rules! names {
     ($ty:ty { $($variant:ident => $name:literal $(| $alias:literal)*),+ $(,)? }) => {
@@ -23,6 +23,24 @@ macro_rules! names {
                     return Ok(<$ty>::$variant);
                 })+
                 Err(format!("unknown value `{s}`; expected one of: {}", [$($name),+].join(", ")))
+            }
+        }
+    };
+}
+
+/// Serialises a type as its `name()` and deserialises it with its `FromStr`.
+macro_rules! serde_as_name {
+    ($ty:ty) => {
+        impl ::serde::Serialize for $ty {
+            fn serialize<S: ::serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                s.serialize_str(self.name())
+            }
+        }
+        impl<'de> ::serde::Deserialize<'de> for $ty {
+            fn deserialize<D: ::serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                <String as ::serde::Deserialize>::deserialize(d)?
+                    .parse()
+                    .map_err(::serde::de::Error::custom)
             }
         }
     };
