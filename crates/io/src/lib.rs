@@ -10,12 +10,14 @@
 //!   temporary files (docs/reliability.md).
 //! - [`frames`]: frame patterns and frame lists of animations.
 //! - [`progress`]: the observer through which libraries report the progress of long work.
+//! - [`sniff`]: binary data handed to a text reader, named from its signature.
 
 pub mod frames;
 pub mod input;
 mod kind;
 pub mod output;
 mod registry;
+pub mod sniff;
 
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
 pub use input::{
