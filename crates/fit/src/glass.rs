@@ -82,49 +82,11 @@ impl Default for GlassFitOptions {
 /// Phases 1 and 3 refuse unless `force`, which turns their findings into warnings (strict
 /// checks stay errors). Smaller physical violations are warnings.
 pub fn fit_glass(table: &GlassAngleTable, opts: &GlassFitOptions) -> Result<GlassFit, FitError> {
-    let mut refusals: Vec<FitError> = Vec::new();
-    let screening = table.screen();
-    for &quantity in &screening.reversed {
-        refusals.push(FitError::ReversedCurve {
-            path: table.path.clone(),
-            glass: table.name.clone(),
-            quantity,
-        });
-    }
-    if !screening.points.is_empty() {
-        refusals.push(FitError::InconsistentPoints {
-            path: table.path.clone(),
-            glass: table.name.clone(),
-            points: screening.points,
-        });
-    }
+    let mut refusals = screen(table);
     if !opts.force && !refusals.is_empty() {
-        return Err(refusals.remove(0));
+        return Err(refusals.swap_remove(0));
     }
-
-    let r_opts = FitOptions {
-        quantity: Quantity::Reflectance,
-        ..opts.reflectance.clone()
-    };
-    let t_opts = FitOptions {
-        quantity: Quantity::Transmittance,
-        ..opts.transmittance.clone()
-    };
-    // Fits one curve of the table when it has one; an error names the glass and the quantity.
-    let fit = |samples: Option<&AngleSamples>, opts: &FitOptions| {
-        samples
-            .map(|s| fit_curve(s, opts))
-            .transpose()
-            .map_err(|e| FitError::Curve {
-                path: table.path.clone(),
-                glass: table.name.clone(),
-                quantity: opts.quantity.name(),
-                error: Box::new(e),
-            })
-    };
-    let r = fit(table.reflectance.as_ref(), &r_opts)?;
-    let t = fit(table.transmittance.as_ref(), &t_opts)?;
-
+    let (r, t) = fit_curves(table, opts)?;
     let violations = physical_checks(r.as_ref(), t.as_ref());
     if opts.strict
         && let Some(v) = violations.first()
@@ -135,57 +97,10 @@ pub fn fit_glass(table: &GlassAngleTable, opts: &GlassFitOptions) -> Result<Glas
             violation: v.clone(),
         });
     }
-    for (curve, samples, o) in [
-        (&r, &table.reflectance, &r_opts),
-        (&t, &table.transmittance, &t_opts),
-    ] {
-        if let (Some(c), Some(s)) = (curve, samples)
-            && let Some(far) = far_from_data(table, c, s, o)
-        {
-            refusals.push(far);
-        }
-    }
-    for (violation, tolerance) in refusing_checks(r.as_ref(), t.as_ref()) {
-        let measured = |s: &Option<AngleSamples>| {
-            s.as_ref().is_some_and(|s| {
-                let lo = s.angle_deg.first().copied().unwrap_or(0.0);
-                let hi = s.angle_deg.last().copied().unwrap_or(90.0);
-                (lo..=hi).contains(&violation.worst_angle_deg)
-            })
-        };
-        let beyond_data = match violation.check.chars().next() {
-            Some('r') if violation.check.starts_with("r + t") => {
-                !(measured(&table.reflectance) && measured(&table.transmittance))
-            }
-            Some('r') => !measured(&table.reflectance),
-            _ => !measured(&table.transmittance),
-        };
-        refusals.push(FitError::UnphysicalFit {
-            path: table.path.clone(),
-            glass: table.name.clone(),
-            violation,
-            tolerance,
-            beyond_data,
-        });
-    }
+    refusals.extend(judge(table, opts, r.as_ref(), t.as_ref()));
     let forced = refuse_unless_forced(refusals, opts.force, table)?;
 
-    let mut warnings = Vec::new();
-    for rep in &table.repeated_angles {
-        let mut spreads = Vec::new();
-        if let Some(s) = rep.reflectance_spread {
-            spreads.push(format!("R spread {s:.5}"));
-        }
-        if let Some(s) = rep.transmittance_spread {
-            spreads.push(format!("T spread {s:.5}"));
-        }
-        warnings.push(format!(
-            "angle {}° given on {} rows: averaged ({})",
-            rep.angle_deg,
-            rep.rows,
-            spreads.join(", ")
-        ));
-    }
+    let mut warnings = repeated_angle_warnings(table);
     warnings.extend(violations.iter().map(|v| format!("physical check: {v}")));
     warnings.extend(forced);
     Ok(GlassFit {
@@ -194,6 +109,137 @@ pub fn fit_glass(table: &GlassAngleTable, opts: &GlassFitOptions) -> Result<Glas
         transmittance: t,
         warnings,
     })
+}
+
+/// Phase 1: the screen's findings as refusals.
+fn screen(table: &GlassAngleTable) -> Vec<FitError> {
+    let screening = table.screen();
+    let mut refusals: Vec<FitError> = screening
+        .reversed
+        .iter()
+        .map(|&quantity| FitError::ReversedCurve {
+            path: table.path.clone(),
+            glass: table.name.clone(),
+            quantity,
+        })
+        .collect();
+    if !screening.points.is_empty() {
+        refusals.push(FitError::InconsistentPoints {
+            path: table.path.clone(),
+            glass: table.name.clone(),
+            points: screening.points,
+        });
+    }
+    refusals
+}
+
+/// Phase 2: the curves the table has, each with its options (quantity set); an error names the
+/// file, the glass and the curve.
+fn fit_curves(
+    table: &GlassAngleTable,
+    opts: &GlassFitOptions,
+) -> Result<(Option<CurveFit>, Option<CurveFit>), FitError> {
+    let fit = |samples: Option<&AngleSamples>, opts: &FitOptions, quantity: Quantity| {
+        let opts = FitOptions {
+            quantity,
+            ..opts.clone()
+        };
+        samples
+            .map(|s| fit_curve(s, &opts))
+            .transpose()
+            .map_err(|e| FitError::Curve {
+                path: table.path.clone(),
+                glass: table.name.clone(),
+                quantity: quantity.name(),
+                error: Box::new(e),
+            })
+    };
+    Ok((
+        fit(
+            table.reflectance.as_ref(),
+            &opts.reflectance,
+            Quantity::Reflectance,
+        )?,
+        fit(
+            table.transmittance.as_ref(),
+            &opts.transmittance,
+            Quantity::Transmittance,
+        )?,
+    ))
+}
+
+/// Phase 3: the fits far from their data ([`far_from_data`]) or failing [`refusing_checks`],
+/// as refusals.
+fn judge(
+    table: &GlassAngleTable,
+    opts: &GlassFitOptions,
+    r: Option<&CurveFit>,
+    t: Option<&CurveFit>,
+) -> Vec<FitError> {
+    let mut refusals: Vec<FitError> = [
+        (
+            r,
+            &table.reflectance,
+            &opts.reflectance,
+            Quantity::Reflectance,
+        ),
+        (
+            t,
+            &table.transmittance,
+            &opts.transmittance,
+            Quantity::Transmittance,
+        ),
+    ]
+    .into_iter()
+    .filter_map(|(curve, samples, o, quantity)| {
+        far_from_data(table, curve?, samples.as_ref()?, o.tol, quantity)
+    })
+    .collect();
+    // whether an angle lies within the measured range of a curve
+    let measured = |s: &Option<AngleSamples>, angle: f64| {
+        s.as_ref().is_some_and(|s| {
+            let lo = s.angle_deg.first().copied().unwrap_or(0.0);
+            let hi = s.angle_deg.last().copied().unwrap_or(90.0);
+            (lo..=hi).contains(&angle)
+        })
+    };
+    for (violation, tolerance) in refusing_checks(r, t) {
+        let (of_r, of_t) = violation.curves();
+        let angle = violation.worst_angle_deg;
+        let beyond_data = (of_r && !measured(&table.reflectance, angle))
+            || (of_t && !measured(&table.transmittance, angle));
+        refusals.push(FitError::UnphysicalFit {
+            path: table.path.clone(),
+            glass: table.name.clone(),
+            violation,
+            tolerance,
+            beyond_data,
+        });
+    }
+    refusals
+}
+
+/// Warnings for the angles given on several rows (averaged).
+fn repeated_angle_warnings(table: &GlassAngleTable) -> Vec<String> {
+    table
+        .repeated_angles
+        .iter()
+        .map(|rep| {
+            let mut spreads = Vec::new();
+            if let Some(s) = rep.reflectance_spread {
+                spreads.push(format!("R spread {s:.5}"));
+            }
+            if let Some(s) = rep.transmittance_spread {
+                spreads.push(format!("T spread {s:.5}"));
+            }
+            format!(
+                "angle {}° given on {} rows: averaged ({})",
+                rep.angle_deg,
+                rep.rows,
+                spreads.join(", ")
+            )
+        })
+        .collect()
 }
 
 /// The first of `refusals` as the error, or with `force` all of them as warnings (without
@@ -220,12 +266,13 @@ fn refuse_unless_forced(
 }
 
 /// The reading a curve misses by most, as [`FitError::FarFromData`] when that is more than
-/// [`REFUSE_TOLERANCE_FACTOR`] × the tolerance.
+/// [`REFUSE_TOLERANCE_FACTOR`] × `tol`.
 fn far_from_data(
     table: &GlassAngleTable,
     curve: &CurveFit,
     samples: &AngleSamples,
-    opts: &FitOptions,
+    tol: f64,
+    quantity: Quantity,
 ) -> Option<FitError> {
     let (angle_deg, error) = samples
         .angle_deg
@@ -233,13 +280,13 @@ fn far_from_data(
         .zip(&samples.value)
         .map(|(&a, &v)| (a, (curve.eval_angle_deg(a) - v).abs()))
         .max_by(|x, y| x.1.total_cmp(&y.1))?;
-    (error > REFUSE_TOLERANCE_FACTOR * opts.tol).then(|| FitError::FarFromData {
+    (error > REFUSE_TOLERANCE_FACTOR * tol).then(|| FitError::FarFromData {
         path: table.path.clone(),
         glass: table.name.clone(),
-        quantity: opts.quantity,
+        quantity,
         angle_deg,
         lines: table.lines_of(angle_deg).to_vec(),
         error,
-        tol: opts.tol,
+        tol,
     })
 }

@@ -53,6 +53,17 @@ pub struct PhysicalViolation {
     pub from_angle_deg: Option<f64>,
 }
 
+impl PhysicalViolation {
+    /// Which curves the failed check is about: (r, t).
+    pub fn curves(&self) -> (bool, bool) {
+        if self.check.starts_with("r + t") {
+            (true, true)
+        } else {
+            (self.check.starts_with('r'), self.check.starts_with('t'))
+        }
+    }
+}
+
 impl std::fmt::Display for PhysicalViolation {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.from_angle_deg {
