@@ -630,7 +630,7 @@ fn the_clean_hand_written_table_fits_and_is_written() {
     let dir = tempfile::tempdir().unwrap();
     let table = hand_table(dir.path(), "hand.csv", None);
     let out = dir.path().join("hand.json");
-    ok(&mut fit(&table, &["-o"]).arg(&out));
+    ok(fit(&table, &["-o"]).arg(&out));
     assert!(out.exists());
 }
 
@@ -641,7 +641,7 @@ fn a_dropped_digit_is_refused_naming_its_angle_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let table = hand_table(dir.path(), "hand.csv", Some((50, "0.100,0.08")));
     let out = dir.path().join("hand.json");
-    let e = fails(&mut fit(&table, &["-o"]).arg(&out));
+    let e = fails(fit(&table, &["-o"]).arg(&out));
     assert_names(
         &e,
         &[
@@ -654,7 +654,7 @@ fn a_dropped_digit_is_refused_naming_its_angle_and_line() {
     );
     assert!(!out.exists(), "a refused fit is not written");
     // --force writes it, the findings kept as warnings in the file
-    let (res, _, stderr) = run(&mut fit(&table, &["--force", "-o"]).arg(&out));
+    let (res, _, stderr) = run(fit(&table, &["--force", "-o"]).arg(&out));
     assert!(res.status.success(), "{stderr}");
     let written = std::fs::read_to_string(&out).unwrap();
     assert!(written.contains("written with --force"), "{written}");
@@ -751,7 +751,7 @@ fn a_fit_far_from_its_data_or_unphysical_beyond_it_is_refused() {
     let out = dir.path().join("f.json");
     // degree 1 cannot follow clear glass: 0.45 off at 90°, line 95
     let e = fails(
-        &mut fit(
+        fit(
             &repo_path(CLEAR),
             &["--degree", "1", "--basis", "full", "-o"],
         )
@@ -767,7 +767,7 @@ fn a_fit_far_from_its_data_or_unphysical_beyond_it_is_refused() {
         ],
     );
     assert!(!out.exists());
-    ok(&mut fit(
+    ok(fit(
         &repo_path(CLEAR),
         &["--degree", "1", "--basis", "full", "--force", "-o"],
     )
@@ -806,7 +806,7 @@ fn other_files_are_named_not_read_as_tables() {
     }
     // each command's file given to the other one points at it
     let fits = dir.path().join("fits.json");
-    ok(&mut fit(&repo_path(BRONZE), &["-o"]).arg(&fits));
+    ok(fit(&repo_path(BRONZE), &["-o"]).arg(&fits));
     let e = fails(glassdb().arg("fit").arg(&fits));
     assert_names(
         &e,
