@@ -7,8 +7,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use glassdb_fit::{
-    Basis, CurveFit, DEFAULT_MAX_DEGREE, DEFAULT_TOL, EXTRAPOLATION_MARGIN_DEG, FileContent,
-    FitError, FitFile, FitOptions, GlassFit, GlassFitOptions, Quantity,
+    Basis, CurveFit, DEFAULT_MAX_DEGREE, DEFAULT_TOL, EXTRAPOLATION_MARGIN_DEG, ExpectedFile,
+    FileContent, FitError, FitFile, FitOptions, GlassFit, GlassFitOptions, Quantity,
 };
 
 /// The basis names accepted by `--basis`.
@@ -421,10 +421,9 @@ pub fn hint(e: &FitError) -> Option<String> {
             kind: FileContent::Binary(_),
             expected,
             ..
-        } => Some(if *expected == "a fit file" {
-            "`glassdb eval` reads the JSON that `glassdb fit -o` writes".into()
-        } else {
-            "`glassdb fit` reads an angle table: CSV text with columns angle_deg, R and/or T (docs/fit.md, \"Input\"); images are read by `compose` and `glassdb view`".into()
+        } => Some(match expected {
+            ExpectedFile::FitFile => "`glassdb eval` reads the JSON that `glassdb fit -o` writes".into(),
+            ExpectedFile::AngleTable => "`glassdb fit` reads an angle table: CSV text with columns angle_deg, R and/or T (docs/fit.md, \"Input\"); images are read by `compose` and `glassdb view`".into(),
         }),
         FitError::ValuesAboveOne { .. } => Some(
             "correct those cells to fractions; a table in percent throughout takes --percent"

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use crate::model::{PolynomialShape, Quantity};
 use crate::physical::PhysicalViolation;
 use crate::screen::InconsistentPoint;
-use crate::sniff::FileContent;
+use crate::sniff::{ExpectedFile, FileContent};
 
 /// A cell of an angle table, for messages that name several.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,8 +72,8 @@ pub enum FitError {
         path: PathBuf,
         /// What the file is.
         kind: FileContent,
-        /// What the reader reads: `an angle table` or `a fit file`.
-        expected: &'static str,
+        /// What the reader reads.
+        expected: ExpectedFile,
     },
     /// The file has no header line (or nothing at all).
     #[error("{path}: the file is empty (expected a header line such as `angle_deg,R,T`)")]

@@ -10,7 +10,7 @@ use crate::error::FitError;
 use crate::glass::GlassFit;
 use crate::model::CurveFit;
 use crate::physical::{Slack, violations};
-use crate::sniff::FileContent;
+use crate::sniff::{ExpectedFile, FileContent};
 
 /// The whole output of `glassdb fit --json` / `-o`.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq, Default)]
@@ -52,7 +52,7 @@ pub fn parse_fit_json(bytes: &[u8], path: &Path) -> Result<FitFile, FitError> {
         return Err(FitError::OtherFile {
             path: path.to_path_buf(),
             kind,
-            expected: "a fit file",
+            expected: ExpectedFile::FitFile,
         });
     }
     let file: FitFile = serde_json::from_slice(bytes).map_err(|e| FitError::FitFile {

@@ -43,7 +43,7 @@ pub use physical::{
     REFUSE_TOLERANCE_FACTOR, physical_checks, refusing_checks,
 };
 pub use screen::{InconsistentPoint, LikelyTypo, NEAR_NORMAL_DEG, Screening, screen_curves};
-pub use sniff::FileContent;
+pub use sniff::{ExpectedFile, FileContent};
 pub use solve::{
     EXTRAPOLATION_MARGIN_DEG, LOO_GUARD_FACTOR, MAX_DEGREE, SUSPECT_STUDENTIZED, fit_curve,
 };

@@ -99,6 +99,24 @@ fn looks_like_angle_table(bytes: &[u8]) -> bool {
     })
 }
 
+/// What a reader of the fit crate reads: the file it was handed should have been one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExpectedFile {
+    /// An angle table (`glassdb fit`).
+    AngleTable,
+    /// A fit file (`glassdb eval`).
+    FitFile,
+}
+
+impl std::fmt::Display for ExpectedFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ExpectedFile::AngleTable => "an angle table",
+            ExpectedFile::FitFile => "a fit file",
+        })
+    }
+}
+
 impl std::fmt::Display for FileContent {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

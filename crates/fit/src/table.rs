@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use crate::error::{CellRef, FitError};
 use crate::model::AngleSamples;
 use crate::screen::{Screening, screen_curves};
-use crate::sniff::FileContent;
+use crate::sniff::{ExpectedFile, FileContent};
 
 /// Largest angle table read (bytes): far above any real table, small enough to never exhaust memory.
 pub const MAX_TABLE_BYTES: u64 = glassdb_io::limits::ANGLE_TABLE.bytes;
@@ -140,7 +140,7 @@ pub fn parse_angle_table(
         return Err(FitError::OtherFile {
             path: path.to_path_buf(),
             kind,
-            expected: "an angle table",
+            expected: ExpectedFile::AngleTable,
         });
     }
     let (names, rows) = read_rows(bytes, path, default_name, percent)?;
