@@ -71,7 +71,7 @@ impl FitFile {
     /// Checks every glass, as the registry checks its curves (`docs/fit-json.md`, "Rules for
     /// readers"): at least one curve per glass; each curve well formed
     /// ([`crate::CosPolynomial::check_shape`]) with finite numbers; its normal value in [0, 1];
-    /// and on the dense grid ([`CHECK_STEP_DEG`]) over each curve's [`CurveFit::data_range`],
+    /// and on the dense grid ([`crate::CHECK_STEP_DEG`]) over each curve's [`CurveFit::data_range`],
     /// 0 ≤ r, t ≤ 1 and r + t ≤ 1, each within the curves'
     /// [`CurveFit::validation_tolerance`]. `path` names the file in messages.
     pub fn validate(&self, path: &Path) -> Result<(), FitError> {
