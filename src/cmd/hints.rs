@@ -3,7 +3,7 @@
 //! error variants that one flag or command answers; [`super::finish`] prints each as `hint:`.
 
 use glassdb_compose::ComposeError;
-use glassdb_fit::{FitError, OtherJson};
+use glassdb_fit::{FileContent, FitError};
 use glassdb_mask::MaskError;
 use glassdb_plot::PlotError;
 use glassdb_registry::RegistryError;
@@ -90,20 +90,20 @@ fn fit_hint(e: &FitError) -> Option<String> {
             Some("if the table is in percent, pass --percent".into())
         }
         FitError::OtherFile {
-            kind: OtherJson::Registry,
+            kind: FileContent::Registry,
             ..
         } => Some(format!(
             "a registry is read by `glassdb registry show`, `glassdb registry check`, \
              `glassdb plot registry` and `glassdb compose --registry`; {FIT_FILES}"
         )),
         FitError::OtherFile {
-            kind: OtherJson::Planes,
+            kind: FileContent::Planes,
             ..
         } => Some(format!(
             "a planes file is read by `glassdb compose --planes` and `glassdb mask --planes`; \
              {FIT_FILES}"
         )),
-        _ => None,
+        _ => super::fit::hint(e),
     }
 }
 

@@ -23,6 +23,7 @@ use crate::model::{
     AngleSamples, Basis, CosPolynomial, CurveFit, FitDiagnostics, FitOptions, FitSummary, Quantity,
     SuspectPoint, cos_deg,
 };
+use crate::physical::{CHECK_SLACK, CHECK_STEP_DEG};
 
 /// Highest degree accepted (fixed or as --max-degree): at 20 the power basis on 0–90° already
 /// has a condition number near 1e15.
@@ -692,15 +693,23 @@ fn select_degree(
 /// degree and basis selection.
 pub fn fit_curve(samples: &AngleSamples, opts: &FitOptions) -> Result<CurveFit, FitError> {
     // the inputs are validated finite numbers, so the linear algebra cannot meet NaN; a panic
-    // inside it would still be a bug, reported as an error rather than a crash
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        fit_curve_inner(samples, opts)
-    }))
-    .unwrap_or_else(|_| {
-        Err(FitError::Singular {
-            degree: opts.degree.unwrap_or(opts.max_degree),
-            points: samples.angle_deg.len(),
-        })
+    // inside it would still be a bug, reported as an internal error rather than a crash (and
+    // not as a property of the data, such as a singular system)
+    internal_errors(samples.angle_deg.len(), || fit_curve_inner(samples, opts))
+}
+
+/// Runs `fit`, turning a panic into [`FitError::Internal`] with the panic's message.
+fn internal_errors<T>(
+    points: usize,
+    fit: impl FnOnce() -> Result<T, FitError>,
+) -> Result<T, FitError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(fit)).unwrap_or_else(|payload| {
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic without a message".to_string());
+        Err(FitError::Internal { points, message })
     })
 }
 
@@ -766,10 +775,10 @@ fn in_unit_range(s: &Solved) -> bool {
         powers: s.basis.powers(s.degree),
         coefficients: s.coefficients.clone(),
     };
-    let steps = (90.0 / crate::glass::CHECK_STEP_DEG).round() as usize;
+    let steps = (90.0 / CHECK_STEP_DEG).round() as usize;
     (0..=steps).all(|i| {
-        let v = s.normal * poly.eval_angle_deg(i as f64 * crate::glass::CHECK_STEP_DEG);
-        (-crate::glass::CHECK_SLACK..=1.0 + crate::glass::CHECK_SLACK).contains(&v)
+        let v = s.normal * poly.eval_angle_deg(i as f64 * CHECK_STEP_DEG);
+        (-CHECK_SLACK..=1.0 + CHECK_SLACK).contains(&v)
     })
 }
 
@@ -838,4 +847,28 @@ fn package(p: &Prepared, s: Solved, how: &'static str, opts: &FitOptions) -> Cur
 
 fn finite_or(v: f64, fallback: f64) -> f64 {
     if v.is_finite() { v } else { fallback }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_in_the_fitter_is_an_internal_error_not_a_property_of_the_data() {
+        let e = internal_errors::<()>(7, || panic!("index out of bounds")).unwrap_err();
+        assert!(
+            matches!(&e, FitError::Internal { points: 7, message } if message == "index out of bounds"),
+            "{e:?}"
+        );
+        assert!(
+            e.to_string().starts_with("internal error in the fitter"),
+            "{e}"
+        );
+        let formatted = internal_errors::<()>(1, || panic!("{} coefficients", 3)).unwrap_err();
+        assert!(
+            formatted.to_string().ends_with("3 coefficients"),
+            "{formatted}"
+        );
+        assert_eq!(internal_errors(1, || Ok(5)).unwrap(), 5);
+    }
 }

@@ -7,8 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::FitError;
+use crate::error::{CellRef, FitError};
 use crate::model::AngleSamples;
+use crate::screen::{Screening, screen_curves};
+use crate::sniff::{ExpectedFile, FileContent};
 
 /// Largest angle table read (bytes): far above any real table, small enough to never exhaust memory.
 pub const MAX_TABLE_BYTES: u64 = glassdb_io::limits::ANGLE_TABLE.bytes;
@@ -16,12 +18,23 @@ pub const MAX_TABLE_BYTES: u64 = glassdb_io::limits::ANGLE_TABLE.bytes;
 /// An angle that appeared on more than one row of a glass: the values were averaged.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RepeatedAngle {
+    /// The repeated angle (degrees).
     pub angle_deg: f64,
     /// How many rows gave this angle.
     pub rows: usize,
-    /// Largest minus smallest value among those rows, per quantity (None: not measured).
+    /// Largest minus smallest R among those rows (None: R not measured there).
     pub reflectance_spread: Option<f64>,
+    /// Largest minus smallest T among those rows (None: T not measured there).
     pub transmittance_spread: Option<f64>,
+}
+
+/// Where one angle of a glass was read: the file's line numbers of its rows (1-based).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AngleRows {
+    /// The angle of incidence (degrees).
+    pub angle_deg: f64,
+    /// The lines of the rows that give this angle, ascending (several when it is repeated).
+    pub lines: Vec<u64>,
 }
 
 /// The measured curves of one glass, sorted by angle, repeated angles averaged.
@@ -29,10 +42,36 @@ pub struct RepeatedAngle {
 pub struct GlassAngleTable {
     /// The `glass` column's value, or the file stem when there is no `glass` column.
     pub name: String,
+    /// The file the table was read from (for messages).
+    pub path: PathBuf,
+    /// The reflectance curve, if the table has R values for this glass.
     pub reflectance: Option<AngleSamples>,
+    /// The transmittance curve, if the table has T values for this glass.
     pub transmittance: Option<AngleSamples>,
     /// Angles given on several rows (averaged), ascending.
     pub repeated_angles: Vec<RepeatedAngle>,
+    /// The rows of each distinct angle, ascending by angle.
+    pub rows: Vec<AngleRows>,
+}
+
+impl GlassAngleTable {
+    /// The readings of this table that their neighbours contradict ([`screen_curves`]), each
+    /// with its file lines.
+    pub fn screen(&self) -> Screening {
+        let mut screening = screen_curves(self.reflectance.as_ref(), self.transmittance.as_ref());
+        for p in &mut screening.points {
+            p.lines = self.lines_of(p.angle_deg).to_vec();
+        }
+        screening
+    }
+
+    /// The file lines that give `angle_deg` (empty when the table has no such angle).
+    pub fn lines_of(&self, angle_deg: f64) -> &[u64] {
+        self.rows
+            .iter()
+            .find(|r| r.angle_deg == angle_deg)
+            .map_or(&[], |r| r.lines.as_slice())
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -53,15 +92,27 @@ fn classify(header: &str) -> Option<Field> {
     }
 }
 
+/// One data row as read: the cells already numbers, not yet checked against the unit.
 struct Row {
     glass: String,
     angle_deg: f64,
-    r: Option<f64>,
-    t: Option<f64>,
+    line: u64,
+    r: Option<Cell>,
+    t: Option<Cell>,
+}
+
+/// An R or T cell: its value as written and where it stands.
+#[derive(Clone, Copy)]
+struct Cell {
+    value: f64,
+    line: u64,
+    /// 0-based column index.
+    column: usize,
 }
 
 /// Reads an angle table. With `percent`, R and T are in percent (0–100) and converted to
-/// fractions; without it a value above 1 is an error that suggests `--percent`.
+/// fractions; without it a table whose values are mostly above 1 is an error that suggests
+/// `--percent`, and a few values above 1 among fractions are named as typos.
 /// Every error names the file, and the line and column of the offending cell.
 pub fn read_angle_table(path: &Path, percent: bool) -> Result<Vec<GlassAngleTable>, FitError> {
     let io_err = |source| FitError::Io {
@@ -77,13 +128,35 @@ pub fn read_angle_table(path: &Path, percent: bool) -> Result<Vec<GlassAngleTabl
 }
 
 /// Parses angle-table bytes (see [`read_angle_table`]); `path` is used in messages only and
-/// `default_name` names the glass when there is no `glass` column.
+/// `default_name` names the glass when there is no `glass` column. Binary data and JSON (a fit
+/// file, a registry) are named as what they are ([`FitError::OtherFile`]).
 pub fn parse_angle_table(
     bytes: &[u8],
     path: &Path,
     default_name: &str,
     percent: bool,
 ) -> Result<Vec<GlassAngleTable>, FitError> {
+    if let Some(kind) = FileContent::not_an_angle_table(bytes) {
+        return Err(FitError::OtherFile {
+            path: path.to_path_buf(),
+            kind,
+            expected: ExpectedFile::AngleTable,
+        });
+    }
+    let (names, rows) = read_rows(bytes, path, default_name, percent)?;
+    check_units(&rows, &names, path, percent)?;
+    let divisor = if percent { 100.0 } else { 1.0 };
+    group(rows, path, divisor)
+}
+
+/// The header's names and the data rows, every cell a finite number, every angle within 0–90°,
+/// no value negative (or above 100 with `percent`).
+fn read_rows(
+    bytes: &[u8],
+    path: &Path,
+    default_name: &str,
+    percent: bool,
+) -> Result<(Vec<String>, Vec<Row>), FitError> {
     let p = || path.to_path_buf();
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let mut rdr = csv::ReaderBuilder::new()
@@ -207,49 +280,36 @@ pub fn parse_angle_table(
                 value: angle_deg,
             });
         }
-        let fraction = |col: Option<usize>| -> Result<Option<f64>, FitError> {
+        let value = |col: Option<usize>| -> Result<Option<Cell>, FitError> {
             let Some(col) = col else { return Ok(None) };
             let text = cell(col)?;
             if text.is_empty() {
                 return Ok(None);
             }
             let v = number(col, text)?;
-            let header = names[col].clone();
-            if percent {
-                if !(0.0..=100.0).contains(&v) {
-                    return Err(FitError::ValueOutOfRange {
-                        path: p(),
-                        line,
-                        column: col + 1,
-                        header,
-                        value: v,
-                        range: "0–100 (percent)",
-                    });
-                }
-                Ok(Some(v / 100.0))
-            } else if v > 1.0 {
-                Err(FitError::AboveOneInFractions {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header,
-                    value: v,
-                })
-            } else if v < 0.0 {
-                Err(FitError::ValueOutOfRange {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header,
-                    value: v,
-                    range: "0–1",
-                })
+            let (top, range) = if percent {
+                (100.0, "0–100 (percent)")
             } else {
-                Ok(Some(v))
+                (f64::INFINITY, "0–1")
+            };
+            if v < 0.0 || v > top {
+                return Err(FitError::ValueOutOfRange {
+                    path: p(),
+                    line,
+                    column: col + 1,
+                    header: names[col].clone(),
+                    value: v,
+                    range,
+                });
             }
+            Ok(Some(Cell {
+                value: v,
+                line,
+                column: col,
+            }))
         };
-        let r = fraction(r_col)?;
-        let t = fraction(t_col)?;
+        let r = value(r_col)?;
+        let t = value(t_col)?;
         let glass = match glass_col {
             Some(col) => {
                 let name = cell(col)?;
@@ -267,6 +327,7 @@ pub fn parse_angle_table(
         rows.push(Row {
             glass,
             angle_deg,
+            line,
             r,
             t,
         });
@@ -274,7 +335,75 @@ pub fn parse_angle_table(
     if rows.is_empty() {
         return Err(FitError::NoRows { path: p() });
     }
-    group(rows, path)
+    Ok((names, rows))
+}
+
+/// The unit of the R and T cells, judged on the whole table: without `percent`, a table whose
+/// values are mostly above 1 is in percent ([`FitError::AboveOneInFractions`]), a column that
+/// is while another is not mixes units ([`FitError::MixedUnits`]), and a few values above 1
+/// among fractions are typos ([`FitError::ValuesAboveOne`]: a percent value or a shifted
+/// decimal point). With `percent`, a table whose non-zero values are mostly at most 1 is in
+/// fractions ([`FitError::FractionsReadAsPercent`]).
+fn check_units(rows: &[Row], names: &[String], path: &Path, percent: bool) -> Result<(), FitError> {
+    let cells = || rows.iter().flat_map(|r| [r.r, r.t]).flatten();
+    let above: Vec<Cell> = cells().filter(|c| c.value > 1.0).collect();
+    let total = cells().count();
+    let header = |c: &Cell| names.get(c.column).cloned().unwrap_or_default();
+    if percent {
+        // zeros (t at 90°, an opaque pane) say nothing about the unit
+        let nonzero = cells().filter(|c| c.value != 0.0).count();
+        let at_most_one = nonzero - above.len();
+        if 2 * at_most_one > nonzero {
+            return Err(FitError::FractionsReadAsPercent {
+                path: path.to_path_buf(),
+                at_most_one,
+                nonzero,
+            });
+        }
+        return Ok(());
+    }
+    let Some(first) = above.first() else {
+        return Ok(());
+    };
+    if 2 * above.len() > total {
+        return Err(FitError::AboveOneInFractions {
+            path: path.to_path_buf(),
+            line: first.line,
+            column: first.column + 1,
+            header: header(first),
+            value: first.value,
+        });
+    }
+    // per column: is it mostly above 1 (in percent) while another column is not?
+    let mut columns: Vec<usize> = cells().map(|c| c.column).collect();
+    columns.sort_unstable();
+    columns.dedup();
+    let mostly_above = |col: usize| {
+        let n = cells().filter(|c| c.column == col).count();
+        2 * above.iter().filter(|c| c.column == col).count() > n
+    };
+    if let (Some(&pc), Some(&fc)) = (
+        columns.iter().find(|&&c| mostly_above(c)),
+        columns.iter().find(|&&c| !mostly_above(c)),
+    ) {
+        return Err(FitError::MixedUnits {
+            path: path.to_path_buf(),
+            percent_column: names.get(pc).cloned().unwrap_or_default(),
+            fraction_column: names.get(fc).cloned().unwrap_or_default(),
+        });
+    }
+    Err(FitError::ValuesAboveOne {
+        path: path.to_path_buf(),
+        cells: above
+            .iter()
+            .map(|c| CellRef {
+                line: c.line,
+                column: c.column + 1,
+                header: header(c),
+                value: c.value,
+            })
+            .collect(),
+    })
 }
 
 fn csv_error(path: PathBuf, e: csv::Error) -> FitError {
@@ -296,8 +425,9 @@ fn csv_error(path: PathBuf, e: csv::Error) -> FitError {
     }
 }
 
-/// Groups rows by glass (first-appearance order), sorts by angle, averages repeated angles.
-fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> {
+/// Groups rows by glass (first-appearance order), sorts by angle, averages repeated angles;
+/// R and T values are divided by `divisor` (100 for percent).
+fn group(rows: Vec<Row>, path: &Path, divisor: f64) -> Result<Vec<GlassAngleTable>, FitError> {
     let mut order: Vec<String> = Vec::new();
     let mut by_glass: std::collections::HashMap<String, Vec<Row>> =
         std::collections::HashMap::new();
@@ -310,10 +440,15 @@ fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> 
     let mut out = Vec::with_capacity(order.len());
     for name in order {
         let mut rows = by_glass.remove(&name).unwrap_or_default();
-        rows.sort_by(|a, b| a.angle_deg.total_cmp(&b.angle_deg));
+        rows.sort_by(|a, b| {
+            a.angle_deg
+                .total_cmp(&b.angle_deg)
+                .then(a.line.cmp(&b.line))
+        });
         let mut r = AngleSamples::default();
         let mut t = AngleSamples::default();
         let mut repeated = Vec::new();
+        let mut angle_rows = Vec::new();
         let mut i = 0;
         while i < rows.len() {
             let mut j = i + 1;
@@ -322,8 +457,16 @@ fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> 
             }
             let group = &rows[i..j];
             let angle = rows[i].angle_deg;
-            let rs: Vec<f64> = group.iter().filter_map(|row| row.r).collect();
-            let ts: Vec<f64> = group.iter().filter_map(|row| row.t).collect();
+            let rs: Vec<f64> = group
+                .iter()
+                .filter_map(|row| row.r)
+                .map(|c| c.value / divisor)
+                .collect();
+            let ts: Vec<f64> = group
+                .iter()
+                .filter_map(|row| row.t)
+                .map(|c| c.value / divisor)
+                .collect();
             if !rs.is_empty() {
                 r.angle_deg.push(angle);
                 r.value.push(mean(&rs));
@@ -340,6 +483,10 @@ fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> 
                     transmittance_spread: spread(&ts),
                 });
             }
+            angle_rows.push(AngleRows {
+                angle_deg: angle,
+                lines: group.iter().map(|row| row.line).collect(),
+            });
             i = j;
         }
         if r.angle_deg.is_empty() && t.angle_deg.is_empty() {
@@ -350,9 +497,11 @@ fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> 
         }
         out.push(GlassAngleTable {
             name,
+            path: path.to_path_buf(),
             reflectance: (!r.angle_deg.is_empty()).then_some(r),
             transmittance: (!t.angle_deg.is_empty()).then_some(t),
             repeated_angles: repeated,
+            rows: angle_rows,
         });
     }
     Ok(out)

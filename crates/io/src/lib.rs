@@ -13,6 +13,7 @@
 //! - [`frames`]: frame patterns and frame lists of animations.
 //! - [`progress`]: the observer through which libraries report the progress of long work.
 //! - [`quoted`]: a value from an input quoted in a message, cut to a bounded length.
+//! - [`sniff`]: binary data handed to a text reader, named from its signature.
 
 mod children;
 pub mod frames;
@@ -20,6 +21,7 @@ pub mod input;
 mod kind;
 pub mod output;
 mod registry;
+pub mod sniff;
 
 pub use children::ChildGroup;
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
