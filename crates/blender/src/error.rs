@@ -111,3 +111,31 @@ impl BlenderError {
         }
     }
 }
+
+impl BlenderError {
+    /// The class of this error: a wrapped error's own class; a Blender missing or too old is
+    /// unsupported, one that does not finish in time a limit, a file of the run that cannot
+    /// be made or moved (or Blender failing) I/O; anything else is a scene, a render or an
+    /// option to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        use glassdb_io::ErrorKind;
+        match self {
+            BlenderError::Scene3d(e) => e.kind(),
+            BlenderError::Mask(e) => e.kind(),
+            BlenderError::Compose(e) => e.kind(),
+            BlenderError::Image(e) => e.kind(),
+            BlenderError::Output(e) => e.kind(),
+            BlenderError::Input(e) => e.kind(),
+            BlenderError::Registry(e) => e.kind(),
+            BlenderError::NotFound { .. }
+            | BlenderError::NoBpyModule { .. }
+            | BlenderError::VersionUnreadable { .. }
+            | BlenderError::TooOld { .. } => ErrorKind::Unsupported,
+            BlenderError::VersionTimedOut { .. } | BlenderError::TimedOut { .. } => {
+                ErrorKind::Limits
+            }
+            BlenderError::Io { .. } | BlenderError::Failed { .. } => ErrorKind::Io,
+            _ => ErrorKind::Invalid,
+        }
+    }
+}

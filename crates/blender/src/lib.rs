@@ -7,6 +7,7 @@
 
 pub mod error;
 pub mod job;
+mod passes;
 pub mod pipeline;
 pub mod program;
 pub mod thin_pane;

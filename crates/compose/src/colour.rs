@@ -44,7 +44,9 @@ impl fmt::Display for SpaceSource {
 /// A pass's linear RGB space and how it was known.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PassSpace {
+    /// The linear RGB space.
     pub space: RgbSpace,
+    /// How it was known.
     pub source: SpaceSource,
 }
 
@@ -175,6 +177,7 @@ impl LazyLut {
 /// The table a frame is composited with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ChosenTable {
+    /// The registry table's colour basis.
     pub basis: ColourBasis,
     /// Whether the table is not in the passes' own space (a luminous grey table, or the paper
     /// method's RGB for untagged passes).

@@ -10,11 +10,14 @@ use std::path::Path;
 use glassdb_image::ImageWindows;
 use glassdb_mask::MaskHeader;
 
+use glassdb_encode::{Encoding, ExrDataType};
+use glassdb_pass::{PassHeader, PassSource, PngBits};
+
 use crate::colour::{self, PassSpace};
-use crate::io::{self, ExrDataType, OutputFormat, PassHeader, PassSource};
+use crate::decode::DecodeTarget;
 use crate::memory::{MemoryEstimate, MemoryItem, file_label};
-use crate::pixels::PngBits;
-use crate::{ComposeError, ComposeJob, ComposeSettings, check_frames, in_frame};
+use crate::place::{check_frames, in_frame};
+use crate::{ComposeError, DecodeSettings, FrameFiles};
 
 /// What the headers decided for one frame.
 pub(crate) struct FramePlan {
@@ -30,36 +33,39 @@ pub(crate) struct FramePlan {
 
 /// Reads every input's header and checks the frame from them (see the module docs).
 pub(crate) fn plan_frame(
-    job: &ComposeJob,
-    settings: &ComposeSettings,
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    target: &DecodeTarget,
 ) -> Result<FramePlan, ComposeError> {
-    let trans = io::read_pass_header(
-        &job.trans,
+    let trans = glassdb_pass::read_pass_header(
+        &files.trans,
         &settings.pass_options(Some(&settings.layers.trans)),
     )?;
-    let mask = glassdb_mask::read_mask_header(&job.mask, &settings.mask)?;
-    let refl = job
+    let mask = glassdb_mask::read_mask_header(&files.mask, &settings.mask)?;
+    let refl = files
         .refl
         .iter()
         .enumerate()
-        .map(|(k, p)| io::read_refl_header(p, &settings.pass_options(settings.layers.refl.get(k))))
+        .map(|(k, p)| {
+            glassdb_pass::read_refl_header(p, &settings.pass_options(settings.layers.refl.get(k)))
+        })
         .collect::<Result<Vec<_>, _>>()?;
 
     let display = trans.windows.display;
     let mask_windows = in_frame(mask.windows, !mask.has_coordinates, &display);
-    let mut others: Vec<(&Path, ImageWindows)> = vec![(job.mask.as_path(), mask_windows)];
-    others.extend(job.refl.iter().zip(&refl).map(|(path, p)| {
+    let mut others: Vec<(&Path, ImageWindows)> = vec![(files.mask.as_path(), mask_windows)];
+    others.extend(files.refl.iter().zip(&refl).map(|(path, p)| {
         (
             path.as_path(),
             in_frame(p.windows, !p.source.has_coordinates(), &display),
         )
     }));
-    check_frames(job, &trans.windows, &others)?;
+    check_frames(&files.trans, &trans.windows, &others)?;
     let refl_windows = others.iter().skip(1).map(|(_, w)| *w).collect();
 
     let declared = settings.input_space;
-    let trans_space = colour::pass_space(&job.trans, &trans.colour, declared)?;
-    let refl_spaces = job
+    let trans_space = colour::pass_space(&files.trans, &trans.colour, declared)?;
+    let refl_spaces = files
         .refl
         .iter()
         .zip(&refl)
@@ -70,16 +76,16 @@ pub(crate) fn plan_frame(
             ))
         })
         .collect::<Result<Vec<_>, ComposeError>>()?;
-    let space = colour::frame_space((&job.trans, trans_space), &refl_spaces)?;
+    let space = colour::frame_space((&files.trans, trans_space), &refl_spaces)?;
 
     if refl.len() > 1 && !mask.stores_planes {
         return Err(ComposeError::MaskWithoutPlanes {
-            mask: job.mask.clone(),
+            mask: files.mask.clone(),
             passes: refl.len(),
         });
     }
 
-    let memory = estimate(job, settings, &trans, &refl, &mask, &mask_windows)?;
+    let memory = estimate(files, target, &trans, &refl, &mask, &mask_windows);
     Ok(FramePlan {
         space,
         display,
@@ -88,68 +94,24 @@ pub(crate) fn plan_frame(
     })
 }
 
-/// The frame's memory from the headers (module docs of [`crate::memory`]).
+/// The frame's memory from the headers (module docs of [`crate::memory`]): the largest of its
+/// three stages, decoding, compositing and encoding, with the program's overhead.
 fn estimate(
-    job: &ComposeJob,
-    settings: &ComposeSettings,
+    files: &FrameFiles,
+    target: &DecodeTarget,
     trans: &PassHeader,
     refl: &[PassHeader],
     mask: &MaskHeader,
     mask_windows: &ImageWindows,
-) -> Result<MemoryEstimate, ComposeError> {
-    let format = io::output_format(&job.output)?;
+) -> MemoryEstimate {
     let pixels = trans.windows.data.pixel_count();
-    let carried = match (&trans.source, format) {
-        (PassSource::Exr { channel_names, .. }, OutputFormat::Exr)
-            if io::carries_whole_file(
-                &trans.parts,
-                channel_names,
-                (
-                    settings.output.keep_channels,
-                    settings.output.output_layer.is_some(),
-                ),
-            ) =>
-        {
-            trans
-                .parts
-                .iter()
-                .map(|p| p.stored_bytes())
-                .fold(0, u64::saturating_add)
-        }
-        _ => 0,
-    };
+    let carried = carried_bytes(trans, target);
     let placed_mask = if mask_windows.data == trans.windows.data {
         0
     } else {
         pixels.saturating_mul(mask.bytes_per_pixel)
     };
-    // Bytes per pixel of the composite (f32 R, G, B and maybe A) and of the carried channels.
-    let composite_bpp = trans.memory.kept / pixels.max(1);
-    let carried_bpp = carried / pixels.max(1);
-    let output = match format {
-        OutputFormat::Exr => {
-            // A half copy of one plane at a time; the compressor's window of blocks (raw, split
-            // and deflated: three copies of 16 rows of every channel, four blocks per thread).
-            let half = match io::output_data_type(&trans.source, &settings.output) {
-                ExrDataType::Half => pixels.saturating_mul(2),
-                ExrDataType::Float => 0,
-            };
-            let row_bytes = (trans.windows.data.width as u64)
-                .saturating_mul(composite_bpp.saturating_add(carried_bpp));
-            let rows = (16 * 4 * rayon::current_num_threads() as u64)
-                .min(trans.windows.data.height as u64);
-            half.saturating_add(row_bytes.saturating_mul(3 * rows))
-        }
-        OutputFormat::Png => {
-            // The encoded samples and the file (at most their size); 16-bit: a big-endian copy.
-            let channels = composite_bpp / 4;
-            match io::output_png_bits(&trans.source, &settings.output) {
-                PngBits::Eight => pixels.saturating_mul(channels).saturating_mul(2),
-                PngBits::Sixteen => pixels.saturating_mul(2 * channels).saturating_mul(3),
-            }
-        }
-    };
-
+    let output = encoding_bytes(trans, target, carried);
     let kept = std::iter::once(&trans.memory)
         .chain(refl.iter().map(|p| &p.memory))
         .chain(std::iter::once(&mask.memory))
@@ -161,14 +123,6 @@ fn estimate(
     let mut by_transient: Vec<usize> = (0..refl.len()).collect();
     by_transient.sort_by_key(|&k| std::cmp::Reverse(refl[k].memory.transient));
     by_transient.truncate(crate::memory::decoding_at_once());
-    let refl_share = |k: usize| {
-        let m = &refl[k].memory;
-        if by_transient.contains(&k) {
-            m.peak()
-        } else {
-            m.kept
-        }
-    };
     let transient = by_transient
         .iter()
         .map(|&k| refl[k].memory.transient)
@@ -184,37 +138,122 @@ fn estimate(
         .saturating_add(output);
     let largest_stage = decoding.max(compositing).max(encoding);
     let total = crate::memory::with_overhead(largest_stage);
-
-    let mut items = vec![MemoryItem {
-        what: file_label(&job.trans),
-        bytes: trans.memory.peak(),
-    }];
-    items.extend(job.refl.iter().enumerate().map(|(k, path)| MemoryItem {
-        what: file_label(path),
-        bytes: refl_share(k),
-    }));
-    items.push(MemoryItem {
-        what: format!("{} (the mask)", file_label(&job.mask)),
-        bytes: mask.memory.peak().saturating_add(placed_mask),
-    });
-    if carried > 0 {
-        items.push(MemoryItem {
-            what: format!("the channels of {} carried over", file_label(&job.trans)),
-            bytes: carried,
-        });
-    }
-    items.push(MemoryItem {
-        what: format!("encoding {}", file_label(&job.output)),
-        bytes: output,
-    });
-    items.push(MemoryItem {
-        what: "the program and what the allocator keeps".into(),
-        bytes: total - largest_stage,
-    });
-    items.sort_by(|a, b| b.bytes.cmp(&a.bytes).then_with(|| a.what.cmp(&b.what)));
-    Ok(MemoryEstimate {
-        total,
-        items,
+    let refl_share = |k: usize| {
+        let m = &refl[k].memory;
+        if by_transient.contains(&k) {
+            m.peak()
+        } else {
+            m.kept
+        }
+    };
+    let shares = Shares {
+        trans: trans.memory.peak(),
+        refl: (0..refl.len()).map(refl_share).collect(),
+        mask: mask.memory.peak().saturating_add(placed_mask),
         carried,
-    })
+        output,
+        overhead: total - largest_stage,
+    };
+    MemoryEstimate {
+        total,
+        items: shares.items(files, target),
+        carried,
+    }
+}
+
+/// Bytes of the transmission file's other channels carried over into an EXR output.
+fn carried_bytes(trans: &PassHeader, target: &DecodeTarget) -> u64 {
+    match (&trans.source, target.encoding) {
+        (PassSource::Exr { channel_names, .. }, Encoding::Exr { .. })
+            if glassdb_pass::carries_whole_file(&trans.parts, channel_names, target.carry) =>
+        {
+            trans
+                .parts
+                .iter()
+                .map(|p| p.stored_bytes())
+                .fold(0, u64::saturating_add)
+        }
+        _ => 0,
+    }
+}
+
+/// The encoder's own buffers for the output of `target`.
+fn encoding_bytes(trans: &PassHeader, target: &DecodeTarget, carried: u64) -> u64 {
+    let pixels = trans.windows.data.pixel_count();
+    // Bytes per pixel of the composite (f32 R, G, B and maybe A) and of the carried channels.
+    let composite_bpp = trans.memory.kept / pixels.max(1);
+    let carried_bpp = carried / pixels.max(1);
+    match target.encoding {
+        Encoding::Exr { data_type } => {
+            // A half copy of one plane at a time; the compressor's window of blocks (raw, split
+            // and deflated: three copies of 16 rows of every channel, four blocks per thread).
+            let half = match glassdb_encode::exr_data_type(&trans.source, data_type) {
+                ExrDataType::Half => pixels.saturating_mul(2),
+                ExrDataType::Float => 0,
+            };
+            let row_bytes = (trans.windows.data.width as u64)
+                .saturating_mul(composite_bpp.saturating_add(carried_bpp));
+            let rows = (16 * 4 * rayon::current_num_threads() as u64)
+                .min(trans.windows.data.height as u64);
+            half.saturating_add(row_bytes.saturating_mul(3 * rows))
+        }
+        Encoding::Png { bits } => {
+            // The encoded samples and the file (at most their size); 16-bit: a big-endian copy.
+            let channels = composite_bpp / 4;
+            match glassdb_encode::png_bits(&trans.source, bits) {
+                PngBits::Eight => pixels.saturating_mul(channels).saturating_mul(2),
+                PngBits::Sixteen => pixels.saturating_mul(2 * channels).saturating_mul(3),
+            }
+        }
+    }
+}
+
+/// The shares of a frame's estimate, in bytes, before they are named.
+struct Shares {
+    trans: u64,
+    refl: Vec<u64>,
+    mask: u64,
+    carried: u64,
+    output: u64,
+    overhead: u64,
+}
+
+impl Shares {
+    /// The shares named for messages, largest first.
+    fn items(self, files: &FrameFiles, target: &DecodeTarget) -> Vec<MemoryItem> {
+        let mut items = vec![MemoryItem {
+            what: file_label(&files.trans),
+            bytes: self.trans,
+        }];
+        items.extend(
+            files
+                .refl
+                .iter()
+                .zip(self.refl)
+                .map(|(path, bytes)| MemoryItem {
+                    what: file_label(path),
+                    bytes,
+                }),
+        );
+        items.push(MemoryItem {
+            what: format!("{} (the mask)", file_label(&files.mask)),
+            bytes: self.mask,
+        });
+        if self.carried > 0 {
+            items.push(MemoryItem {
+                what: format!("the channels of {} carried over", file_label(&files.trans)),
+                bytes: self.carried,
+            });
+        }
+        items.push(MemoryItem {
+            what: format!("encoding {}", target.name),
+            bytes: self.output,
+        });
+        items.push(MemoryItem {
+            what: "the program and what the allocator keeps".into(),
+            bytes: self.overhead,
+        });
+        items.sort_by(|a, b| b.bytes.cmp(&a.bytes).then_with(|| a.what.cmp(&b.what)));
+        items
+    }
 }

@@ -202,4 +202,34 @@ pub enum FitError {
     /// A physical check failed and strict mode turns it into an error.
     #[error("glass `{glass}`: {message}")]
     Physical { glass: String, message: String },
+    /// The fitter failed internally (a caught panic): a bug, not a property of the table.
+    #[error("{what} failed internally (it panicked: {message}); this is a bug of glassdb's")]
+    Internal {
+        /// What failed.
+        what: &'static str,
+        /// The panic's message.
+        message: String,
+    },
+}
+
+impl FitError {
+    /// The class of this error: a file that cannot be read is the reader's class, a caught
+    /// panic is internal, anything else is a table, a fit file or an option to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        match self {
+            FitError::Io { source, .. } => source.kind(),
+            FitError::Internal { .. } => glassdb_io::ErrorKind::Internal,
+            FitError::Curve { error, .. } => error.kind(),
+            _ => glassdb_io::ErrorKind::Invalid,
+        }
+    }
+}
+
+/// The text of a caught panic's payload (a `&str` or `String` message; else a placeholder).
+pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "no message".to_string())
 }

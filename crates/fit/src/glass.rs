@@ -10,11 +10,7 @@ use crate::model::{AngleSamples, CurveFit, FitOptions, Quantity};
 use crate::solve::fit_curve;
 use crate::table::GlassAngleTable;
 
-/// Step of the dense grid the physical checks run on (degrees, 0–90 inclusive).
-pub const CHECK_STEP_DEG: f64 = 0.25;
-/// Slack for the physical checks (absolute): a millionth, far below any measurement precision,
-/// so only real violations are reported.
-pub const CHECK_SLACK: f64 = 1e-6;
+pub use crate::model::{CHECK_SLACK, CHECK_STEP_DEG};
 
 /// The largest slack (absolute, on r or t) that validation ever allows a curve beyond the
 /// physical range 0 ≤ r, t ≤ 1, r + t ≤ 1: 0.01, one percentage point of reflectance or

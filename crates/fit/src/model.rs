@@ -3,6 +3,12 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Step of the dense grid the physical checks run on (degrees, 0–90 inclusive).
+pub const CHECK_STEP_DEG: f64 = 0.25;
+/// Slack for the physical checks (absolute): a millionth, far below any measurement precision,
+/// so only real violations are reported.
+pub const CHECK_SLACK: f64 = 1e-6;
+
 /// Which powers of cos θ a curve uses.
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]

@@ -696,10 +696,10 @@ pub fn fit_curve(samples: &AngleSamples, opts: &FitOptions) -> Result<CurveFit, 
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         fit_curve_inner(samples, opts)
     }))
-    .unwrap_or_else(|_| {
-        Err(FitError::Singular {
-            degree: opts.degree.unwrap_or(opts.max_degree),
-            points: samples.angle_deg.len(),
+    .unwrap_or_else(|panic| {
+        Err(FitError::Internal {
+            what: "the curve fit",
+            message: crate::error::panic_message(panic.as_ref()),
         })
     })
 }
@@ -766,10 +766,10 @@ fn in_unit_range(s: &Solved) -> bool {
         powers: s.basis.powers(s.degree),
         coefficients: s.coefficients.clone(),
     };
-    let steps = (90.0 / crate::glass::CHECK_STEP_DEG).round() as usize;
+    let steps = (90.0 / crate::model::CHECK_STEP_DEG).round() as usize;
     (0..=steps).all(|i| {
-        let v = s.normal * poly.eval_angle_deg(i as f64 * crate::glass::CHECK_STEP_DEG);
-        (-crate::glass::CHECK_SLACK..=1.0 + crate::glass::CHECK_SLACK).contains(&v)
+        let v = s.normal * poly.eval_angle_deg(i as f64 * crate::model::CHECK_STEP_DEG);
+        (-crate::model::CHECK_SLACK..=1.0 + crate::model::CHECK_SLACK).contains(&v)
     })
 }
 

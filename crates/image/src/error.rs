@@ -1,21 +1,9 @@
 //! The one error type of glassdb-image. Each variant belongs to one [`ImageErrorKind`], the
 //! class a user can act on; the decoder's or encoder's own error is kept as the `source`.
 
-/// What a user can do about an [`ImageError`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum ImageErrorKind {
-    /// The bytes are not a well-formed image (corrupt, truncated): replace the file.
-    Invalid,
-    /// A well-formed image using a feature this crate does not read or write (deep data,
-    /// subsampled channels, another file format): convert the file.
-    Unsupported,
-    /// The image is larger than the configured pixel limit: raise the limit or shrink the image.
-    Limits,
-    /// Reading or writing the underlying stream failed.
-    Io,
-    /// A decoder or encoder failed internally (a caught panic): a bug, not a property of the file.
-    Internal,
-}
+/// What a user can do about an [`ImageError`]: the class every glassdb error shares
+/// ([`glassdb_io::ErrorKind`]), under the name this crate has always given it.
+pub use glassdb_io::ErrorKind as ImageErrorKind;
 
 /// The codec a [`ImageError::CodecPanic`] came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -45,6 +45,10 @@ pub use png_read::{PngHeader, PngPixels, PngSamples, decode_png, read_png_header
 pub use png_write::{PngColor, PngCompression, PngEncodeOptions, PngSampleSlice, encode_png};
 pub use window::{ImageWindows, PixelWindow, place_plane};
 
+/// The largest image file read: a pass or a mask, PNG or EXR (its pixel count is limited
+/// separately, from its header, before decoding).
+pub const IMAGE_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::gib(8, "an image");
+
 /// Default pixel limit: 2^27 (134 million pixels, e.g. 16384×8192).
 pub const DEFAULT_MAX_PIXELS: u64 = 1 << 27;
 

@@ -18,6 +18,13 @@ pub enum FrameError {
     NoPattern { path: PathBuf },
 }
 
+impl FrameError {
+    /// The class of this error: always invalid input (a frame list or a path to fix).
+    pub fn kind(&self) -> crate::ErrorKind {
+        crate::ErrorKind::Invalid
+    }
+}
+
 /// Whether `pattern` contains a `#` run.
 pub fn is_frame_pattern(pattern: &Path) -> bool {
     pattern.to_string_lossy().contains('#')

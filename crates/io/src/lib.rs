@@ -10,13 +10,17 @@
 //!   temporary files (docs/reliability.md).
 //! - [`frames`]: frame patterns and frame lists of animations.
 //! - [`progress`]: the observer through which libraries report the progress of long work.
+//! - [`ErrorKind`]: the class of every glassdb error (invalid, unsupported, limits, I/O,
+//!   internal), which each library's error type reports through its `kind()`.
 
+mod error_kind;
 pub mod frames;
 pub mod input;
 mod kind;
 pub mod output;
 mod registry;
 
+pub use error_kind::ErrorKind;
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
 pub use input::{
     InputError, InputLimit, limits, open_input, read_input, read_input_string, read_open_input,
@@ -27,7 +31,7 @@ pub use output::{
     OutputError, StagedOutput, SyncingFile, refuse_input_as_output, write_atomic,
     write_bytes_atomic,
 };
-pub use registry::{TEMP_PREFIX, exit_removing_temporaries, protect_inputs};
+pub use registry::{TEMP_PREFIX, declare_inputs, exit_removing_temporaries, protect_inputs};
 pub mod progress;
 pub use progress::{NoProgress, Progress, StageLog};
 

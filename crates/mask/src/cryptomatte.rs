@@ -152,7 +152,7 @@ fn read_side_manifest(image: &Path, file: &str) -> Result<String, MaskError> {
         path: side.clone(),
         source,
     };
-    glassdb_io::read_input_string(&side, glassdb_io::limits::MANIFEST).map_err(read_err)
+    glassdb_io::read_input_string(&side, crate::MANIFEST_FILE).map_err(read_err)
 }
 
 /// `{"name": "hex"}` → name → hash.

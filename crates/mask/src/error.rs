@@ -90,6 +90,20 @@ pub enum MaskError {
 }
 
 impl MaskError {
+    /// The class of this error: a read's, decoder's or writer's own class; a mask image that
+    /// does not hold together is glassdb's bug; anything else is a mask (or a glass mapping)
+    /// to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        use glassdb_io::ErrorKind;
+        match self {
+            MaskError::Read { source, .. } => source.kind(),
+            MaskError::Decode { source, .. } | MaskError::Encode { source, .. } => source.kind(),
+            MaskError::Write(e) => e.kind(),
+            MaskError::Inconsistent(_) => ErrorKind::Internal,
+            _ => ErrorKind::Invalid,
+        }
+    }
+
     /// The image-level class of a decoding or encoding failure (`None` for mask-level errors).
     pub fn image_error_kind(&self) -> Option<ImageErrorKind> {
         match self {

@@ -23,6 +23,10 @@ use std::collections::BTreeMap;
 
 use rayon::prelude::*;
 
+/// The largest Cryptomatte manifest side file (JSON) read.
+pub const MANIFEST_FILE: glassdb_io::InputLimit =
+    glassdb_io::InputLimit::mib(64, "a Cryptomatte manifest");
+
 pub use cos_code::CosCode;
 pub use cryptomatte::{
     AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, PlaneSource, cryptomatte_layers,

@@ -40,7 +40,7 @@ pub fn read_mask_header(path: &Path, opts: &MaskReadOptions) -> Result<MaskHeade
         source,
     };
     let (file, file_len) =
-        glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(read_err)?;
+        glassdb_io::open_input(path, glassdb_image::IMAGE_FILE).map_err(read_err)?;
     let header = glassdb_image::read_image_header(BufReader::new(file), opts.max_pixels)
         .map_err(|source| decode_err(path, source))?;
     Ok(MaskPlan::new(&header, path, opts)?.header(file_len))
@@ -55,7 +55,7 @@ pub fn read_mask(path: &Path, opts: &MaskReadOptions) -> Result<MaskImage, MaskE
 
 /// Reads a mask file with its windows and whether it stores planes.
 pub fn read_placed_mask(path: &Path, opts: &MaskReadOptions) -> Result<PlacedMask, MaskError> {
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|source| {
+    let bytes = glassdb_io::read_input(path, glassdb_image::IMAGE_FILE).map_err(|source| {
         MaskError::Read {
             path: path.to_path_buf(),
             source,

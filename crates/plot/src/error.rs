@@ -66,3 +66,26 @@ pub enum PlotError {
 pub(crate) fn draw_err<E: std::fmt::Display>(e: E) -> PlotError {
     PlotError::Draw(e.to_string())
 }
+
+impl PlotError {
+    /// The class of this error: a wrapped reader's or writer's own class; a panic of the
+    /// drawing library is internal; a figure size over the limit is a limit; anything else is
+    /// an input or an option to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        use glassdb_io::ErrorKind;
+        match self {
+            PlotError::Fit(e) => e.kind(),
+            PlotError::Spectral(e) => e.kind(),
+            PlotError::Registry(e) => e.kind(),
+            PlotError::Mask(e) => e.kind(),
+            PlotError::Output(e) => e.kind(),
+            PlotError::Read { source, .. } => source.kind(),
+            PlotError::Encode(e) | PlotError::Decode { source: e, .. } => e.kind(),
+            PlotError::DrawPanic { .. } | PlotError::Font | PlotError::Draw(_) => {
+                ErrorKind::Internal
+            }
+            PlotError::BadSize { .. } => ErrorKind::Limits,
+            _ => ErrorKind::Invalid,
+        }
+    }
+}

@@ -23,7 +23,7 @@ pub struct PngSummary {
 /// Decodes the PNG at `path` (grey, RGB or RGBA; 16-bit samples as their high byte) and
 /// summarises it.
 pub fn summarize_png(path: &Path) -> Result<PngSummary, PlotError> {
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|source| {
+    let bytes = glassdb_io::read_input(path, glassdb_image::IMAGE_FILE).map_err(|source| {
         PlotError::Read {
             path: path.into(),
             source,

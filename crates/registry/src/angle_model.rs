@@ -234,7 +234,7 @@ pub(crate) fn read_measured_table(
     let Some((rel, percent)) = &spec.angles else {
         return Ok(None);
     };
-    let (full, bytes) = files.read(rel, glass, glassdb_io::limits::ANGLE_TABLE)?;
+    let (full, bytes) = files.read(rel, glass, glassdb_fit::ANGLE_TABLE_FILE)?;
     let stem = full
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

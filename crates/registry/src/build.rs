@@ -104,9 +104,9 @@ pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// The bytes of a catalog file, of at most [`glassdb_io::limits::CATALOG`].
+/// The bytes of a catalog file, of at most [`crate::CATALOG_FILE`].
 fn read_catalog(catalog_path: &Path) -> Result<Vec<u8>, RegistryError> {
-    glassdb_io::read_input(catalog_path, glassdb_io::limits::CATALOG).map_err(|source| {
+    glassdb_io::read_input(catalog_path, crate::CATALOG_FILE).map_err(|source| {
         RegistryError::Read {
             path: catalog_path.to_path_buf(),
             source,

@@ -268,3 +268,27 @@ fn missing_ids_message(catalog: &std::path::Path, ids: &[(u16, u64)]) -> String 
         list.join(", ")
     )
 }
+
+impl RegistryError {
+    /// The class of this error: a file that cannot be read is the reader's class, a failure
+    /// of a catalog's spectral file, angle table or fit keeps its own class, a registry that
+    /// cannot be serialised is glassdb's bug; anything else is a registry or catalog to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        use glassdb_io::ErrorKind;
+        match self {
+            RegistryError::Read { source, .. } | RegistryError::InputFile { source, .. } => {
+                source.kind()
+            }
+            RegistryError::Write(e) => e.kind(),
+            RegistryError::Spectral { source, .. } | RegistryError::Integration { source, .. } => {
+                source.kind()
+            }
+            RegistryError::SpectralMethod(e) => e.kind(),
+            RegistryError::AngleTable { source, .. } | RegistryError::Fit { source, .. } => {
+                source.kind()
+            }
+            RegistryError::Serialize(_) => ErrorKind::Internal,
+            _ => ErrorKind::Invalid,
+        }
+    }
+}

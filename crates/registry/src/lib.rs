@@ -20,13 +20,17 @@ pub mod physics;
 mod record;
 mod validate;
 
+/// The largest catalog (`catalog.toml`) read.
+pub const CATALOG_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::mib(16, "a catalog");
+
 pub use build::{Application, BuildOptions, MaskIds, build_registry, catalog_inputs};
 pub use bundled::{DEFAULT_REGISTRY_JSON, DEFAULT_REGISTRY_NAME, default_registry};
 pub use error::RegistryError;
 /// The cap on every curve's recorded validation tolerance (shared with fit files).
 pub use glassdb_fit::MAX_CURVE_TOLERANCE;
+/// The face of a pane a record's values are for (the `glassdb-side` crate's type).
+pub use glassdb_side::{Side, UnknownSide};
 pub use record::{
     AngleCurve, AngleModelRecord, CHANNELS, ColourBasis, FileRef, GlassRecord, LuminousRecord,
     ProductRecord, Provenance, Registry, RegistryTable, SCHEMA_VERSION, SCHEMA_VERSION_ONE_TABLE,
-    Side, UnknownSide,
 };

@@ -62,7 +62,7 @@ pub(crate) fn read_spectral_source(
     let NormalSource::Spectral { path, percent } = &spec.normal else {
         return Ok(None);
     };
-    let (full, bytes) = files.read(path, glass, glassdb_io::limits::SPECTRAL)?;
+    let (full, bytes) = files.read(path, glass, glassdb_spectral::SPECTRAL_FILE)?;
     let read_opts = glassdb_spectral::ReadOptions { percent: *percent };
     let data =
         glassdb_spectral::read_spectral_bytes(&bytes, &full.display().to_string(), &read_opts)

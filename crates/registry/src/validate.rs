@@ -6,7 +6,8 @@ use std::collections::BTreeMap;
 use glassdb_fit::MAX_CURVE_TOLERANCE;
 
 use crate::RegistryError;
-use crate::record::{CHANNELS, GlassRecord, Registry, RegistryTable, Side};
+use crate::Side;
+use crate::record::{CHANNELS, GlassRecord, Registry, RegistryTable};
 
 /// Angle step of the validation grid (degrees): 0, 0.25, …, 90.
 const VALIDATION_STEP_DEG: f64 = 0.25;

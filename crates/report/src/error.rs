@@ -39,3 +39,21 @@ pub enum ReportError {
     #[error(transparent)]
     Mask(#[from] glassdb_mask::MaskError),
 }
+
+impl ReportError {
+    /// The class of this error: a wrapped error's own class; a folder that cannot be made is
+    /// I/O.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        match self {
+            ReportError::Read { source, .. } => source.kind(),
+            ReportError::CreateDir { .. } => glassdb_io::ErrorKind::Io,
+            ReportError::Output(e) => e.kind(),
+            ReportError::Plot(e) => e.kind(),
+            ReportError::Fit(e) => e.kind(),
+            ReportError::Spectral(e) => e.kind(),
+            ReportError::Registry(e) => e.kind(),
+            ReportError::Scene(e) => e.kind(),
+            ReportError::Mask(e) => e.kind(),
+        }
+    }
+}

@@ -85,6 +85,15 @@ pub enum SceneError {
         #[source]
         source: serde_json::Error,
     },
+    /// A `planes.json` describing another number of planes than the reflection passes given.
+    #[error(
+        "{planes_file} describes {planes} glass plane(s) but {passes} reflection pass(es) were given: one pass per plane, in the file's order"
+    )]
+    PlaneCountMismatch {
+        planes_file: PathBuf,
+        planes: usize,
+        passes: usize,
+    },
     /// A plane-bounds file (`glassdb mask --bounds`) that is not valid JSON of its schema.
     #[error("plane bounds file {path}")]
     BoundsJson {
@@ -123,9 +132,34 @@ pub enum SceneError {
     /// Writing an output failed (atomic: the target is left as it was).
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),
+    /// A mask could not be written.
+    #[error(transparent)]
+    Mask(#[from] glassdb_mask::MaskError),
+    /// A frame's file pattern could not be expanded.
+    #[error(transparent)]
+    Frame(#[from] glassdb_io::FrameError),
 }
 
 /// `, frame N` for errors about one frame of an animation.
 fn frame_suffix(frame: Option<u32>) -> String {
     frame.map(|f| format!(", frame {f}")).unwrap_or_default()
+}
+
+impl SceneError {
+    /// The class of this error: a file that cannot be read or written is the reader's or
+    /// writer's class; an image size over the limit is a limit; the OBJ reader's inner failure
+    /// is glassdb's bug; anything else is a scene, camera, planes file or option to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        use glassdb_io::ErrorKind;
+        match self {
+            SceneError::Read { source, .. } => source.kind(),
+            SceneError::Output(e) => e.kind(),
+            SceneError::Mask(e) => e.kind(),
+            SceneError::Frame(e) => e.kind(),
+            SceneError::CreateDir { .. } => ErrorKind::Io,
+            SceneError::BadImageSize { .. } => ErrorKind::Limits,
+            SceneError::EncodeJson { .. } => ErrorKind::Internal,
+            _ => ErrorKind::Invalid,
+        }
+    }
 }

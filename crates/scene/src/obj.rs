@@ -26,6 +26,11 @@ use crate::math::Vec3;
 use crate::triangulate::triangulate_polygon;
 use crate::warning::SceneWarning;
 
+/// The largest OBJ scene read.
+pub const OBJ_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::gib(2, "an OBJ scene");
+/// The largest MTL material library (named by an OBJ's `mtllib`) read.
+pub const MTL_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::mib(64, "an MTL file");
+
 /// Most vertices/faces accepted in one OBJ, so that a hostile file cannot exhaust memory
 /// through index arithmetic (the text itself bounds real data).
 const MAX_ELEMENTS: usize = 1 << 31;
@@ -575,7 +580,7 @@ fn scan_mtl(text: &str, path: &Path) -> Result<Vec<String>, SceneError> {
 /// Reads, validates and triangulates an OBJ scene. Polygons are ear-clipped in their plane;
 /// one that cannot be (non-planar, self-intersecting) is fanned with a warning.
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
-    let text = read_text(path, glassdb_io::limits::OBJ)?;
+    let text = read_text(path, OBJ_FILE)?;
     let scan = scan_obj(&text, path)?;
     if scan.face_lines.is_empty() {
         return Err(SceneError::EmptyScene {
@@ -595,7 +600,7 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
             });
             continue;
         }
-        let mtl_text = read_text(&mtl_path, glassdb_io::limits::MTL)?;
+        let mtl_text = read_text(&mtl_path, MTL_FILE)?;
         defined.extend(scan_mtl(&mtl_text, &mtl_path)?);
     }
     if !scan.mtllibs.is_empty() {
@@ -758,13 +763,16 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
             count: fanned - MAX_POLYGON_WARNINGS,
         });
     }
-    Ok(Scene {
+    let scene = Scene {
         source: path.to_path_buf(),
         mtllibs: scan.mtllibs.into_iter().map(|(name, _)| name).collect(),
         materials: scan.usemtl,
         meshes,
         warnings,
-    })
+    };
+    // Its material libraries, read or missing: no output may replace or create one.
+    glassdb_io::declare_inputs(scene.input_files().iter().map(PathBuf::as_path));
+    Ok(scene)
 }
 
 /// `name` as one `mtllib` argument: as it is when [`split_mtllib`] reads it back as one name,

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum SpectralError {
     /// The file could not be read: missing, not a regular file, or over
-    /// [`glassdb_io::limits::SPECTRAL`].
+    /// [`crate::SPECTRAL_FILE`].
     #[error("{path}: cannot read")]
     Io {
         path: PathBuf,
@@ -272,6 +272,23 @@ impl fmt::Display for UnsupportedKind {
                 Some(what) => write!(f, "is binary data ({what}), not a text spectral file"),
                 None => write!(f, "is binary data, not a text spectral file"),
             },
+        }
+    }
+}
+
+impl SpectralError {
+    /// The class of this error: a file that cannot be read is the reader's class; a kind of
+    /// data glassdb does not read is unsupported; a corrupt embedded table is glassdb's bug;
+    /// anything else is data (or an option) to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        use glassdb_io::ErrorKind;
+        match self {
+            SpectralError::Io { source, .. } => source.kind(),
+            SpectralError::Unsupported { .. } => ErrorKind::Unsupported,
+            SpectralError::EmbeddedTable { .. } | SpectralError::EmbeddedData { .. } => {
+                ErrorKind::Internal
+            }
+            _ => ErrorKind::Invalid,
         }
     }
 }

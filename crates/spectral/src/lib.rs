@@ -39,6 +39,6 @@ pub use integrate::{
 };
 pub use interp::resample;
 pub use read::{
-    ProductInfo, ReadOptions, SpectralData, SpectralFormat, detect_format, microns_to_nm,
-    read_spectral_bytes, read_spectral_file,
+    ProductInfo, ReadOptions, SPECTRAL_FILE, SpectralData, SpectralFormat, detect_format,
+    microns_to_nm, read_spectral_bytes, read_spectral_file,
 };

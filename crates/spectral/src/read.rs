@@ -88,14 +88,17 @@ pub struct ReadOptions {
     pub percent: bool,
 }
 
+/// The largest spectral data file read (CSV, LBNL Optics text or IGSDB JSON).
+pub const SPECTRAL_FILE: glassdb_io::InputLimit =
+    glassdb_io::InputLimit::mib(64, "a spectral data file");
+
 /// Reads a spectral file; the format comes from the extension, then from the content.
 pub fn read_spectral_file(path: &Path, opts: &ReadOptions) -> Result<SpectralData, SpectralError> {
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::SPECTRAL).map_err(|source| {
-        SpectralError::Io {
+    let bytes =
+        glassdb_io::read_input(path, SPECTRAL_FILE).map_err(|source| SpectralError::Io {
             path: path.to_path_buf(),
             source,
-        }
-    })?;
+        })?;
     read_spectral_bytes(&bytes, &path.display().to_string(), opts)
 }
 

@@ -2,48 +2,110 @@
 
 use std::path::PathBuf;
 
+use glassdb_io::ErrorKind;
+
 /// The viewer's errors.
 #[derive(Debug, thiserror::Error)]
 pub enum ViewError {
     /// A frame's inputs could not be read, placed or checked (the compositor's own error).
     #[error(transparent)]
     Compose(#[from] glassdb_compose::ComposeError),
+    /// A frame's file pattern could not be expanded.
+    #[error(transparent)]
+    Frame(#[from] glassdb_io::FrameError),
     /// Frames of a sequence store cos θ differently (the page's shader reads one kind).
     #[error(
         "frame {frame}: the mask {} stores cos θ as {found}, but the first frame's as {first}; a sequence must use one mask kind",
         mask.display()
     )]
     MaskKindChanges {
+        /// The frame.
         frame: u32,
+        /// Its mask.
         mask: PathBuf,
+        /// How it stores cos θ.
         found: &'static str,
+        /// How the first frame's mask does.
         first: &'static str,
     },
     /// A glass choice is not `ID:PRODUCT`.
     #[error("glass choice {spec:?}: {why}")]
-    GlassSpec { spec: String, why: String },
+    GlassSpec {
+        /// The choice as given.
+        spec: String,
+        /// What is wrong with it.
+        why: String,
+    },
     /// No candidate product matches a name.
     #[error("no product matches {name:?}; the candidates are: {candidates}")]
-    UnknownProduct { name: String, candidates: String },
+    UnknownProduct {
+        /// The name given.
+        name: String,
+        /// Every product, listed.
+        candidates: String,
+    },
     /// Several candidate products match a name.
     #[error("{name:?} matches several products: {matches}; give more of the name")]
-    AmbiguousProduct { name: String, matches: String },
+    AmbiguousProduct {
+        /// The name given.
+        name: String,
+        /// The products it matches, listed.
+        matches: String,
+    },
     /// The id a choice names is not a glass the registry knows.
     #[error("glass id {id} is not in the registry's table, so it has no slot to swap")]
-    UnknownGlassId { id: u16 },
+    UnknownGlassId {
+        /// The id.
+        id: u16,
+    },
     /// The server could not listen.
     #[error("cannot listen on {address}: {source}")]
     Bind {
+        /// `host:port`.
         address: String,
+        /// The server's error.
         source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// The export folder could not be created or is not a directory.
     #[error("cannot write the export into {}", path.display())]
     ExportDir {
+        /// The folder.
         path: PathBuf,
+        /// Why.
         source: std::io::Error,
     },
     /// Writing an export file failed.
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),
+}
+
+impl ViewError {
+    /// The class of this error: a frame's own (compose's) class; a bad choice on the page or
+    /// a mask kind that changes is invalid; the server's and the export's file failures are
+    /// I/O.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            ViewError::Compose(e) => e.kind(),
+            ViewError::Frame(e) => e.kind(),
+            ViewError::Output(e) => e.kind(),
+            ViewError::Bind { .. } | ViewError::ExportDir { .. } => ErrorKind::Io,
+            ViewError::MaskKindChanges { .. }
+            | ViewError::GlassSpec { .. }
+            | ViewError::UnknownProduct { .. }
+            | ViewError::AmbiguousProduct { .. }
+            | ViewError::UnknownGlassId { .. } => ErrorKind::Invalid,
+        }
+    }
+
+    /// The HTTP status the server answers this error with, by its kind: 422 for a frame whose
+    /// files cannot be composited as they are (invalid or unsupported: they must be fixed),
+    /// 503 for one over a limit (the machine may manage it later, or with a higher limit), 500
+    /// for a file that could not be read or glassdb's own failure.
+    pub fn http_status(&self) -> u16 {
+        match self.kind() {
+            ErrorKind::Invalid | ErrorKind::Unsupported => 422,
+            ErrorKind::Limits => 503,
+            ErrorKind::Io | ErrorKind::Internal => 500,
+        }
+    }
 }

@@ -115,8 +115,8 @@ impl ViewServer {
             "/viewer.css" => Reply::text(assets::VIEWER_CSS, "text/css; charset=utf-8"),
             "/api/scene" => {
                 let mut scene = v.scene().clone();
-                scene["export_available"] = json!(self.export_dir.is_some());
-                Reply::json(&scene)
+                scene.export_available = self.export_dir.is_some();
+                Reply::json(&json!(scene))
             }
             _ => {
                 let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
@@ -152,10 +152,10 @@ impl ViewServer {
         };
         let data = match self.viewer.frame(i) {
             Ok(d) => d,
-            Err(e) => return Reply::error(500, &ErrorChain(&e).to_string()),
+            Err(e) => return Reply::error(e.http_status(), &ErrorChain(&e).to_string()),
         };
         match rest {
-            [] => Reply::json(&data.info),
+            [] => Reply::json(&json!(data.info)),
             ["passes"] => Reply::binary(Body::Frame(data, FramePart::Passes)),
             ["mask"] => Reply::binary(Body::Frame(data, FramePart::Mask)),
             _ => Reply::error(404, "no such resource"),

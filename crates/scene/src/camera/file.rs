@@ -16,7 +16,10 @@ use crate::error::SceneError;
 
 /// Largest camera file read (a camera is a few hundred bytes; an animation file of ten
 /// thousand frames a few megabytes).
-pub const MAX_CAMERA_FILE_BYTES: u64 = glassdb_io::limits::CAMERA.bytes;
+pub const CAMERA_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::mib(16, "a camera file");
+
+/// Largest camera file read, in bytes ([`CAMERA_FILE`]).
+pub const MAX_CAMERA_FILE_BYTES: u64 = CAMERA_FILE.bytes;
 
 /// Where the camera of each frame comes from.
 #[derive(Debug, Clone, PartialEq)]
@@ -158,7 +161,7 @@ fn read_camera_text(path: &Path, frame: Option<u32>) -> Result<String, SceneErro
             source,
         },
     };
-    glassdb_io::read_input_string(path, glassdb_io::limits::CAMERA).map_err(read_err)
+    glassdb_io::read_input_string(path, CAMERA_FILE).map_err(read_err)
 }
 
 /// Parses a camera file: an object with a `frames` key is an animation, anything else one

@@ -15,7 +15,7 @@ mod tests;
 
 use std::path::Path;
 
-pub use file::{CameraSource, MAX_CAMERA_FILE_BYTES};
+pub use file::{CAMERA_FILE, CameraSource, MAX_CAMERA_FILE_BYTES};
 pub use spec::{CameraSpec, SensorFit};
 
 use crate::error::SceneError;
