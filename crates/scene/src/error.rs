@@ -18,9 +18,6 @@ pub enum SceneError {
         line: usize,
         message: String,
     },
-    /// The OBJ loader rejected the file after validation (should not happen; names the file).
-    #[error("cannot load {path}: {message}")]
-    Load { path: PathBuf, message: String },
     /// The scene has no triangles at all.
     #[error("{path} contains no faces")]
     EmptyScene { path: PathBuf },
@@ -147,8 +144,8 @@ fn frame_suffix(frame: Option<u32>) -> String {
 
 impl SceneError {
     /// The class of this error: a file that cannot be read or written is the reader's or
-    /// writer's class; an image size over the limit is a limit; the OBJ reader's inner failure
-    /// is glassdb's bug; anything else is a scene, camera, planes file or option to fix.
+    /// writer's class; an image size over the limit is a limit; a JSON output that cannot be
+    /// encoded is glassdb's bug; anything else is a scene, camera, planes file or option to fix.
     pub fn kind(&self) -> glassdb_io::ErrorKind {
         use glassdb_io::ErrorKind;
         match self {
