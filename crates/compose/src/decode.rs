@@ -6,7 +6,6 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use glassdb_encode::Encoding;
 use glassdb_image::{ImageWindows, PixelWindow};
 use glassdb_mask::{MaskImage, PlacedMask};
 use glassdb_pass::{CarriedFrame, Carry, Pass};
@@ -16,33 +15,8 @@ use crate::colour::{ChosenTable, PassSpace, RegistryLuts};
 use crate::lut::GlassLut;
 use crate::memory::{self, MemoryBudget, MemoryEstimate};
 use crate::place::{absolute_from, check_frames, in_frame, relative_to};
-use crate::plan::{self, FramePlan};
+use crate::plan::{self, DecodeTarget, FramePlan};
 use crate::{ComposeError, DecodeSettings, FrameFiles, OutsidePolicy, UnknownIds};
-
-/// What a frame is decoded for, as far as reading it must know: the channels of the
-/// transmission file an output carries over, and the encoding whose buffers the frame's memory
-/// estimate counts (`name` says what is encoded, in the estimate's shares).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct DecodeTarget {
-    /// The transmission file's channels carried over.
-    pub carry: Carry,
-    /// The output's format and sample type or bit depth.
-    pub encoding: Encoding,
-    /// What is encoded, for the memory estimate's shares (an output's file name).
-    pub name: String,
-}
-
-impl DecodeTarget {
-    /// A frame decoded to be shown, not written (the viewer): nothing carried over, its memory
-    /// counted as the 8-bit (or the passes' 16-bit) PNG a display shows.
-    pub fn display() -> DecodeTarget {
-        DecodeTarget {
-            carry: Carry::NONE,
-            encoding: Encoding::Png { bits: None },
-            name: "the displayed image".into(),
-        }
-    }
-}
 
 /// One frame's inputs decoded, placed in the transmission pass's frame and checked, ready for
 /// the kernel (compose) or for the viewer's GPU textures.

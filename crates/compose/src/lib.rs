@@ -31,7 +31,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-pub use decode::{DecodeTarget, DecodedFrame, decode_frame};
+pub use decode::{DecodedFrame, decode_frame};
 pub use error::ComposeError;
 use glassdb_encode::{OutputFormat, OutputOptions, WrittenOutput};
 use glassdb_image::ImageWindows;
@@ -39,6 +39,7 @@ use glassdb_mask::MaskReadOptions;
 use glassdb_pass::{Carry, PassReadOptions};
 use glassdb_side::Side;
 use memory::{MemoryBudget, MemoryEstimate};
+pub use plan::DecodeTarget;
 
 use crate::colour::{ChosenTable, PassSpace, RegistryLuts, SpaceSource};
 use crate::kernel::{KernelCounts, KernelInput, OutsidePass, PlacedRefl};

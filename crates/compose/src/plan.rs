@@ -11,13 +11,37 @@ use glassdb_image::ImageWindows;
 use glassdb_mask::MaskHeader;
 
 use glassdb_encode::{Encoding, ExrDataType};
-use glassdb_pass::{PassHeader, PassSource, PngBits};
+use glassdb_pass::{Carry, PassHeader, PassSource, PngBits};
 
 use crate::colour::{self, PassSpace};
-use crate::decode::DecodeTarget;
 use crate::memory::{MemoryEstimate, MemoryItem, file_label};
 use crate::place::{check_frames, in_frame};
 use crate::{ComposeError, DecodeSettings, FrameFiles};
+
+/// What a frame is decoded for, as far as reading it must know: the channels of the
+/// transmission file an output carries over, and the encoding whose buffers the frame's memory
+/// estimate counts (`name` says what is encoded, in the estimate's shares).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DecodeTarget {
+    /// The transmission file's channels carried over.
+    pub carry: Carry,
+    /// The output's format and sample type or bit depth.
+    pub encoding: Encoding,
+    /// What is encoded, for the memory estimate's shares (an output's file name).
+    pub name: String,
+}
+
+impl DecodeTarget {
+    /// A frame decoded to be shown, not written (the viewer): nothing carried over, its memory
+    /// counted as the 8-bit (or the passes' 16-bit) PNG a display shows.
+    pub fn display() -> DecodeTarget {
+        DecodeTarget {
+            carry: Carry::NONE,
+            encoding: Encoding::Png { bits: None },
+            name: "the displayed image".into(),
+        }
+    }
+}
 
 /// What the headers decided for one frame.
 pub(crate) struct FramePlan {

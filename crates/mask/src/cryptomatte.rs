@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use glassdb_image::{ExrFile, ExrHeaders, ExrPart, ImageWindows, ReadMemory};
 
-use crate::read::{MaskHeader, PixelError, decode_channels, locate_channel, plan_channels};
+use crate::channels::{MaskHeader, PixelError, decode_channels, locate_channel, plan_channels};
 use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
 
 /// How an AOV relates to the glass it describes.

@@ -12,6 +12,7 @@
 //! Id 0 means "no glass" everywhere. Decoding and encoding the files is glassdb-image's job;
 //! this crate maps the formats' layouts to and from [`MaskImage`].
 
+mod channels;
 mod cos_code;
 mod cryptomatte;
 mod error;
@@ -27,6 +28,7 @@ use rayon::prelude::*;
 pub const MANIFEST_FILE: glassdb_io::InputLimit =
     glassdb_io::InputLimit::mib(64, "a Cryptomatte manifest");
 
+pub use channels::MaskHeader;
 pub use cos_code::CosCode;
 pub use cryptomatte::{
     AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, PlaneSource, cryptomatte_layers,
@@ -36,8 +38,7 @@ pub use glass_names::{GlassMapping, GlassNames};
 pub use glassdb_image::DEFAULT_MAX_PIXELS;
 use glassdb_image::PixelWindow;
 pub use read::{
-    MaskHeader, read_mask, read_mask_bytes, read_mask_header, read_placed_mask,
-    read_placed_mask_bytes,
+    read_mask, read_mask_bytes, read_mask_header, read_placed_mask, read_placed_mask_bytes,
 };
 pub use write::{MaskFormat, write_mask, write_mask_bytes};
 

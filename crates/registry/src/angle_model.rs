@@ -5,8 +5,8 @@
 use glassdb_fit::AngleSamples;
 use glassdb_spectral::Integrator;
 
-use crate::build::{Application, CatalogFiles, sha256_hex};
 use crate::catalog::{GlassSpec, ModelChoice};
+use crate::catalog_files::{Application, CatalogFiles, sha256_hex};
 use crate::normal::{NormalValues, Spectra, integrate};
 use crate::physics::{
     CoatedCurve, UncoatedSlab, fresnel_single_surface, ior_from_reflectance, opaque_reflectance,

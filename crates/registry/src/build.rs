@@ -7,34 +7,16 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use glassdb_spectral::{IntegrationSettings, Integrator};
-use sha2::{Digest, Sha256};
 
 use crate::angle_model::{ModelTables, Physical, choose_model, read_measured_table};
 use crate::catalog::{GlassSpec, NormalSource, parse_catalog, resolve};
+pub use crate::catalog_files::Application;
+pub(crate) use crate::catalog_files::{CatalogFiles, sha256_hex};
 use crate::curves::fit_glass_curves;
 use crate::normal::{normal_values, read_spectral_source};
 use crate::{
     AngleModelRecord, FileRef, GlassRecord, Provenance, Registry, RegistryError, RegistryTable,
 };
-
-/// Where the angle model is applied.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Application {
-    /// To the spectrum, wavelength by wavelength, before integration (what WINDOW does).
-    #[default]
-    PerWavelength,
-    /// To the integrated per-channel values (the cheaper approximation; for comparison).
-    PerChannel,
-}
-
-impl Application {
-    pub fn name(self) -> &'static str {
-        match self {
-            Application::PerWavelength => "per-wavelength",
-            Application::PerChannel => "per-channel",
-        }
-    }
-}
 
 /// The glass ids a scene's masks use: a build restricted to them builds only these.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -72,36 +54,6 @@ impl Default for BuildOptions {
             application: Application::PerWavelength,
         }
     }
-}
-
-/// Reads the files a catalog names, relative to the catalog.
-pub(crate) struct CatalogFiles<'a> {
-    catalog_path: &'a Path,
-}
-
-impl CatalogFiles<'_> {
-    /// The full path and bytes of the file `rel` that `glass` names, of at most `limit`.
-    pub(crate) fn read(
-        &self,
-        rel: &str,
-        glass: &str,
-        limit: glassdb_io::InputLimit,
-    ) -> Result<(PathBuf, Vec<u8>), RegistryError> {
-        let path = resolve(self.catalog_path, rel);
-        match glassdb_io::read_input(&path, limit) {
-            Ok(bytes) => Ok((path, bytes)),
-            Err(source) => Err(RegistryError::InputFile {
-                glass: glass.to_string(),
-                path,
-                source,
-            }),
-        }
-    }
-}
-
-pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
-    let digest = Sha256::digest(bytes);
-    digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// The bytes of a catalog file, of at most [`crate::CATALOG_FILE`].

@@ -13,6 +13,7 @@ mod angle_model;
 mod build;
 mod bundled;
 pub mod catalog;
+mod catalog_files;
 mod curves;
 mod error;
 mod normal;

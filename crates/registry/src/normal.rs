@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use glassdb_spectral::{Integrator, SpectralData};
 
-use crate::build::{CatalogFiles, sha256_hex};
 use crate::catalog::{GlassSpec, ModelChoice, NormalSource};
+use crate::catalog_files::{CatalogFiles, sha256_hex};
 use crate::{FileRef, LuminousRecord, ProductRecord, RegistryError};
 
 /// Spectra of one glass at normal incidence on the file's own wavelengths.

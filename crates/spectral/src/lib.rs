@@ -21,6 +21,7 @@ mod balance;
 mod error;
 mod integrate;
 mod interp;
+mod open;
 mod read;
 mod read_csv;
 mod read_igsdb;
@@ -38,7 +39,5 @@ pub use integrate::{
     RgbCmf, luminous, luminous_iso9050, rgb_matrix,
 };
 pub use interp::resample;
-pub use read::{
-    ProductInfo, ReadOptions, SPECTRAL_FILE, SpectralData, SpectralFormat, detect_format,
-    microns_to_nm, read_spectral_bytes, read_spectral_file,
-};
+pub use open::{SPECTRAL_FILE, detect_format, read_spectral_bytes, read_spectral_file};
+pub use read::{ProductInfo, ReadOptions, SpectralData, SpectralFormat, microns_to_nm};
