@@ -402,7 +402,15 @@ fn check_range(what: &str, (a, b): (f64, f64)) -> Result<(), PlotError> {
     Ok(())
 }
 
-/// Draws a panel into `area`.
+/// The chart of a panel: f64 coordinates on both axes.
+type PanelChart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// Draws a panel into `area`: its axes and grid, then its shades, zero line, lines, markers
+/// and annotations, then the legend of what has a label.
 pub fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
@@ -438,6 +446,41 @@ pub fn draw_panel<DB: DrawingBackend>(
         .draw()
         .map_err(draw_err)?;
 
+    let mut any_label = draw_shades(&mut chart, panel, (x0, x1), (y0, y1))?;
+    if panel.zero_line && y0 < 0.0 && y1 > 0.0 {
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(x0, 0.0), (x1, 0.0)],
+                BLACK.mix(0.55).stroke_width(1),
+            )))
+            .map_err(draw_err)?;
+    }
+    any_label |= draw_lines(&mut chart, panel, (x0, x1), (y0, y1))?;
+    any_label |= draw_markers(&mut chart, panel, (x0, x1), (y0, y1))?;
+    for a in &panel.annotations {
+        if a.x.is_finite() && a.y.is_finite() && a.x >= x0 && a.x <= x1 && a.y >= y0 && a.y <= y1 {
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    a.text.clone(),
+                    (a.x, a.y),
+                    (FAMILY, 13).into_font().color(&a.colour),
+                )))
+                .map_err(draw_err)?;
+        }
+    }
+    if let (Some(corner), true) = (panel.legend, any_label) {
+        draw_legend(&mut chart, panel, corner, (x0, x1), (y0, y1))?;
+    }
+    Ok(())
+}
+
+/// The shaded x ranges (clipped to the panel); whether one has a label.
+fn draw_shades<'a, DB: DrawingBackend + 'a>(
+    chart: &mut PanelChart<'a, DB>,
+    panel: &Panel,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<bool, PlotError> {
     let mut any_label = false;
     for s in &panel.shades {
         let (sx0, sx1) = (s.x0.max(x0), s.x1.min(x1));
@@ -458,14 +501,17 @@ pub fn draw_panel<DB: DrawingBackend>(
             });
         }
     }
-    if panel.zero_line && y0 < 0.0 && y1 > 0.0 {
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                vec![(x0, 0.0), (x1, 0.0)],
-                BLACK.mix(0.55).stroke_width(1),
-            )))
-            .map_err(draw_err)?;
-    }
+    Ok(any_label)
+}
+
+/// The lines, each clipped into runs inside the panel; whether one has a label.
+fn draw_lines<'a, DB: DrawingBackend + 'a>(
+    chart: &mut PanelChart<'a, DB>,
+    panel: &Panel,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<bool, PlotError> {
+    let mut any_label = false;
     for line in &panel.lines {
         let style = line.colour.stroke_width(line.width);
         let mut labelled = false;
@@ -498,6 +544,17 @@ pub fn draw_panel<DB: DrawingBackend>(
             }
         }
     }
+    Ok(any_label)
+}
+
+/// The markers inside the panel; whether a series of them has a label.
+fn draw_markers<'a, DB: DrawingBackend + 'a>(
+    chart: &mut PanelChart<'a, DB>,
+    panel: &Panel,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<bool, PlotError> {
+    let mut any_label = false;
     for m in &panel.markers {
         let inside: Vec<(f64, f64)> = m
             .points
@@ -538,40 +595,38 @@ pub fn draw_panel<DB: DrawingBackend>(
             }),
         }
     }
-    for a in &panel.annotations {
-        if a.x.is_finite() && a.y.is_finite() && a.x >= x0 && a.x <= x1 && a.y >= y0 && a.y <= y1 {
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    a.text.clone(),
-                    (a.x, a.y),
-                    (FAMILY, 13).into_font().color(&a.colour),
-                )))
-                .map_err(draw_err)?;
+    Ok(any_label)
+}
+
+/// The legend in `corner` (chosen where the data leave room, for `Auto`).
+fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut PanelChart<'a, DB>,
+    panel: &Panel,
+    corner: LegendCorner,
+    x_range: (f64, f64),
+    y_range: (f64, f64),
+) -> Result<(), PlotError> {
+    let position = match corner {
+        LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
+        LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
+        LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
+        LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
+        LegendCorner::MiddleRight => SeriesLabelPosition::MiddleRight,
+        LegendCorner::MiddleLeft => SeriesLabelPosition::MiddleLeft,
+        LegendCorner::UpperMiddle => SeriesLabelPosition::UpperMiddle,
+        LegendCorner::LowerMiddle => SeriesLabelPosition::LowerMiddle,
+        LegendCorner::Auto => {
+            let (pw, ph) = chart.plotting_area().dim_in_pixel();
+            auto_legend_position(panel, x_range, y_range, (pw, ph))
         }
-    }
-    if let (Some(corner), true) = (panel.legend, any_label) {
-        let position = match corner {
-            LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
-            LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
-            LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
-            LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
-            LegendCorner::MiddleRight => SeriesLabelPosition::MiddleRight,
-            LegendCorner::MiddleLeft => SeriesLabelPosition::MiddleLeft,
-            LegendCorner::UpperMiddle => SeriesLabelPosition::UpperMiddle,
-            LegendCorner::LowerMiddle => SeriesLabelPosition::LowerMiddle,
-            LegendCorner::Auto => {
-                let (pw, ph) = chart.plotting_area().dim_in_pixel();
-                auto_legend_position(panel, (x0, x1), (y0, y1), (pw, ph))
-            }
-        };
-        chart
-            .configure_series_labels()
-            .position(position)
-            .label_font((FAMILY, 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.35))
-            .draw()
-            .map_err(draw_err)?;
-    }
+    };
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FAMILY, 13))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.35))
+        .draw()
+        .map_err(draw_err)?;
     Ok(())
 }

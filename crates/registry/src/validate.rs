@@ -131,6 +131,19 @@ fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryErro
             }
         }
     }
+    validate_curves(g, source_name)?;
+    validate_physical(g, source_name)
+}
+
+/// Every curve of `g` well formed, with finite numbers and a tolerance in
+/// [0, [`MAX_CURVE_TOLERANCE`]].
+fn validate_curves(g: &GlassRecord, source_name: &str) -> Result<(), RegistryError> {
+    let glass = g.label();
+    let non_finite = |field: String| RegistryError::NonFinite {
+        source_name: source_name.to_string(),
+        glass: glass.clone(),
+        field,
+    };
     for (field, curves) in [("c_r", &g.c_r), ("c_t", &g.c_t), ("c_r_back", &g.c_r_back)] {
         for (c, curve) in curves.iter().enumerate() {
             let name = format!("{field}[{c}] ({})", CHANNELS[c]);
@@ -177,6 +190,13 @@ fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryErro
             }
         }
     }
+    Ok(())
+}
+
+/// r, t and r + t of `g` within [0, 1] (each within its curves' tolerance) on both sides, at
+/// every [`VALIDATION_STEP_DEG`] from 0° to 90°.
+fn validate_physical(g: &GlassRecord, source_name: &str) -> Result<(), RegistryError> {
+    let glass = g.label();
     let steps = (90.0 / VALIDATION_STEP_DEG).round() as usize;
     for side in [Side::Front, Side::Back] {
         let (_, c_r) = g.r_parts(side);
