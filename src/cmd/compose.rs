@@ -9,7 +9,7 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use glassdb_colour::DisplayView;
-use glassdb_compose::colour::RegistryLuts;
+use glassdb_compose::colour::{RegistryLuts, SpaceSource};
 use glassdb_compose::{
     ComposeJob, ComposeSettings, FrameReport, OutsidePolicy, UnknownIds,
     compose_frame_with_progress,
@@ -261,9 +261,14 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
         ColourBasis::PaperRgb => " (the paper's CIE 1931 RGB, not a renderer's space)",
         ColourBasis::Space(_) => "",
     };
+    // The passes' space as the command line names how it was known.
+    let source = match &colour.space.source {
+        SpaceSource::Declared => "--input-space".to_string(),
+        other => other.to_string(),
+    };
     outln!(
-        "colour       passes in {}; registry table {}{table_note}",
-        colour.space,
+        "colour       passes in {} ({source}); registry table {}{table_note}",
+        glassdb_compose::colour::space_label(colour.space.space),
         colour.table.basis
     );
     if colour.converted_for_display {

@@ -311,7 +311,9 @@ pub fn planes_and_masks(
     let Some(&first_frame) = info.frames.first() else {
         return Err(BlenderError::BadRender {
             path: dir.join("export.json"),
-            message: "no frames to render (the scene's frame range or --frames is empty)".into(),
+            message:
+                "no frames to render (the scene's frame range, or the frames asked for, is empty)"
+                    .into(),
         });
     };
     let first = cameras.camera(Some(first_frame))?;

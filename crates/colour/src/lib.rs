@@ -4,6 +4,8 @@
 //! [`display`]: the display views (the sRGB transfer, `.cube` LUTs) that turn scene-linear RGB
 //! into a PNG's display-encoded values.
 
+#![warn(missing_docs)]
+
 pub mod display;
 
 use std::fmt;

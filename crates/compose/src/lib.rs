@@ -4,7 +4,7 @@
 //!
 //! A frame goes through four phases, each a function in its own file:
 //!
-//! 1. header ([`plan`]): every input's header read and compared before any pixel is decoded,
+//! 1. header (`plan.rs`): every input's header read and compared before any pixel is decoded,
 //!    and the frame's memory estimated from them ([`memory`]);
 //! 2. decode ([`decode_frame`]): the inputs decoded in parallel (glassdb-pass reads the
 //!    passes, glassdb-mask the mask), placed in the transmission pass's frame and checked;

@@ -25,10 +25,13 @@ pub const MAX_CURVE_TOLERANCE: f64 = 0.01;
 /// The fitted curves of one glass. A glass measured for only one of R/T has only that key.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct GlassFit {
+    /// The glass's name, as in the table.
     pub name: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// The fitted reflectance curve.
     pub reflectance: Option<CurveFit>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// The fitted transmittance curve.
     pub transmittance: Option<CurveFit>,
     /// Glass-level warnings: failed physical checks, repeated angles averaged.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -53,6 +56,7 @@ impl GlassFit {
 /// The whole output of `glassdb fit --json` / `-o`.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq, Default)]
 pub struct FitFile {
+    /// Every glass fitted, in the table's order.
     pub glasses: Vec<GlassFit>,
 }
 
@@ -268,6 +272,7 @@ fn validate_curve(
 pub struct PhysicalViolation {
     /// What failed, e.g. `r < 0`, `t > 1`, `r + t > 1`.
     pub check: &'static str,
+    /// The angle (degrees) where it fails most.
     pub worst_angle_deg: f64,
     /// The offending value at that angle (r, t or r + t).
     pub worst_value: f64,

@@ -11,6 +11,8 @@
 //!   within [`MAX_CURVE_TOLERANCE`] at most, as the registry checks its curves), and
 //!   [`CurveFit::eval_angle_deg`] / [`CosPolynomial::eval`] to use it.
 
+#![warn(missing_docs)]
+
 mod dd;
 mod error;
 mod glass;

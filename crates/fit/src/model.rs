@@ -67,8 +67,11 @@ impl std::str::FromStr for Basis {
 /// quantity at incidence angle θ to its normal-incidence value. `powers` ascend strictly.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct CosPolynomial {
+    /// Which powers it uses.
     pub basis: Basis,
+    /// The powers of cos θ, strictly ascending.
     pub powers: Vec<u32>,
+    /// One coefficient per power.
     pub coefficients: Vec<f64>,
 }
 
@@ -108,14 +111,24 @@ pub const MAX_POWER: u32 = 64;
 /// Why a [`CosPolynomial`] as written (in a fit file or a registry) cannot be evaluated.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum PolynomialShape {
+    /// Neither a power nor a coefficient.
     #[error("no terms")]
     NoTerms,
+    /// Not as many powers as coefficients.
     #[error("{powers} powers but {coefficients} coefficients")]
-    LengthMismatch { powers: usize, coefficients: usize },
+    LengthMismatch {
+        /// Powers given.
+        powers: usize,
+        /// Coefficients given.
+        coefficients: usize,
+    },
+    /// A power above [`MAX_POWER`].
     #[error("power {0} is beyond the supported {MAX_POWER}")]
     PowerTooHigh(u32),
+    /// Two powers out of order (this one, then that one).
     #[error("powers must ascend strictly, but {0} is followed by {1}")]
     NotAscending(u32, u32),
+    /// Power 0 in the paper basis (which has no constant term).
     #[error("the paper basis has no constant term (power 0)")]
     ConstantInPaperBasis,
 }
@@ -172,6 +185,7 @@ pub fn cos_deg(angle_deg: f64) -> f64 {
 /// residual above 4, and above the tolerance): a probable outlier or typo in the table.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct SuspectPoint {
+    /// Its angle of incidence, degrees.
     pub angle_deg: f64,
     /// fitted − measured, in the quantity's units (fraction).
     pub residual: f64,
@@ -214,6 +228,7 @@ impl FitSummary {
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct FitDiagnostics {
     #[serde(flatten)]
+    /// The keys of the JSON (`rms_error`, `max_abs_error`, …).
     pub summary: FitSummary,
     /// Condition number of the same fit written in the power basis (cos^p θ columns): what a
     /// naive solver would face; the normal equations square it.
@@ -226,6 +241,7 @@ pub struct FitDiagnostics {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angle_min_deg: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// The largest measured angle.
     pub angle_max_deg: Option<f64>,
     /// True when `normal` is the table's 0° value; false when the table had no 0° row and
     /// `normal` is the fitted absolute curve's value at cos θ = 1.
@@ -258,8 +274,10 @@ pub struct CurveFit {
     /// The normal-incidence value r0 or t0 (fraction).
     pub normal: f64,
     #[serde(flatten)]
+    /// The ratio C(θ) = value(θ) / normal.
     pub polynomial: CosPolynomial,
     #[serde(flatten)]
+    /// How well it fits, and what was solved.
     pub diagnostics: FitDiagnostics,
 }
 
@@ -286,7 +304,9 @@ impl CurveFit {
 /// One measured curve: angles of incidence (degrees, 0–90) and the value at each (fraction).
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct AngleSamples {
+    /// Angles of incidence, degrees (0–90).
     pub angle_deg: Vec<f64>,
+    /// The value at each (fraction).
     pub value: Vec<f64>,
 }
 
@@ -294,11 +314,14 @@ pub struct AngleSamples {
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum Quantity {
+    /// r(θ).
     Reflectance,
+    /// t(θ).
     Transmittance,
 }
 
 impl Quantity {
+    /// Its name in JSON and messages: `reflectance` or `transmittance`.
     pub fn name(self) -> &'static str {
         match self {
             Quantity::Reflectance => "reflectance",
@@ -324,6 +347,7 @@ pub struct FitOptions {
     /// `None`: full for reflectance; for transmittance the more accurate of paper and full on
     /// the data, preferring one whose t(θ) stays within 0–1 over 0–90°.
     pub basis: Option<Basis>,
+    /// Which quantity the values are.
     pub quantity: Quantity,
 }
 

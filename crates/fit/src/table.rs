@@ -21,11 +21,13 @@ pub const MAX_TABLE_BYTES: u64 = ANGLE_TABLE_FILE.bytes;
 /// An angle that appeared on more than one row of a glass: the values were averaged.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RepeatedAngle {
+    /// The angle, degrees.
     pub angle_deg: f64,
     /// How many rows gave this angle.
     pub rows: usize,
     /// Largest minus smallest value among those rows, per quantity (None: not measured).
     pub reflectance_spread: Option<f64>,
+    /// Largest minus smallest transmittance among those rows (None: not measured).
     pub transmittance_spread: Option<f64>,
 }
 
@@ -34,7 +36,9 @@ pub struct RepeatedAngle {
 pub struct GlassAngleTable {
     /// The `glass` column's value, or the file stem when there is no `glass` column.
     pub name: String,
+    /// The measured reflectance, if any.
     pub reflectance: Option<AngleSamples>,
+    /// The measured transmittance, if any.
     pub transmittance: Option<AngleSamples>,
     /// Angles given on several rows (averaged), ascending.
     pub repeated_angles: Vec<RepeatedAngle>,

@@ -8,7 +8,9 @@ pub use glassdb_io::ErrorKind as ImageErrorKind;
 /// The codec a [`ImageError::CodecPanic`] came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Codec {
+    /// PNG (the `png` crate).
     Png,
+    /// OpenEXR (the `exr` crate).
     Exr,
 }
 
@@ -26,7 +28,10 @@ impl std::fmt::Display for Codec {
 pub enum ImageError {
     /// The bytes start with neither the PNG nor the OpenEXR magic number.
     #[error("neither PNG nor OpenEXR (it starts with bytes {start:02x?})")]
-    UnknownFormat { start: Vec<u8> },
+    UnknownFormat {
+        /// The file's first bytes.
+        start: Vec<u8>,
+    },
     /// The `exr` crate rejected the bytes; its error tells whether they are invalid,
     /// unsupported or unreadable.
     #[error("the OpenEXR data cannot be decoded")]
@@ -36,29 +41,47 @@ pub enum ImageError {
     PngDecode(#[source] png::DecodingError),
     /// The file's blocks are missing, overlapping or of the wrong size: truncated or corrupt.
     #[error("pixel data incomplete: {detail}")]
-    Incomplete { detail: String },
+    Incomplete {
+        /// What is missing or wrong.
+        detail: String,
+    },
     /// A feature this crate does not handle (deep data, subsampled channels, an empty image).
     #[error("unsupported: {feature}")]
-    Unsupported { feature: String },
+    Unsupported {
+        /// The feature.
+        feature: String,
+    },
     /// Larger than the allowed number of pixels (checked from the header, before allocating).
     #[error("{width}×{height} pixels exceeds the limit of {max_pixels} pixels")]
     TooLarge {
+        /// The image's width.
         width: u64,
+        /// The image's height.
         height: u64,
+        /// The pixel limit.
         max_pixels: u64,
     },
     /// A codec panicked (a bug in it, reached by these bytes); the panic is caught, not renamed.
     #[error("the {codec} codec failed internally (it panicked: {message})")]
-    CodecPanic { codec: Codec, message: String },
+    CodecPanic {
+        /// The codec that panicked.
+        codec: Codec,
+        /// The panic's message.
+        message: String,
+    },
     /// Reading the file's header from its stream failed.
     #[error("cannot read the image header")]
     Read(#[source] std::io::Error),
     /// The sample buffer handed to an encoder does not match the image size.
     #[error("{samples} samples given for a {width}×{height} image of {channels} channel(s)")]
     SampleCount {
+        /// Samples given.
         samples: usize,
+        /// The image's width.
         width: u32,
+        /// The image's height.
         height: u32,
+        /// Channels per pixel.
         channels: usize,
     },
     /// The `png` crate could not encode the image.

@@ -6,7 +6,10 @@
 //! Every call into a codec runs under a panic guard: a panic becomes
 //! [`ImageError::CodecPanic`] (class [`ImageErrorKind::Internal`]), never a claim about the file.
 
+#![warn(missing_docs)]
+
 mod error;
+mod exr_bands;
 mod exr_layers;
 pub mod exr_read;
 mod exr_write;
@@ -55,7 +58,9 @@ pub const DEFAULT_MAX_PIXELS: u64 = 1 << 27;
 /// The file formats this crate recognises by their first bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ImageFileKind {
+    /// PNG (its signature).
     Png,
+    /// OpenEXR (its magic number).
     Exr,
 }
 
@@ -74,7 +79,9 @@ pub fn sniff_image_kind(bytes: &[u8]) -> Option<ImageFileKind> {
 /// ([`read_image_header`]).
 #[derive(Debug, Clone)]
 pub enum ImageHeader {
+    /// A PNG's header chunks.
     Png(PngHeader),
+    /// An OpenEXR's headers.
     Exr(ExrHeaders),
 }
 
@@ -105,7 +112,9 @@ pub fn read_image_header<R: std::io::BufRead + std::io::Seek>(
 /// and its channels are decoded on request (only the part and channels a caller needs).
 #[derive(Debug)]
 pub enum ImageFile<'a> {
+    /// A PNG, decoded whole.
     Png(PngPixels),
+    /// An OpenEXR, its headers read and its channels decoded on request.
     Exr(ExrFile<'a>),
 }
 

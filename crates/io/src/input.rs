@@ -89,7 +89,10 @@ pub enum InputError {
     /// The path names something that is not a regular file and would be read without end or
     /// not at all (a directory, `/dev/zero`, a FIFO, a socket).
     #[error("it is {kind}, not a regular file")]
-    NotAFile { kind: FileKind },
+    NotAFile {
+        /// What it is.
+        kind: FileKind,
+    },
     /// The file is over the limit of its kind (see [`limits`]); nothing was read.
     #[error(
         "{} more than the {} {} may have",
@@ -100,11 +103,15 @@ pub enum InputError {
     TooLarge {
         /// Its size from its metadata (`None` when it grew past the limit while being read).
         size: Option<u64>,
+        /// The limit of its kind.
         limit: InputLimit,
     },
     /// The file was read as text but is not UTF-8.
     #[error("it is not UTF-8 text (byte {valid_up_to} is not)")]
-    NotUtf8 { valid_up_to: usize },
+    NotUtf8 {
+        /// The first byte that is not UTF-8.
+        valid_up_to: usize,
+    },
 }
 
 impl InputError {

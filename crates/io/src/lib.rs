@@ -13,6 +13,8 @@
 //! - [`ErrorKind`]: the class of every glassdb error (invalid, unsupported, limits, I/O,
 //!   internal), which each library's error type reports through its `kind()`.
 
+#![warn(missing_docs)]
+
 mod error_kind;
 pub mod frames;
 pub mod input;

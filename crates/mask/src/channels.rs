@@ -12,11 +12,13 @@ use crate::MaskError;
 /// where its pixels lie, whether it stores planes, and what reading it costs in memory.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MaskHeader {
+    /// Where its pixels lie.
     pub windows: ImageWindows,
+    /// Whether it stores a plane per pixel.
     pub stores_planes: bool,
-    /// Whether the file states its pixels' coordinates (EXR); see [`PlacedMask`].
+    /// Whether the file states its pixels' coordinates (EXR); see [`crate::PlacedMask`].
     pub has_coordinates: bool,
-    /// Bytes per pixel of the decoded [`MaskImage`] (id, plane, cos θ, coverage).
+    /// Bytes per pixel of the decoded [`crate::MaskImage`] (id, plane, cos θ, coverage).
     pub bytes_per_pixel: u64,
     /// Reading it: the file and the decoder's buffers while reading, the mask after.
     pub memory: ReadMemory,

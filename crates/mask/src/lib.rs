@@ -12,6 +12,8 @@
 //! Id 0 means "no glass" everywhere. Decoding and encoding the files is glassdb-image's job;
 //! this crate maps the formats' layouts to and from [`MaskImage`].
 
+#![warn(missing_docs)]
+
 mod channels;
 mod cos_code;
 mod cryptomatte;
@@ -46,7 +48,9 @@ pub use write::{MaskFormat, write_mask, write_mask_bytes};
 /// entries.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MaskImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Glass registration id per pixel; 0 means "no glass".
     pub id: Vec<u16>,
@@ -62,8 +66,11 @@ pub struct MaskImage {
 /// stores a plane per pixel (a mask without planes has every glass pixel on plane 0).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlacedMask {
+    /// The mask's pixels.
     pub image: MaskImage,
+    /// Where they lie: the file's data and display windows.
     pub windows: glassdb_image::ImageWindows,
+    /// Whether the file stores a plane per pixel.
     pub stores_planes: bool,
     /// Whether the file states its pixels' coordinates (EXR); a PNG holds a whole frame at
     /// (0, 0), wherever the frame of the passes lies.
@@ -123,10 +130,15 @@ impl MaskImage {
 /// (`x_min..=x_max`, `y_min..=y_max`, row 0 at the top) and the glass pixels inside.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PlaneBounds {
+    /// Leftmost glass column.
     pub x_min: i32,
+    /// Topmost glass row.
     pub y_min: i32,
+    /// Rightmost glass column.
     pub x_max: i32,
+    /// Bottom glass row.
     pub y_max: i32,
+    /// Glass pixels of the plane.
     pub glass_pixels: u64,
 }
 

@@ -37,10 +37,15 @@ pub fn palette(i: usize) -> RGBColor {
 /// A polyline. Non-finite points break the line (they are never joined across).
 #[derive(Debug, Clone)]
 pub struct Line {
+    /// Its legend entry, if any.
     pub label: Option<String>,
+    /// Its colour.
     pub colour: RGBColor,
+    /// Drawn dashed.
     pub dashed: bool,
+    /// Stroke width in pixels.
     pub width: u32,
+    /// Its points, in data coordinates.
     pub points: Vec<(f64, f64)>,
 }
 
@@ -74,23 +79,33 @@ impl Line {
 /// Marker shapes for measured points and marked values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MarkerShape {
+    /// A filled circle.
     Circle,
+    /// A cross.
     Cross,
+    /// A filled triangle.
     Triangle,
+    /// A filled square.
     Square,
 }
 
 /// A set of markers (measured points, marked channel values).
 #[derive(Debug, Clone)]
 pub struct Markers {
+    /// Its legend entry, if any.
     pub label: Option<String>,
+    /// Its colour.
     pub colour: RGBColor,
+    /// Its shape.
     pub shape: MarkerShape,
+    /// Its size in pixels.
     pub size: u32,
+    /// Its points, in data coordinates.
     pub points: Vec<(f64, f64)>,
 }
 
 impl Markers {
+    /// Markers of `shape` at `points`, 4 pixels, with an optional legend entry.
     pub fn new(
         label: impl Into<Option<String>>,
         colour: RGBColor,
@@ -110,31 +125,47 @@ impl Markers {
 /// A shaded vertical band from `x0` to `x1` over the whole height of the panel.
 #[derive(Debug, Clone)]
 pub struct Shade {
+    /// Where it starts on the x axis.
     pub x0: f64,
+    /// Where it ends on the x axis.
     pub x1: f64,
+    /// Its legend entry, if any.
     pub label: Option<String>,
+    /// Its colour (drawn translucent).
     pub colour: RGBColor,
 }
 
 /// A text label at a data position.
 #[derive(Debug, Clone)]
 pub struct Annotation {
+    /// x of the text's left end, data coordinates.
     pub x: f64,
+    /// y of the text, data coordinates.
     pub y: f64,
+    /// The text.
     pub text: String,
+    /// Its colour.
     pub colour: RGBColor,
 }
 
 /// Where a panel's legend goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LegendCorner {
+    /// Top left.
     UpperLeft,
+    /// Top right.
     UpperRight,
+    /// Bottom left.
     LowerLeft,
+    /// Bottom right.
     LowerRight,
+    /// Middle of the right side.
     MiddleRight,
+    /// Middle of the left side.
     MiddleLeft,
+    /// Middle of the top.
     UpperMiddle,
+    /// Middle of the bottom.
     LowerMiddle,
     /// The position where the legend box covers the fewest drawn points.
     Auto,
@@ -144,15 +175,23 @@ pub enum LegendCorner {
 /// markers and text on top).
 #[derive(Debug, Clone)]
 pub struct Panel {
+    /// The panel's title, if any.
     pub title: Option<String>,
+    /// The x axis's label.
     pub x_label: String,
+    /// The y axis's label.
     pub y_label: String,
+    /// The x range shown.
     pub x_range: (f64, f64),
     /// `None`: fit the data (finite values inside the x range) with a small margin.
     pub y_range: Option<(f64, f64)>,
+    /// Its lines.
     pub lines: Vec<Line>,
+    /// Its markers.
     pub markers: Vec<Markers>,
+    /// Its shaded x ranges.
     pub shades: Vec<Shade>,
+    /// Its text annotations.
     pub annotations: Vec<Annotation>,
     /// Draw the line y = 0 when it is inside the range (residual panels).
     pub zero_line: bool,

@@ -18,9 +18,13 @@ pub const NO_VALUE_COLOUR: RGBColor = RGBColor(225, 225, 225);
 /// A row-major grid of optional values, row 0 at the top (image convention).
 #[derive(Debug, Clone)]
 pub struct HeatMapFigure {
+    /// The figure's title.
     pub title: String,
+    /// A line under it, if any.
     pub subtitle: Option<String>,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// `width * height` values; `None` where nothing is shown (drawn grey).
     pub values: Vec<Option<f64>>,
@@ -197,7 +201,7 @@ fn draw_colour_bar<DB: DrawingBackend>(
     value_label: &str,
     (vmin, vmax): (f64, f64),
 ) -> Result<(), PlotError> {
-    let mut bar = ChartBuilder::on(&bar_area)
+    let mut bar = ChartBuilder::on(bar_area)
         .margin_top(10)
         .margin_bottom(50)
         .margin_right(8)

@@ -10,7 +10,9 @@ use crate::PlotError;
 /// What a PNG holds, in numbers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PngSummary {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Number of distinct RGB colours.
     pub distinct_colours: usize,

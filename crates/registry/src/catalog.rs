@@ -91,8 +91,11 @@ impl ModelChoice {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(untagged)]
 pub enum IorValue {
+    /// One real index n (k = 0), every channel.
     Real(f64),
+    /// One complex index `[n, k]`, every channel.
     Complex([f64; 2]),
+    /// `[n, k]` per channel (R, G, B).
     PerChannel([[f64; 2]; 3]),
 }
 
@@ -110,11 +113,17 @@ impl IorValue {
 /// A validated catalog entry, ready to build.
 #[derive(Debug, Clone)]
 pub struct GlassSpec {
+    /// Its registry id.
     pub id: u16,
+    /// Its name.
     pub name: String,
+    /// Where its normal-incidence values come from.
     pub normal: NormalSource,
+    /// Its measured angle table and whether it is in percent, if any.
     pub angles: Option<(String, bool)>,
+    /// Its angle model.
     pub model: ModelChoice,
+    /// The complex refractive index per channel (the opaque model), if given.
     pub ior: Option<[(f64, f64); 3]>,
 }
 
@@ -122,11 +131,19 @@ pub struct GlassSpec {
 #[derive(Debug, Clone)]
 pub enum NormalSource {
     /// A spectral file (path relative to the catalog) and whether it is in percent.
-    Spectral { path: String, percent: bool },
+    Spectral {
+        /// The spectral file, relative to the catalog.
+        path: String,
+        /// Whether its values are in percent.
+        percent: bool,
+    },
     /// Explicit per-channel values.
     Explicit {
+        /// Front reflectance per channel.
         r0: [f64; 3],
+        /// Transmittance per channel.
         t0: [f64; 3],
+        /// Back reflectance per channel.
         r0_back: [f64; 3],
     },
 }

@@ -9,6 +9,8 @@
 //! - [`build_registry`]: catalog → registry; [`default_registry`]: the bundled, prebuilt
 //!   `data/registry.json`.
 
+#![warn(missing_docs)]
+
 mod angle_model;
 mod build;
 mod bundled;

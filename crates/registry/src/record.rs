@@ -134,8 +134,10 @@ pub struct GlassRecord {
 /// keys of `glassdb fit` (`basis`, `powers`, `coefficients`, `degree`, `rms_error`, …).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AngleCurve {
+    /// C(θ) in the fit crate's form.
     #[serde(flatten)]
     pub polynomial: CosPolynomial,
+    /// How well it fits its data.
     #[serde(flatten)]
     pub fit: FitSummary,
     /// Absolute tolerance on r (or t) that validation allows beyond the physical range (the
@@ -197,22 +199,28 @@ pub struct Provenance {
 /// A file and the sha256 of its bytes (hex).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct FileRef {
+    /// The file, relative to the catalog.
     pub path: String,
+    /// Its SHA-256 (hex).
     pub sha256: String,
 }
 
 /// The product as its data file describes it.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ProductRecord {
+    /// The product's name in the file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
+    /// Its maker.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub manufacturer: Option<String>,
     /// `Monolithic`, `Coated`, `coated-glass`, `laminate`, … as in the file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub product_type: Option<String>,
+    /// Which face is coated, as the file says.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coated_side: Option<String>,
+    /// Its thickness.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness_mm: Option<f64>,
 }

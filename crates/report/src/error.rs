@@ -8,13 +8,17 @@ pub enum ReportError {
     /// An input file (the catalog) could not be read.
     #[error("cannot read {path}")]
     Read {
+        /// The catalog.
         path: PathBuf,
+        /// Why it could not be read.
         source: glassdb_io::InputError,
     },
     /// The figures directory could not be created.
     #[error("cannot create the figures directory {path}")]
     CreateDir {
+        /// The folder.
         path: PathBuf,
+        /// Why it could not be made.
         source: std::io::Error,
     },
     /// Writing the page or a figure failed (nothing was written).

@@ -8,77 +8,120 @@ pub enum SceneError {
     /// The scene, material library or camera file could not be read.
     #[error("cannot read {path}")]
     Read {
+        /// The file.
         path: PathBuf,
+        /// Why it could not be read.
         source: glassdb_io::InputError,
     },
     /// A line of an OBJ or MTL file is malformed.
     #[error("{path}:{line}: {message}")]
     Syntax {
+        /// The OBJ or MTL file.
         path: PathBuf,
+        /// The 1-based line.
         line: usize,
+        /// What is wrong.
         message: String,
     },
     /// The scene has no triangles at all.
     #[error("{path} contains no faces")]
-    EmptyScene { path: PathBuf },
+    EmptyScene {
+        /// The OBJ.
+        path: PathBuf,
+    },
     /// No face uses a material matched by the glass patterns.
     #[error(
         "no faces of {path} use a glass material matching {patterns}; materials in the scene: {available}"
     )]
     NoGlassFaces {
+        /// The OBJ.
         path: PathBuf,
+        /// The patterns, listed.
         patterns: String,
+        /// The scene's materials, listed.
         available: String,
     },
     /// A glass pattern is not a valid glob pattern.
     #[error("invalid glass material pattern {pattern:?}: {message}")]
-    BadPattern { pattern: String, message: String },
+    BadPattern {
+        /// The pattern.
+        pattern: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A plane equation with a zero (or non-finite) normal, or glass faces that are all degenerate.
     #[error("degenerate plane: {message}")]
-    DegeneratePlane { message: String },
+    DegeneratePlane {
+        /// What is wrong.
+        message: String,
+    },
     /// The eye lies on the glass plane, so it sees neither side.
     #[error(
         "the eye {eye:?} lies on glass plane {plane} (distance {distance:e}); it sees neither side"
     )]
     EyeOnPlane {
+        /// The eye.
         eye: [f64; 3],
+        /// The plane.
         plane: usize,
+        /// The eye's distance from it.
         distance: f64,
     },
     /// The camera JSON is malformed or describes an impossible camera (the message names the
     /// field; `frame` is the animation frame whose camera it is).
     #[error("camera {path}{}: {message}", frame_suffix(*.frame))]
     BadCamera {
+        /// The camera file.
         path: PathBuf,
+        /// The frame, in an animation.
         frame: Option<u32>,
+        /// What is wrong, naming the field.
         message: String,
     },
     /// An animation has no camera for a frame: its per-frame file does not exist, or the
     /// animation file has no such frame.
     #[error("no camera for frame {frame}: {path} {why}")]
     MissingCameraFrame {
+        /// The camera file or pattern.
         path: PathBuf,
+        /// The frame.
         frame: u32,
+        /// Why there is none.
         why: String,
     },
     /// An animated camera (one per frame) where one camera is needed: no frame was chosen.
     #[error("camera {path} {what}: choose the frames to render")]
-    CameraNeedsFrame { path: PathBuf, what: String },
+    CameraNeedsFrame {
+        /// The camera file or pattern.
+        path: PathBuf,
+        /// What it is.
+        what: String,
+    },
     /// The requested image is empty or too large to allocate.
     #[error("image size {width}x{height}: {message}")]
     BadImageSize {
+        /// The width asked for.
         width: u64,
+        /// The height asked for.
         height: u64,
+        /// What is wrong.
         message: String,
     },
     /// A `planes.json` is malformed, or a glass face lies on none of its planes.
     #[error("planes file {path}: {message}")]
-    BadPlanes { path: PathBuf, message: String },
+    BadPlanes {
+        /// The planes file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// A planes file that is not valid JSON of the planes schema (serde's error gives the line
     /// and column).
     #[error("planes file {path}")]
     PlanesJson {
+        /// The planes file.
         path: PathBuf,
+        /// serde's error (line and column).
         #[source]
         source: serde_json::Error,
     },
@@ -87,29 +130,52 @@ pub enum SceneError {
         "{planes_file} describes {planes} glass plane(s) but {passes} reflection pass(es) were given: one pass per plane, in the file's order"
     )]
     PlaneCountMismatch {
+        /// The planes file.
         planes_file: PathBuf,
+        /// The planes it describes.
         planes: usize,
+        /// The reflection passes given.
         passes: usize,
     },
     /// A plane-bounds file (`glassdb mask --bounds`) that is not valid JSON of its schema.
     #[error("plane bounds file {path}")]
     BoundsJson {
+        /// The plane-bounds file.
         path: PathBuf,
+        /// serde's error (line and column).
         #[source]
         source: serde_json::Error,
     },
     /// A plane-bounds file with a wrong format tag or a rectangle outside its frame.
     #[error("plane bounds file {path}: {message}")]
-    BadBounds { path: PathBuf, message: String },
+    BadBounds {
+        /// The plane-bounds file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// An option value is out of range (tolerances, plane count).
     #[error("{message}")]
-    BadOption { message: String },
+    BadOption {
+        /// What is wrong.
+        message: String,
+    },
     /// The K of K×K coverage samples per pixel is 0 or above the limit.
     #[error("{samples} samples per pixel side must be between 1 and {max}")]
-    SamplesOutOfRange { samples: u32, max: u32 },
+    SamplesOutOfRange {
+        /// K.
+        samples: u32,
+        /// The largest K.
+        max: u32,
+    },
     /// The N of the Gouraud N×N mesh is 0 or above the limit.
     #[error("a Gouraud mesh of {mesh}×{mesh} cells must have between 1 and {max} per side")]
-    MeshOutOfRange { mesh: u32, max: u32 },
+    MeshOutOfRange {
+        /// N.
+        mesh: u32,
+        /// The largest N.
+        max: u32,
+    },
     /// Neither glass materials nor an explicit plane say where the mirrors are.
     #[error("give the glass materials or one plane to mirror across")]
     NoGlassSelected,
@@ -117,13 +183,17 @@ pub enum SceneError {
     /// number).
     #[error("cannot encode {path}")]
     EncodeJson {
+        /// The JSON output.
         path: PathBuf,
+        /// serde's error.
         source: serde_json::Error,
     },
     /// The output directory could not be created.
     #[error("cannot create the output directory {path}")]
     CreateDir {
+        /// The folder.
         path: PathBuf,
+        /// Why it could not be made.
         source: std::io::Error,
     },
     /// Writing an output failed (atomic: the target is left as it was).

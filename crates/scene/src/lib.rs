@@ -3,6 +3,8 @@
 //! (section 3, eqs. 4–7), and the id + cos θ mask (sections 5–6) by z-buffer rasterisation.
 //! Conventions and formats: docs/scene.md.
 
+#![warn(missing_docs)]
+
 pub mod bounds_file;
 pub mod camera;
 pub mod error;

@@ -20,7 +20,9 @@ pub enum PlaneSource {
     Detect(PlaneTolerance),
     /// Use these planes (from a `planes.json`); every glass face must lie on one.
     Given {
+        /// The planes, by index.
         planes: Vec<Plane>,
+        /// How far a glass face may lie from its plane.
         tolerance: PlaneTolerance,
     },
 }
@@ -28,6 +30,7 @@ pub enum PlaneSource {
 /// The labelled scene plus what the user should know about it.
 #[derive(Debug, Clone)]
 pub struct MaskScene {
+    /// The triangles, labelled, as the rasteriser draws them.
     pub raster: RasterScene,
     /// The planes, by index.
     pub planes: Vec<Plane>,
@@ -100,6 +103,9 @@ pub fn build_mask_scene(
     })
 }
 
+/// Each mesh's triangles' plane (`None`: not glass), mesh by mesh.
+type PlaneAssignment = Vec<Vec<Option<usize>>>;
+
 /// The glass planes (detected, or given with every glass face assigned to one) and each mesh's
 /// triangles' plane (`None`: not glass).
 fn glass_planes(
@@ -107,7 +113,7 @@ fn glass_planes(
     source: &PlaneSource,
     matcher: &MaterialMatcher,
     is_glass: impl Fn(Option<usize>) -> bool,
-) -> Result<(Vec<Plane>, Vec<Vec<Option<usize>>>), SceneError> {
+) -> Result<(Vec<Plane>, PlaneAssignment), SceneError> {
     let (planes, assignment) = match source {
         PlaneSource::Detect(tol) => {
             let (gp, a) = detect_planes(scene, is_glass, *tol, &matcher.describe())?;

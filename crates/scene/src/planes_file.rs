@@ -16,18 +16,24 @@ pub const PLANES_FORMAT: &str = "glassdb-planes/1";
 /// The whole file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlanesFile {
+    /// [`PLANES_FORMAT`].
     pub format: String,
     /// The OBJ the planes were found in.
     pub source: String,
     /// The eye given with `--eye`, if any.
     pub eye: Option<[f64; 3]>,
+    /// The tolerance the planes were found with.
     pub tolerance: ToleranceJson,
+    /// The planes, in index order.
     pub planes: Vec<PlaneEntry>,
 }
 
+/// A [`crate::PlaneTolerance`] as JSON.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ToleranceJson {
+    /// Largest angle between face normals on one plane, degrees.
     pub angle_deg: f64,
+    /// Largest distance of a face from its plane, scene units.
     pub distance: f64,
 }
 
@@ -41,6 +47,7 @@ pub struct PlaneEntry {
     pub equation: [f64; 4],
     /// Area of the glass faces on the plane, scene units².
     pub area: f64,
+    /// The glass materials on it.
     pub materials: Vec<String>,
     /// Glass triangles on the plane.
     pub triangles: usize,

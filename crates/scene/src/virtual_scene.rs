@@ -14,6 +14,7 @@ use crate::planes_file::{PLANES_FORMAT, PlaneEntry, PlanesFile, ToleranceJson};
 /// What to mirror and where to put it.
 #[derive(Debug, Clone)]
 pub struct MirrorRequest<'a> {
+    /// The scene.
     pub scene: &'a Scene,
     /// Glob patterns of the glass materials (may be empty with an explicit plane).
     pub glass_patterns: Vec<String>,
@@ -21,15 +22,20 @@ pub struct MirrorRequest<'a> {
     pub explicit_plane: Option<[f64; 4]>,
     /// The eye: selects the kept half-space of each plane. Without it, the front side.
     pub eye: Option<Vec3>,
+    /// How faces are grouped into planes.
     pub tolerance: PlaneTolerance,
+    /// Where the virtual scenes and `planes.json` go.
     pub out_dir: &'a Path,
 }
 
 /// What was written.
 #[derive(Debug, Clone)]
 pub struct MirrorReport {
+    /// The `planes.json` written.
     pub planes_path: PathBuf,
+    /// What it holds.
     pub planes: PlanesFile,
+    /// Each virtual scene's counts.
     pub stats: Vec<MirrorStats>,
 }
 

@@ -17,6 +17,8 @@
 //! agree with it to 1e-9 relative; the differences where colour is wrong are in
 //! `docs/spectral.md`.
 
+#![warn(missing_docs)]
+
 mod balance;
 mod error;
 mod integrate;

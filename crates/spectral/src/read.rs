@@ -29,17 +29,21 @@ pub enum SpectralFormat {
 /// Product metadata found in the file (all optional: our CSV carries none).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ProductInfo {
+    /// The product's name.
     pub name: Option<String>,
+    /// Its maker.
     pub manufacturer: Option<String>,
     /// Optics `{ Type: … }` or IGSDB `subtype` (falling back to `type` in the older schema), as written.
     pub product_type: Option<String>,
     /// `Front`, `Back`, `Neither`, `Both`, as written.
     pub coated_side: Option<String>,
+    /// Its thickness.
     pub thickness_mm: Option<f64>,
     /// Incidence angles (degrees) other than 0° for which the file also holds spectra (IGSDB v2
     /// angle blocks), in file order. Only the 0° spectrum is read; empty for other formats.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub other_incidence_angles_deg: Vec<f64>,
+    /// The reader that read it.
     pub format: SpectralFormat,
 }
 
@@ -63,8 +67,9 @@ impl ProductInfo {
 /// length and holds fractions in `[0, 1]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SpectralData {
-    /// The file name (or the name given to [`read_spectral_bytes`]), for messages.
+    /// The file name (or the name given to [`crate::read_spectral_bytes`]), for messages.
     pub source: String,
+    /// Wavelengths, nm, strictly increasing.
     pub wavelength_nm: Vec<f64>,
     /// Spectral transmittance τ(λ).
     pub transmittance: Option<Vec<f64>>,
@@ -72,6 +77,7 @@ pub struct SpectralData {
     pub reflectance_front: Option<Vec<f64>>,
     /// Spectral reflectance of the back side (CSV `Rb`).
     pub reflectance_back: Option<Vec<f64>>,
+    /// The product, as far as the file says.
     pub product: ProductInfo,
 }
 

@@ -16,7 +16,9 @@ use crate::plots::fit::{REFLECTANCE_COLOUR, TRANSMITTANCE_COLOUR};
 /// Options of the spectral figure.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SpectralPlotOptions {
+    /// How values are integrated.
     pub settings: IntegrationSettings,
+    /// How the file is read.
     pub read: ReadOptions,
 }
 

@@ -25,12 +25,22 @@ pub const MAX_CAMERA_FILE_BYTES: u64 = CAMERA_FILE.bytes;
 #[derive(Debug, Clone, PartialEq)]
 pub enum CameraSource {
     /// One camera, the same for every frame.
-    One { path: PathBuf, camera: Camera },
+    One {
+        /// The camera file.
+        path: PathBuf,
+        /// Its camera.
+        camera: Camera,
+    },
     /// One file per frame: `pattern` has a `#` run that the frame number replaces.
-    PerFrame { pattern: PathBuf },
+    PerFrame {
+        /// The file pattern.
+        pattern: PathBuf,
+    },
     /// One file with a `frames` object: each frame's camera JSON, validated when asked for.
     Animation {
+        /// The animation file.
         path: PathBuf,
+        /// Each frame's camera JSON.
         frames: BTreeMap<u32, Value>,
     },
 }

@@ -1,12 +1,12 @@
 //! Reading OBJ scenes and writing them back.
 //!
-//! An OBJ is read line by line here ([`read`]): every statement checked and its errors named
+//! An OBJ is read line by line here (`read.rs`): every statement checked and its errors named
 //! by file and line, then its faces grouped into meshes by group (`g`/`o`) and material
 //! (`usemtl`) runs, each mesh with its own copy of the vertices it uses, in order of first use
 //! (as `tobj` and most OBJ readers build them). Comments, tabs and continuation lines are read
 //! as OBJ allows; statements this tool does not use are passed over. Material *properties* are
 //! never needed: the mirror writes an `mtllib` reference to the original files, and the mask
-//! only matches material names; a material library is checked ([`text`]) and its names are
+//! only matches material names; a material library is checked (`text.rs`) and its names are
 //! compared with the `usemtl` names, a missing library or material is a warning.
 //!
 //! Each polygon is triangulated by ear clipping in its own plane ([`crate::triangulate`]), or
@@ -57,8 +57,11 @@ pub struct Mesh {
     pub group: String,
     /// Index into [`Scene::materials`], `None` before any `usemtl`.
     pub material: Option<usize>,
+    /// Its vertices, in order of first use.
     pub positions: Vec<Vec3>,
+    /// Its texture coordinates, in order of first use.
     pub texcoords: Vec<[f64; 2]>,
+    /// Its normals, in order of first use.
     pub normals: Vec<Vec3>,
     /// Position indices per triangle, counter-clockwise seen from the front (each polygon's
     /// triangles keep its winding).
