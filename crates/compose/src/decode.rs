@@ -1,21 +1,21 @@
-//! The decode phase: a frame's inputs decoded in parallel (the header phase, [`crate::plan`],
-//! first), placed in the transmission pass's frame and checked, ready for the kernel
-//! (`compose`) or for the viewer's GPU textures. Nothing here knows of an output file: what
-//! decoding must know of the output is a [`DecodeTarget`].
+//! The decode phase: a frame's inputs decoded in parallel as its header phase
+//! ([`crate::plan`]) planned them, placed in the transmission pass's frame and checked, ready
+//! for the kernel (`composite`) or for the viewer's GPU textures. Nothing here knows of an
+//! output file: what the transmission file carries over is a [`Carry`].
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use glassdb_image::{ImageWindows, PixelWindow};
 use glassdb_mask::{MaskImage, PlacedMask};
-use glassdb_pass::{CarriedFrame, Carry, Pass};
+use glassdb_pass::{CarriedFrame, Carry, Pass, PassReadOptions};
 use rayon::prelude::*;
 
-use crate::colour::{ChosenTable, PassSpace, RegistryLuts};
+use crate::colour::{ChosenTable, PassSpace};
 use crate::lut::GlassLut;
-use crate::memory::{self, MemoryBudget, MemoryEstimate};
+use crate::memory::{self, MemoryEstimate};
 use crate::place::{absolute_from, check_frames, in_frame, relative_to};
-use crate::plan::{self, DecodeTarget, FramePlan};
+use crate::plan::{FramePlan, InputReads};
 use crate::{ComposeError, DecodeSettings, FrameFiles, OutsidePolicy, UnknownIds};
 
 /// One frame's inputs decoded, placed in the transmission pass's frame and checked, ready for
@@ -55,38 +55,26 @@ struct DecodedInputs {
     mask: PlacedMask,
 }
 
-/// Reads every input's header and checks the frame from them (memory within `budget`), decodes
-/// the inputs, places them in the transmission pass's frame and checks ids, planes and glass
-/// outside cropped passes (as `settings` says). `target` says what the transmission file
-/// carries over and what the frame will be encoded as.
-pub fn decode_frame<'a>(
+/// The decode phase of a frame its header phase planned: decodes the inputs, places them in
+/// the transmission pass's frame and checks ids, planes and glass outside cropped passes (as
+/// `settings` says). `carry` says what the transmission file carries over.
+pub(crate) fn decode_planned<'a>(
     files: &FrameFiles,
     settings: &DecodeSettings,
-    luts: &'a RegistryLuts,
-    budget: &'a MemoryBudget,
-    target: &DecodeTarget,
+    plan: FramePlan<'a>,
+    carry: Carry,
 ) -> Result<DecodedFrame<'a>, ComposeError> {
-    if files.refl.is_empty() {
-        return Err(ComposeError::NoReflectionPass);
-    }
     let FramePlan {
+        reads,
         space,
+        table,
+        lut,
         display,
         refl_windows: stored_refl_windows,
         memory,
-    } = plan::plan_frame(files, settings, target)?;
-    let (table, lut) = luts.for_space(&space, &files.trans, &settings.registry_label)?;
-    if memory.total > budget.limit() {
-        return Err(ComposeError::MemoryLimit {
-            trans: files.trans.clone(),
-            estimate: memory.total,
-            limit: budget.limit(),
-            items: memory.items,
-            carried: memory.carried,
-        });
-    }
-    let reservation = budget.reserve(memory.total);
-    let inputs = decode_inputs(files, settings, &display, target.carry)?;
+        reservation,
+    } = plan;
+    let inputs = decode_inputs(files, settings, &reads, &display, carry)?;
     let placed = place_inputs(files, inputs)?;
     let id_counts = placed.mask.id_pixel_counts();
     check_inputs(
@@ -132,12 +120,16 @@ pub fn decode_frame<'a>(
 fn decode_inputs(
     files: &FrameFiles,
     settings: &DecodeSettings,
+    reads: &InputReads,
     display: &PixelWindow,
     carry: Carry,
 ) -> Result<DecodedInputs, ComposeError> {
     let read_trans = || -> Result<(Pass, CarriedFrame), ComposeError> {
-        let opts = settings.pass_options(Some(&settings.layers.trans));
-        Ok(glassdb_pass::read_transmission(&files.trans, &opts, carry)?)
+        Ok(glassdb_pass::read_transmission(
+            &files.trans,
+            &reads.trans,
+            carry,
+        )?)
     };
     let mask_then_refl = || -> Result<(PlacedMask, Vec<Pass>), ComposeError> {
         let mask = glassdb_mask::read_placed_mask(&files.mask, &settings.mask)?;
@@ -151,7 +143,7 @@ fn decode_inputs(
                 (plane, (y + i64::from(b.y_min), y + i64::from(b.y_max)))
             })
             .collect();
-        let refl = read_reflections(files, settings, &rows)?;
+        let refl = read_reflections(files, &reads.refl, &rows)?;
         Ok((mask, refl))
     };
     let (trans, mask_refl) = rayon::join(read_trans, mask_then_refl);
@@ -172,7 +164,7 @@ fn decode_inputs(
 /// decodes one block).
 fn read_reflections(
     files: &FrameFiles,
-    settings: &DecodeSettings,
+    reads: &[PassReadOptions],
     rows: &BTreeMap<u16, (i64, i64)>,
 ) -> Result<Vec<Pass>, ComposeError> {
     let at_once = memory::decoding_at_once();
@@ -188,8 +180,7 @@ fn read_reflections(
                     .and_then(|plane| rows.get(&plane))
                     .copied()
                     .unwrap_or((i64::MIN, i64::MIN));
-                let opts = settings.pass_options(settings.layers.refl.get(k));
-                glassdb_pass::read_pass_rows(p, &opts, rows)
+                glassdb_pass::read_pass_rows(p, &reads[k], rows)
             })
             .collect::<Result<Vec<_>, _>>()?;
         passes.extend(decoded);

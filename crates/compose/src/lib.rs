@@ -2,23 +2,26 @@
 //! plane) and a transmission pass, combined through an id + cos θ mask with each glass's r and
 //! t from the registry, in linear light.
 //!
-//! A frame goes through four phases, each a function in its own file:
+//! A frame goes through four phases, each in its own file, and a frame's settings enter each
+//! file once per phase:
 //!
 //! 1. header (`plan.rs`): every input's header read and compared before any pixel is decoded,
-//!    and the frame's memory estimated from them ([`memory`]);
-//! 2. decode ([`decode_frame`]): the inputs decoded in parallel (glassdb-pass reads the
-//!    passes, glassdb-mask the mask), placed in the transmission pass's frame and checked;
-//! 3. composite ([`kernel`]): the per-pixel composite, in place, with the tables of [`lut`]
-//!    in the passes' colour space ([`colour`]);
-//! 4. write: glassdb-encode writes the composite as EXR or PNG, atomically.
+//!    the passes' colour space and registry table chosen ([`colour`]), and the frame's memory
+//!    estimated from them and held ([`memory`]);
+//! 2. decode (`decode.rs`): the inputs decoded in parallel (glassdb-pass reads the passes,
+//!    glassdb-mask the mask), placed in the transmission pass's frame and checked;
+//! 3. composite (`composite.rs`): the per-pixel composite ([`kernel`]), in place, with the
+//!    tables of [`lut`] in the passes' colour space;
+//! 4. write (`write.rs`): glassdb-encode writes the composite as EXR or PNG, atomically.
 //!
 //! [`compose_frame`] runs them for one image, with per-stage timings for `--stats`;
 //! [`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`. The
-//! viewer stops after the decode phase ([`decode_frame`]), with no output at all.
+//! viewer runs the first two ([`decode_frame`]), with no output at all.
 
 #![warn(missing_docs)]
 
 pub mod colour;
+mod composite;
 mod decode;
 pub mod error;
 pub mod kernel;
@@ -26,12 +29,13 @@ pub mod lut;
 pub mod memory;
 mod place;
 mod plan;
+mod write;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-pub use decode::{DecodedFrame, decode_frame};
+pub use decode::DecodedFrame;
 pub use error::ComposeError;
 use glassdb_encode::{OutputFormat, OutputOptions, WrittenOutput};
 use glassdb_image::ImageWindows;
@@ -41,8 +45,9 @@ use glassdb_side::Side;
 use memory::{MemoryBudget, MemoryEstimate};
 pub use plan::DecodeTarget;
 
-use crate::colour::{ChosenTable, PassSpace, RegistryLuts, SpaceSource};
-use crate::kernel::{KernelCounts, KernelInput, OutsidePass, PlacedRefl};
+use crate::colour::{ChosenTable, PassSpace, RegistryLuts};
+use crate::composite::Composited;
+use crate::kernel::KernelCounts;
 
 /// What to do with mask ids the registry does not have.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -178,17 +183,6 @@ impl Default for DecodeSettings {
     }
 }
 
-impl DecodeSettings {
-    /// Read options for a pass whose own layer is `layer` (else the default).
-    fn pass_options(&self, layer: Option<&Option<String>>) -> PassReadOptions {
-        let mut opts = self.pass.clone();
-        if let Some(Some(l)) = layer {
-            opts.layer = Some(l.clone());
-        }
-        opts
-    }
-}
-
 /// Settings shared by every frame of a composite.
 #[derive(Debug, Clone, Default)]
 pub struct ComposeSettings {
@@ -314,17 +308,18 @@ pub fn compose_frame_within(
 
     progress.stage(decode_stage);
     let t0 = Instant::now();
-    let frame = decode_frame(&job.inputs, &settings.decode, luts, budget, &target)?;
+    let plan = plan::plan_frame(&job.inputs, &settings.decode, luts, budget, &target)?;
+    let frame = decode::decode_planned(&job.inputs, &settings.decode, plan, target.carry)?;
     let decode = t0.elapsed();
 
     progress.stage(composite_stage);
     let t1 = Instant::now();
-    let composited = composite(frame, settings)?;
+    let composited = composite::composite(frame, settings)?;
     let compose = t1.elapsed();
 
     progress.stage(encode_stage);
     let t2 = Instant::now();
-    let (output, colour) = write(job, composited.image, settings)?;
+    let (output, colour) = write::write(job, composited.image, settings)?;
     let encode = t2.elapsed();
 
     let Composited { facts, .. } = composited;
@@ -348,6 +343,22 @@ pub fn compose_frame_within(
     })
 }
 
+/// Reads every input's header and checks the frame from them (memory within `budget`), decodes
+/// the inputs, places them in the transmission pass's frame and checks ids, planes and glass
+/// outside cropped passes (as `settings` says): the header and decode phases, with no output.
+/// `target` says what the transmission file carries over and what the frame will be encoded
+/// as ([`DecodeTarget::display`] for a frame that is only shown).
+pub fn decode_frame<'a>(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    luts: &'a RegistryLuts,
+    budget: &'a MemoryBudget,
+    target: &DecodeTarget,
+) -> Result<DecodedFrame<'a>, ComposeError> {
+    let plan = plan::plan_frame(files, settings, luts, budget, target)?;
+    decode::decode_planned(files, settings, plan, target.carry)
+}
+
 /// Refuses a job before any pixel is read: no reflection pass, an output that cannot be
 /// written as asked, an output that is one of the inputs (declared here; the binaries protect
 /// every file declared or read). Returns what the frame is decoded
@@ -368,147 +379,6 @@ fn check_job(job: &ComposeJob, settings: &ComposeSettings) -> Result<DecodeTarge
         encoding: glassdb_encode::Encoding::of(&job.output, opts)?,
         name: memory::file_label(&job.output),
     })
-}
-
-/// The composite of a frame, ready to be written, and what the report says of it.
-struct Composited {
-    /// The transmission pass, composited in place, with what its output carries.
-    image: ToWrite,
-    facts: FrameFacts,
-}
-
-/// What is written: the composite in the transmission pass's frame, and the passes' space.
-struct ToWrite {
-    trans: glassdb_pass::Pass,
-    frame: glassdb_pass::CarriedFrame,
-    space: PassSpace,
-    table: ChosenTable,
-}
-
-/// The report's facts of a composited frame.
-struct FrameFacts {
-    width: u32,
-    height: u32,
-    windows: ImageWindows,
-    id_counts: BTreeMap<u16, u64>,
-    cos_range: Option<(f64, f64)>,
-    counts: KernelCounts,
-    outside_pixels: u64,
-    memory: MemoryEstimate,
-}
-
-/// The composite phase: every reflection pass placed in the frame with its plane's side, the
-/// kernel run in place on the transmission pass, and the decoded passes freed beside the
-/// encoder.
-fn composite(
-    frame: DecodedFrame<'_>,
-    settings: &ComposeSettings,
-) -> Result<Composited, ComposeError> {
-    let DecodedFrame {
-        mut trans,
-        frame: carried,
-        refl,
-        refl_windows: windows,
-        mask,
-        space,
-        table,
-        lut,
-        id_counts,
-        outside,
-        memory,
-        reservation: _reserved,
-    } = frame;
-    let placed: Vec<PlacedRefl<'_>> = refl
-        .iter()
-        .zip(&windows)
-        .enumerate()
-        .map(|(k, (p, &window))| {
-            let [r, g, b] = &p.image.rgb;
-            PlacedRefl {
-                rgb: [r.as_slice(), g.as_slice(), b.as_slice()],
-                window,
-                side: settings.plane_sides.get(&k).copied().unwrap_or(Side::Front),
-            }
-        })
-        .collect();
-    let outside_mode = match settings.decode.outside {
-        OutsidePolicy::Transmission => OutsidePass::Transmission,
-        OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
-    };
-    let [r, g, b] = &mut trans.image.rgb;
-    let input = KernelInput::placed([r, g, b], &placed, &mask, lut, outside_mode)?;
-    let counts = kernel::compose_in_place(input);
-    let cos_range = mask.cos_theta_range();
-    drop(placed);
-    // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
-    // another thread does it while the encoder keeps both cores busy.
-    // Where no thread can be started, the closure, and so the passes, are dropped here.
-    let _ = std::thread::Builder::new()
-        .name("glassdb-free".into())
-        .spawn(move || drop((refl, mask)));
-    let facts = FrameFacts {
-        width: trans.image.width,
-        height: trans.image.height,
-        windows: trans.windows,
-        id_counts,
-        cos_range,
-        counts,
-        outside_pixels: outside.values().map(|(n, _)| n).sum(),
-        memory,
-    };
-    Ok(Composited {
-        image: ToWrite {
-            trans,
-            frame: carried,
-            space,
-            table,
-        },
-        facts,
-    })
-}
-
-/// The write phase: the composite tagged with the passes' space (EXR) or converted to linear
-/// Rec.709 for the standard view (PNG), written by glassdb-encode.
-fn write(
-    job: &ComposeJob,
-    image: ToWrite,
-    settings: &ComposeSettings,
-) -> Result<(WrittenOutput, FrameColour), ComposeError> {
-    let ToWrite {
-        mut trans,
-        mut frame,
-        space,
-        table,
-    } = image;
-    if space.source != SpaceSource::Untagged {
-        frame.tag_space = Some(space.space);
-    }
-    let format = glassdb_encode::output_format(&job.output)?;
-    let converted_for_display = format == OutputFormat::Png
-        && matches!(
-            settings.output.view,
-            None | Some(glassdb_colour::DisplayView::Standard)
-        )
-        && space.space != glassdb_colour::RgbSpace::Srgb;
-    if converted_for_display {
-        trans.image.convert_rgb(glassdb_colour::rgb_to_rgb(
-            space.space,
-            glassdb_colour::RgbSpace::Srgb,
-        ));
-    }
-    let output = glassdb_encode::write_output(
-        &job.output,
-        trans.image,
-        frame,
-        &trans.source,
-        &settings.output,
-    )?;
-    let colour = FrameColour {
-        space,
-        table,
-        converted_for_display,
-    };
-    Ok((output, colour))
 }
 
 #[cfg(test)]

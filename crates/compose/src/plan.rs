@@ -11,10 +11,11 @@ use glassdb_image::ImageWindows;
 use glassdb_mask::MaskHeader;
 
 use glassdb_encode::{Encoding, ExrDataType};
-use glassdb_pass::{Carry, PassHeader, PassSource, PngBits};
+use glassdb_pass::{Carry, PassHeader, PassReadOptions, PassSource, PngBits};
 
-use crate::colour::{self, PassSpace};
-use crate::memory::{MemoryEstimate, MemoryItem, file_label};
+use crate::colour::{self, ChosenTable, PassSpace, RegistryLuts};
+use crate::lut::GlassLut;
+use crate::memory::{MemoryBudget, MemoryEstimate, MemoryItem, Reservation, file_label};
 use crate::place::{check_frames, in_frame};
 use crate::{ComposeError, DecodeSettings, FrameFiles};
 
@@ -43,36 +44,77 @@ impl DecodeTarget {
     }
 }
 
-/// What the headers decided for one frame.
-pub(crate) struct FramePlan {
+/// How each input is read: the pass options with each pass's own layer, decided once.
+pub(crate) struct InputReads {
+    /// The transmission pass's.
+    pub(crate) trans: PassReadOptions,
+    /// Reflection pass k's at k.
+    pub(crate) refl: Vec<PassReadOptions>,
+}
+
+impl InputReads {
+    /// The read options of every pass of `files`: `settings.pass`, each with its own layer
+    /// where `settings.layers` names one.
+    fn of(files: &FrameFiles, settings: &DecodeSettings) -> InputReads {
+        let with_layer = |layer: Option<&Option<String>>| {
+            let mut opts = settings.pass.clone();
+            if let Some(Some(l)) = layer {
+                opts.layer = Some(l.clone());
+            }
+            opts
+        };
+        InputReads {
+            trans: with_layer(Some(&settings.layers.trans)),
+            refl: (0..files.refl.len())
+                .map(|k| with_layer(settings.layers.refl.get(k)))
+                .collect(),
+        }
+    }
+}
+
+/// What the headers decided for one frame: how it is read, its colour, where its inputs lie
+/// and the memory held for it.
+pub(crate) struct FramePlan<'a> {
+    /// How each pass is read.
+    pub(crate) reads: InputReads,
     /// The passes' one colour space.
     pub(crate) space: PassSpace,
+    /// The registry table chosen for that space.
+    pub(crate) table: ChosenTable,
+    /// The lookup table of that registry table.
+    pub(crate) lut: &'a GlassLut,
     /// The frame's display window (the transmission pass's), where a PNG mask is placed.
     pub(crate) display: glassdb_image::PixelWindow,
     /// Each reflection pass's windows in the frame as its file stores them (decoding may keep
     /// only the rows its plane's glass needs).
     pub(crate) refl_windows: Vec<ImageWindows>,
+    /// The frame's memory estimate.
     pub(crate) memory: MemoryEstimate,
+    /// The estimate held from the budget until the frame is dropped.
+    pub(crate) reservation: Reservation<'a>,
 }
 
-/// Reads every input's header and checks the frame from them (see the module docs).
-pub(crate) fn plan_frame(
+/// The header phase: reads every input's header and checks the frame from them (see the
+/// module docs), chooses the registry table for the passes' space and holds the frame's
+/// memory from `budget` (refused over its limit).
+pub(crate) fn plan_frame<'a>(
     files: &FrameFiles,
     settings: &DecodeSettings,
+    luts: &'a RegistryLuts,
+    budget: &'a MemoryBudget,
     target: &DecodeTarget,
-) -> Result<FramePlan, ComposeError> {
-    let trans = glassdb_pass::read_pass_header(
-        &files.trans,
-        &settings.pass_options(Some(&settings.layers.trans)),
-    )?;
+) -> Result<FramePlan<'a>, ComposeError> {
+    if files.refl.is_empty() {
+        return Err(ComposeError::NoReflectionPass);
+    }
+    let reads = InputReads::of(files, settings);
+    let trans = glassdb_pass::read_pass_header(&files.trans, &reads.trans)?;
     let mask = glassdb_mask::read_mask_header(&files.mask, &settings.mask)?;
     let refl = files
         .refl
         .iter()
-        .enumerate()
-        .map(|(k, p)| {
-            glassdb_pass::read_refl_header(p, &settings.pass_options(settings.layers.refl.get(k)))
-        })
+        .zip(&reads.refl)
+        .map(|(p, opts)| glassdb_pass::read_refl_header(p, opts))
         .collect::<Result<Vec<_>, _>>()?;
 
     let display = trans.windows.display;
@@ -87,12 +129,52 @@ pub(crate) fn plan_frame(
     check_frames(&files.trans, &trans.windows, &others)?;
     let refl_windows = others.iter().skip(1).map(|(_, w)| *w).collect();
 
+    let space = frame_space(files, settings, &trans, &refl)?;
+    if refl.len() > 1 && !mask.stores_planes {
+        return Err(ComposeError::MaskWithoutPlanes {
+            mask: files.mask.clone(),
+            passes: refl.len(),
+        });
+    }
+    let (table, lut) = luts.for_space(&space, &files.trans, &settings.registry_label)?;
+
+    let memory = estimate(files, target, &trans, &refl, &mask, &mask_windows);
+    if memory.total > budget.limit() {
+        return Err(ComposeError::MemoryLimit {
+            trans: files.trans.clone(),
+            estimate: memory.total,
+            limit: budget.limit(),
+            items: memory.items,
+            carried: memory.carried,
+        });
+    }
+    let reservation = budget.reserve(memory.total);
+    Ok(FramePlan {
+        reads,
+        space,
+        table,
+        lut,
+        display,
+        refl_windows,
+        memory,
+        reservation,
+    })
+}
+
+/// The passes' one colour space: each pass's from its header, or as declared; they must
+/// agree.
+fn frame_space(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    trans: &PassHeader,
+    refl: &[PassHeader],
+) -> Result<PassSpace, ComposeError> {
     let declared = settings.input_space;
     let trans_space = colour::pass_space(&files.trans, &trans.colour, declared)?;
     let refl_spaces = files
         .refl
         .iter()
-        .zip(&refl)
+        .zip(refl)
         .map(|(path, pass)| {
             Ok((
                 path.clone(),
@@ -100,22 +182,7 @@ pub(crate) fn plan_frame(
             ))
         })
         .collect::<Result<Vec<_>, ComposeError>>()?;
-    let space = colour::frame_space((&files.trans, trans_space), &refl_spaces)?;
-
-    if refl.len() > 1 && !mask.stores_planes {
-        return Err(ComposeError::MaskWithoutPlanes {
-            mask: files.mask.clone(),
-            passes: refl.len(),
-        });
-    }
-
-    let memory = estimate(files, target, &trans, &refl, &mask, &mask_windows);
-    Ok(FramePlan {
-        space,
-        display,
-        refl_windows,
-        memory,
-    })
+    colour::frame_space((&files.trans, trans_space), &refl_spaces)
 }
 
 /// The frame's memory from the headers (module docs of [`crate::memory`]): the largest of its

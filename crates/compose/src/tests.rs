@@ -9,7 +9,7 @@ use proptest::prelude::*;
 
 use super::*;
 use crate::colour::RegistryLuts;
-use crate::kernel::{KernelShapeError, compose_in_place};
+use crate::kernel::{KernelInput, KernelShapeError, compose_in_place};
 use crate::lut::GlassLut;
 
 /// Glass 1: r = (0.1, 0.2, 0.3), t = (0.5, 0.6, 0.7) at every angle, back r = (0.4, 0.4, 0.4).

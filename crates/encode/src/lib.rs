@@ -188,15 +188,11 @@ pub fn write_output(
             path: path.to_path_buf(),
         });
     }
+    let data_type = exr_data_type(source, opts.exr_data_type);
+    let bits = png_bits(source, opts.png_bits);
     let written = match format {
-        OutputFormat::Exr => {
-            let data_type = exr_data_type(source, opts.exr_data_type);
-            exr_file::write_exr_output(path, image, frame, data_type, opts)?
-        }
-        OutputFormat::Png => {
-            let bits = png_bits(source, opts.png_bits);
-            png_file::write_png_output(path, image, bits, opts)?
-        }
+        OutputFormat::Exr => exr_file::write_exr_output(path, image, frame, data_type, opts)?,
+        OutputFormat::Png => png_file::write_png_output(path, image, bits, opts)?,
     };
     Ok(WrittenOutput {
         path: path.to_path_buf(),
