@@ -43,26 +43,13 @@ pub(crate) struct FrameFacts {
 /// kernel run in place on the transmission pass, and the decoded passes freed beside the
 /// encoder.
 pub(crate) fn composite(
-    frame: DecodedFrame<'_>,
+    mut frame: DecodedFrame<'_>,
     settings: &ComposeSettings,
 ) -> Result<Composited, ComposeError> {
-    let DecodedFrame {
-        mut trans,
-        frame: carried,
-        refl,
-        refl_windows: windows,
-        mask,
-        space,
-        table,
-        lut,
-        id_counts,
-        outside,
-        memory,
-        reservation: _reserved,
-    } = frame;
-    let placed: Vec<PlacedRefl<'_>> = refl
+    let placed: Vec<PlacedRefl<'_>> = frame
+        .refl
         .iter()
-        .zip(&windows)
+        .zip(&frame.refl_windows)
         .enumerate()
         .map(|(k, (p, &window))| {
             let [r, g, b] = &p.image.rgb;
@@ -77,33 +64,35 @@ pub(crate) fn composite(
         OutsidePolicy::Transmission => OutsidePass::Transmission,
         OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
     };
-    let [r, g, b] = &mut trans.image.rgb;
-    let input = KernelInput::placed([r, g, b], &placed, &mask, lut, outside_mode)?;
+    let [r, g, b] = &mut frame.trans.image.rgb;
+    let input = KernelInput::placed([r, g, b], &placed, &frame.mask, frame.lut, outside_mode)?;
     let counts = kernel::compose_in_place(input);
-    let cos_range = mask.cos_theta_range();
+    let cos_range = frame.mask.cos_theta_range();
     drop(placed);
     // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
     // another thread does it while the encoder keeps both cores busy.
     // Where no thread can be started, the closure, and so the passes, are dropped here.
+    let (refl, mask) = (frame.refl, frame.mask);
     let _ = std::thread::Builder::new()
         .name("glassdb-free".into())
         .spawn(move || drop((refl, mask)));
+    let trans = frame.trans;
     let facts = FrameFacts {
         width: trans.image.width,
         height: trans.image.height,
         windows: trans.windows,
-        id_counts,
+        id_counts: frame.id_counts,
         cos_range,
         counts,
-        outside_pixels: outside.values().map(|(n, _)| n).sum(),
-        memory,
+        outside_pixels: frame.outside.values().map(|(n, _)| n).sum(),
+        memory: frame.memory,
     };
     Ok(Composited {
         image: ToWrite {
             trans,
-            frame: carried,
-            space,
-            table,
+            frame: frame.frame,
+            space: frame.space,
+            table: frame.table,
         },
         facts,
     })
