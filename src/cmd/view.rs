@@ -75,7 +75,7 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         settings,
         plane_sides,
         registry,
-        views: args
+        display_views: args
             .view
             .iter()
             .map(|p| CubeLut::read(p))

@@ -53,7 +53,7 @@ pub struct PageScene {
     /// The candidate products.
     pub products: Vec<PageProduct>,
     /// The `.cube` views offered beside `standard`.
-    pub views: Vec<PageView>,
+    pub views: Vec<PageDisplayView>,
     /// Whether the page's export button can write (a served page started with an export
     /// folder).
     pub export_available: bool,
@@ -131,9 +131,9 @@ impl PageProduct {
     }
 }
 
-/// A `.cube` view as the page lists it: its name and its tables' sizes and domains.
+/// A `.cube` display view as the page lists it (its `views`): its name and its tables' sizes and domains.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PageView {
+pub struct PageDisplayView {
     /// The file's stem.
     pub name: String,
     /// Its `TITLE`.
@@ -168,14 +168,14 @@ pub struct PageCube {
     pub offset: [f32; 3],
 }
 
-impl PageView {
+impl PageDisplayView {
     /// The view of `lut`.
-    pub fn of(lut: &CubeLut) -> PageView {
+    pub fn of(lut: &CubeLut) -> PageDisplayView {
         let name = lut.path.file_stem().map_or_else(
             || lut.path.display().to_string(),
             |s| s.to_string_lossy().into_owned(),
         );
-        PageView {
+        PageDisplayView {
             name,
             title: lut.title.clone(),
             shaper: lut.shaper_table().map(|t| PageShaper {

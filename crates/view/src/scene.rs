@@ -16,7 +16,7 @@ use glassdb_side::Side;
 
 use crate::ViewError;
 use crate::data::{self, MaskMode};
-use crate::page::{LutLayout, PAGE_FORMAT, PageFrame, PageProduct, PageScene, PageView};
+use crate::page::{LutLayout, PAGE_FORMAT, PageDisplayView, PageFrame, PageProduct, PageScene};
 
 /// The viewer's inputs: the frame's files (paths may hold `####` when `frames` is given), how
 /// to read them, and the registry whose records are the candidate products.
@@ -31,8 +31,8 @@ pub struct ViewerInputs {
     pub plane_sides: BTreeMap<usize, Side>,
     /// The registry whose records are the candidate products.
     pub registry: Registry,
-    /// `.cube` views the page offers beside `standard`.
-    pub views: Vec<CubeLut>,
+    /// `.cube` display views the page offers beside `standard`.
+    pub display_views: Vec<CubeLut>,
 }
 
 /// One decoded frame as the page uploads it.
@@ -141,13 +141,17 @@ impl Viewer {
                 .enumerate()
                 .map(|(i, g)| PageProduct::of(i, g))
                 .collect(),
-            views: inputs.views.iter().map(PageView::of).collect(),
+            views: inputs
+                .display_views
+                .iter()
+                .map(PageDisplayView::of)
+                .collect(),
             export_available: false,
             initial_glass: None,
             initial_ev: None,
         };
         let view_tables = inputs
-            .views
+            .display_views
             .iter()
             .map(|v| data::view_bytes(v).into())
             .collect();
