@@ -106,7 +106,7 @@ pub fn run_fit(args: FitArgs) -> anyhow::Result<ExitCode> {
     // by more than its tolerance (smaller violations are warnings, errors with --strict).
     file.validate(&args.table)?;
     if let Some(out) = &args.output {
-        glassdb_io::refuse_input_as_output(out, [args.table.as_path()])?;
+        glassdb_io::refuse_input_as_output(out)?;
         glassdb_io::write_bytes_atomic(out, file.to_json().as_bytes())?;
     }
     for g in &file.glasses {

@@ -39,6 +39,10 @@ use std::process::ExitCode;
 /// Exit code for a run that failed on its input or output (clap uses 2 for usage errors).
 pub const EXIT_FAILURE: u8 = 1;
 
+/// Exit code for a run that failed inside glassdb (an error of kind internal: a caught panic),
+/// `EX_SOFTWARE` of sysexits.h: the input is not to blame, and a retry will not help.
+pub const EXIT_INTERNAL: u8 = 70;
+
 /// What every binary does first (docs/reliability.md): protect each file it reads from its
 /// outputs, and on SIGINT, SIGTERM or SIGHUP remove the unfinished outputs' temporary files
 /// and exit with 128 + the signal's number (130, 143, 129).
@@ -103,7 +107,9 @@ fn install_signal_cleanup() {
 fn install_signal_cleanup() {}
 
 /// Turns a subcommand's result into the process exit code, printing the whole error chain and
-/// the hints that say which flag or command fixes it.
+/// the hints that say which flag or command fixes it. The code follows the error's kind:
+/// [`EXIT_INTERNAL`] for glassdb's own failure, [`EXIT_FAILURE`] for everything a user can act
+/// on (the input, an option, a limit, the files).
 pub fn finish(result: anyhow::Result<ExitCode>) -> ExitCode {
     match result {
         Ok(code) => code,
@@ -112,7 +118,16 @@ pub fn finish(result: anyhow::Result<ExitCode>) -> ExitCode {
             for hint in hints::hints(&err) {
                 eprintln!("hint: {hint}");
             }
-            ExitCode::from(EXIT_FAILURE)
+            match hints::kind(&err) {
+                Some(glassdb_io::ErrorKind::Internal) => {
+                    eprintln!(
+                        "hint: this is a bug of glassdb's, not a problem of the input: please \
+                         report it with the command and its files"
+                    );
+                    ExitCode::from(EXIT_INTERNAL)
+                }
+                _ => ExitCode::from(EXIT_FAILURE),
+            }
         }
     }
 }

@@ -160,7 +160,8 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     // The catalog, every spectral file and angle table it names, and the masks.
     let mut inputs = glassdb_registry::catalog_inputs(&a.catalog).map_err(anyhow::Error::new)?;
     inputs.extend(a.masks.iter().cloned());
-    glassdb_io::refuse_input_as_output(&a.output, inputs.iter().map(PathBuf::as_path))?;
+    glassdb_io::declare_inputs(inputs.iter().map(PathBuf::as_path));
+    glassdb_io::refuse_input_as_output(&a.output)?;
     let opts = BuildOptions {
         tables: table_settings(&a)?,
         mask_ids: mask_ids(&a.masks)?,

@@ -5,14 +5,14 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use glassdb_compose::view::CubeLut;
+use glassdb_colour::CubeLut;
 use glassdb_compose::{OutsidePolicy, UnknownIds};
 use glassdb_view::export::ExportFolder;
 use glassdb_view::server::ViewServer;
 use glassdb_view::{Viewer, ViewerInputs};
 
 use crate::cmd::compose::load_registry;
-use crate::cmd::inputs::{FrameInputArgs, split_layer};
+use crate::cmd::inputs::FrameInputArgs;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -70,28 +70,18 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         Some(c) => glassdb_registry::catalog_inputs(c).map_err(anyhow::Error::new)?,
         None => Vec::new(),
     };
+    // The catalog's files: no export may replace one.
+    glassdb_io::declare_inputs(catalog_inputs.iter().map(PathBuf::as_path));
     let inputs = &args.inputs;
-    let settings = inputs.settings(
-        OutsidePolicy::Error,
-        UnknownIds::Error,
-        Default::default(),
-        label,
-        catalog_inputs
-            .into_iter()
-            .chain(args.registry.iter().cloned())
-            .chain(args.view.iter().cloned()),
-    )?;
-    let trans = split_layer(&inputs.trans).0;
-    // Never written (the viewer only decodes the inputs); the frame's memory estimate counts
-    // encoding it as the PNG the page shows.
-    let job = inputs.job(trans.with_extension("viewer.png"));
-    let frames = inputs.frame_numbers()?;
+    let settings = inputs.decode_settings(OutsidePolicy::Error, UnknownIds::Error, label)?;
+    let plane_sides = inputs.plane_sides()?;
     let viewer = Viewer::open(ViewerInputs {
-        job,
-        frames,
+        files: inputs.files(),
+        frames: inputs.frame_numbers()?,
         settings,
+        plane_sides,
         registry,
-        views: args
+        display_views: args
             .view
             .iter()
             .map(|p| CubeLut::read(p))

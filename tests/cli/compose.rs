@@ -3,14 +3,14 @@
 
 use std::path::{Path, PathBuf};
 
-use glassdb_compose::io::{ExrDataType, OutputOptions, PassSource, write_output};
-use glassdb_compose::pixels::{LinearImage, PngBits};
+use glassdb_encode::{ExrDataType, OutputOptions};
 use glassdb_image::ExrSampleType;
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
+use glassdb_pass::{LinearImage, PassSource, PngBits};
 
 use crate::util::{
     Planes, compose, fails, fails_naming, glassdb, ok, read_exr_planes, read_png_planes, repo_path,
-    run,
+    run, write_pass,
 };
 
 /// A constant curve C = 1 (so r = r0 and t = t0 at every angle).
@@ -77,7 +77,7 @@ fn write_image(path: &Path, w: u32, h: u32, px: &[[f32; 3]]) {
         dither: false,
         ..OutputOptions::default()
     };
-    write_output(path, img, &float_src(), &opts).unwrap();
+    write_pass(path, img, &float_src(), &opts).unwrap();
 }
 
 /// The channel of an output EXR whose name is `name` or ends in `.name`, read with the `exr`
@@ -400,14 +400,14 @@ fn png_in_and_out_are_srgb_encoded() {
         dither: false,
         ..OutputOptions::default()
     };
-    write_output(
+    write_pass(
         &t,
         LinearImage::filled(2, 1, [1.0; 3], None),
         &src8,
         &no_dither,
     )
     .unwrap();
-    write_output(
+    write_pass(
         &r,
         LinearImage::filled(2, 1, [0.0; 3], None),
         &src8,

@@ -460,9 +460,10 @@ fn oversized_inputs_are_refused_from_their_size() {
 /// Writes the inputs of a compose that takes a while to encode: `w`×`h` float passes of
 /// render-like noise (uncompressed, quick to write) and an 8-bit mask, half glass.
 fn slow_compose_inputs(dir: &Path, w: u32, h: u32) {
-    use glassdb_compose::io::{OutputOptions, PassSource, parse_exr_compression, write_output};
-    use glassdb_compose::pixels::{LinearImage, PngBits};
+    use crate::util::write_pass;
+    use glassdb_encode::{OutputOptions, parse_exr_compression};
     use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
+    use glassdb_pass::{LinearImage, PassSource, PngBits};
     let n = (w * h) as usize;
     let noise = |i: u64| {
         let mut x = i.wrapping_mul(0x9e37_79b9_7f4a_7c15);
@@ -488,8 +489,8 @@ fn slow_compose_inputs(dir: &Path, w: u32, h: u32) {
     let src = PassSource::Png {
         bits: PngBits::Eight,
     };
-    write_output(&dir.join("trans.exr"), pass(1), &src, &opts).unwrap();
-    write_output(&dir.join("refl.exr"), pass(1 << 40), &src, &opts).unwrap();
+    write_pass(&dir.join("trans.exr"), pass(1), &src, &opts).unwrap();
+    write_pass(&dir.join("refl.exr"), pass(1 << 40), &src, &opts).unwrap();
     let mask = MaskImage {
         width: w,
         height: h,

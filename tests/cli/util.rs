@@ -315,3 +315,15 @@ pub fn read_png_planes(path: &Path) -> Planes {
         channels,
     }
 }
+
+/// Writes `image` to `path` as glassdb writes an output of the whole frame (format from the
+/// extension), the defaults taken from `src`.
+pub fn write_pass(
+    path: &Path,
+    image: glassdb_pass::LinearImage,
+    src: &glassdb_pass::PassSource,
+    opts: &glassdb_encode::OutputOptions,
+) -> Result<glassdb_encode::WrittenOutput, glassdb_encode::EncodeError> {
+    let frame = glassdb_pass::CarriedFrame::whole(image.width, image.height);
+    glassdb_encode::write_output(path, image, frame, src, opts)
+}

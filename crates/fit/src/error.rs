@@ -490,3 +490,16 @@ pub enum FitError {
         violation: PhysicalViolation,
     },
 }
+
+impl FitError {
+    /// The class of this error: a file that cannot be read is the reader's class, a caught
+    /// panic is internal, anything else is a table, a fit file or an option to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        match self {
+            FitError::Io { source, .. } => source.kind(),
+            FitError::Internal { .. } => glassdb_io::ErrorKind::Internal,
+            FitError::Curve { error, .. } => error.kind(),
+            _ => glassdb_io::ErrorKind::Invalid,
+        }
+    }
+}

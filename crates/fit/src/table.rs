@@ -12,8 +12,13 @@ use crate::model::AngleSamples;
 use crate::screen::{Screening, screen_curves};
 use crate::sniff::{ExpectedFile, FileContent};
 
-/// Largest angle table read (bytes): far above any real table, small enough to never exhaust memory.
-pub const MAX_TABLE_BYTES: u64 = glassdb_io::limits::ANGLE_TABLE.bytes;
+/// The largest angle table read (CSV): far above any real table, small enough to never exhaust
+/// memory.
+pub const ANGLE_TABLE_FILE: glassdb_io::InputLimit =
+    glassdb_io::InputLimit::mib(64, "an angle table");
+
+/// Largest angle table read (bytes).
+pub const MAX_TABLE_BYTES: u64 = ANGLE_TABLE_FILE.bytes;
 
 /// An angle that appeared on more than one row of a glass: the values were averaged.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,7 +124,7 @@ pub fn read_angle_table(path: &Path, percent: bool) -> Result<Vec<GlassAngleTabl
         path: path.to_path_buf(),
         source,
     };
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::ANGLE_TABLE).map_err(io_err)?;
+    let bytes = glassdb_io::read_input(path, ANGLE_TABLE_FILE).map_err(io_err)?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

@@ -6,7 +6,6 @@
 use std::io::{Cursor, Read, Seek, SeekFrom};
 use std::sync::{Arc, Mutex};
 
-use exr::block::UncompressedBlock;
 use exr::block::chunk::Chunk;
 use exr::block::chunk::TileCoordinates;
 use exr::math::Vec2;
@@ -14,8 +13,8 @@ use exr::meta::BlockDescription;
 use exr::meta::attribute::{SampleType, Text};
 use exr::meta::header::{Header, ImageAttributes, LayerAttributes};
 use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
-use rayon::prelude::*;
 
+use crate::exr_bands::{BandLayout, decode_bands};
 use crate::guard::catch_codec_panic;
 use crate::{Codec, ImageError, ImageWindows, PixelWindow};
 
@@ -45,6 +44,7 @@ impl From<SampleType> for ExrSampleType {
 pub struct ExrChannelInfo {
     /// The channel name as stored (Blender stores `ViewLayer.Combined.R` in single-part files).
     pub name: String,
+    /// Its sample type.
     pub sample_type: ExrSampleType,
     /// Subsampling factors (x, y); this reader needs (1, 1).
     pub sampling: (usize, usize),
@@ -57,13 +57,17 @@ pub struct ExrPart {
     pub layer_name: Option<String>,
     /// Data window size in pixels.
     pub width: usize,
+    /// Height of the data window.
     pub height: usize,
     /// The data window: the pixels the part stores, in the file's pixel coordinates.
     pub data_window: PixelWindow,
     /// The display window: the frame the image is meant to fill (shared by all parts).
     pub display_window: PixelWindow,
+    /// Its channels, in the file's (alphabetical) order.
     pub channels: Vec<ExrChannelInfo>,
+    /// Its compression.
     pub compression: exr::compression::Compression,
+    /// Whether it holds deep data (not read here).
     pub deep: bool,
     /// The part's `view` attribute (multi-part stereo files: `left`, `right`).
     pub view: Option<String>,
@@ -210,7 +214,7 @@ pub fn read_exr_headers(bytes: &[u8]) -> Result<Vec<ExrPart>, ImageError> {
 /// Shared, not copied: the passes of the planes of one multi-part file hold one list.
 #[derive(Debug, Clone)]
 pub struct ExrHeaders {
-    /// The parts, in file order.
+    /// Every part's header, in file order.
     pub parts: Arc<[ExrPart]>,
     /// Every text attribute, from the attributes shared by the parts and each part's own, as
     /// (part, name, value), sorted, without repeats (see [`read_exr_text_attributes`]).
@@ -388,11 +392,11 @@ impl<R: Read> HeaderScan<R> {
 }
 
 /// Runs an `exr` call that sees file bytes: a panic becomes `CodecPanic`, an error `ExrDecode`.
-fn guarded<T>(decode: impl FnOnce() -> exr::error::Result<T>) -> Result<T, ImageError> {
+pub(crate) fn guarded<T>(decode: impl FnOnce() -> exr::error::Result<T>) -> Result<T, ImageError> {
     catch_codec_panic(Codec::Exr, decode)?.map_err(ImageError::ExrDecode)
 }
 
-fn incomplete(detail: String) -> ImageError {
+pub(crate) fn incomplete(detail: String) -> ImageError {
     ImageError::Incomplete { detail }
 }
 
@@ -608,220 +612,6 @@ pub fn check_exr_readable(
     Ok(())
 }
 
-/// The image size, its division into bands of `band_height` rows, and the bands decoded
-/// (`first_band..end_band`).
-struct BandLayout {
-    width: usize,
-    height: usize,
-    band_height: usize,
-    first_band: usize,
-    end_band: usize,
-}
-
-impl BandLayout {
-    /// The first row decoded, from the data window's top.
-    fn y_start(&self) -> usize {
-        self.first_band * self.band_height
-    }
-
-    /// How many rows are decoded (whole bands, the last cut at the image's bottom).
-    fn decoded_rows(&self) -> usize {
-        (self.end_band * self.band_height)
-            .min(self.height)
-            .saturating_sub(self.y_start())
-    }
-}
-
-/// Decompresses the blocks `chunks` yields in parallel, each straight into the output buffers
-/// of its band (one buffer per selected channel), checking that each band's rows are fully
-/// covered.
-fn decode_bands(
-    meta: &exr::meta::MetaData,
-    header: &Header,
-    info: &ExrPart,
-    channels: &[usize],
-    chunks: impl Iterator<Item = exr::error::Result<Chunk>> + Send,
-    layout: &BandLayout,
-) -> Result<Vec<Vec<f32>>, ImageError> {
-    let BandLayout {
-        width,
-        height,
-        band_height,
-        first_band,
-        end_band,
-    } = *layout;
-    // Which output buffer each channel of the part goes to.
-    let mut target: Vec<Option<usize>> = vec![None; info.channels.len()];
-    for (k, &c) in channels.iter().enumerate() {
-        if let Some(t) = target.get_mut(c) {
-            *t = Some(k);
-        }
-    }
-    let sample_types: Vec<ExrSampleType> = info.channels.iter().map(|c| c.sample_type).collect();
-
-    let mut outputs: Vec<Vec<f32>> = channels
-        .iter()
-        .map(|_| vec![0f32; width * layout.decoded_rows()])
-        .collect();
-    let mut band_slices: Vec<BandTarget<'_>> = (first_band..end_band)
-        .map(|_| BandTarget {
-            slices: Vec::with_capacity(channels.len()),
-            written: 0,
-        })
-        .collect();
-    for buffer in outputs.iter_mut() {
-        for (band, slice) in band_slices
-            .iter_mut()
-            .zip(buffer.chunks_mut(width * band_height))
-        {
-            band.slices.push(slice);
-        }
-    }
-    let bands: Vec<Mutex<BandTarget<'_>>> = band_slices.into_iter().map(Mutex::new).collect();
-
-    guarded_chunks(chunks)
-        .par_bridge()
-        .try_for_each(|chunk| -> Result<(), ImageError> {
-            let chunk = chunk?;
-            let tile = guarded(|| header.get_block_data_indices(&chunk.compressed_block))?;
-            let index = tile.tile_index.y().wrapping_sub(first_band);
-            let band = bands.get(index).ok_or_else(|| {
-                incomplete(format!(
-                    "block row {} is outside the image",
-                    tile.tile_index.y()
-                ))
-            })?;
-            let block = guarded(|| UncompressedBlock::decompress_chunk(chunk, meta, false))?;
-            let y0 = (first_band + index) * band_height;
-            let rows = band_height.min(height - y0);
-            let mut band = band
-                .lock()
-                .map_err(|_| incomplete("a band's decoder stopped".into()))?;
-            let BandTarget { slices, written } = &mut *band;
-            *written += catch_codec_panic(Codec::Exr, || {
-                scatter_block(
-                    &block,
-                    header,
-                    &target,
-                    &sample_types,
-                    slices,
-                    y0,
-                    rows,
-                    width,
-                )
-            })??;
-            Ok(())
-        })?;
-    for (index, band) in bands.into_iter().enumerate() {
-        let written = band.into_inner().map(|b| b.written).unwrap_or_default();
-        let y0 = (first_band + index) * band_height;
-        let rows = band_height.min(height - y0);
-        let expected = rows * width * channels.len();
-        if written != expected {
-            return Err(incomplete(format!(
-                "rows {}..{}: {written} of {expected} samples present",
-                y0,
-                y0 + rows
-            )));
-        }
-    }
-    Ok(outputs)
-}
-
-/// One band's slice of every output buffer, and the samples written into them so far.
-struct BandTarget<'a> {
-    slices: Vec<&'a mut [f32]>,
-    written: usize,
-}
-
-/// The blocks of a chunk reader, with a panic in the reader on a corrupt file turned into an
-/// error; nothing more is read after an error.
-fn guarded_chunks(
-    mut chunks: impl Iterator<Item = exr::error::Result<Chunk>> + Send,
-) -> impl Iterator<Item = Result<Chunk, ImageError>> + Send {
-    let mut failed = false;
-    std::iter::from_fn(move || {
-        if failed {
-            return None;
-        }
-        let next = match catch_codec_panic(Codec::Exr, || chunks.next()) {
-            Ok(next) => next?.map_err(ImageError::ExrDecode),
-            Err(panic) => Err(panic),
-        };
-        failed = next.is_err();
-        Some(next)
-    })
-}
-
-/// Copies the selected channels' lines of one decompressed block into the band's buffers;
-/// returns the number of samples written.
-#[allow(clippy::too_many_arguments)]
-fn scatter_block(
-    block: &UncompressedBlock,
-    header: &Header,
-    target: &[Option<usize>],
-    sample_types: &[ExrSampleType],
-    slices: &mut [&mut [f32]],
-    y0: usize,
-    rows: usize,
-    width: usize,
-) -> Result<usize, ImageError> {
-    let mut written = 0;
-    for line in block.lines(&header.channels) {
-        let loc = line.location;
-        let Some(&Some(k)) = target.get(loc.channel) else {
-            continue;
-        };
-        let (x, y, n) = (loc.position.x(), loc.position.y(), loc.sample_count);
-        if y < y0 || y >= y0 + rows || x + n > width {
-            return Err(incomplete(format!(
-                "a block line at ({x}, {y}) lies outside its block"
-            )));
-        }
-        let start = (y - y0) * width + x;
-        let dst = slices
-            .get_mut(k)
-            .and_then(|s| s.get_mut(start..start + n))
-            .ok_or_else(|| incomplete("block line out of range".into()))?;
-        let ty = sample_types
-            .get(loc.channel)
-            .copied()
-            .unwrap_or(ExrSampleType::Float);
-        convert_samples(line.value, ty, dst)?;
-        written += n;
-    }
-    Ok(written)
-}
-
-/// Native-endian sample bytes to `f32`.
-fn convert_samples(bytes: &[u8], ty: ExrSampleType, dst: &mut [f32]) -> Result<(), ImageError> {
-    let size = match ty {
-        ExrSampleType::Half => 2,
-        ExrSampleType::Float | ExrSampleType::Uint => 4,
-    };
-    if bytes.len() != dst.len() * size {
-        return Err(incomplete("a block line has the wrong byte length".into()));
-    }
-    match ty {
-        ExrSampleType::Float => {
-            for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(4)) {
-                *d = f32::from_ne_bytes([c[0], c[1], c[2], c[3]]);
-            }
-        }
-        ExrSampleType::Uint => {
-            for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(4)) {
-                *d = u32::from_ne_bytes([c[0], c[1], c[2], c[3]]) as f32;
-            }
-        }
-        ExrSampleType::Half => {
-            for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(2)) {
-                *d = half::f16::from_bits(u16::from_ne_bytes([c[0], c[1]])).to_f32();
-            }
-        }
-    }
-    Ok(())
-}
-
 /// The attributes of an EXR (`file` from its start; only its headers are read), as the `exr`
 /// crate models them: those shared by every part (display window, chromaticities, pixel
 /// aspect, custom ones) and part `part`'s own (name, view, renderer attributes). No pixel data
@@ -844,7 +634,9 @@ pub fn read_exr_attributes(
 /// One part of an [`ExactExr`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExactPart {
+    /// The part's own attributes.
     pub attributes: LayerAttributes,
+    /// The part's data window.
     pub data_window: PixelWindow,
     /// Channel names as stored, and their full-resolution samples as stored (half, float or
     /// uint), row-major over the data window.
@@ -855,7 +647,9 @@ pub struct ExactPart {
 /// what is copied, unchanged, into a file written from it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExactExr {
+    /// The file's shared attributes.
     pub attributes: ImageAttributes,
+    /// Every part, exactly as stored.
     pub parts: Vec<ExactPart>,
 }
 

@@ -30,7 +30,9 @@ pub enum ExrStorage {
 /// samples kept exactly as another file stored them (half, float or uint).
 #[derive(Debug, Clone, PartialEq)]
 pub enum PlaneSamples {
+    /// Linear samples, written in the output's storage (half or float).
     Converted(Vec<f32>),
+    /// Samples copied exactly, in their own type (carried channels).
     Exact(FlatSamples),
 }
 
@@ -49,7 +51,9 @@ impl PlaneSamples {
 /// row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExrPlane {
+    /// The channel's full name (`layer.R`).
     pub name: String,
+    /// Its samples, one per pixel of the part's data window.
     pub samples: PlaneSamples,
     /// Quantise linearly in lossy compressions (alpha and other data); `false` leaves it to
     /// the `exr` crate's guess from the channel name.
@@ -75,6 +79,7 @@ pub struct ExrPartOut {
     /// The part's own attributes (its name, view, renderer attributes); the data window is
     /// set from `data_window`.
     pub attributes: LayerAttributes,
+    /// Its channels (any order: written sorted by name).
     pub planes: Vec<ExrPlane>,
 }
 
@@ -82,17 +87,21 @@ pub struct ExrPartOut {
 /// parts (several make a multi-part file, each of which needs a name).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExrImageOut {
+    /// The file's display window.
     pub display_window: PixelWindow,
     /// Attributes shared by the parts (chromaticities, pixel aspect, time code, custom ones);
     /// the display window is set from `display_window`.
     pub attributes: ImageAttributes,
+    /// Its parts, in order.
     pub parts: Vec<ExrPartOut>,
 }
 
 /// Encoding settings of [`write_exr_image`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExrWriteOptions {
+    /// How converted samples are stored.
     pub storage: ExrStorage,
+    /// The compression of every part.
     pub compression: Compression,
     /// zlib level (0–9) for ZIP/ZIPS, deflated in parallel by libdeflate (`exr_zip`); `None`
     /// leaves ZIP to the `exr` crate's own encoder (level 4).

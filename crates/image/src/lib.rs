@@ -6,7 +6,10 @@
 //! Every call into a codec runs under a panic guard: a panic becomes
 //! [`ImageError::CodecPanic`] (class [`ImageErrorKind::Internal`]), never a claim about the file.
 
+#![warn(missing_docs)]
+
 mod error;
+mod exr_bands;
 mod exr_layers;
 pub mod exr_read;
 mod exr_write;
@@ -45,13 +48,19 @@ pub use png_read::{PngHeader, PngPixels, PngSamples, decode_png, read_png_header
 pub use png_write::{PngColor, PngCompression, PngEncodeOptions, PngSampleSlice, encode_png};
 pub use window::{ImageWindows, PixelWindow, place_plane};
 
+/// The largest image file read: a pass or a mask, PNG or EXR (its pixel count is limited
+/// separately, from its header, before decoding).
+pub const IMAGE_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::gib(8, "an image");
+
 /// Default pixel limit: 2^27 (134 million pixels, e.g. 16384×8192).
 pub const DEFAULT_MAX_PIXELS: u64 = 1 << 27;
 
 /// The file formats this crate recognises by their first bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ImageFileKind {
+    /// PNG (its signature).
     Png,
+    /// OpenEXR (its magic number).
     Exr,
 }
 
@@ -70,7 +79,9 @@ pub fn sniff_image_kind(bytes: &[u8]) -> Option<ImageFileKind> {
 /// ([`read_image_header`]).
 #[derive(Debug, Clone)]
 pub enum ImageHeader {
+    /// A PNG's header chunks.
     Png(PngHeader),
+    /// An OpenEXR's headers.
     Exr(ExrHeaders),
 }
 
@@ -101,7 +112,9 @@ pub fn read_image_header<R: std::io::BufRead + std::io::Seek>(
 /// and its channels are decoded on request (only the part and channels a caller needs).
 #[derive(Debug)]
 pub enum ImageFile<'a> {
+    /// A PNG, decoded whole.
     Png(PngPixels),
+    /// An OpenEXR, its headers read and its channels decoded on request.
     Exr(ExrFile<'a>),
 }
 

@@ -14,8 +14,13 @@
 //! - [`progress`]: the observer through which libraries report the progress of long work.
 //! - [`quoted`]: a value from an input quoted in a message, cut to a bounded length.
 //! - [`sniff`]: binary data handed to a text reader, named from its signature.
+//! - [`ErrorKind`]: the class of every glassdb error (invalid, unsupported, limits, I/O,
+//!   internal), which each library's error type reports through its `kind()`.
+
+#![warn(missing_docs)]
 
 mod children;
+mod error_kind;
 pub mod frames;
 pub mod input;
 mod kind;
@@ -24,6 +29,7 @@ mod registry;
 pub mod sniff;
 
 pub use children::ChildGroup;
+pub use error_kind::ErrorKind;
 pub use frames::{FrameError, expand_frame_pattern, is_frame_pattern, parse_frame_list};
 pub use input::{
     InputError, InputLimit, limits, open_input, read_input, read_input_string, read_open_input,
@@ -34,7 +40,7 @@ pub use output::{
     OutputError, StagedOutput, SyncingFile, refuse_input_as_output, write_atomic,
     write_bytes_atomic,
 };
-pub use registry::{TEMP_PREFIX, exit_removing_temporaries, protect_inputs};
+pub use registry::{TEMP_PREFIX, declare_inputs, exit_removing_temporaries, protect_inputs};
 pub mod progress;
 mod quote;
 pub use progress::{NoProgress, Progress, StageLog};

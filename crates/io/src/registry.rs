@@ -86,10 +86,28 @@ pub(crate) fn state() -> MutexGuard<'static, State> {
 
 /// From now on, every file read through [`crate::read_input`] is an input that no output of
 /// this process may replace: [`crate::write_atomic`] and [`crate::refuse_input_as_output`]
-/// refuse an output that is (by device and inode) a file read before. The binaries call this
-/// first thing; a library never does, so that library users and tests are not affected.
+/// refuse an output that is (by device and inode) a file read or declared ([`declare_inputs`])
+/// before. This record is glassdb's one protection of inputs. The binaries call this first
+/// thing; a library never does, so that library users and tests are not affected (the record
+/// is process-wide, and a deleted file's inode is handed on).
 pub fn protect_inputs() {
     state().protect_inputs = true;
+}
+
+/// Declares `paths` as inputs of this process (when [`protect_inputs`] was called): files it
+/// will read, or names it reads from but that may not exist (a material library an OBJ names).
+/// No output may then replace or create one ([`crate::refuse_input_as_output`]). A library
+/// declares its inputs before its first output, so that a run refuses an output that is one of
+/// them before it does any work; reading a file through [`crate::read_input`] records it too.
+pub fn declare_inputs<'a>(paths: impl IntoIterator<Item = &'a Path>) {
+    let mut s = state();
+    if s.protect_inputs {
+        for path in paths {
+            if let Some(id) = FileId::of_path(path) {
+                s.inputs.entry(id).or_insert_with(|| path.to_path_buf());
+            }
+        }
+    }
 }
 
 /// Records a file read (when [`protect_inputs`] was called).

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use glassdb_image::{ExrFile, ExrHeaders, ExrPart, ImageWindows, ReadMemory};
 
-use crate::read::{MaskHeader, PixelError, decode_channels, locate_channel, plan_channels};
+use crate::channels::{MaskHeader, PixelError, decode_channels, locate_channel, plan_channels};
 use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
 
 /// How an AOV relates to the glass it describes.
@@ -33,12 +33,18 @@ pub enum AovWeighting {
 #[derive(Debug, Clone, PartialEq)]
 pub enum CosSource {
     /// An AOV channel holding |N·I| (e.g. Blender: Geometry Normal · Incoming, absolute).
-    Aov { channel: String },
+    Aov {
+        /// The AOV's channel name.
+        channel: String,
+    },
     /// World-space Normal and Position passes (channel layers, e.g. `Normal`, `Position`, with
     /// `.X/.Y/.Z` or `.R/.G/.B`) and the camera position: cos θ = |N·(P − C)| / |P − C|.
     Geometry {
+        /// The Normal pass's layer name.
         normal: String,
+        /// The Position pass's layer name.
         position: String,
+        /// Where the camera is (the view rays' origin).
         camera_origin: [f64; 3],
     },
 }
@@ -52,9 +58,11 @@ pub struct CryptomatteOptions {
     pub layer: Option<String>,
     /// Which manifest names are glass, with their registration ids.
     pub glass: GlassNames,
+    /// Where cos θ comes from.
     pub cos: CosSource,
     /// Where each glass pixel's plane index comes from.
     pub planes: PlaneSource,
+    /// How the AOVs were written.
     pub weighting: AovWeighting,
 }
 
@@ -70,9 +78,13 @@ pub enum PlaneSource {
     /// (`planes.json`): the plane nearest the pixel's position among those whose normal is
     /// within `max_angle_deg` of the pixel's normal (either orientation).
     Geometry {
+        /// The Normal pass's layer name.
         normal: String,
+        /// The Position pass's layer name.
         position: String,
+        /// The planes' equations, in plane order.
         equations: Vec<[f64; 4]>,
+        /// The largest angle between a pixel's normal and its plane's, degrees.
         max_angle_deg: f64,
     },
 }
@@ -80,6 +92,7 @@ pub enum PlaneSource {
 /// One Cryptomatte layer found in a file's header.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CryptomatteLayer {
+    /// Its layer name.
     pub name: String,
     /// Name → hash, from the manifest.
     pub manifest: BTreeMap<String, u32>,
@@ -152,7 +165,7 @@ fn read_side_manifest(image: &Path, file: &str) -> Result<String, MaskError> {
         path: side.clone(),
         source,
     };
-    glassdb_io::read_input_string(&side, glassdb_io::limits::MANIFEST).map_err(read_err)
+    glassdb_io::read_input_string(&side, crate::MANIFEST_FILE).map_err(read_err)
 }
 
 /// `{"name": "hex"}` → name → hash.
@@ -591,7 +604,7 @@ fn cos_from_aov(
             return Err(pixel.at(
                 i,
                 format!(
-                    "cos θ {v} from AOV {channel:?} is not in [0, 1] (is the AOV |N·I|, written as --mask-aovs says?)"
+                    "cos θ {v} from AOV {channel:?} is not in [0, 1] (is the AOV |N·I|, and written by the materials the options say: the glass only, or every material?)"
                 ),
             ));
         }

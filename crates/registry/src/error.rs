@@ -9,14 +9,18 @@ pub enum RegistryError {
     /// A registry or catalog file could not be read.
     #[error("cannot read {path}")]
     Read {
+        /// The registry or catalog.
         path: PathBuf,
+        /// Why it could not be read.
         source: glassdb_io::InputError,
     },
 
     /// The registry JSON is malformed or does not follow the schema (serde names line and column).
     #[error("{source_name}: not a valid glassdb registry")]
     Json {
+        /// The registry's name.
         source_name: String,
+        /// serde's error (line and column).
         source: serde_json::Error,
     },
 
@@ -25,29 +29,42 @@ pub enum RegistryError {
         "{source_name}: registry schema {found} is not supported (this build reads schemas 2 to {expected}); rebuild it from its catalog"
     )]
     SchemaVersion {
+        /// The registry's name.
         source_name: String,
+        /// Its schema.
         found: u32,
+        /// The newest schema this build reads.
         expected: u32,
     },
 
     /// A registry with no table.
     #[error("{source_name}: the registry has no table (`tables` needs at least one)")]
-    NoTables { source_name: String },
+    NoTables {
+        /// The registry's name.
+        source_name: String,
+    },
 
     /// The registry holds no table in the colour basis asked for.
     #[error("{source_name} has no table in {wanted} (it holds: {})", have.join(", "))]
     NoSuchTable {
+        /// The registry's name.
         source_name: String,
+        /// The table asked for.
         wanted: String,
+        /// The tables it holds.
         have: Vec<String>,
     },
 
     /// Two tables in one colour basis: a compositor could not tell which to use.
     #[error("{source_name}: two tables in {basis}: {first} and {second}; keep one table per space")]
     DuplicateTable {
+        /// The registry's name.
         source_name: String,
+        /// Their colour basis.
         basis: String,
+        /// The first table.
         first: String,
+        /// The second table.
         second: String,
     },
 
@@ -56,10 +73,15 @@ pub enum RegistryError {
         "{source_name}: the {other} table holds other glasses than the {first} table ({other_glasses:?} against {first_glasses:?}); build every table from one catalog"
     )]
     TablesDiffer {
+        /// The registry's name.
         source_name: String,
+        /// The first table's basis.
         first: String,
+        /// The other table's basis.
         other: String,
+        /// The first table's glasses.
         first_glasses: Vec<String>,
+        /// The other table's glasses.
         other_glasses: Vec<String>,
     },
 
@@ -67,39 +89,58 @@ pub enum RegistryError {
     #[error(
         "{source_name}: glass \"{name}\" has id 0, which masks reserve for \"no glass\" (use 1–65535)"
     )]
-    IdZero { source_name: String, name: String },
+    IdZero {
+        /// The registry's name.
+        source_name: String,
+        /// The glass.
+        name: String,
+    },
 
     /// Two glasses share one id.
     #[error("{source_name}: id {id} is used twice: by \"{first}\" and by \"{second}\"")]
     DuplicateId {
+        /// The registry's name.
         source_name: String,
+        /// The id.
         id: u16,
+        /// The first glass with it.
         first: String,
+        /// The second glass with it.
         second: String,
     },
 
     /// A number in a glass record is NaN or infinite.
     #[error("{source_name}: glass {glass}: {field} is not a finite number")]
     NonFinite {
+        /// The registry's name.
         source_name: String,
+        /// The glass.
         glass: String,
+        /// The field.
         field: String,
     },
 
     /// A normal-incidence value is outside [0, 1] or r0 + t0 > 1.
     #[error("{source_name}: glass {glass}: {what}")]
     NormalValue {
+        /// The registry's name.
         source_name: String,
+        /// The glass.
         glass: String,
+        /// Which value, and what is wrong with it.
         what: String,
     },
 
     /// A curve object is malformed (no terms, powers and coefficients of different lengths, …).
     #[error("{source_name}: glass {glass}: curve {field}")]
     CurveShape {
+        /// The registry's name.
         source_name: String,
+        /// The glass.
         glass: String,
+        /// The curve.
         field: String,
+        /// What is wrong with its polynomial.
         #[source]
         shape: glassdb_fit::PolynomialShape,
     },
@@ -107,9 +148,13 @@ pub enum RegistryError {
     /// A curve's recorded validation tolerance is negative.
     #[error("{source_name}: glass {glass}: curve {field}: negative tolerance {tolerance}")]
     NegativeTolerance {
+        /// The registry's name.
         source_name: String,
+        /// The glass.
         glass: String,
+        /// The curve.
         field: String,
+        /// Its tolerance.
         tolerance: f64,
     },
 
@@ -119,17 +164,27 @@ pub enum RegistryError {
         "{source_name}: glass {glass}: curve {field}: tolerance {tolerance} is above the largest validation tolerance {max} (a file cannot widen validation)"
     )]
     ToleranceTooLarge {
+        /// The registry's name.
         source_name: String,
+        /// The glass.
         glass: String,
+        /// The curve.
         field: String,
+        /// Its tolerance.
         tolerance: f64,
+        /// The largest a curve may record.
         max: f64,
     },
 
     /// The fit tolerance of a build is not positive or is above the largest tolerance a curve
     /// may record ([`glassdb_fit::MAX_CURVE_TOLERANCE`]).
     #[error("fit tolerance {tol} is outside (0, {max}], the range a registry's curves may record")]
-    FitTolerance { tol: f64, max: f64 },
+    FitTolerance {
+        /// The tolerance given.
+        tol: f64,
+        /// The largest a curve may record.
+        max: f64,
+    },
 
     /// The curves give an unphysical value at some angle (outside [0, 1] or r + t > 1) by more
     /// than the fit tolerance recorded for the curve.
@@ -137,12 +192,19 @@ pub enum RegistryError {
         "{source_name}: glass {glass}: {side} side, channel {channel}, at {angle_deg}°: {what} (allowed tolerance {tolerance:.2e})"
     )]
     Unphysical {
+        /// The registry's name.
         source_name: String,
+        /// The glass.
         glass: String,
+        /// The face of the glass.
         side: crate::Side,
+        /// The channel.
         channel: &'static str,
+        /// The angle of incidence, degrees.
         angle_deg: f64,
+        /// What is out of range.
         what: String,
+        /// The tolerance it exceeds.
         tolerance: f64,
     },
 
@@ -157,17 +219,30 @@ pub enum RegistryError {
     /// The catalog TOML is malformed, has an unknown key or a value of the wrong type
     /// (the source names the key, line and column).
     #[error("{path}: not a valid catalog: {message}")]
-    CatalogToml { path: PathBuf, message: String },
+    CatalogToml {
+        /// The catalog.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
 
     /// The catalog is not UTF-8 text, or lists no glass.
     #[error("{path}: {message}")]
-    CatalogSyntax { path: PathBuf, message: String },
+    CatalogSyntax {
+        /// The catalog.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
 
     /// A catalog entry is well formed TOML but says something impossible or incomplete.
     #[error("{path}: glass {glass}: {message}")]
     CatalogEntry {
+        /// The catalog.
         path: PathBuf,
+        /// The entry's glass.
         glass: String,
+        /// What is wrong.
         message: String,
     },
 
@@ -215,16 +290,22 @@ pub enum RegistryError {
     /// A file named by the catalog (spectral data or angle table) could not be read.
     #[error("glass {glass}: cannot read {path}")]
     InputFile {
+        /// The glass that names it.
         glass: String,
+        /// The file.
         path: PathBuf,
+        /// Why it could not be read.
         source: glassdb_io::InputError,
     },
 
     /// A spectral file named by the catalog could not be parsed.
     #[error("glass {glass}: spectral file {path}")]
     Spectral {
+        /// The glass that names it.
         glass: String,
+        /// The spectral file.
         path: PathBuf,
+        /// The reader's error.
         source: Box<glassdb_spectral::SpectralError>,
     },
 
@@ -232,8 +313,11 @@ pub enum RegistryError {
     /// light out than in, …).
     #[error("glass {glass}: spectral file {path}: {detail}")]
     SpectralContent {
+        /// The glass that names it.
         glass: String,
+        /// The spectral file.
         path: PathBuf,
+        /// What is wrong.
         detail: String,
     },
 
@@ -245,39 +329,53 @@ pub enum RegistryError {
     /// wavelength coverage.
     #[error("glass {glass}: spectral integration of the {what}")]
     Integration {
+        /// The glass.
         glass: String,
+        /// Which spectrum.
         what: String,
+        /// The integrator's error.
         source: Box<glassdb_spectral::SpectralError>,
     },
 
     /// A measured angle table named by the catalog could not be parsed.
     #[error("glass {glass}: angle table {path}")]
     AngleTable {
+        /// The glass that names it.
         glass: String,
+        /// The angle table.
         path: PathBuf,
+        /// The reader's error.
         source: Box<glassdb_fit::FitError>,
     },
 
     /// A measured angle table holds no glass, or several and none of this glass's name.
     #[error("glass {glass}: angle table {path}: {detail}")]
     AngleTableGlass {
+        /// The glass that names it.
         glass: String,
+        /// The angle table.
         path: PathBuf,
+        /// What is wrong.
         detail: String,
     },
 
     /// Fitting the angle curves failed.
     #[error("glass {glass}: fitting {curve}")]
     Fit {
+        /// The glass.
         glass: String,
+        /// The curve.
         curve: String,
+        /// The fitter's error.
         source: Box<glassdb_fit::FitError>,
     },
 
     /// Masks use ids that the catalog does not define.
     #[error("{}", missing_ids_message(catalog, ids))]
     IdsNotInCatalog {
+        /// The catalog.
         catalog: PathBuf,
+        /// The missing ids and their pixel counts.
         ids: Vec<(u16, u64)>,
     },
 
@@ -286,11 +384,43 @@ pub enum RegistryError {
         "{path}: glass \"{name}\" has id {id}, but the 8-bit mask {mask} can only hold ids 1–255 (use a 16-bit mask)"
     )]
     IdTooLargeForMask {
+        /// The catalog.
         path: PathBuf,
+        /// The glass.
         name: String,
+        /// Its id.
         id: u16,
+        /// The 8-bit mask.
         mask: PathBuf,
     },
+}
+
+impl RegistryError {
+    /// The class of this error: a file that cannot be read is the reader's class, a failure
+    /// of a catalog's spectral file, angle table, fit or unit keeps its own class, a registry
+    /// that cannot be serialised is glassdb's bug; anything else is a registry or catalog to
+    /// fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        use glassdb_io::ErrorKind;
+        match self {
+            RegistryError::Read { source, .. } | RegistryError::InputFile { source, .. } => {
+                source.kind()
+            }
+            RegistryError::Write(e) => e.kind(),
+            RegistryError::Spectral { source, .. } | RegistryError::Integration { source, .. } => {
+                source.kind()
+            }
+            RegistryError::SpectralMethod(e) => e.kind(),
+            RegistryError::AngleTable { source, .. } | RegistryError::Fit { source, .. } => {
+                source.kind()
+            }
+            RegistryError::Unit { source, .. } | RegistryError::UnitChoice { source, .. } => {
+                source.kind()
+            }
+            RegistryError::Serialize(_) => ErrorKind::Internal,
+            _ => ErrorKind::Invalid,
+        }
+    }
 }
 
 fn missing_ids_message(catalog: &std::path::Path, ids: &[(u16, u64)]) -> String {

@@ -6,6 +6,7 @@ use std::path::Path;
 use std::str::FromStr;
 
 use glassdb_fit::{CosPolynomial, FitSummary};
+use glassdb_side::Side;
 use glassdb_spectral::{IntegrationSettings, Method, RgbSpace};
 use serde::{Deserialize, Serialize};
 
@@ -141,8 +142,10 @@ pub struct GlassRecord {
 /// keys of `glassdb fit` (`basis`, `powers`, `coefficients`, `degree`, `rms_error`, …).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AngleCurve {
+    /// C(θ) in the fit crate's form.
     #[serde(flatten)]
     pub polynomial: CosPolynomial,
+    /// How well it fits its data.
     #[serde(flatten)]
     pub fit: FitSummary,
     /// Absolute tolerance on r (or t) that validation allows beyond the physical range (the
@@ -204,70 +207,33 @@ pub struct Provenance {
 /// A file and the sha256 of its bytes (hex).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct FileRef {
+    /// The file, relative to the catalog.
     pub path: String,
+    /// Its SHA-256 (hex).
     pub sha256: String,
 }
 
 /// The product as its data file describes it.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ProductRecord {
+    /// The product's name in the file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
+    /// Its maker.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub manufacturer: Option<String>,
     /// `Monolithic`, `Coated`, `coated-glass`, `laminate`, … as in the file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub product_type: Option<String>,
+    /// Which face is coated, as the file says.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coated_side: Option<String>,
+    /// Its thickness.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness_mm: Option<f64>,
     /// The parts an IGSDB product lists (a laminate's plies and interlayer), when it lists them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub composition: Vec<String>,
-}
-
-/// Which face of the glass the viewer sees (`front` or `back` in JSON and on the command line).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Side {
-    /// The front face (the catalog's Rf; the viewer's side in the scene).
-    Front,
-    /// The back face (Rb).
-    Back,
-}
-
-impl Side {
-    /// The lowercase name: `front` or `back`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Side::Front => "front",
-            Side::Back => "back",
-        }
-    }
-}
-
-impl fmt::Display for Side {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A side name that is neither `front` nor `back`.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown side `{0}`; expected front or back")]
-pub struct UnknownSide(pub String);
-
-impl FromStr for Side {
-    type Err = UnknownSide;
-
-    /// `front` or `back`, any case, surrounding spaces ignored.
-    fn from_str(s: &str) -> Result<Side, UnknownSide> {
-        [Side::Front, Side::Back]
-            .into_iter()
-            .find(|side| s.trim().eq_ignore_ascii_case(side.name()))
-            .ok_or_else(|| UnknownSide(s.to_string()))
-    }
 }
 
 impl AngleCurve {
@@ -530,7 +496,9 @@ impl Registry {
     /// SHA-256 (hex) of the registry's canonical JSON ([`Registry::to_json_string`]): names
     /// the glass data a composite was made with, whatever the file's formatting.
     pub fn content_sha256(&self) -> Result<String, RegistryError> {
-        Ok(crate::build::sha256_hex(self.to_json_string()?.as_bytes()))
+        Ok(crate::catalog_files::sha256_hex(
+            self.to_json_string()?.as_bytes(),
+        ))
     }
 
     /// The registry as pretty JSON text (schema 4).
@@ -651,17 +619,6 @@ mod tests {
             reg.validate(),
             Err(RegistryError::DuplicateId { id: 4, .. })
         ));
-    }
-
-    #[test]
-    fn side_names_parse_print_and_serialise() {
-        for side in [Side::Front, Side::Back] {
-            assert_eq!(side.to_string().parse::<Side>().unwrap(), side);
-            assert_eq!(serde_json::to_string(&side).unwrap(), format!("\"{side}\""));
-        }
-        assert_eq!(" Back ".parse::<Side>().unwrap(), Side::Back);
-        assert!("left".parse::<Side>().is_err());
-        assert!(serde_json::from_str::<Side>("\"up\"").is_err());
     }
 
     #[test]

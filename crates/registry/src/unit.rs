@@ -15,9 +15,10 @@ use glassdb_stack::{
 
 use crate::angle_model::{ModelTables, integration_error, read_measured_table};
 use crate::build::{
-    BuildOptions, CatalogFiles, build_glass, glass_record, integrators_of, load_catalog, oriented,
+    BuildOptions, build_glass, glass_record, integrators_of, load_catalog, oriented,
 };
 use crate::catalog::{ElementSpec, GlassBuild, GlassSpec, LayerSpec, NormalSource};
+use crate::catalog_files::CatalogFiles;
 use crate::curves::{fit_glass_curves, fit_share_curves};
 use crate::normal::{CatalogLayer, normal_values, read_layer};
 use crate::unit_record::{

@@ -439,28 +439,48 @@ pub(crate) fn spline_kernel(
     let n = x.len();
     kernel.clear();
     kernel.resize(n, [0.0; 3]);
-    let (first, last) = (x[0], x[n - 1]);
     let (lo, hi) = spline_window(x, grid);
     let xw = &x[lo..hi];
-    let nw = xw.len();
-    // β: weights of the slopes; α goes straight into the kernel.
-    let mut beta = vec![[0.0f64; 3]; nw];
-    let add = |dst: &mut [f64; 3], w: &[f64; 3], f: f64| {
-        dst[0] += w[0] * f;
-        dst[1] += w[1] * f;
-        dst[2] += w[2] * f;
-    };
     let dxs: Vec<f64> = xw.windows(2).map(|p| p[1] - p[0]).collect();
+    let beta = hermite_weights(x, (lo, hi), &dxs, grid, weights, kernel);
+    let z = transposed_slopes_solve(xw, &dxs, beta);
+    add_slope_weights(xw, &dxs, &z, &mut kernel[lo..]);
+}
+
+/// `dst += w · f`, per channel.
+#[inline]
+fn add3(dst: &mut [f64; 3], w: &[f64; 3], f: f64) {
+    dst[0] += w[0] * f;
+    dst[1] += w[1] * f;
+    dst[2] += w[2] * f;
+}
+
+/// The Hermite form's weights: the samples' (α) go straight into `kernel`, the slopes' (β,
+/// over the window `lo..hi` of `x`) are returned; grid points outside the data take the end
+/// values.
+fn hermite_weights(
+    x: &[f64],
+    (lo, hi): (usize, usize),
+    dxs: &[f64],
+    grid: &[f64],
+    weights: &[[f64; 3]],
+    kernel: &mut [[f64; 3]],
+) -> Vec<[f64; 3]> {
+    let n = x.len();
+    let (first, last) = (x[0], x[n - 1]);
+    let xw = &x[lo..hi];
+    let nw = xw.len();
+    let mut beta = vec![[0.0f64; 3]; nw];
     let mut k = 0usize;
     let mut inv_h = 1.0 / dxs[0];
     for (j, &t) in grid.iter().enumerate() {
         let Some(w) = weights.get(j) else { break };
         if t < first {
-            add(&mut kernel[0], w, 1.0);
+            add3(&mut kernel[0], w, 1.0);
             continue;
         }
         if t > last {
-            add(&mut kernel[n - 1], w, 1.0);
+            add3(&mut kernel[n - 1], w, 1.0);
             continue;
         }
         if k + 2 < nw && xw[k + 1] < t {
@@ -472,11 +492,18 @@ pub(crate) fn spline_kernel(
         let h = dxs[k];
         let u = (t - xw[k]) * inv_h;
         let (u2, u3) = (u * u, u * u * u);
-        add(&mut kernel[lo + k], w, 2.0 * u3 - 3.0 * u2 + 1.0);
-        add(&mut kernel[lo + k + 1], w, -2.0 * u3 + 3.0 * u2);
-        add(&mut beta[k], w, h * (u3 - 2.0 * u2 + u));
-        add(&mut beta[k + 1], w, h * (u3 - u2));
+        add3(&mut kernel[lo + k], w, 2.0 * u3 - 3.0 * u2 + 1.0);
+        add3(&mut kernel[lo + k + 1], w, -2.0 * u3 + 3.0 * u2);
+        add3(&mut beta[k], w, h * (u3 - 2.0 * u2 + u));
+        add3(&mut beta[k + 1], w, h * (u3 - u2));
     }
+    beta
+}
+
+/// Solves `Aᵀ z = β` (A: the not-a-knot rows of [`spline_slopes`] over the window `xw`) by
+/// Thomas' algorithm, the three channels at once.
+fn transposed_slopes_solve(xw: &[f64], dxs: &[f64], beta: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
+    let nw = xw.len();
     let dx = |i: usize| dxs[i];
     // Aᵀ (A: the rows of spline_slopes) as three diagonals: Aᵀ row i has
     // sub = upper_A(i-1), diag_A(i), super = lower_A(i+1).
@@ -533,21 +560,28 @@ pub(crate) fn spline_kernel(
             z[i][c] -= cprime[i] * next[c];
         }
     }
-    // Bᵀz: the right-hand side is linear in the secant slopes m_i = (y_{i+1} - y_i) / dx_i.
+    z
+}
+
+/// Adds `Bᵀz` to the window's kernel: the right-hand side is linear in the secant slopes
+/// `m_i = (y_{i+1} - y_i) / dx_i`.
+fn add_slope_weights(xw: &[f64], dxs: &[f64], z: &[[f64; 3]], kernel: &mut [[f64; 3]]) {
+    let nw = xw.len();
+    let dx = |i: usize| dxs[i];
     let mut g = vec![[0.0f64; 3]; nw - 1];
     {
         let d = xw[2] - xw[0];
-        add(&mut g[0], &z[0], (dx(0) + 2.0 * d) * dx(1) / d);
-        add(&mut g[1], &z[0], dx(0) * dx(0) / d);
+        add3(&mut g[0], &z[0], (dx(0) + 2.0 * d) * dx(1) / d);
+        add3(&mut g[1], &z[0], dx(0) * dx(0) / d);
     }
     for i in 1..nw - 1 {
-        add(&mut g[i - 1], &z[i], 3.0 * dx(i));
-        add(&mut g[i], &z[i], 3.0 * dx(i - 1));
+        add3(&mut g[i - 1], &z[i], 3.0 * dx(i));
+        add3(&mut g[i], &z[i], 3.0 * dx(i - 1));
     }
     {
         let d = xw[nw - 1] - xw[nw - 3];
-        add(&mut g[nw - 3], &z[nw - 1], dx(nw - 2) * dx(nw - 2) / d);
-        add(
+        add3(&mut g[nw - 3], &z[nw - 1], dx(nw - 2) * dx(nw - 2) / d);
+        add3(
             &mut g[nw - 2],
             &z[nw - 1],
             (2.0 * d + dx(nw - 2)) * dx(nw - 3) / d,
@@ -555,8 +589,8 @@ pub(crate) fn spline_kernel(
     }
     for (i, gi) in g.iter().enumerate() {
         let inv = 1.0 / dx(i);
-        add(&mut kernel[lo + i + 1], gi, inv);
-        add(&mut kernel[lo + i], gi, -inv);
+        add3(&mut kernel[i + 1], gi, inv);
+        add3(&mut kernel[i], gi, -inv);
     }
 }
 

@@ -46,21 +46,33 @@
     return kind === 'json' ? r.json() : r.arrayBuffer();
   }
 
+  // The page's data (crates/view/src/page.rs), from the server or from an export: read here
+  // only, so that every field the page uses comes through one place that knows its version.
+  const PAGE_FORMAT = 'glassdb-viewer-page/1';
+
+  function readScene(scene) {
+    if (!scene || scene.format !== PAGE_FORMAT) {
+      throw new Error('the page data is ' + (scene && scene.format) + ', not ' + PAGE_FORMAT
+        + ': serve or export it with the glassdb of this page');
+    }
+    return scene;
+  }
+
+  function readFrame(info, passes, mask) {
+    return { info: { ids: info.ids, trans: info.trans }, passes, mask };
+  }
+
   const source = EXPORT ? {
-    scene: async () => EXPORT.scene,
+    scene: async () => readScene(EXPORT.scene),
     luts: async () => EXPORT.luts.map((text) => new Float32Array(base64Bytes(text))),
     view: async (i) => new Float32Array(base64Bytes(EXPORT.views[i])),
     frame: async (i) => {
       if (!EXPORT.frames[i]) await loadScript(window.GLASSDB_EXPORT_FRAME_FILES[i]);
       const f = EXPORT.frames[i];
-      return {
-        info: f.info,
-        passes: new Uint16Array(base64Bytes(f.passes)),
-        mask: new Float32Array(base64Bytes(f.mask)),
-      };
+      return readFrame(f.info, new Uint16Array(base64Bytes(f.passes)), new Float32Array(base64Bytes(f.mask)));
     },
   } : {
-    scene: () => fetchOk('api/scene', 'json'),
+    scene: async () => readScene(await fetchOk('api/scene', 'json')),
     // One request for every table, and a frame's parts one after the other: the page keeps to
     // one connection.
     luts: async (n) => {
@@ -73,7 +85,7 @@
       const info = await fetchOk('api/frame/' + i, 'json');
       const passes = await fetchOk('api/frame/' + i + '/passes');
       const mask = await fetchOk('api/frame/' + i + '/mask');
-      return { info, passes: new Uint16Array(passes), mask: new Float32Array(mask) };
+      return readFrame(info, new Uint16Array(passes), new Float32Array(mask));
     },
   };
 

@@ -155,9 +155,10 @@ pub fn write_export(
     staged.write_bytes_replacing_link(&dir.join("viewer.css"), assets::VIEWER_CSS.as_bytes())?;
 
     let mut scene = viewer.scene().clone();
-    scene["initial_glass"] = json!(viewer.choices_param(choices));
-    scene["initial_ev"] = json!(ev);
-    scene["export_available"] = json!(false);
+    scene.initial_glass = Some(viewer.choices_param(choices));
+    scene.initial_ev = Some(ev);
+    scene.export_available = false;
+    let scene = json!(scene);
     staged.write_replacing_link(&dir.join("data.js"), |w| {
         write!(
             w,
@@ -176,7 +177,7 @@ pub fn write_export(
             writeln!(
                 w,
                 "window.GLASSDB_EXPORT.frames[{i}] = {{\"info\": {}, \"passes\": \"{}\", \"mask\": \"{}\"}};",
-                frame.info,
+                json!(frame.info),
                 Base64Display::new(&frame.passes, &STANDARD),
                 Base64Display::new(&frame.mask, &STANDARD)
             )

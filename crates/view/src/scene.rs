@@ -2,39 +2,44 @@
 //! products (every record of the registry's table in the passes' space) and their lookup
 //! tables, and the choice of a product per glass id.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
 use std::sync::{Arc, Mutex};
 
-use glassdb_colour::RgbSpace;
+use glassdb_colour::{CubeLut, RgbSpace};
 use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::lut::GlassLut;
 use glassdb_compose::memory::MemoryBudget;
-use glassdb_compose::view::CubeLut;
-use glassdb_compose::{ComposeJob, ComposeSettings, DecodedFrame, decode_frame, sequence};
-use glassdb_registry::{GlassRecord, Registry, Side};
-use serde_json::{Value, json};
+use glassdb_compose::{DecodeSettings, DecodeTarget, DecodedFrame, FrameFiles, decode_frame};
+use glassdb_registry::{GlassRecord, Registry};
+use glassdb_side::Side;
 
 use crate::ViewError;
 use crate::data::{self, MaskMode};
+use crate::page::{LutLayout, PAGE_FORMAT, PageDisplayView, PageFrame, PageProduct, PageScene};
 
-/// The viewer's inputs: the compose job (paths may hold `####` when `frames` is given), how
-/// to read it, and the registry whose records are the candidate products.
+/// The viewer's inputs: the frame's files (paths may hold `####` when `frames` is given), how
+/// to read them, and the registry whose records are the candidate products.
 pub struct ViewerInputs {
-    pub job: ComposeJob,
+    /// The passes and the mask.
+    pub files: FrameFiles,
     /// Frame numbers of a sequence; empty for a single frame.
     pub frames: Vec<u32>,
-    pub settings: ComposeSettings,
+    /// How the inputs are read and checked, as `compose` reads them.
+    pub settings: DecodeSettings,
+    /// Side of each plane that faces the camera; planes not listed show the front.
+    pub plane_sides: BTreeMap<usize, Side>,
+    /// The registry whose records are the candidate products.
     pub registry: Registry,
-    /// `.cube` views the page offers beside `standard`.
-    pub views: Vec<CubeLut>,
+    /// `.cube` display views the page offers beside `standard`.
+    pub display_views: Vec<CubeLut>,
 }
 
 /// One decoded frame as the page uploads it.
 #[derive(Debug)]
 pub struct FrameData {
-    /// Glass pixels per id, the mask kind: the frame's JSON.
-    pub info: Value,
+    /// Glass pixels per id and the frame's transmission pass: the frame's JSON.
+    pub info: PageFrame,
     /// Half-float passes ([`data::pass_bytes`]).
     pub passes: Vec<u8>,
     /// The mask ([`data::mask_bytes`]).
@@ -44,7 +49,9 @@ pub struct FrameData {
 /// A product chosen for a glass id: (id, index of the product in [`Viewer::products`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GlassChoice {
+    /// The glass id.
     pub id: u16,
+    /// The product's index in [`Viewer::products`].
     pub product: usize,
 }
 
@@ -62,7 +69,7 @@ pub struct Viewer {
     product_luts: Arc<[u8]>,
     /// Each `.cube` view's tables as the page uploads them ([`data::view_bytes`]).
     view_tables: Vec<Arc<[u8]>>,
-    scene: Value,
+    scene: PageScene,
     mask_mode: MaskMode,
     /// The last frame decoded.
     cache: Mutex<Option<(usize, Arc<FrameData>)>>,
@@ -74,8 +81,14 @@ impl Viewer {
     pub fn open(inputs: ViewerInputs) -> Result<Viewer, ViewError> {
         let luts = RegistryLuts::new(&inputs.registry);
         let budget = MemoryBudget::new(inputs.settings.max_memory);
-        let first_job = job_of(&inputs, 0)?;
-        let first = decode_frame(&first_job, &inputs.settings, &luts, &budget, (false, false))?;
+        let first_files = files_of(&inputs, 0)?;
+        let first = decode_frame(
+            &first_files,
+            &inputs.settings,
+            &luts,
+            &budget,
+            &DecodeTarget::display(),
+        )?;
         let (width, height, planes) = (
             first.trans.image.width,
             first.trans.image.height,
@@ -91,7 +104,7 @@ impl Viewer {
         let slots = slot_map(&products);
         let product_luts = product_tables(&products, &slots, first.lut);
         // Kept for the page's first request.
-        let first_data = Arc::new(frame_data(&first, &first_job, &slots));
+        let first_data = Arc::new(frame_data(&first, &first_files, &slots));
         drop(first);
         let display_matrix = (space.space != RgbSpace::Srgb).then(|| {
             let m = glassdb_colour::rgb_to_rgb(space.space, RgbSpace::Srgb);
@@ -101,37 +114,44 @@ impl Viewer {
                 .collect::<Vec<f64>>()
         });
         let frames: Vec<String> = if inputs.frames.is_empty() {
-            vec![first_job.trans.display().to_string()]
+            vec![first_files.trans.display().to_string()]
         } else {
             inputs.frames.iter().map(u32::to_string).collect()
         };
-        let scene = json!({
-            "width": width,
-            "height": height,
-            "planes": planes,
-            "plane_sides": (0..planes).map(|k| side_name(inputs.settings.plane_sides.get(&k).copied().unwrap_or(Side::Front))).collect::<Vec<_>>(),
-            "frames": frames,
-            "space": space.to_string(),
-            "table": table.basis.to_string(),
-            "approximate_table": table.approximate,
-            "display_matrix": display_matrix,
-            "registry": inputs.settings.registry_label,
-            "mask_mode": mask_mode.name(),
-            "trans": first_job.trans.display().to_string(),
-            "lut": {
-                "width": data::LUT_WIDTH,
-                "rows_per_curve": data::LUT_ROWS_PER_CURVE,
-                "rows_per_slot": data::LUT_ROWS_PER_SLOT,
-                "fine_offset": data::LUT_FINE_OFFSET,
-                "fine_steps": glassdb_compose::lut::FINE_STEPS,
-                "normal_offset": data::LUT_NORMAL_OFFSET,
-            },
-            "slots": products.iter().map(|g| g.id).collect::<Vec<_>>(),
-            "products": products.iter().enumerate().map(|(i, g)| product_json(i, g)).collect::<Vec<_>>(),
-            "views": inputs.views.iter().map(view_json).collect::<Vec<_>>(),
-        });
+        let scene = PageScene {
+            format: PAGE_FORMAT,
+            width,
+            height,
+            planes,
+            plane_sides: (0..planes)
+                .map(|k| inputs.plane_sides.get(&k).copied().unwrap_or(Side::Front))
+                .collect(),
+            frames,
+            space: space.to_string(),
+            table: table.basis.to_string(),
+            approximate_table: table.approximate,
+            display_matrix,
+            registry: inputs.settings.registry_label.clone(),
+            mask_mode: mask_mode.name(),
+            trans: first_files.trans.display().to_string(),
+            lut: LutLayout::TEXTURE,
+            slots: products.iter().map(|g| g.id).collect(),
+            products: products
+                .iter()
+                .enumerate()
+                .map(|(i, g)| PageProduct::of(i, g))
+                .collect(),
+            views: inputs
+                .display_views
+                .iter()
+                .map(PageDisplayView::of)
+                .collect(),
+            export_available: false,
+            initial_glass: None,
+            initial_ev: None,
+        };
         let view_tables = inputs
-            .views
+            .display_views
             .iter()
             .map(|v| data::view_bytes(v).into())
             .collect();
@@ -149,8 +169,8 @@ impl Viewer {
         })
     }
 
-    /// The scene description the page starts from.
-    pub fn scene(&self) -> &Value {
+    /// The scene the page starts from (no export button, no initial choices).
+    pub fn scene(&self) -> &PageScene {
         &self.scene
     }
 
@@ -203,24 +223,24 @@ impl Viewer {
         }
         // Free the old frame first: two frames need not fit in memory together.
         *cache = None;
-        let job = job_of(&self.inputs, index)?;
+        let files = files_of(&self.inputs, index)?;
         let frame = decode_frame(
-            &job,
+            &files,
             &self.inputs.settings,
             &self.luts,
             &self.budget,
-            (false, false),
+            &DecodeTarget::display(),
         )?;
         let mode = MaskMode::of(&frame.mask.cos_theta);
         if mode != self.mask_mode {
             return Err(ViewError::MaskKindChanges {
                 frame: self.inputs.frames.get(index).copied().unwrap_or(0),
-                mask: job.mask.clone(),
+                mask: files.mask.clone(),
                 found: mode.name(),
                 first: self.mask_mode.name(),
             });
         }
-        let data = Arc::new(frame_data(&frame, &job, &self.slots));
+        let data = Arc::new(frame_data(&frame, &files, &self.slots));
         drop(frame);
         *cache = Some((index, data.clone()));
         Ok(data)
@@ -308,11 +328,14 @@ impl Viewer {
 /// A decoded frame as the page uploads it; `slots` gives each mask id's glass slot.
 fn frame_data(
     frame: &DecodedFrame<'_>,
-    job: &ComposeJob,
+    files: &FrameFiles,
     slots: &HashMap<u16, usize>,
 ) -> FrameData {
     FrameData {
-        info: json!({ "ids": frame.id_counts, "trans": job.trans.display().to_string() }),
+        info: PageFrame {
+            ids: frame.id_counts.clone(),
+            trans: files.trans.display().to_string(),
+        },
         passes: data::pass_bytes(frame),
         mask: data::mask_bytes(frame, |id| slots.get(&id).copied()),
     }
@@ -376,58 +399,11 @@ fn split_choices(spec: &str) -> Vec<&str> {
     parts.into_iter().filter(|p| !p.trim().is_empty()).collect()
 }
 
-fn side_name(side: Side) -> &'static str {
-    match side {
-        Side::Front => "front",
-        Side::Back => "back",
-    }
-}
-
-/// A `.cube` view as the scene lists it: its name and its tables' sizes and domains.
-fn view_json(lut: &CubeLut) -> Value {
-    let name = lut.path.file_stem().map_or_else(
-        || lut.path.display().to_string(),
-        |s| s.to_string_lossy().into_owned(),
-    );
-    json!({
-        "name": name,
-        "title": lut.title,
-        "shaper": lut.shaper_table().map(|t| json!({
-            "len": t.size,
-            "rows": t.size.div_ceil(data::LUT_WIDTH),
-            "scale": t.scale,
-            "offset": t.offset,
-        })),
-        "cube": lut.cube_table().map(|t| json!({
-            "n": t.size,
-            "scale": t.scale,
-            "offset": t.offset,
-        })),
-    })
-}
-
-fn product_json(index: usize, g: &GlassRecord) -> Value {
-    json!({
-        "index": index,
-        "id": g.id,
-        "name": g.name,
-        "r0": g.r0,
-        "t0": g.t0,
-        "r0_back": g.r0_back,
-        "luminous": g.luminous.map(|l| json!({
-            "transmittance": l.transmittance,
-            "reflectance": l.reflectance,
-            "reflectance_back": l.reflectance_back,
-        })),
-        "angle_model": g.angle_model.kind,
-    })
-}
-
-/// The job of frame `index`: the pattern's paths with its number, or the job itself.
-fn job_of(inputs: &ViewerInputs, index: usize) -> Result<ComposeJob, ViewError> {
+/// The files of frame `index`: the pattern's paths with its number, or the files themselves.
+fn files_of(inputs: &ViewerInputs, index: usize) -> Result<FrameFiles, ViewError> {
     match inputs.frames.get(index) {
-        Some(&n) => Ok(sequence::frame_job(&inputs.job, n)?),
-        None => Ok(inputs.job.clone()),
+        Some(&n) => Ok(inputs.files.for_frame(n)?),
+        None => Ok(inputs.files.clone()),
     }
 }
 

@@ -225,8 +225,8 @@ impl ViewServer {
             ),
             "/api/scene" => {
                 let mut scene = v.scene().clone();
-                scene["export_available"] = json!(self.export.is_some());
-                Reply::json(&scene)
+                scene.export_available = self.export.is_some();
+                Reply::json(&json!(scene))
             }
             _ => {
                 let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
@@ -262,10 +262,10 @@ impl ViewServer {
         };
         let data = match self.viewer.frame(i) {
             Ok(d) => d,
-            Err(e) => return Reply::error(500, &ErrorChain(&e).to_string()),
+            Err(e) => return Reply::error(e.http_status(), &ErrorChain(&e).to_string()),
         };
         match rest {
-            [] => Reply::json(&data.info),
+            [] => Reply::json(&json!(data.info)),
             ["passes"] => Reply::binary(Body::Frame(data, FramePart::Passes)),
             ["mask"] => Reply::binary(Body::Frame(data, FramePart::Mask)),
             _ => Reply::error(404, "no such resource"),

@@ -14,12 +14,14 @@
 
 use rayon::prelude::*;
 
-use crate::view::ViewTransform;
+use glassdb_colour::DisplayView;
 
 /// Linear-light RGB(A), planar, row-major, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// R, G, B planes, `width * height` samples each.
     pub rgb: [Vec<f32>; 3],
@@ -92,18 +94,13 @@ impl LinearImage {
     /// with an 8×8 ordered (Bayer) pattern when `dither` is set. Values outside [0, 1] are
     /// clamped, NaN becomes 0.
     pub fn to_encoded(&self, bits: PngBits, dither: bool) -> EncodedImage {
-        self.to_encoded_view(bits, dither, &ViewTransform::Standard)
+        self.to_encoded_view(bits, dither, &DisplayView::Standard)
     }
 
-    /// Encodes into PNG samples through `view`: [`ViewTransform::Standard`] is the sRGB
+    /// Encodes into PNG samples through `view`: [`DisplayView::Standard`] is the sRGB
     /// transfer of [`LinearImage::to_encoded`]; a LUT's output is taken as display-encoded and
     /// only clamped to [0, 1] (NaN → 0) before the same quantisation (and dither).
-    pub fn to_encoded_view(
-        &self,
-        bits: PngBits,
-        dither: bool,
-        view: &ViewTransform,
-    ) -> EncodedImage {
+    pub fn to_encoded_view(&self, bits: PngBits, dither: bool, view: &DisplayView) -> EncodedImage {
         let w = self.width as usize;
         let channels = if self.alpha.is_some() { 4 } else { 3 };
         let n = self.pixel_count();
@@ -112,8 +109,8 @@ impl LinearImage {
             let i = y * w + x;
             let rgb = [linear(i, 0), linear(i, 1), linear(i, 2)];
             let [r, g, b] = match view {
-                ViewTransform::Standard => rgb.map(linear_to_srgb),
-                ViewTransform::Lut(lut) => lut.apply(rgb).map(sanitize),
+                DisplayView::Standard => rgb.map(linear_to_srgb),
+                DisplayView::Lut(lut) => lut.apply(rgb).map(sanitize),
             };
             let a = self
                 .alpha
@@ -166,7 +163,9 @@ impl LinearImage {
 /// Bit depth of PNG samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PngBits {
+    /// 8 bits per sample.
     Eight,
+    /// 16 bits per sample.
     Sixteen,
 }
 
@@ -184,17 +183,22 @@ pub enum InputTransfer {
 /// light: convert with [`EncodedImage::to_linear`] before any arithmetic.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EncodedImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA.
     pub channels: usize,
+    /// The samples, `width × height × channels` of them.
     pub samples: EncodedSamples,
 }
 
 /// Interleaved encoded samples.
 #[derive(Debug, Clone, PartialEq)]
 pub enum EncodedSamples {
+    /// 8-bit samples.
     U8(Vec<u8>),
+    /// 16-bit samples.
     U16(Vec<u16>),
 }
 
