@@ -20,6 +20,13 @@
     viewer_driver.py export URL
         Opens the page, clicks its export button and prints JSON: the status line it shows.
 
+    viewer_driver.py layout URL [--run JS ...] [--window WxH] [--screenshot FILE.png]
+        Opens the page, runs each JS snippet (awaited; `window.glassdb` hooks), and prints JSON
+        of what a designer sees: the window, the stage and the canvas's on-screen box, every
+        product and glass name whose text is cut (wider than the box it is shown in, or beyond
+        its list's edge) and whether it has a tooltip, and what lies on screen where the A/B
+        split line should be (the element there and its colour against the pixels beside it).
+
 Chromium runs as Debian ships it (/usr/bin/chromium, /usr/bin/chromedriver), WebGL2 on
 SwiftShader when there is no GPU.
 """
@@ -188,6 +195,62 @@ def export(args):
         driver.quit()
 
 
+LAYOUT_JS = r"""
+const done = arguments[arguments.length - 1];
+(async () => {
+  for (const js of arguments[0]) await (new Function('return (async () => {' + js + '})()'))();
+  await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+  const box = (el) => { if (!el) return null; const r = el.getBoundingClientRect();
+    return {left: r.left, top: r.top, width: r.width, height: r.height, right: r.right, bottom: r.bottom}; };
+  const canvas = document.getElementById('view-canvas');
+  const names = [];
+  for (const list of ['products', 'glasses']) {
+    const ul = document.getElementById(list);
+    const edge = ul.getBoundingClientRect().right;
+    for (const el of ul.querySelectorAll('li .name')) {
+      const r = el.getBoundingClientRect();
+      const li = el.closest('li');
+      const text = el.firstChild ? el.firstChild.textContent : el.textContent;
+      names.push({list, text, cut: el.scrollWidth > el.clientWidth + 1 || r.right > edge + 0.5
+          || ul.scrollWidth > ul.clientWidth + 1,
+        tooltip: (li.title || '').includes(text) || (el.title || '').includes(text)});
+    }
+  }
+  const scene = window.glassdb && window.glassdb.scene;
+  const c = box(canvas);
+  const split = window.glassdb && window.glassdb.split ? window.glassdb.split() : null;
+  let line = null;
+  if (split !== null && c) {
+    const x = c.left + split * c.width, y = c.top + c.height / 2;
+    const el = document.elementFromPoint(x, y);
+    const style = el ? getComputedStyle(el) : null;
+    line = {x, element: el ? (el.id || el.tagName) : null, background: style ? style.backgroundColor : null,
+      visible: !!el && el !== canvas && style.visibility !== 'hidden' && Number(style.opacity) > 0,
+      box: box(document.getElementById('split-line'))};
+  }
+  return {window: [window.innerWidth, window.innerHeight], stage: box(document.getElementById('stage')),
+    canvas: c, frame: scene ? [scene.width, scene.height] : null, names, split_line: line,
+    zoom: window.glassdb && window.glassdb.zoom ? window.glassdb.zoom() : null,
+    errors: window.glassdbErrors || []};
+})().then(done, (e) => done({error: String(e)}));
+"""
+
+
+def layout(args):
+    extra = [f"--window-size={args.window.replace('x', ',')}"] if args.window else []
+    driver = browser(args.gpu, extra)
+    try:
+        driver.set_script_timeout(args.timeout)
+        driver.get(args.url)
+        wait_ready(driver, args.timeout)
+        report = driver.execute_async_script(LAYOUT_JS, args.run)
+        if args.screenshot:
+            driver.save_screenshot(args.screenshot)
+        print(json.dumps(report))
+    finally:
+        driver.quit()
+
+
 def main():
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -205,11 +268,17 @@ def main():
     r.add_argument("--name", required=True)
     e = sub.add_parser("export")
     e.add_argument("url")
-    for p in (c, b, r, e):
+    lay = sub.add_parser("layout")
+    lay.add_argument("url")
+    lay.add_argument("--run", action="append", default=[], help="JS to run (awaited) before measuring")
+    lay.add_argument("--window", help="window size WxH (default 1400x1000)")
+    lay.add_argument("--screenshot", help="also save the window as this PNG")
+    for p in (c, b, r, e, lay):
         p.add_argument("--timeout", type=float, default=60)
         p.add_argument("--gpu", action="store_true", help="use the machine's GPU, not SwiftShader")
     args = ap.parse_args()
-    {"check": check, "bench": bench, "rebind": rebind, "export": export}[args.cmd](args)
+    {"check": check, "bench": bench, "rebind": rebind, "export": export,
+     "layout": layout}[args.cmd](args)
 
 
 if __name__ == "__main__":

@@ -414,6 +414,11 @@ fn view_hint(e: &ViewError) -> Option<String> {
         }
         ViewError::Frame(e) => frame_hint(e),
         ViewError::GlassSpec { .. }
+        | ViewError::NoFrames
+        | ViewError::NoSuchFrame { .. }
+        | ViewError::UnitCatalog(_)
+        | ViewError::Unit(_)
+        | ViewError::UnitRequest { .. }
         | ViewError::UnknownGlassId { .. }
         | ViewError::ExportDir { .. }
         | ViewError::ExportNotAFolder { .. }

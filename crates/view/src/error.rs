@@ -19,14 +19,39 @@ pub enum ViewError {
         mask.display()
     )]
     MaskKindChanges {
-        /// The frame.
-        frame: u32,
+        /// The frame's label (its number).
+        frame: String,
         /// Its mask.
         mask: PathBuf,
         /// How it stores cos θ.
         found: &'static str,
         /// How the first frame's mask does.
         first: &'static str,
+    },
+    /// The catalog units are built from on the page cannot be loaded.
+    #[error("cannot load the catalog that units are built from")]
+    UnitCatalog(#[source] glassdb_registry::RegistryError),
+    /// A unit the page asked for cannot be built (the stack engine's or the catalog's error).
+    #[error("cannot build the unit")]
+    Unit(#[source] glassdb_registry::RegistryError),
+    /// A unit request from the page is malformed (element 0: the request as a whole).
+    #[error("{}{why}", if *element == 0 { String::new() } else { format!("element {element} of the unit: ") })]
+    UnitRequest {
+        /// The element (1-based; 0 for the whole request).
+        element: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// The viewer was given no frame.
+    #[error("no frame to show")]
+    NoFrames,
+    /// A frame index beyond the frames.
+    #[error("there is no frame {index} (the viewer has {frames}, counted from 0)")]
+    NoSuchFrame {
+        /// The index asked for.
+        index: usize,
+        /// How many frames there are.
+        frames: usize,
     },
     /// A glass choice is not `ID:PRODUCT`.
     #[error("glass choice {spec:?}: {why}")]
@@ -126,10 +151,14 @@ impl ViewError {
             ViewError::Compose(e) => e.kind(),
             ViewError::Frame(e) => e.kind(),
             ViewError::Output(e) => e.kind(),
+            ViewError::UnitCatalog(e) | ViewError::Unit(e) => e.kind(),
             ViewError::Bind { .. }
             | ViewError::ExportDir { .. }
             | ViewError::SessionToken { .. } => ErrorKind::Io,
             ViewError::MaskKindChanges { .. }
+            | ViewError::NoFrames
+            | ViewError::NoSuchFrame { .. }
+            | ViewError::UnitRequest { .. }
             | ViewError::Resolve { .. }
             | ViewError::ExportNotAFolder { .. }
             | ViewError::ExportFolderInUse { .. }

@@ -1,9 +1,15 @@
 //! The export: a folder that shows the same page without glassdb, from `file://` or any static
 //! host. Browsers refuse `fetch()` of local files, so the data travels as scripts that the
 //! page loads with `<script>` tags: `data.js` (the scene, every candidate product's lookup
-//! table in base64, the chosen products and exposure) and one `frame-NNNN.js` per frame (its
-//! passes and mask in base64), beside `index.html`, `viewer.js` and `viewer.css`. Every file
-//! lands together or not at all (`glassdb_io::StagedOutput`).
+//! table, the chosen products and exposure) and one `frame-NNNN.js` per frame (its passes and
+//! mask), beside `index.html`, `viewer.js` and `viewer.css`. Every file lands together or not
+//! at all (`glassdb_io::StagedOutput`).
+//!
+//! The binary data is stored compactly ([`packed_base64`]): the passes as half floats, the
+//! tables and the mask as `f32`, each with its elements' bytes gathered by position (byte 0 of
+//! every element, then byte 1, …: the exponents and high bytes of neighbouring values repeat),
+//! then gzip (libdeflate), then base64; the page inflates it with the browser's own
+//! `DecompressionStream`. The values are the page's exactly.
 //!
 //! What an export does to a folder that exists (docs/reliability.md): it writes into an empty
 //! folder, or one that holds a previous export (recognised by its [`MARKER`] file), replacing
@@ -16,12 +22,44 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use base64::Engine;
 use base64::display::Base64Display;
 use base64::engine::general_purpose::STANDARD;
 use glassdb_io::StagedOutput;
 use serde_json::json;
 
+use crate::page::PageProduct;
+use crate::units::BuiltUnit;
 use crate::{GlassChoice, ViewError, Viewer, assets};
+
+/// What an export wrote: its files and their size on disk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ExportSummary {
+    /// Files written.
+    pub files: usize,
+    /// Their bytes in all.
+    pub bytes: u64,
+}
+
+/// `bytes`, elements of `element_bytes` each, as the export stores them: each element's bytes
+/// gathered by position, gzip, base64 (see the module docs).
+pub fn packed_base64(bytes: &[u8], element_bytes: usize) -> std::io::Result<String> {
+    let n = bytes.len() / element_bytes.max(1);
+    let mut planes = vec![0u8; bytes.len()];
+    for (i, element) in bytes.chunks_exact(element_bytes).enumerate() {
+        for (b, &v) in element.iter().enumerate() {
+            planes[b * n + i] = v;
+        }
+    }
+    let level = libdeflater::CompressionLvl::new(9).unwrap_or_default();
+    let mut compressor = libdeflater::Compressor::new(level);
+    let mut gz = vec![0u8; compressor.gzip_compress_bound(planes.len())];
+    let len = compressor
+        .gzip_compress(&planes, &mut gz)
+        .map_err(|e| std::io::Error::other(format!("gzip of the export's data: {e:?}")))?;
+    gz.truncate(len);
+    Ok(STANDARD.encode(&gz))
+}
 
 /// The file that marks a folder as an export (JSON: what wrote it and the files it wrote), so
 /// that a later export recognises the folder as its own to replace.
@@ -127,13 +165,16 @@ fn is_export_file_name(name: &str) -> bool {
 const STATIC_FILES: [&str; 4] = ["index.html", "viewer.js", "viewer.css", "data.js"];
 
 /// Writes the export of `viewer` into `folder` (created if missing; see [`ExportFolder::check`]
-/// for which existing folders are refused), starting with `choices` and exposure `ev`.
+/// for which existing folders are refused), with the `units` built on the page among the
+/// candidates (after the products), starting with `choices` (numbered as
+/// [`Viewer::parse_choices_among`] numbers them) and exposure `ev`.
 pub fn write_export(
     viewer: &Viewer,
     folder: &ExportFolder,
     choices: &[GlassChoice],
     ev: f64,
-) -> Result<(), ViewError> {
+    units: &[BuiltUnit],
+) -> Result<ExportSummary, ViewError> {
     let dir = folder.dir.as_path();
     let previous = folder.check()?;
     std::fs::create_dir_all(dir).map_err(|source| ViewError::ExportDir {
@@ -155,18 +196,30 @@ pub fn write_export(
     staged.write_bytes_replacing_link(&dir.join("viewer.css"), assets::VIEWER_CSS.as_bytes())?;
 
     let mut scene = viewer.scene().clone();
-    scene.initial_glass = Some(viewer.choices_param(choices));
+    scene.initial_glass = Some(viewer.choices_param(choices, units));
     scene.initial_ev = Some(ev);
     scene.export_available = false;
+    let first = scene.products.len();
+    scene.products.extend(
+        units
+            .iter()
+            .enumerate()
+            .map(|(k, u)| PageProduct::of(first + k, &u.record)),
+    );
     let scene = json!(scene);
     staged.write_replacing_link(&dir.join("data.js"), |w| {
         write!(
             w,
-            "window.GLASSDB_EXPORT = {{\"scene\": {scene}, \"luts\": "
+            "window.GLASSDB_EXPORT = {{\"scene\": {scene}, \"luts\": ["
         )?;
-        let luts = (0..viewer.products().len()).filter_map(|i| viewer.product_lut(i));
-        write_base64_array(w, luts)?;
-        w.write_all(b", \"views\": ")?;
+        let luts = (0..viewer.products().len())
+            .filter_map(|i| viewer.product_lut(i))
+            .chain(units.iter().map(|u| u.lut.as_slice()));
+        for (k, lut) in luts.enumerate() {
+            let sep = if k > 0 { "," } else { "" };
+            write!(w, "{sep}\"{}\"", packed_base64(lut, 4)?)?;
+        }
+        w.write_all(b"], \"views\": ")?;
         let views = (0..viewer.view_count()).filter_map(|i| viewer.view_data(i));
         write_base64_array(w, views.map(|v| &v[..]))?;
         w.write_all(b", \"frames\": {}};\n")
@@ -178,8 +231,8 @@ pub fn write_export(
                 w,
                 "window.GLASSDB_EXPORT.frames[{i}] = {{\"info\": {}, \"passes\": \"{}\", \"mask\": \"{}\"}};",
                 json!(frame.info),
-                Base64Display::new(&frame.passes, &STANDARD),
-                Base64Display::new(&frame.mask, &STANDARD)
+                packed_base64(&frame.passes, 2)?,
+                packed_base64(&frame.mask, 4)?
             )
         })?;
     }
@@ -198,7 +251,16 @@ pub fn write_export(
     {
         let _ = std::fs::remove_file(dir.join(stale));
     }
-    Ok(())
+    let bytes = written
+        .iter()
+        .chain(std::iter::once(&MARKER.to_string()))
+        .filter_map(|f| std::fs::symlink_metadata(dir.join(f)).ok())
+        .map(|m| m.len())
+        .sum();
+    Ok(ExportSummary {
+        files: written.len() + 1,
+        bytes,
+    })
 }
 
 /// A JSON array of base64 strings, one per item, as `serde_json` writes it.
@@ -214,4 +276,45 @@ fn write_base64_array<'a>(
         write!(w, "\"{}\"", Base64Display::new(bytes, &STANDARD))?;
     }
     w.write_all(b"]")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The page's unpacking (viewer.js `packedBytes`), here: gunzip, then each element's bytes
+    /// taken back from their planes.
+    fn unpacked(text: &str, element_bytes: usize) -> Vec<u8> {
+        let gz = STANDARD.decode(text).unwrap();
+        let mut planes = vec![0u8; 1 << 20];
+        let n = libdeflater::Decompressor::new()
+            .gzip_decompress(&gz, &mut planes)
+            .unwrap();
+        planes.truncate(n);
+        let count = n / element_bytes;
+        (0..n)
+            .map(|j| planes[(j % element_bytes) * count + j / element_bytes])
+            .collect()
+    }
+
+    #[test]
+    fn packed_data_unpacks_to_the_same_bytes_and_is_smaller() {
+        let floats: Vec<u8> = (0..4096)
+            .flat_map(|i| ((0.9 - 0.3 * (f64::from(i) / 4096.0).powi(3)) as f32).to_le_bytes())
+            .collect();
+        let packed = packed_base64(&floats, 4).unwrap();
+        assert_eq!(unpacked(&packed, 4), floats);
+        assert!(
+            packed.len() * 2 < floats.len(),
+            "{} of {}",
+            packed.len(),
+            floats.len()
+        );
+        let halves: Vec<u8> = (0..999u16).flat_map(|h| h.to_le_bytes()).collect();
+        assert_eq!(unpacked(&packed_base64(&halves, 2).unwrap(), 2), halves);
+        assert_eq!(
+            unpacked(&packed_base64(&[], 4).unwrap(), 4),
+            Vec::<u8>::new()
+        );
+    }
 }

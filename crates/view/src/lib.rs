@@ -15,6 +15,7 @@
 //! - [`server`]: the small HTTP server (tiny_http, [`server::WORKERS`] threads, 127.0.0.1 by
 //!   default).
 //! - [`export`]: the self-contained folder that works from `file://`.
+//! - [`units`]: insulated units built on the page by the registry's stack engine.
 
 #![warn(missing_docs)]
 
@@ -24,9 +25,10 @@ pub mod export;
 pub mod page;
 pub mod scene;
 pub mod server;
+pub mod units;
 
 pub use error::ViewError;
-pub use scene::{GlassChoice, Viewer, ViewerInputs};
+pub use scene::{GlassChoice, Viewer, ViewerFrame, ViewerInputs};
 
 /// The page: HTML, script and style, embedded in the binary.
 pub mod assets {

@@ -6,14 +6,14 @@
 use std::collections::BTreeMap;
 
 use glassdb_colour::CubeLut;
-use glassdb_registry::{GlassRecord, LuminousRecord};
+use glassdb_registry::{GlassRecord, LuminousRecord, SystemValues, UnitElement, UnitRecord};
 use glassdb_side::Side;
 use serde::Serialize;
 
 use crate::data;
 
 /// Value of [`PageScene::format`]; `viewer.js` refuses anything else.
-pub const PAGE_FORMAT: &str = "glassdb-viewer-page/1";
+pub const PAGE_FORMAT: &str = "glassdb-viewer-page/2";
 
 /// The scene the page starts from: the frames, their colour, the candidate products and the
 /// layout of their tables.
@@ -27,8 +27,6 @@ pub struct PageScene {
     pub height: u32,
     /// Number of reflection passes (glass planes).
     pub planes: usize,
-    /// The side each plane shows the camera.
-    pub plane_sides: Vec<Side>,
     /// The frames' labels: frame numbers, or the transmission pass of a single frame.
     pub frames: Vec<String>,
     /// The passes' colour space and how it was known.
@@ -54,6 +52,11 @@ pub struct PageScene {
     pub products: Vec<PageProduct>,
     /// The `.cube` views offered beside `standard`.
     pub views: Vec<PageDisplayView>,
+    /// The single glasses a unit can be built from on the page (empty: the page builds no
+    /// units), in the catalog's order.
+    pub unit_layers: Vec<PageUnitLayer>,
+    /// The gases a gap may hold.
+    pub gases: Vec<&'static str>,
     /// Whether the page's export button can write (a served page started with an export
     /// folder).
     pub export_available: bool,
@@ -113,6 +116,117 @@ pub struct PageProduct {
     pub luminous: Option<LuminousRecord>,
     /// The angle model behind its curves.
     pub angle_model: String,
+    /// Its build-up, when it is an insulated unit.
+    pub unit: Option<PageUnit>,
+}
+
+/// A unit's build-up as the picker shows it: its layers and gaps, outside first, and the
+/// system's WINDOW photopic values (the registry's; the page computes nothing itself).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PageUnit {
+    /// Layers and gaps, outside first.
+    pub elements: Vec<PageUnitElement>,
+    /// The unit's thickness (mm), when every layer's is known.
+    pub thickness_mm: Option<f64>,
+    /// Visible transmittance and reflectance from outdoors and indoors at normal incidence
+    /// (WINDOW's NFRC photopic method), when every layer has a spectrum.
+    pub photopic: Option<SystemValues>,
+}
+
+/// One element of a unit's build-up.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum PageUnitElement {
+    /// A pane (or a laminate).
+    Layer {
+        /// The product its file names, else its file.
+        name: String,
+        /// Its thickness (mm).
+        thickness_mm: Option<f64>,
+        /// Turned round in the unit.
+        flipped: bool,
+        /// Its angle model (`uncoated`, `coated`, `measured`, …).
+        model: String,
+        /// The unit's surfaces that carry its coating, numbered from outdoors (#1 the outer
+        /// face of the outer pane); empty when uncoated or the file does not say which side.
+        coated_surfaces: Vec<u32>,
+    },
+    /// A gap between panes.
+    Gap {
+        /// Its width (mm).
+        thickness_mm: f64,
+        /// Its gas.
+        gas: &'static str,
+    },
+}
+
+impl PageUnit {
+    /// The build-up of a registry unit record.
+    pub fn of(unit: &UnitRecord) -> PageUnit {
+        let mut layer_index = 0u32;
+        let elements = unit
+            .elements
+            .iter()
+            .map(|e| match e {
+                UnitElement::Gap(g) => PageUnitElement::Gap {
+                    thickness_mm: g.thickness_mm,
+                    gas: g.gas.name(),
+                },
+                UnitElement::Layer(l) => {
+                    let product = l.provenance.product.as_ref();
+                    let name = product
+                        .and_then(|p| p.name.clone())
+                        .or_else(|| l.provenance.spectral.as_ref().map(|f| f.path.clone()))
+                        .unwrap_or_else(|| format!("layer {}", layer_index + 1));
+                    let coated_side = product.and_then(|p| p.coated_side.as_deref());
+                    let surfaces =
+                        coated_surfaces(layer_index, coated_side.unwrap_or(""), l.flipped);
+                    layer_index += 1;
+                    PageUnitElement::Layer {
+                        name: name.trim().to_string(),
+                        thickness_mm: l.thickness_mm,
+                        flipped: l.flipped,
+                        model: l.model.clone(),
+                        coated_surfaces: surfaces,
+                    }
+                }
+            })
+            .collect();
+        PageUnit {
+            elements,
+            thickness_mm: unit.thickness_mm,
+            photopic: unit.photopic,
+        }
+    }
+}
+
+/// The unit surfaces (numbered from outdoors, #1 and #2 the outer pane's) that carry the
+/// coating of layer `layer` (0: outermost) whose file says its coating is on `side` (`Front`,
+/// `Back`, `Both`; anything else: none), turned round or not.
+fn coated_surfaces(layer: u32, side: &str, flipped: bool) -> Vec<u32> {
+    let (front, back) = (2 * layer + 1, 2 * layer + 2);
+    let (file_front, file_back) = if flipped {
+        (back, front)
+    } else {
+        (front, back)
+    };
+    let mut out = match side.to_ascii_lowercase().as_str() {
+        "front" => vec![file_front],
+        "back" => vec![file_back],
+        "both" => vec![file_front, file_back],
+        _ => Vec::new(),
+    };
+    out.sort_unstable();
+    out
+}
+
+/// A single glass of the catalog that the page can put in a unit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PageUnitLayer {
+    /// Its catalog id.
+    pub id: u16,
+    /// Its name.
+    pub name: String,
 }
 
 impl PageProduct {
@@ -127,8 +241,23 @@ impl PageProduct {
             r0_back: g.r0_back,
             luminous: g.luminous,
             angle_model: g.angle_model.kind.clone(),
+            unit: g.unit.as_ref().map(PageUnit::of),
         }
     }
+}
+
+/// What `POST /api/unit` answers: the unit built, as a product of the picker, and the
+/// compositor's lookup table of it in the page's layout ([`data::lut_bytes`]) in base64.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PageBuiltUnit {
+    /// [`PAGE_FORMAT`].
+    pub format: &'static str,
+    /// The unit as a product (its `index` is 0: the page numbers the units it holds).
+    pub product: PageProduct,
+    /// Its lookup table, base64.
+    pub lut: String,
+    /// Milliseconds the server took to build it (stack engine, fit, table).
+    pub build_ms: f64,
 }
 
 /// A `.cube` display view as the page lists it (its `views`): its name and its tables' sizes and domains.
@@ -200,4 +329,52 @@ pub struct PageFrame {
     pub ids: BTreeMap<u16, u64>,
     /// The frame's transmission pass.
     pub trans: String,
+    /// The side each plane shows the camera in this frame.
+    pub plane_sides: Vec<Side>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coated_surfaces_count_from_outdoors_and_turn_with_the_pane() {
+        assert_eq!(coated_surfaces(0, "Back", false), [2]);
+        assert_eq!(coated_surfaces(0, "Front", true), [2]);
+        assert_eq!(coated_surfaces(2, "Front", false), [5]);
+        assert_eq!(coated_surfaces(1, "both", true), [3, 4]);
+        assert!(coated_surfaces(0, "Neither", false).is_empty());
+        assert!(coated_surfaces(0, "NA", true).is_empty());
+    }
+
+    #[test]
+    fn the_bundled_units_show_their_build_up() {
+        let reg = glassdb_registry::default_registry().unwrap();
+        let table = reg.default_table();
+        let triple = PageProduct::of(0, table.glass(13).unwrap());
+        let unit = triple.unit.expect("13 is a unit");
+        let surfaces: Vec<Vec<u32>> = unit
+            .elements
+            .iter()
+            .filter_map(|e| match e {
+                PageUnitElement::Layer {
+                    coated_surfaces, ..
+                } => Some(coated_surfaces.clone()),
+                PageUnitElement::Gap { .. } => None,
+            })
+            .collect();
+        // Energy Advantage on #2 and #5, as the catalog's name says.
+        assert_eq!(surfaces, [vec![2], vec![], vec![5]]);
+        assert!(matches!(
+            unit.elements[1],
+            PageUnitElement::Gap { gas: "argon", thickness_mm } if thickness_mm == 12.0
+        ));
+        assert!(unit.photopic.is_some());
+        let r67 = PageProduct::of(0, table.glass(12).unwrap()).unit.unwrap();
+        assert!(matches!(
+            &r67.elements[0],
+            PageUnitElement::Layer { coated_surfaces, .. } if coated_surfaces == &[2]
+        ));
+        assert!(PageProduct::of(0, table.glass(1).unwrap()).unit.is_none());
+    }
 }
