@@ -20,8 +20,17 @@
     viewer_driver.py export URL
         Opens the page, clicks its export button and prints JSON: the status line it shows.
 
+    viewer_driver.py unit URL --glass ID --panes 'P1|GAP_MM:GAS|P2' [--flip K] [--out FILE.rgba]
+        Builds a unit through the page's own controls: clicks glass ID in the list, chooses each
+        pane's catalog glass (by id) and each gap's width (typed; `nan` clears the box) and gas
+        on the unit builder, ticks "flip" of pane K (1: outer; repeatable), clicks "build" and
+        waits for its answer. Prints JSON: the builder's status line, the time from the click to
+        the frame on screen (and the server's share), the product sets, page errors; writes the
+        canvas to --out.
+
     viewer_driver.py layout URL [--run JS ...] [--window WxH] [--screenshot FILE.png]
-        Opens the page, runs each JS snippet (awaited; `window.glassdb` hooks), and prints JSON
+        Opens the page, runs each JS snippet (awaited; `window.glassdb` hooks; what each returns,
+        or {"thrown": message}, is in `results`), and prints JSON
         of what a designer sees: the window, the stage and the canvas's on-screen box, every
         product and glass name whose text is cut (wider than the box it is shown in, or beyond
         its list's edge) and whether it has a tooltip, and what lies on screen where the A/B
@@ -198,7 +207,14 @@ def export(args):
 LAYOUT_JS = r"""
 const done = arguments[arguments.length - 1];
 (async () => {
-  for (const js of arguments[0]) await (new Function('return (async () => {' + js + '})()'))();
+  const results = [];
+  for (const js of arguments[0]) {
+    try {
+      results.push(await (new Function('return (async () => {' + js + '})()'))());
+    } catch (e) {
+      results.push({thrown: String(e.message || e)});
+    }
+  }
   await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
   const box = (el) => { if (!el) return null; const r = el.getBoundingClientRect();
     return {left: r.left, top: r.top, width: r.width, height: r.height, right: r.right, bottom: r.bottom}; };
@@ -230,6 +246,9 @@ const done = arguments[arguments.length - 1];
   }
   return {window: [window.innerWidth, window.innerHeight], stage: box(document.getElementById('stage')),
     canvas: c, frame: scene ? [scene.width, scene.height] : null, names, split_line: line,
+    split_box: box(document.getElementById('split-line')), results,
+    products_text: [...document.querySelectorAll('#products li')].map((li) => li.innerText),
+    unit_status: document.getElementById('unit-status') ? document.getElementById('unit-status').innerText : null,
     zoom: window.glassdb && window.glassdb.zoom ? window.glassdb.zoom() : null,
     errors: window.glassdbErrors || []};
 })().then(done, (e) => done({error: String(e)}));
@@ -251,6 +270,54 @@ def layout(args):
         driver.quit()
 
 
+def build_unit(args):
+    from selenium.webdriver.support.ui import Select
+    driver = browser(args.gpu)
+    try:
+        driver.get(args.url)
+        wait_ready(driver, args.timeout)
+        driver.find_element(By.CSS_SELECTOR, f'#glasses li[data-id="{args.glass}"]').click()
+        parts = args.panes.split("|")
+        # The builder starts as pane, gap, pane; add gap + pane pairs for more panes.
+        while len(driver.find_elements(By.CSS_SELECTOR, "#unit-elements > li")) < len(parts):
+            driver.find_element(By.ID, "unit-add-pane").click()
+        items = driver.find_elements(By.CSS_SELECTOR, "#unit-elements > li")
+        pane = 0
+        for item, part in zip(items, parts):
+            if ":" in part:
+                width, gas = part.split(":", 1)
+                box = item.find_element(By.CSS_SELECTOR, "input.unit-gap")
+                box.clear()
+                if width != "nan":
+                    box.send_keys(width)
+                Select(item.find_element(By.CSS_SELECTOR, "select.unit-gas")).select_by_value(gas)
+            else:
+                pane += 1
+                Select(item.find_element(By.CSS_SELECTOR, "select.unit-glass")).select_by_value(part)
+                if pane in args.flip:
+                    item.find_element(By.CSS_SELECTOR, "input.unit-flip").click()
+        before = drawn(driver)
+        driver.find_element(By.ID, "unit-build").click()
+        WebDriverWait(driver, args.timeout).until(
+            lambda d: d.find_element(By.ID, "unit-status").text not in ("", "building…"))
+        said = driver.find_element(By.ID, "unit-status").text
+        if args.out:
+            pixels = base64.b64decode(driver.execute_script("return window.glassdb.readPixels()"))
+            with open(args.out, "wb") as f:
+                f.write(pixels)
+        print(json.dumps({
+            "status": said,
+            "status_class": driver.find_element(By.ID, "unit-status").get_attribute("class"),
+            "unit": driver.execute_script("return window.glassdb.lastUnit()"),
+            "drawn": drawn(driver) - before,
+            "products": driver.execute_script("return window.glassdbProducts()"),
+            "errors": driver.execute_script("return window.glassdbErrors"),
+            "renderer": renderer(driver),
+        }))
+    finally:
+        driver.quit()
+
+
 def main():
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -268,17 +335,23 @@ def main():
     r.add_argument("--name", required=True)
     e = sub.add_parser("export")
     e.add_argument("url")
+    un = sub.add_parser("unit")
+    un.add_argument("url")
+    un.add_argument("--glass", type=int, required=True)
+    un.add_argument("--panes", required=True)
+    un.add_argument("--flip", type=int, action="append", default=[])
+    un.add_argument("--out")
     lay = sub.add_parser("layout")
     lay.add_argument("url")
     lay.add_argument("--run", action="append", default=[], help="JS to run (awaited) before measuring")
     lay.add_argument("--window", help="window size WxH (default 1400x1000)")
     lay.add_argument("--screenshot", help="also save the window as this PNG")
-    for p in (c, b, r, e, lay):
+    for p in (c, b, r, e, lay, un):
         p.add_argument("--timeout", type=float, default=60)
         p.add_argument("--gpu", action="store_true", help="use the machine's GPU, not SwiftShader")
     args = ap.parse_args()
     {"check": check, "bench": bench, "rebind": rebind, "export": export,
-     "layout": layout}[args.cmd](args)
+     "layout": layout, "unit": build_unit}[args.cmd](args)
 
 
 if __name__ == "__main__":

@@ -164,6 +164,20 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
 /// The frames of a `glassdb blender render` output folder, from its run record: each frame's
 /// passes, mask and sides (the camera may see a plane from either side as it moves).
 fn blender_run_frames(dir: &Path) -> anyhow::Result<Vec<ViewerFrame>> {
+    let record_path = dir.join(glassdb_blender::job::RECORD_NAME);
+    if !dir.is_dir() {
+        bail!(
+            "{}: no such folder (glassdb view DIR opens a `glassdb blender render` output folder)",
+            dir.display()
+        );
+    }
+    if !record_path.is_file() {
+        bail!(
+            "{} holds no {}: it is not a `glassdb blender render` output folder (to view passes, give --trans, --refl and --mask)",
+            dir.display(),
+            glassdb_blender::job::RECORD_NAME
+        );
+    }
     let record = glassdb_blender::RunRecord::load(dir)?;
     if record.frames.is_empty() {
         bail!(

@@ -15,13 +15,13 @@ use crate::util::{
 };
 
 /// The tiny scene, its facts, Cycles' index renders and two glassdb runs (seeds 0 and 1).
-struct Rendered {
+pub(crate) struct Rendered {
     _dir: tempfile::TempDir,
     root: PathBuf,
     blend: PathBuf,
     facts: serde_json::Value,
     /// `glassdb blender render … --reference` with seed 0 and with seed 1.
-    runs: [PathBuf; 2],
+    pub(crate) runs: [PathBuf; 2],
 }
 
 const GLASS: [&str; 2] = ["Glass_clear=1", "Tinted*=5"];
@@ -51,7 +51,7 @@ fn render_run(blend: &Path, out: &Path, seed: u32) {
     ok(&mut cmd);
 }
 
-fn rendered() -> &'static Rendered {
+pub(crate) fn rendered() -> &'static Rendered {
     static R: OnceLock<Rendered> = OnceLock::new();
     R.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();

@@ -26,9 +26,10 @@
     return out.buffer;
   }
 
-  // An export's data: gzip of the bytes with each element's bytes gathered by position
-  // (byte 0 of every element, then byte 1, …), which compresses floats far better
-  // (crates/view/src/export.rs); the browser's own DecompressionStream inflates it.
+  // An export's data (crates/view/src/export.rs, packed_base64): RGBA texels of 2- or 4-byte
+  // elements, each the difference from the same channel of the texel before, their bytes
+  // gathered by position (byte 0 of every element, then byte 1, …), gzip, base64. Undone here,
+  // the browser's own DecompressionStream inflating it.
   async function packedBytes(text, elementBytes) {
     const stream = new Blob([base64Bytes(text)]).stream().pipeThrough(new DecompressionStream('gzip'));
     const packed = new Uint8Array(await new Response(stream).arrayBuffer());
@@ -38,6 +39,9 @@
       const plane = packed.subarray(b * n, (b + 1) * n);
       for (let i = 0; i < n; i++) out[i * elementBytes + b] = plane[i];
     }
+    // Typed arrays wrap on store, as the differences did.
+    const values = elementBytes === 4 ? new Uint32Array(out.buffer) : new Uint16Array(out.buffer);
+    for (let i = 4; i < values.length; i++) values[i] += values[i - 4];
     return out.buffer;
   }
 
@@ -887,7 +891,8 @@ void main() {
           width.min = '0';
           width.step = '0.1';
           width.value = String(e.gap_mm);
-          width.oninput = () => { e.gap_mm = width.value.trim() === '' ? NaN : Number(width.value); };
+          // An empty or malformed box is NaN (sent as null, refused by the server, which says why).
+          width.oninput = width.onchange = () => { e.gap_mm = width.value.trim() === '' ? NaN : Number(width.value); };
           const gas = document.createElement('select');
           gas.className = 'unit-gas';
           for (const g of scene.gases) {
@@ -948,6 +953,8 @@ void main() {
       return state.lastUnit;
     }
     $('unit-build').onclick = async () => {
+      // What the controls show (a box cleared without an input event included).
+      for (const box of document.querySelectorAll('#unit-elements input.unit-gap')) box.onchange();
       unitStatus('building…');
       try {
         const u = await buildUnit();

@@ -6,10 +6,12 @@
 //! at all (`glassdb_io::StagedOutput`).
 //!
 //! The binary data is stored compactly ([`packed_base64`]): the passes as half floats, the
-//! tables and the mask as `f32`, each with its elements' bytes gathered by position (byte 0 of
-//! every element, then byte 1, …: the exponents and high bytes of neighbouring values repeat),
-//! then gzip (libdeflate), then base64; the page inflates it with the browser's own
-//! `DecompressionStream`. The values are the page's exactly.
+//! tables and the mask as `f32` (RGBA texels), each element replaced by its difference from
+//! the same channel of the texel before (the integer difference of their bits, wrapping: a
+//! smooth curve's neighbours differ in their low bits only), the elements' bytes gathered by
+//! position (byte 0 of every element, then byte 1, …), then gzip (libdeflate), then base64;
+//! the page undoes it, inflating with the browser's own `DecompressionStream`. The values are
+//! the page's exactly.
 //!
 //! What an export does to a folder that exists (docs/reliability.md): it writes into an empty
 //! folder, or one that holds a previous export (recognised by its [`MARKER`] file), replacing
@@ -41,14 +43,31 @@ pub struct ExportSummary {
     pub bytes: u64,
 }
 
-/// `bytes`, elements of `element_bytes` each, as the export stores them: each element's bytes
-/// gathered by position, gzip, base64 (see the module docs).
+/// Elements per texel: the differences are taken channel by channel.
+const TEXEL_ELEMENTS: usize = 4;
+
+/// `bytes`, little-endian elements of `element_bytes` (2 or 4) each, in RGBA texels, as the
+/// export stores them: differences from the texel before, bytes gathered by position, gzip,
+/// base64 (see the module docs).
 pub fn packed_base64(bytes: &[u8], element_bytes: usize) -> std::io::Result<String> {
-    let n = bytes.len() / element_bytes.max(1);
-    let mut planes = vec![0u8; bytes.len()];
-    for (i, element) in bytes.chunks_exact(element_bytes).enumerate() {
-        for (b, &v) in element.iter().enumerate() {
-            planes[b * n + i] = v;
+    let k = element_bytes.clamp(1, 4);
+    let n = bytes.len() / k;
+    let value = |i: usize| {
+        bytes[i * k..(i + 1) * k]
+            .iter()
+            .rev()
+            .fold(0u32, |v, &b| (v << 8) | u32::from(b))
+    };
+    let mut planes = vec![0u8; n * k];
+    for i in 0..n {
+        let prev = if i >= TEXEL_ELEMENTS {
+            value(i - TEXEL_ELEMENTS)
+        } else {
+            0
+        };
+        let delta = value(i).wrapping_sub(prev);
+        for b in 0..k {
+            planes[b * n + i] = (delta >> (8 * b)) as u8;
         }
     }
     let level = libdeflater::CompressionLvl::new(9).unwrap_or_default();
@@ -282,8 +301,8 @@ fn write_base64_array<'a>(
 mod tests {
     use super::*;
 
-    /// The page's unpacking (viewer.js `packedBytes`), here: gunzip, then each element's bytes
-    /// taken back from their planes.
+    /// The page's unpacking (viewer.js `packedBytes`), here: gunzip, each element's bytes
+    /// taken back from their planes, the differences summed.
     fn unpacked(text: &str, element_bytes: usize) -> Vec<u8> {
         let gz = STANDARD.decode(text).unwrap();
         let mut planes = vec![0u8; 1 << 20];
@@ -292,8 +311,22 @@ mod tests {
             .unwrap();
         planes.truncate(n);
         let count = n / element_bytes;
-        (0..n)
-            .map(|j| planes[(j % element_bytes) * count + j / element_bytes])
+        let mask = if element_bytes == 4 {
+            u32::MAX
+        } else {
+            (1 << (8 * element_bytes)) - 1
+        };
+        let mut values: Vec<u32> = (0..count)
+            .map(|i| {
+                (0..element_bytes).fold(0, |v, b| v | u32::from(planes[b * count + i]) << (8 * b))
+            })
+            .collect();
+        for i in TEXEL_ELEMENTS..count {
+            values[i] = values[i].wrapping_add(values[i - TEXEL_ELEMENTS]) & mask;
+        }
+        values
+            .iter()
+            .flat_map(|v| v.to_le_bytes().into_iter().take(element_bytes))
             .collect()
     }
 
@@ -310,7 +343,9 @@ mod tests {
             packed.len(),
             floats.len()
         );
-        let halves: Vec<u8> = (0..999u16).flat_map(|h| h.to_le_bytes()).collect();
+        let halves: Vec<u8> = (0..1000u16)
+            .flat_map(|h| (h.wrapping_mul(40_503)).to_le_bytes())
+            .collect();
         assert_eq!(unpacked(&packed_base64(&halves, 2).unwrap(), 2), halves);
         assert_eq!(
             unpacked(&packed_base64(&[], 4).unwrap(), 4),
