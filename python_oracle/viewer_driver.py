@@ -6,9 +6,12 @@
         for the new frame, and writes the canvas's RGBA bytes (rows top to bottom) to --out.
         Prints JSON: size, frames drawn, the product sets, the last swap's time, page errors.
 
-    viewer_driver.py bench URL --id ID --products 'P1|P2' [--repeat N]
+    viewer_driver.py bench URL --id ID --products 'P1|P2' [--repeat N] [--unit 'P1|GAP_MM:GAS|P2']
         Times product choices through the page's automation hook: from the choice to the new
-        frame drawn (a 1-pixel read-back finishes the drawing), and the page's load time.
+        frame drawn (a 1-pixel read-back finishes the drawing), and the page's load time. With
+        --unit, also units built on the page (the hook the builder's button calls) for glass ID,
+        the gap widened by 0.1 mm each time so that every build is new: from the request to the
+        frame on screen, and the server's share (stack engine, fit, table).
 
     viewer_driver.py rebind URL --name NAME
         A page of another site against the viewer at URL: Chromium resolves NAME to the
@@ -154,6 +157,28 @@ def bench(args):
                     "return window.glassdb.choose(arguments[0], arguments[1])", args.id, p)
                 swaps.append(ms)
         swaps.sort()
+        units, unit_server = [], []
+        if args.unit:
+            driver.execute_script("window.glassdb.choose(arguments[0], 0)", args.id)
+            driver.set_script_timeout(args.timeout)
+            for k in range(args.repeat * 3):
+                elements = []
+                for part in args.unit.split("|"):
+                    if ":" in part:
+                        width, gas = part.split(":", 1)
+                        elements.append({"gap_mm": round(float(width) + 0.1 * k, 3), "gas": gas})
+                    else:
+                        elements.append({"glass": int(part)})
+                done = driver.execute_async_script(
+                    "const done = arguments[arguments.length - 1];"
+                    "window.glassdb.buildUnit(arguments[0]).then(done, (e) => done({error: String(e)}));",
+                    elements)
+                if "error" in done:
+                    raise SystemExit("building the unit: " + done["error"])
+                units.append(done["ms"])
+                unit_server.append(done["buildMs"])
+            units.sort()
+            unit_server.sort()
         print(json.dumps({
             "load_ms": load_ms,
             "page_ready_ms": page_ms,
@@ -162,6 +187,9 @@ def bench(args):
             "swap_ms_median": swaps[len(swaps) // 2],
             "swap_ms_min": swaps[0],
             "swap_ms_max": swaps[-1],
+            **({"units": len(units), "unit_ms_median": units[len(units) // 2], "unit_ms_min": units[0],
+                "unit_ms_max": units[-1], "unit_server_ms_median": unit_server[len(unit_server) // 2]}
+               if units else {}),
             "renderer": renderer(driver),
         }))
     finally:
@@ -330,6 +358,7 @@ def main():
     b.add_argument("--id", type=int, required=True)
     b.add_argument("--products", required=True, help="product names separated by |")
     b.add_argument("--repeat", type=int, default=5)
+    b.add_argument("--unit", help="also time units built on the page: 'P1|GAP_MM:GAS|P2' (catalog ids)")
     r = sub.add_parser("rebind")
     r.add_argument("url")
     r.add_argument("--name", required=True)

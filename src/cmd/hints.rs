@@ -418,6 +418,7 @@ fn view_hint(e: &ViewError) -> Option<String> {
         | ViewError::NoSuchFrame { .. }
         | ViewError::UnitCatalog(_)
         | ViewError::Unit(_)
+        | ViewError::UnitPanicked
         | ViewError::UnitRequest { .. }
         | ViewError::UnknownGlassId { .. }
         | ViewError::ExportDir { .. }

@@ -132,12 +132,16 @@ fn canvas(url: &str, swaps: &[String], out: &Path) -> (Vec<[f64; 3]>, serde_json
     let refs: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
     let report: serde_json::Value =
         serde_json::from_str(run_oracle("viewer_driver.py", &refs).trim()).unwrap();
-    let bytes = std::fs::read(out).unwrap();
-    let pixels = bytes
+    (rgba_pixels(out), report)
+}
+
+/// The RGB of the RGBA bytes the driver wrote, per pixel.
+fn rgba_pixels(path: &Path) -> Vec<[f64; 3]> {
+    std::fs::read(path)
+        .unwrap()
         .chunks_exact(4)
         .map(|p| [0, 1, 2].map(|c| f64::from(p[c])))
-        .collect();
-    (pixels, report)
+        .collect()
 }
 
 /// The atrium exported with `extra` arguments into `dir/export`, opened from `file://`: its
@@ -301,31 +305,14 @@ fn page_token(url: &str) -> String {
     rest[..rest.find('"').unwrap()].to_string()
 }
 
-/// A POST as the viewer's own page sends it: its `Origin` and session token.
+/// A POST as the viewer's own page sends it: its `Origin` and session token; the status.
 fn post(url: &str, path: &str, body: &[u8]) -> u16 {
-    let origin = format!("http://{}", host_of(url));
-    let token = page_token(url);
-    post_with(
-        url,
-        path,
-        body,
-        &[("Origin", &origin), ("X-Glassdb-Session", &token)],
-    )
+    post_reply(url, path, body).0
 }
 
-/// A POST of `body` with the `Host` of `url` and the extra `headers`.
+/// A POST of `body` with the `Host` of `url` and the extra `headers`; the status.
 fn post_with(url: &str, path: &str, body: &[u8], headers: &[(&str, &str)]) -> u16 {
-    let mut req = format!(
-        "POST {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\nContent-Length: {}\r\n",
-        host_of(url),
-        body.len()
-    );
-    for (name, value) in headers {
-        req += &format!("{name}: {value}\r\n");
-    }
-    let mut req = format!("{req}\r\n").into_bytes();
-    req.extend_from_slice(body);
-    status(url, &req)
+    post_with_reply(url, path, body, headers).0
 }
 
 #[test]
@@ -1190,11 +1177,7 @@ fn a_unit_built_on_the_page_gives_composes_pixels_of_that_unit() {
         "{report}"
     );
     assert_eq!(report["drawn"], 1, "{report}");
-    let bytes = std::fs::read(&out).unwrap();
-    let got: Vec<[f64; 3]> = bytes
-        .chunks_exact(4)
-        .map(|p| [0, 1, 2].map(|c| f64::from(p[c])))
-        .collect();
+    let got = rgba_pixels(&out);
     let db = psnr(&got, &want);
     assert!(db >= 50.0, "unit built on the page vs compose: {db:.1} dB");
 

@@ -34,6 +34,9 @@ pub enum ViewError {
     /// A unit the page asked for cannot be built (the stack engine's or the catalog's error).
     #[error("cannot build the unit")]
     Unit(#[source] glassdb_registry::RegistryError),
+    /// Building a unit failed inside glassdb (a bug: the engine panicked on this choice).
+    #[error("building the unit failed inside glassdb (please report the unit chosen)")]
+    UnitPanicked,
     /// A unit request from the page is malformed (element 0: the request as a whole).
     #[error("{}{why}", if *element == 0 { String::new() } else { format!("element {element} of the unit: ") })]
     UnitRequest {
@@ -152,6 +155,7 @@ impl ViewError {
             ViewError::Frame(e) => e.kind(),
             ViewError::Output(e) => e.kind(),
             ViewError::UnitCatalog(e) | ViewError::Unit(e) => e.kind(),
+            ViewError::UnitPanicked => ErrorKind::Internal,
             ViewError::Bind { .. }
             | ViewError::ExportDir { .. }
             | ViewError::SessionToken { .. } => ErrorKind::Io,

@@ -5,6 +5,7 @@
 //! record and the compositor's lookup table of it. The page computes nothing physical itself.
 //! The server keeps nothing of a unit it built: the page holds the units it asked for.
 
+use std::panic::AssertUnwindSafe;
 use std::path::Path;
 
 use glassdb_compose::lut::GlassLut;
@@ -73,14 +74,16 @@ impl UnitWorkshop {
     pub fn build(&self, request: &Value) -> Result<BuiltUnit, ViewError> {
         let elements = parse_request(request)?;
         let name = self.name_of(&elements);
-        let registry = self
-            .builder
-            .build(&UnitChoice {
-                id: BUILT_UNIT_ID,
-                name,
-                elements,
-            })
-            .map_err(ViewError::Unit)?;
+        let choice = UnitChoice {
+            id: BUILT_UNIT_ID,
+            name,
+            elements,
+        };
+        // A failure of the engine on some input is an answer to the page, not the end of the
+        // server.
+        let built = std::panic::catch_unwind(AssertUnwindSafe(|| self.builder.build(&choice)))
+            .map_err(|_| ViewError::UnitPanicked)?;
+        let registry = built.map_err(ViewError::Unit)?;
         let record = registry.default_table().glasses[0].clone();
         let lut = GlassLut::from_records(&[(1, &record)]);
         let table = match (lut.side(1, Side::Front), lut.side(1, Side::Back)) {
