@@ -1221,6 +1221,11 @@ fn a_unit_built_on_the_page_gives_composes_pixels_of_that_unit() {
     assert!(thrown[0].contains("two gaps in a row"), "{thrown:?}");
     assert!(thrown[1].contains("no glass with id 99"), "{thrown:?}");
     assert!(thrown[2].contains("-4"), "{thrown:?}");
+    let said = r["unit_status"].as_str().unwrap();
+    assert!(
+        said.starts_with("cannot build the unit") && said.contains("-4"),
+        "{said}"
+    );
     // The picker shows the catalog units' build-up: panes, gaps, coated surfaces, Tv/Rv.
     let unit = r["products_text"]
         .as_array()

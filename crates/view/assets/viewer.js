@@ -901,6 +901,7 @@ void main() {
             o.textContent = g;
             gas.append(o);
           }
+          if (e.gas === undefined) e.gas = 'air';
           gas.value = e.gas;
           gas.onchange = () => { e.gas = gas.value; };
           li.append(width, ' mm ', gas);
@@ -952,16 +953,22 @@ void main() {
       state.lastUnit = { ms: performance.now() - t0, buildMs, name: p.name };
       return state.lastUnit;
     }
-    $('unit-build').onclick = async () => {
-      // What the controls show (a box cleared without an input event included).
-      for (const box of document.querySelectorAll('#unit-elements input.unit-gap')) box.onchange();
+    // Builds and says the outcome under the builder (the button and the hook alike).
+    async function buildAndSay() {
       unitStatus('building…');
       try {
         const u = await buildUnit();
         unitStatus('id ' + state.selected + ' → ' + u.name + '\non screen in ' + u.ms.toFixed(0) + ' ms (server ' + u.buildMs.toFixed(0) + ' ms)');
+        return u;
       } catch (e) {
         unitStatus('cannot build the unit: ' + e.message, true);
+        throw e;
       }
+    }
+    $('unit-build').onclick = async () => {
+      // What the controls show (a box cleared without an input event included).
+      for (const box of document.querySelectorAll('#unit-elements input.unit-gap')) box.onchange();
+      try { await buildAndSay(); } catch (e) { /* said under the builder */ }
     };
     renderUnitBuilder();
 
@@ -978,7 +985,7 @@ void main() {
       // The frame's scale on screen (screen pixels per frame pixel) and whether it fits the stage.
       zoom: () => ({ fit: zoom.fit, scale: zoom.scale }),
       // Puts `elements` on the unit builder and builds it (as its button does).
-      buildUnit: async (elements) => { state.unit = elements.map((e) => ({ ...e })); renderUnitBuilder(); return buildUnit(); },
+      buildUnit: async (elements) => { state.unit = elements.map((e) => ({ ...e })); renderUnitBuilder(); return buildAndSay(); },
       lastUnit: () => state.lastUnit,
       loadFrame,
       products: () => ({ A: Object.fromEntries(slots.map((id, s) => [id, products[state.sets.A[s]].name])),
