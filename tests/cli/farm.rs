@@ -5,7 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::util::{compose, fails, ok, oracle_python, read_exr_planes, repo_path, run, run_oracle};
+use crate::util::{
+    compose, fails, fails_naming, ok, oracle_python, read_exr_planes, repo_path, run, run_oracle,
+};
 
 /// The atrium's passes copied as frames `frames` of a sequence in `dir`
 /// (`refl_K.####.exr`, `trans.####.exr`, `mask.####.png`), as a renderer would write them.
@@ -25,6 +27,11 @@ fn atrium_frames(dir: &Path, frames: &[u32]) {
 
 /// `compose` over the frame sequence in `dir` into `out.####.exr`.
 fn compose_frames(dir: &Path, frames: &str) -> std::process::Command {
+    compose_frames_to(dir, frames, "out.####.exr")
+}
+
+/// `compose` over the frame sequence in `dir` into `output`.
+fn compose_frames_to(dir: &Path, frames: &str, output: &str) -> std::process::Command {
     let mut c = compose();
     c.current_dir(dir);
     for k in 0..3 {
@@ -33,7 +40,7 @@ fn compose_frames(dir: &Path, frames: &str) -> std::process::Command {
     c.args(["--trans", "trans.####.exr", "--mask", "mask.####.png"])
         .arg("--planes")
         .arg(repo_path("fixtures/atrium/virtual/planes.json"))
-        .args(["-o", "out.####.exr", "--frames", frames]);
+        .args(["-o", output, "--frames", frames]);
     c
 }
 
@@ -362,5 +369,48 @@ fn one_file_holds_every_planes_reflection_cropped_to_its_glass() {
     assert!(
         err.contains("plane 0 is missing") && err.contains("gap.exr"),
         "{err}"
+    );
+}
+
+#[test]
+fn compose_creates_the_folders_of_its_outputs_and_report() {
+    // docs/farm.md's `-o comp/out.####.exr --report reports/…` in a shot folder that has
+    // neither folder yet: every frame used to fail ("the directory comp does not exist").
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    atrium_frames(d, &[1, 2]);
+    let mut c = compose_frames_to(d, "1-2", "comp/a/out.####.exr");
+    let out = ok(c.args(["--report", "reports/b/frames.1-2.json"]));
+    for f in [1, 2] {
+        assert!(d.join(format!("comp/a/out.{f:04}.exr")).is_file(), "{out}");
+    }
+    let report = json(&d.join("reports/b/frames.1-2.json"));
+    assert_eq!(
+        statuses(&report),
+        vec![(1, "composed".to_string()), (2, "composed".to_string())]
+    );
+    // One frame, into a new folder; no temporary file is left in it.
+    ok(&mut atrium_compose(
+        &atrium_refl(),
+        &d.join("single/x/out.png"),
+    ));
+    let names: Vec<_> = std::fs::read_dir(d.join("single/x"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, ["out.png"]);
+    // A run that fails makes no folder.
+    fails(
+        compose()
+            .current_dir(d)
+            .args(["--refl", "refl_0.0009.exr", "--trans", "trans.0009.exr"])
+            .args(["--mask", "mask.0001.png", "-o", "never/out.exr"]),
+    );
+    assert!(!d.join("never").exists());
+    // A folder that cannot be made is named.
+    std::fs::write(d.join("file"), "").unwrap();
+    fails_naming(
+        &mut atrium_compose(&atrium_refl(), &d.join("file/sub/out.exr")),
+        &["file/sub"],
     );
 }
