@@ -182,6 +182,9 @@ def export(opts):
         fh.write("\n")
     info = {
         "blender": bpy.app.version_string,
+        # Settings the passes override (render's honest_passes), as the scene has them.
+        "denoising": bool(scene.cycles.use_denoising),
+        "motion_blur": bool(scene.render.use_motion_blur),
         "blender_version": list(bpy.app.version),
         "file": bpy.data.filepath,
         "frames": frames,
@@ -417,6 +420,19 @@ def reflection_matrix(plane):
     return Matrix(rows)
 
 
+def honest_passes(scene):
+    """Cycles' denoiser and motion blur off, whatever the scene says: the passes must carry
+    Cycles' own noise (the composite's and the reference's error are compared with it; and
+    Debian's Blender has no OpenImageDenoise), and glassdb's masks are of the frame's instant.
+    glassdb records what was overridden (export.json says what the scene had)."""
+    if scene.cycles.use_denoising:
+        print("glassdb_blender: denoising off for the passes (the scene denoises)")
+    scene.cycles.use_denoising = False
+    if scene.render.use_motion_blur:
+        print("glassdb_blender: motion blur off for the passes (the masks are of the frame's instant)")
+    scene.render.use_motion_blur = False
+
+
 def render(opts):
     path = opts.get("job") or fail("render needs --job FILE")
     with open(path) as fh:
@@ -433,6 +449,7 @@ def render(opts):
     if job.get("threads"):
         scene.render.threads_mode = "FIXED"
         scene.render.threads = int(job["threads"])
+    honest_passes(scene)
     set_exr_output(scene)
     glass_by_name = {g["material"]: g for g in job["glass"]}
     missing = [m for m in glass_by_name if m not in bpy.data.materials]

@@ -178,6 +178,9 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
             .collect::<Vec<_>>()
             .join(", ")
     );
+    for o in &report.record.overrides {
+        outln!("passes: {o}");
+    }
     print_composites(&a.out_dir, &report.compose);
     outln!(
         "Blender export {:.2} s, passes {:.2} s{}; planes and masks {:.3} s",

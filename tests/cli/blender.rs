@@ -722,3 +722,56 @@ fn a_scene_without_the_glass_materials_is_refused() {
         assert!(err.contains(m), "{err}");
     }
 }
+
+/// `scripts/blender/make_default_scene.py --scene KIND` saved as `dir/KIND.blend` (with its
+/// facts in `dir/KIND.json`): a scene as people leave it (Blender's factory settings, Cycles).
+fn default_scene(dir: &Path, kind: &str) -> PathBuf {
+    let blend = dir.join(format!("{kind}.blend"));
+    let made = Command::new(blender_program())
+        .args(["-b", "--factory-startup", "-noaudio"])
+        .args(["--python-exit-code", "1", "-P"])
+        .arg(repo_path("scripts/blender/make_default_scene.py"))
+        .args(["--", "--scene", kind, "--out"])
+        .arg(&blend)
+        .arg("--facts")
+        .arg(dir.join(format!("{kind}.json")))
+        .output()
+        .unwrap();
+    assert!(
+        made.status.success(),
+        "building the {kind} scene: {}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    blend
+}
+
+#[test]
+fn a_scene_saved_with_blenders_defaults_renders_without_denoising() {
+    // Blender's default scene denoises; Debian's Blender has no OpenImageDenoise ("Build
+    // without OpenImageDenoiser"), and denoised passes would not be noise-honest anyway.
+    let dir = tempfile::tempdir().unwrap();
+    let blend = default_scene(dir.path(), "defaults");
+    let out = dir.path().join("run");
+    let stdout = ok(glassdb()
+        .args(["blender", "render"])
+        .arg(&blend)
+        .args(["--glass", "Glass=1", "--out-dir"])
+        .arg(&out)
+        .args(["--frames", "1", "--samples", "4", "--resolution", "64x36"])
+        .args(["--threads", "2"]));
+    assert!(stdout.contains("denoising off"), "{stdout}");
+    let record = json(&out.join("glassdb-blender.json"));
+    let overrides = record["overrides"].as_array().expect("the record says");
+    assert!(
+        overrides
+            .iter()
+            .any(|o| o.as_str().unwrap().starts_with("denoising off")),
+        "{record}"
+    );
+    let log = std::fs::read_to_string(out.join("blender.log")).unwrap();
+    assert!(log.contains("glassdb_blender: denoising off"), "{log}");
+    let comp = read_exr_planes(&out.join("composite.0001.exr"));
+    assert_eq!((comp.width, comp.height), (64, 36));
+    let mask = read_exr_planes(&out.join("mask.0001.exr"));
+    assert!(channel(&mask, "id").iter().filter(|&&v| v == 1.0).count() > 50);
+}

@@ -149,7 +149,7 @@ pub fn render(
     let job = render_passes(&work, &masks)?;
     let render_s = t.elapsed().as_secs_f64();
     let render_cpu_s = cpu_since(cpu);
-    let record = write_record(&work, masks.frames, masks.size)?;
+    let record = write_record(&work, masks.frames, masks.size, info.overrides())?;
 
     let (mut reference_s, mut reference_cpu_s) = (0.0, None);
     if request.reference {
@@ -518,6 +518,7 @@ fn write_record(
     work: &Workspace<'_>,
     frames: Vec<FrameRecord>,
     (width, height): (u32, u32),
+    overrides: Vec<String>,
 ) -> Result<RunRecord, BlenderError> {
     let request = work.request;
     let record = RunRecord {
@@ -528,6 +529,7 @@ fn write_record(
         samples: request.samples,
         width,
         height,
+        overrides,
         frames,
     };
     let record_path = work.dir.join(RECORD_NAME);
