@@ -71,12 +71,23 @@ pub struct ExportInfo {
     pub frames: Vec<u32>,
     /// The scene's materials.
     pub materials: Vec<String>,
+    /// The frames whose geometry differs from the first frame's (by frame number): each has
+    /// its own OBJ (`scene.NNNN.obj`), planes (`planes.NNNN/`) and mask.
+    #[serde(default)]
+    pub moving: std::collections::BTreeMap<u32, MovingFrame>,
     /// The scene denoises (Cycles' denoiser on), which the passes turn off.
     #[serde(default)]
     pub denoising: bool,
     /// The scene has motion blur on, which the passes turn off.
     #[serde(default)]
     pub motion_blur: bool,
+}
+
+/// A frame whose objects are not where they are in the first frame.
+#[derive(Debug, Clone, Deserialize)]
+pub struct MovingFrame {
+    /// The objects whose geometry differs from the first frame's.
+    pub objects: Vec<String>,
 }
 
 impl ExportInfo {
