@@ -9,8 +9,8 @@ use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 use glassdb_pass::{LinearImage, PassSource, PngBits};
 
 use crate::util::{
-    Planes, compose, fails, fails_naming, glassdb, ok, read_exr_planes, read_png_planes, repo_path,
-    run, write_pass,
+    Planes, compose, fails, fails_naming, glassdb, ok, read_exr_planes, read_png_planes, run,
+    write_pass,
 };
 
 /// A constant curve C = 1 (so r = r0 and t = t0 at every angle).

@@ -65,7 +65,7 @@ fn second_command_runs_every_test_as_ci_does() {
 fn registry_build_usage_makes_no_option_look_required() {
     // clap's usage line in an error used to list the options given: `--space <…>` looked
     // required after a forgotten `-o`
-    let e = crate::util::fails(glassdb().args(["registry", "build", "--space", "srgb"]));
+    let e = fails(glassdb().args(["registry", "build", "--space", "srgb"]));
     let usage = e
         .lines()
         .find(|l| l.starts_with("Usage:"))
