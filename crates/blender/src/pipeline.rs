@@ -64,6 +64,9 @@ pub struct RenderRequest {
     /// Also render the Cycles reference (the glass as a thin pane seen by the camera) as
     /// `reference.####.exr`.
     pub reference: bool,
+    /// Composite every frame at the end (else the run stops at its passes, masks and record,
+    /// for [`compose_dir`] to composite: a farm's render and composite steps).
+    pub composite: bool,
 }
 
 /// The registry and how it is named in messages and outputs.
@@ -153,8 +156,15 @@ pub fn render(
         reference_cpu_s = cpu_since(cpu);
     }
 
-    progress.stage("composite");
-    let compose = compose_record(&work.dir, &record, registry)?;
+    let compose = if request.composite {
+        progress.stage("composite");
+        compose_record(&work.dir, &record, registry)?
+    } else {
+        ComposeReport {
+            frames: Vec::new(),
+            seconds: 0.0,
+        }
+    };
     std::fs::remove_dir_all(&work.staging).map_err(BlenderError::io("remove", &work.staging))?;
     Ok(RenderReport {
         blender: work.blender,
