@@ -19,7 +19,7 @@ use glassdb_pass::PngBits;
 use glassdb_registry::{ColourBasis, Registry};
 use glassdb_sequence::{FrameDone, FrameOutcome, FramesReport, SequenceOptions};
 
-use crate::cmd::inputs::{FrameInputArgs, split_layer};
+use crate::cmd::inputs::FrameInputArgs;
 use crate::cmd::progress::Spinner;
 
 #[derive(Debug, clap::Args)]
@@ -30,9 +30,10 @@ pub struct Args {
     /// from data/catalog.toml).
     #[arg(long, value_name = "JSON")]
     pub registry: Option<PathBuf>,
-    /// Output, .exr or .png (default: beside the transmission pass, `<name>.composite.<ext>`).
-    #[arg(short, long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
+    /// Output, .exr or .png (required: a default beside the passes would write into a render
+    /// or source folder); with --frames, a pattern with ####.
+    #[arg(short, long, value_name = "FILE", required = true)]
+    pub output: PathBuf,
     /// Glass pixels of a plane that its (cropped) reflection pass does not cover: refuse
     /// (`error`), composite them without reflection (`no-reflection`), or leave them as the
     /// transmission pass (`transmission`).
@@ -120,24 +121,6 @@ pub enum DataTypeArg {
 pub enum DitherArg {
     Ordered,
     None,
-}
-
-/// `t.exr` → `t.composite.exr` (PNG passes give a PNG), beside the transmission pass.
-fn default_output(trans: &Path) -> PathBuf {
-    let stem = trans
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let ext = match trans
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("png") => "png",
-        _ => "exr",
-    };
-    trans.with_file_name(format!("{stem}.composite.{ext}"))
 }
 
 /// The registry at `path`, or the bundled one, with the label outputs and messages name it by.
@@ -342,13 +325,9 @@ fn report_nonfinite(r: &FrameReport, label: &str) {
 pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     args.inputs.expand_plane_layers()?;
     let (settings, luts) = settings_from(&args)?;
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&split_layer(&args.inputs.trans).0));
     let job = ComposeJob {
         inputs: args.inputs.files(),
-        output,
+        output: args.output.clone(),
     };
     match &args.inputs.frames {
         None => run_frame(&args, &job, &settings, &luts),

@@ -1,11 +1,14 @@
 //! Frames on a farm (docs/farm.md): `--skip-existing`, `--report frames.json`, the exit code of
-//! a sequence with failed frames, and the Open Job Description template of
-//! `integrations/farm/` run by `openjd run` (its render step copies the atrium's fixture passes
-//! per frame, standing in for a renderer).
+//! a sequence with failed frames, the output folders compose creates, and the Open Job
+//! Description templates of `integrations/farm/` run by `openjd run`: the compose template (its
+//! render step copies the atrium's fixture passes per frame, standing in for a renderer) and
+//! the Blender shot's, and docs/farm.md's commands as written.
 
 use std::path::{Path, PathBuf};
 
-use crate::util::{compose, fails, ok, oracle_python, read_exr_planes, repo_path, run, run_oracle};
+use crate::util::{
+    compose, fails, fails_naming, ok, oracle_python, read_exr_planes, repo_path, run, run_oracle,
+};
 
 /// The atrium's passes copied as frames `frames` of a sequence in `dir`
 /// (`refl_K.####.exr`, `trans.####.exr`, `mask.####.png`), as a renderer would write them.
@@ -25,6 +28,11 @@ fn atrium_frames(dir: &Path, frames: &[u32]) {
 
 /// `compose` over the frame sequence in `dir` into `out.####.exr`.
 fn compose_frames(dir: &Path, frames: &str) -> std::process::Command {
+    compose_frames_to(dir, frames, "out.####.exr")
+}
+
+/// `compose` over the frame sequence in `dir` into `output`.
+fn compose_frames_to(dir: &Path, frames: &str, output: &str) -> std::process::Command {
     let mut c = compose();
     c.current_dir(dir);
     for k in 0..3 {
@@ -33,7 +41,7 @@ fn compose_frames(dir: &Path, frames: &str) -> std::process::Command {
     c.args(["--trans", "trans.####.exr", "--mask", "mask.####.png"])
         .arg("--planes")
         .arg(repo_path("fixtures/atrium/virtual/planes.json"))
-        .args(["-o", "out.####.exr", "--frames", frames]);
+        .args(["-o", output, "--frames", frames]);
     c
 }
 
@@ -363,4 +371,154 @@ fn one_file_holds_every_planes_reflection_cropped_to_its_glass() {
         err.contains("plane 0 is missing") && err.contains("gap.exr"),
         "{err}"
     );
+}
+
+#[test]
+fn compose_creates_the_folders_of_its_outputs_and_report() {
+    // docs/farm.md's `-o comp/out.####.exr --report reports/…` in a shot folder that has
+    // neither folder yet: every frame used to fail ("the directory comp does not exist").
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    atrium_frames(d, &[1, 2]);
+    let mut c = compose_frames_to(d, "1-2", "comp/a/out.####.exr");
+    let out = ok(c.args(["--report", "reports/b/frames.1-2.json"]));
+    for f in [1, 2] {
+        assert!(d.join(format!("comp/a/out.{f:04}.exr")).is_file(), "{out}");
+    }
+    let report = json(&d.join("reports/b/frames.1-2.json"));
+    assert_eq!(
+        statuses(&report),
+        vec![(1, "composed".to_string()), (2, "composed".to_string())]
+    );
+    // One frame, into a new folder; no temporary file is left in it.
+    ok(&mut atrium_compose(
+        &atrium_refl(),
+        &d.join("single/x/out.png"),
+    ));
+    let names: Vec<_> = std::fs::read_dir(d.join("single/x"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, ["out.png"]);
+    // A run that fails makes no folder.
+    fails(
+        compose()
+            .current_dir(d)
+            .args(["--refl", "refl_0.0009.exr", "--trans", "trans.0009.exr"])
+            .args(["--mask", "mask.0001.png", "-o", "never/out.exr"]),
+    );
+    assert!(!d.join("never").exists());
+    // A folder that cannot be made is named.
+    std::fs::write(d.join("file"), "").unwrap();
+    fails_naming(
+        &mut atrium_compose(&atrium_refl(), &d.join("file/sub/out.exr")),
+        &["file/sub"],
+    );
+}
+
+/// The indented command of docs/farm.md that starts with `start`, its continuation lines
+/// joined (backslashes dropped).
+fn docs_command(start: &str) -> String {
+    let doc = std::fs::read_to_string(repo_path("docs/farm.md")).unwrap();
+    let mut lines = doc
+        .lines()
+        .skip_while(|l| !l.trim_start().starts_with(start));
+    let mut command = String::new();
+    for line in lines.by_ref() {
+        let line = line.trim();
+        match line.strip_suffix('\\') {
+            Some(part) => command.push_str(part),
+            None => {
+                command.push_str(line);
+                break;
+            }
+        }
+    }
+    assert!(!command.is_empty(), "docs/farm.md has no `{start}` command");
+    command
+}
+
+#[test]
+fn the_docs_standalone_compose_runs_as_written() {
+    // docs/farm.md's `compose …` as written, in a shot folder holding the atrium's passes as
+    // frames 101-108 and its planes.json: comp/ and reports/ do not exist yet.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    atrium_frames(d, &(101..=108).collect::<Vec<_>>());
+    std::fs::copy(
+        repo_path("fixtures/atrium/virtual/planes.json"),
+        d.join("planes.json"),
+    )
+    .unwrap();
+    let command = docs_command("compose --refl");
+    let args: Vec<&str> = command.split_whitespace().skip(1).collect();
+    ok(compose().current_dir(d).args(&args));
+    let report = json(&d.join("reports/frames.101-108.json"));
+    let composed: Vec<(u64, String)> = (101..=108).map(|f| (f, "composed".into())).collect();
+    assert_eq!(statuses(&report), composed);
+    // A farm's retry: every frame is complete and kept.
+    ok(compose().current_dir(d).args(&args));
+    let report = json(&d.join("reports/frames.101-108.json"));
+    assert!(
+        statuses(&report).iter().all(|(_, s)| s == "skipped"),
+        "{report}"
+    );
+}
+
+#[test]
+fn the_docs_blender_shot_renders_then_composites_each_once() {
+    // docs/farm.md's `openjd run …/glassdb-blender.yaml` as written, but for two frames in
+    // chunks of one, a work folder of its own and a small, quick render.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blend = crate::blender::default_scene(d, "defaults");
+    std::fs::rename(&blend, d.join("scene.blend")).unwrap();
+    let mut command = docs_command("openjd run integrations/farm/openjd/glassdb-blender.yaml");
+    // The parameters a test cannot take as written (1-240 frames in /shots/atrium).
+    for (param, value) in [
+        ("Frames=", "1-2".to_string()),
+        ("ChunkSize=", "1".to_string()),
+        ("WorkDir=", d.display().to_string()),
+    ] {
+        let at = command
+            .find(param)
+            .unwrap_or_else(|| panic!("no {param}: {command}"))
+            + param.len();
+        let end = command[at..].find(' ').map_or(command.len(), |e| at + e);
+        command.replace_range(at..end, &format!("'{value}'"));
+    }
+    // A small, quick render: flags added to RenderArgs="…".
+    let at = command.find("RenderArgs=\"").expect("RenderArgs") + "RenderArgs=\"".len();
+    let close = at + command[at..].find('"').unwrap();
+    command.insert_str(close, " --samples 4 --resolution 64x36 --threads 2");
+    let openjd = oracle_python().with_file_name("openjd");
+    let script = format!(
+        "{} -p Glassdb='{}'",
+        command.replacen("openjd", &openjd.display().to_string(), 1),
+        env!("CARGO_BIN_EXE_glassdb")
+    );
+    let (out, stdout, stderr) = run(std::process::Command::new("bash")
+        .args(["-c", &script])
+        .current_dir(crate::util::repo_root()));
+    let log = format!("{script}\n{stdout}\n{stderr}");
+    assert!(out.status.success(), "{log}");
+    assert!(
+        log.contains("Chunks run: 4"),
+        "2 render + 2 composite chunks: {log}"
+    );
+    // Render tasks stop at the passes; each frame is composited once, by its composite task.
+    assert_eq!(log.matches("ready in").count(), 2, "{log}");
+    assert_eq!(log.matches("composited 1 frame(s)").count(), 2, "{log}");
+    let composites: Vec<PathBuf> = std::fs::read_dir(d.join("glassdb"))
+        .unwrap()
+        .flat_map(|chunk| std::fs::read_dir(chunk.unwrap().path()).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("composite.")
+        })
+        .collect();
+    assert_eq!(composites.len(), 2, "{composites:?}");
 }

@@ -2,7 +2,7 @@
 //! both tools and runs the main job on the bundled data, the second runs every test (and is
 //! what CI runs).
 
-use crate::util::{compose, glassdb, ok, repo_path, repo_root};
+use crate::util::{compose, fails, glassdb, ok, repo_path, repo_root};
 
 /// The first two lines of the README's first `sh` block, comments cut.
 fn readme_commands() -> (String, String) {
@@ -65,7 +65,7 @@ fn second_command_runs_every_test_as_ci_does() {
 fn registry_build_usage_makes_no_option_look_required() {
     // clap's usage line in an error used to list the options given: `--space <…>` looked
     // required after a forgotten `-o`
-    let e = crate::util::fails(glassdb().args(["registry", "build", "--space", "srgb"]));
+    let e = fails(glassdb().args(["registry", "build", "--space", "srgb"]));
     let usage = e
         .lines()
         .find(|l| l.starts_with("Usage:"))
@@ -75,4 +75,76 @@ fn registry_build_usage_makes_no_option_look_required() {
         usage.contains("<CATALOG>") && usage.contains("--output"),
         "{usage}"
     );
+}
+
+/// `git status --porcelain` of the repository (untracked files included, ignored ones not).
+fn git_status() -> std::collections::BTreeSet<String> {
+    let out = std::process::Command::new("git")
+        .args(["status", "--porcelain", "--untracked-files=all"])
+        .current_dir(repo_root())
+        .output()
+        .expect("git runs (the tests run in a clone)");
+    assert!(out.status.success(), "git status failed");
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn the_compose_docs_example_leaves_the_clone_clean() {
+    // docs/compose.md's "Try it:" command, run as written from the repository root with the
+    // compose this test was built with: its output goes to an ignored folder, so the clone
+    // stays as it was.
+    let doc = std::fs::read_to_string(repo_path("docs/compose.md")).unwrap();
+    let line = doc
+        .lines()
+        .find(|l| l.starts_with("Try it: `compose "))
+        .expect("docs/compose.md has a `Try it:` command");
+    let command = line.split('`').nth(1).unwrap();
+    let mut args: Vec<&str> = command.split_whitespace().collect();
+    assert_eq!(args.remove(0), "compose");
+    let out = args[args
+        .iter()
+        .position(|a| *a == "-o")
+        .expect("it names its output")
+        + 1];
+    let before = git_status();
+    ok(compose().args(&args).current_dir(repo_root()));
+    let written = repo_root().join(out);
+    assert!(written.is_file(), "{command} wrote no {out}");
+    let ignored = std::process::Command::new("git")
+        .args(["check-ignore", "-q", out])
+        .current_dir(repo_root())
+        .status()
+        .unwrap();
+    let after = git_status();
+    let _ = std::fs::remove_file(&written);
+    assert!(ignored.success(), "{out} is not in an ignored folder");
+    let new: Vec<_> = after.difference(&before).collect();
+    assert!(new.is_empty(), "`{command}` left {new:?} in the clone");
+}
+
+#[test]
+fn compose_without_an_output_writes_nothing_and_asks_for_one() {
+    // Without -o, compose used to write `<trans>.composite.exr` beside the transmission pass:
+    // into the clone's fixtures (or a shared render folder).
+    let dir = crate::util::example_copy();
+    for mut command in [compose(), {
+        let mut g = glassdb();
+        g.arg("compose");
+        g
+    }] {
+        let err = fails(
+            command
+                .current_dir(dir.path())
+                .args(crate::util::EXAMPLE_INPUTS),
+        );
+        assert!(err.contains("--output"), "{err}");
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 3, "{names:?}");
+    }
 }

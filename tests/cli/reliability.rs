@@ -506,13 +506,8 @@ fn slow_compose_inputs(dir: &Path, w: u32, h: u32) {
 fn start_compose(dir: &Path, out: &Path) -> Child {
     compose()
         .current_dir(dir)
+        .args(crate::util::EXAMPLE_INPUTS)
         .args([
-            "--refl",
-            "refl.exr",
-            "--trans",
-            "trans.exr",
-            "--mask",
-            "mask.png",
             "--data-type",
             "float",
             "--compression",

@@ -327,3 +327,22 @@ pub fn write_pass(
     let frame = glassdb_pass::CarriedFrame::whole(image.width, image.height);
     glassdb_encode::write_output(path, image, frame, src, opts)
 }
+
+/// The bundled example's inputs as `compose` takes them, relative to [`example_copy`]'s folder.
+pub const EXAMPLE_INPUTS: [&str; 6] = [
+    "--refl",
+    "refl.exr",
+    "--trans",
+    "trans.exr",
+    "--mask",
+    "mask.png",
+];
+
+/// A temporary folder holding a copy of `fixtures/example`'s passes and mask.
+pub fn example_copy() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    for f in ["refl.exr", "trans.exr", "mask.png"] {
+        std::fs::copy(repo_path("fixtures/example").join(f), dir.path().join(f)).unwrap();
+    }
+    dir
+}

@@ -71,6 +71,45 @@ pub struct ExportInfo {
     pub frames: Vec<u32>,
     /// The scene's materials.
     pub materials: Vec<String>,
+    /// The frames whose geometry differs from the first frame's (by frame number): each has
+    /// its own OBJ (`scene.NNNN.obj`), planes (`planes.NNNN/`) and mask.
+    #[serde(default)]
+    pub moving: std::collections::BTreeMap<u32, MovingFrame>,
+    /// The scene denoises (Cycles' denoiser on), which the passes turn off.
+    #[serde(default)]
+    pub denoising: bool,
+    /// The scene has motion blur on, which the passes turn off.
+    #[serde(default)]
+    pub motion_blur: bool,
+}
+
+/// A frame whose objects are not where they are in the first frame.
+#[derive(Debug, Clone, Deserialize)]
+pub struct MovingFrame {
+    /// The objects whose geometry differs from the first frame's.
+    pub objects: Vec<String>,
+}
+
+impl ExportInfo {
+    /// The scene's render settings that the passes do not take, said as the run record and
+    /// the command say them.
+    pub fn overrides(&self) -> Vec<String> {
+        let mut said = Vec::new();
+        if self.denoising {
+            said.push(
+                "denoising off (the scene denoises; the passes keep Cycles' own noise, and \
+                 Blender builds without OpenImageDenoise could not render them)"
+                    .to_string(),
+            );
+        }
+        if self.motion_blur {
+            said.push(
+                "motion blur off (the scene blurs motion; the masks are of each frame's instant)"
+                    .to_string(),
+            );
+        }
+        said
+    }
 }
 
 /// A plane's pixels in one frame: columns `x..x+width`, rows `y..y+height` (row 0 at the top).
@@ -137,6 +176,10 @@ pub struct RunRecord {
     pub width: u32,
     /// The frames' height in pixels.
     pub height: u32,
+    /// The scene's render settings the passes overrode (denoising, motion blur), in words;
+    /// Cycles never denoises the passes.
+    #[serde(default)]
+    pub overrides: Vec<String>,
     /// Every frame rendered.
     pub frames: Vec<FrameRecord>,
 }

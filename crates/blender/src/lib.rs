@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod geometry;
 pub mod job;
 mod passes;
 pub mod pipeline;

@@ -3,36 +3,28 @@
 //!
 //! [`render`] runs its phases in order, each a function: [`Workspace::prepare`] (checks, the
 //! program, the output and staging folders), [`export_scene`] (Blender exports the scene and
-//! every frame's camera), [`planes_and_masks`] (glassdb's planes, masks and each plane's pixels,
-//! through `glassdb_scene::mask_frames`), [`render_passes`] (Blender renders the passes;
+//! every frame's camera), [`planes_and_masks`] (glassdb's planes, masks and each plane's pixels
+//! per frame, through `glassdb_scene::mask_frames`), [`render_passes`] (Blender renders the passes;
 //! glassdb places the crops), [`render_reference`] (optional) and [`compose_record`].
 
 use std::collections::BTreeMap;
-use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use glassdb_colour::RgbSpace;
 use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::{ComposeJob, ComposeSettings, DecodeSettings, FrameFiles, FrameReport};
-use glassdb_image::PixelWindow;
 use glassdb_io::Progress;
-use glassdb_mask::{GlassMapping, MaskFormat};
-use glassdb_registry::{ColourBasis, Registry};
-use glassdb_scene::{
-    CameraSource, CosMode, FrameMask, MaskJob, MaskPlanes, MirrorRequest, PlaneSource,
-    PlaneTolerance, RasterOptions, label_scene, load_obj, mask_frames, write_virtual_scenes,
-};
-use glassdb_side::Side;
+use glassdb_mask::GlassMapping;
+use glassdb_registry::Registry;
+use glassdb_scene::{CosMode, RasterOptions};
 
 use crate::BlenderError;
+use crate::geometry::{Masks, planes_and_masks};
 use crate::job::{
-    ExportInfo, FrameRecord, PixelBounds, RECORD_FORMAT, RECORD_NAME, RunRecord, ScriptFrame,
-    ScriptJob, ScriptPlane,
+    ExportInfo, FrameRecord, RECORD_FORMAT, RECORD_NAME, RunRecord, ScriptFrame, ScriptJob,
 };
 use crate::passes::{place_crop, rename, write_unused_pass};
 use crate::program::{Blender, BlenderRun, check_blend_file, children_cpu_seconds};
-use crate::thin_pane::ThinPane;
 
 /// The Blender-side script, embedded so that the binary needs nothing else.
 pub const SCRIPT: &str = include_str!("../../../integrations/blender/glassdb_blender.py");
@@ -72,6 +64,9 @@ pub struct RenderRequest {
     /// Also render the Cycles reference (the glass as a thin pane seen by the camera) as
     /// `reference.####.exr`.
     pub reference: bool,
+    /// Composite every frame at the end (else the run stops at its passes, masks and record,
+    /// for [`compose_dir`] to composite: a farm's render and composite steps).
+    pub composite: bool,
 }
 
 /// The registry and how it is named in messages and outputs.
@@ -121,7 +116,7 @@ pub struct ComposeReport {
 }
 
 /// Pattern names of the frame's files.
-fn frame_name(stem: &str, frame: u32) -> String {
+pub(crate) fn frame_name(stem: &str, frame: u32) -> String {
     format!("{stem}.{frame:04}.exr")
 }
 
@@ -149,7 +144,7 @@ pub fn render(
     let job = render_passes(&work, &masks)?;
     let render_s = t.elapsed().as_secs_f64();
     let render_cpu_s = cpu_since(cpu);
-    let record = write_record(&work, masks.frames, masks.size)?;
+    let record = write_record(&work, masks.frames, masks.size, info.overrides())?;
 
     let (mut reference_s, mut reference_cpu_s) = (0.0, None);
     if request.reference {
@@ -161,8 +156,15 @@ pub fn render(
         reference_cpu_s = cpu_since(cpu);
     }
 
-    progress.stage("composite");
-    let compose = compose_record(&work.dir, &record, registry)?;
+    let compose = if request.composite {
+        progress.stage("composite");
+        compose_record(&work.dir, &record, registry)?
+    } else {
+        ComposeReport {
+            frames: Vec::new(),
+            seconds: 0.0,
+        }
+    };
     std::fs::remove_dir_all(&work.staging).map_err(BlenderError::io("remove", &work.staging))?;
     Ok(RenderReport {
         blender: work.blender,
@@ -181,14 +183,14 @@ pub fn render(
 
 /// What every phase of a run shares: the request, its glass, the program and the folders.
 pub struct Workspace<'a> {
-    request: &'a RenderRequest,
-    mappings: Vec<GlassMapping>,
-    options: RasterOptions,
-    blender: Blender,
-    dir: PathBuf,
-    staging: PathBuf,
-    script: PathBuf,
-    log: PathBuf,
+    pub(crate) request: &'a RenderRequest,
+    pub(crate) mappings: Vec<GlassMapping>,
+    pub(crate) options: RasterOptions,
+    pub(crate) blender: Blender,
+    pub(crate) dir: PathBuf,
+    pub(crate) staging: PathBuf,
+    pub(crate) script: PathBuf,
+    pub(crate) log: PathBuf,
 }
 
 impl<'a> Workspace<'a> {
@@ -273,215 +275,21 @@ pub fn export_scene(work: &Workspace<'_>) -> Result<ExportInfo, BlenderError> {
     }
     let path = work.dir.join("export.json");
     let text = glassdb_io::read_input_string(&path, glassdb_io::limits::JSON)?;
-    serde_json::from_str(&text).map_err(|e| BlenderError::BadRender {
+    let info: ExportInfo = serde_json::from_str(&text).map_err(|e| BlenderError::BadRender {
         path: path.clone(),
         message: e.to_string(),
-    })
-}
-
-/// The planes, masks and each plane's pixels of every frame, and what Blender renders next.
-pub struct Masks {
-    /// Glass planes found.
-    planes: usize,
-    /// Each glass material and its registry id.
-    glass_materials: Vec<(String, u16)>,
-    /// The glass as the thin-pane shader draws it.
-    panes: Vec<ThinPane>,
-    /// Each frame's files, sides and plane rectangles.
-    frames: Vec<FrameRecord>,
-    /// What Blender renders of each frame.
-    script_frames: Vec<ScriptFrame>,
-    /// Each frame's plane rectangles, where its crops go.
-    crops: Vec<Vec<Option<PixelWindow>>>,
-    /// The frames' size.
-    size: (u32, u32),
-}
-
-/// glassdb's own geometry: the planes (`glassdb mirror`'s detection, from the first frame's
-/// eye), every frame's mask (`glassdb_scene::mask_frames`, float EXR), each plane's side and
-/// pixel rectangle per frame, and the glass as thin panes for Blender.
-pub fn planes_and_masks(
-    work: &Workspace<'_>,
-    info: &ExportInfo,
-    registry: &RegistryChoice,
-) -> Result<Masks, BlenderError> {
-    let dir = &work.dir;
-    let scene = load_obj(&dir.join("scene.obj"))?;
-    let cameras = CameraSource::open(&dir.join("camera.json"))?;
-    let Some(&first_frame) = info.frames.first() else {
-        return Err(BlenderError::BadRender {
-            path: dir.join("export.json"),
-            message:
-                "no frames to render (the scene's frame range, or the frames asked for, is empty)"
-                    .into(),
-        });
-    };
-    let first = cameras.camera(Some(first_frame))?;
-    let report = write_virtual_scenes(&MirrorRequest {
-        scene: &scene,
-        glass_patterns: work.mappings.iter().map(|m| m.pattern.clone()).collect(),
-        explicit_plane: None,
-        eye: Some(first.origin),
-        tolerance: PlaneTolerance::default_for(&scene),
-        out_dir: dir,
     })?;
-    let planes = report.planes.planes();
-    let source = PlaneSource::Given {
-        planes: planes.clone(),
-        tolerance: report.planes.tolerance(),
-    };
-    let labelled = label_scene(&scene, &work.mappings, &MaskPlanes::Given(source), false)?;
-    let glass_materials = glass_of_materials(&info.materials, &work.mappings)?;
-    let panes = thin_panes(&glass_materials, registry)?;
-    let job = MaskJob {
-        labelled: &labelled,
-        cameras: &cameras,
-        options: work.options,
-        format: MaskFormat::Exr,
-        output: dir.join("mask.####.exr"),
-        bounds: None,
-    };
-    let mut frames = FramesOfMasks {
-        work,
-        planes: &planes,
-        tolerance: report.planes.tolerance.distance,
-        first_frame,
-        size: None,
-        records: Vec::new(),
-        script_frames: Vec::new(),
-        crops: Vec::new(),
-        error: None,
-    };
-    mask_frames(
-        &job,
-        &info.frames,
-        &glassdb_io::NoProgress,
-        &mut |frame, mask| match mask
-            .map_err(BlenderError::from)
-            .and_then(|m| frames.add(frame, &m))
-        {
-            Ok(()) => ControlFlow::Continue(()),
-            Err(e) => {
-                frames.error = Some(e);
-                ControlFlow::Break(())
-            }
-        },
-    );
-    if let Some(e) = frames.error {
-        return Err(e);
+    for &frame in info.moving.keys() {
+        let from = export_dir.join(moving_obj_name(frame));
+        std::fs::rename(&from, work.dir.join(moving_obj_name(frame)))
+            .map_err(BlenderError::io("move", &from))?;
     }
-    drop(scene);
-    Ok(Masks {
-        planes: planes.len(),
-        glass_materials,
-        panes,
-        frames: frames.records,
-        script_frames: frames.script_frames,
-        crops: frames.crops,
-        size: frames.size.unwrap_or_default(),
-    })
+    Ok(info)
 }
 
-/// The frames' records and render jobs, gathered mask by mask.
-struct FramesOfMasks<'w, 'a> {
-    work: &'w Workspace<'a>,
-    planes: &'w [glassdb_scene::Plane],
-    /// planes.json's distance tolerance.
-    tolerance: f64,
-    first_frame: u32,
-    /// The first frame's size, which every frame must have.
-    size: Option<(u32, u32)>,
-    records: Vec<FrameRecord>,
-    script_frames: Vec<ScriptFrame>,
-    crops: Vec<Vec<Option<PixelWindow>>>,
-    error: Option<BlenderError>,
-}
-
-impl FramesOfMasks<'_, '_> {
-    /// Adds frame `frame`, whose mask is `mask`: each plane's side (from the camera) and glass
-    /// rectangle, where Blender renders its crop.
-    fn add(&mut self, frame: u32, mask: &FrameMask) -> Result<(), BlenderError> {
-        let (width, height) = *self.size.get_or_insert((mask.width, mask.height));
-        if (mask.width, mask.height) != (width, height) {
-            return Err(BlenderError::BadRender {
-                path: self.work.dir.join("camera.json"),
-                message: format!(
-                    "frame {frame} is {}x{}, but frame {} is {width}x{height}; \
-                     every frame of a run must have one size",
-                    mask.width, mask.height, self.first_frame
-                ),
-            });
-        }
-        let rectangles: Vec<_> = (0..self.planes.len())
-            .map(|k| {
-                u16::try_from(k)
-                    .ok()
-                    .and_then(|k| mask.plane_bounds.get(&k))
-            })
-            .collect();
-        let refl: Vec<String> = (0..self.planes.len())
-            .map(|k| frame_name(&format!("refl_{k}"), frame))
-            .collect();
-        let mut sides = Vec::new();
-        let mut script_planes = Vec::new();
-        for (k, plane) in self.planes.iter().enumerate() {
-            let front = plane.signed_distance(mask.camera_origin) >= 0.0;
-            sides.push(if front { Side::Front } else { Side::Back });
-            let facing = if front { *plane } else { plane.flipped() };
-            if let Some(r) = rectangles[k] {
-                script_planes.push(ScriptPlane {
-                    index: k,
-                    equation: facing.equation(),
-                    tolerance: self.tolerance,
-                    border: r.blender_border(width, height),
-                    output: self.work.staging.join(&refl[k]),
-                });
-            }
-        }
-        self.script_frames.push(ScriptFrame {
-            frame,
-            trans: self.work.staging.join(frame_name("trans", frame)),
-            planes: script_planes,
-        });
-        let windows: Vec<Option<PixelWindow>> =
-            rectangles.iter().map(|r| r.map(|r| r.window())).collect();
-        self.records.push(FrameRecord {
-            frame,
-            trans: frame_name("trans", frame),
-            mask: frame_name("mask", frame),
-            refl,
-            sides,
-            bounds: windows.iter().map(|w| w.map(PixelBounds::from)).collect(),
-            composite: frame_name("composite", frame),
-        });
-        self.crops.push(windows);
-        Ok(())
-    }
-}
-
-/// Each glass material's registry record as the thin-pane shader's tables (the registry's
-/// linear Rec.709 table, else its default one).
-fn thin_panes(
-    glass_materials: &[(String, u16)],
-    registry: &RegistryChoice,
-) -> Result<Vec<ThinPane>, BlenderError> {
-    let table = registry
-        .registry
-        .table(ColourBasis::Space(RgbSpace::Srgb))
-        .unwrap_or_else(|| registry.registry.default_table());
-    glass_materials
-        .iter()
-        .map(|(material, id)| {
-            table
-                .glass(*id)
-                .map(|g| ThinPane::of(material, g))
-                .ok_or_else(|| BlenderError::UnknownGlass {
-                    id: *id,
-                    material: material.clone(),
-                    registry: registry.label.clone(),
-                })
-        })
-        .collect()
+/// The OBJ of a frame whose geometry differs from the first frame's.
+pub(crate) fn moving_obj_name(frame: u32) -> String {
+    format!("scene.{frame:04}.obj")
 }
 
 /// Blender renders every frame's transmission pass and one cropped reflection pass per plane
@@ -518,6 +326,7 @@ fn write_record(
     work: &Workspace<'_>,
     frames: Vec<FrameRecord>,
     (width, height): (u32, u32),
+    overrides: Vec<String>,
 ) -> Result<RunRecord, BlenderError> {
     let request = work.request;
     let record = RunRecord {
@@ -528,6 +337,7 @@ fn write_record(
         samples: request.samples,
         width,
         height,
+        overrides,
         frames,
     };
     let record_path = work.dir.join(RECORD_NAME);
@@ -601,19 +411,6 @@ fn join_frames(frames: &[u32]) -> String {
         .map(u32::to_string)
         .collect::<Vec<_>>()
         .join(",")
-}
-
-/// Each Blender material that a `--glass` pattern matches (first match wins), with its id.
-fn glass_of_materials(
-    materials: &[String],
-    mappings: &[GlassMapping],
-) -> Result<Vec<(String, u16)>, BlenderError> {
-    let patterns: Vec<&str> = mappings.iter().map(|m| m.pattern.as_str()).collect();
-    let matcher = glassdb_scene::MaterialMatcher::new(&patterns)?;
-    Ok(materials
-        .iter()
-        .filter_map(|m| matcher.first_match(m).map(|k| (m.clone(), mappings[k].id)))
-        .collect())
 }
 
 /// Composites every frame of a run record in `dir` with `registry`.

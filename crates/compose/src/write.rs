@@ -36,6 +36,9 @@ pub(crate) fn write(
             glassdb_colour::RgbSpace::Srgb,
         ));
     }
+    // The folders `-o` names are made now, once the frame has composited (a failed frame
+    // makes none).
+    glassdb_io::create_output_dirs(&job.output)?;
     let output = glassdb_encode::write_output(
         &job.output,
         trans.image,

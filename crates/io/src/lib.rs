@@ -37,8 +37,8 @@ pub use input::{
 };
 pub use kind::FileKind;
 pub use output::{
-    OutputError, StagedOutput, SyncingFile, refuse_input_as_output, write_atomic,
-    write_bytes_atomic,
+    OutputError, StagedOutput, SyncingFile, create_output_dirs, refuse_input_as_output,
+    write_atomic, write_bytes_atomic,
 };
 pub use registry::{TEMP_PREFIX, declare_inputs, exit_removing_temporaries, protect_inputs};
 pub mod progress;

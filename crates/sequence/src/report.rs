@@ -102,6 +102,7 @@ impl FramesReport {
                 path: path.to_path_buf(),
                 source,
             })?;
+        glassdb_io::create_output_dirs(path)?;
         glassdb_io::write_bytes_atomic(path, format!("{text}\n").as_bytes())?;
         Ok(())
     }

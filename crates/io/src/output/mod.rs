@@ -47,13 +47,24 @@ pub enum OutputError {
         /// Why it failed.
         source: std::io::Error,
     },
-    /// The directory the output goes into does not exist (outputs never create directories).
+    /// The directory the output goes into does not exist ([`write_atomic`] creates none; see
+    /// [`create_output_dirs`]).
     #[error("cannot write {path}: the directory {dir} does not exist")]
     MissingDirectory {
         /// The output.
         path: PathBuf,
         /// The folder that does not exist.
         dir: PathBuf,
+    },
+    /// A folder an output goes into could not be created ([`create_output_dirs`]).
+    #[error("cannot create the folder {dir} for {path}")]
+    CreateDirectory {
+        /// The output.
+        path: PathBuf,
+        /// The folder.
+        dir: PathBuf,
+        /// Why it failed.
+        source: std::io::Error,
     },
     /// The output is one of the run's own inputs (the same file, whatever the spelling, link
     /// or hard link).
@@ -88,7 +99,8 @@ impl OutputError {
             OutputError::CreateTemp { .. }
             | OutputError::Write { .. }
             | OutputError::Persist { .. }
-            | OutputError::MissingDirectory { .. } => ErrorKind::Io,
+            | OutputError::MissingDirectory { .. }
+            | OutputError::CreateDirectory { .. } => ErrorKind::Io,
         }
     }
 }
@@ -299,6 +311,19 @@ where
             path: staged.path,
             source,
         })
+}
+
+/// Creates the folders `path` goes into where they are missing (as `mkdir -p`: concurrent
+/// runs creating the same folders both succeed), for commands whose outputs name their folders
+/// (`compose -o comp/out.####.exr --report reports/…`); the file itself is then written with
+/// [`write_atomic`]: a temporary file in that folder, renamed.
+pub fn create_output_dirs(path: &Path) -> Result<(), OutputError> {
+    let dir = registry::parent_dir(path);
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::CreateDirectory {
+        path: path.to_path_buf(),
+        dir: dir.to_path_buf(),
+        source,
+    })
 }
 
 /// Writes `bytes` atomically to `path` (see [`write_atomic`]).
