@@ -549,6 +549,66 @@ fn blender_3_and_5_renders_composite_with_the_same_command_line() {
 }
 
 #[test]
+fn a_composite_is_composited_again() {
+    // A composite is a transmission pass like any other: its glassdb/* attributes (the run that
+    // wrote it) are replaced by this run's, in a single-part file (its attributes carried) and a
+    // multi-part one (every part carried). Both once failed at the write: "duplicate attribute
+    // name: `glassdb/version`".
+    let dir = tempfile::tempdir().unwrap();
+    let (reg, values) = registry(dir.path());
+    let (r0, t0) = values[&1];
+    let t08 = repo_path("fixtures/exr_windows/t08.exr");
+    let mask = dir.path().join("m.png");
+    rect_mask_png(&mask, 501, 401, [10, 20, 120, 90], 1);
+    let once = dir.path().join("once.exr");
+    ok(compose_cmd(&[&t08], &t08, &mask, &reg)
+        .args(["--data-type", "float", "-o"])
+        .arg(&once));
+    let reg2 = dir.path().join("second.json");
+    std::fs::copy(&reg, &reg2).unwrap();
+    let twice = dir.path().join("twice.exr");
+    ok(compose_cmd(&[&t08], &once, &mask, &reg2)
+        .args(["--data-type", "float", "-o"])
+        .arg(&twice));
+    let (_, _, input) = read_parts(&t08);
+    let (_, shared, output) = read_parts(&twice);
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let v = at(&input[0], name, 50, 50).unwrap();
+        let want = v * r0[c] + v * (r0[c] + t0[c]) * t0[c];
+        let got = at(&output[0], name, 50, 50).unwrap();
+        assert!(close(got, want), "{name}: got {got}, want {want}");
+    }
+    // The attributes are this run's: every copy of them (multi-part files hold them in each
+    // part) names the second registry, and the file reads back.
+    let provenance_is = |shared: &HashMap<String, String>, parts: &[Part], registry: &Path| {
+        let values: Vec<&String> = std::iter::once(shared)
+            .chain(parts.iter().map(|p| &p.other))
+            .filter_map(|m| m.get("glassdb/registry"))
+            .collect();
+        assert!(!values.is_empty(), "glassdb/registry is written");
+        for v in values {
+            assert_eq!(v, &registry.display().to_string());
+        }
+    };
+    provenance_is(&shared, &output, &reg2);
+
+    let render = "fixtures/blender/b50/multilayer.exr";
+    let (file, once) = blender_composite(dir.path(), render, &[]);
+    let twice = dir.path().join("twice_b50.exr");
+    ok(compose_cmd(&[&file], &once, &file, &reg2)
+        .args(["--mask-channels", "id=IndexMA,cos=facing"])
+        .args(["--data-type", "float", "-o"])
+        .arg(&twice));
+    let (_, shared, output) = read_parts(&twice);
+    assert_eq!(
+        output.len(),
+        read_parts(&file).2.len(),
+        "every part is kept"
+    );
+    provenance_is(&shared, &output, &reg2);
+}
+
+#[test]
 fn keep_channels_none_and_an_output_layer() {
     let dir = tempfile::tempdir().unwrap();
     let render = "fixtures/blender/b34/multilayer.exr";

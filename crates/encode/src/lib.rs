@@ -81,6 +81,7 @@ pub struct OutputOptions {
     /// channels instead of replacing the transmission pass's RGB.
     pub output_layer: Option<String>,
     /// Attributes glassdb adds to EXR output (name, text): its version, the registry's hash.
+    /// Names start with `glassdb/`; those the transmission file carries are replaced.
     pub provenance: Vec<(String, String)>,
 }
 
