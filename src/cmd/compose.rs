@@ -319,8 +319,21 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
 
 fn report_nonfinite(r: &FrameReport, label: &str) {
     if r.output.half_overflow > 0 {
+        let first = r
+            .output
+            .first_half_overflow
+            .as_ref()
+            .map_or(String::new(), |s| {
+                format!(
+                    " (the first at pixel ({}, {}), channel {}: {})",
+                    s.x,
+                    s.y,
+                    glassdb_io::quoted(&s.channel),
+                    s.value
+                )
+            });
         eprintln!(
-            "warning: {label}{} output samples exceed the half-float range (±65504) and were stored as infinite; write float (--data-type float) to keep them",
+            "warning: {label}{} output samples exceed the half-float range and were clamped to ±65504, the largest half{first}; write float (--data-type float) to keep them",
             r.output.half_overflow
         );
     }

@@ -775,9 +775,12 @@ fn png_alpha_is_straight_and_exr_alpha_premultiplied() {
 }
 
 #[test]
-fn half_output_counts_values_beyond_half_range() {
+fn half_output_clamps_values_beyond_half_range_and_reads_back() {
+    // Finite values beyond ±65504 are stored as the largest half, said with the first pixel,
+    // so that the output composites again (an infinity was written, and it came back as
+    // non-finite transmission samples).
     let dir = tempfile::tempdir().unwrap();
-    let (reg, _) = registry(dir.path());
+    let (reg, values) = registry(dir.path());
     let frame = PixelWindow::at_origin(3, 1);
     let trans = dir.path().join("t.exr");
     write_windowed_exr(
@@ -788,14 +791,34 @@ fn half_output_counts_values_beyond_half_range() {
     );
     let mask = dir.path().join("m.png");
     rect_mask_png(&mask, 3, 1, [2, 0, 2, 0], 1);
+    let half = dir.path().join("half.exr");
     let (_, _, stderr) = run(compose_cmd(&[&trans], &trans, &mask, &reg)
         .args(["--data-type", "half", "-o"])
-        .arg(dir.path().join("o.exr")));
+        .arg(&half));
     assert!(
-        stderr.contains("warning: 2 output samples exceed the half-float range"),
+        stderr.contains("warning: 2 output samples exceed the half-float range")
+            && stderr.contains("clamped to ±65504")
+            && stderr.contains("the first at pixel (0, 0), channel \"R\": 100000"),
         "{stderr}"
     );
     assert!(stderr.contains("--data-type float"), "{stderr}");
+    let (_, _, parts) = read_parts(&half);
+    assert_eq!(parts[0].channels["R"][..2], [65504.0, 1.0]);
+    assert_eq!(parts[0].channels["B"][..2], [-65504.0, 1.0]);
+
+    // Read back as the transmission pass, and as a reflection pass, by compose.
+    let again = dir.path().join("again.exr");
+    let (out, _, stderr) = run(compose_cmd(&[&half], &half, &mask, &reg)
+        .args(["--data-type", "float", "-o"])
+        .arg(&again));
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("NaN or infinite"), "{stderr}");
+    let (_, _, parts) = read_parts(&again);
+    let (r0, t0) = values[&1];
+    assert_eq!(parts[0].channels["R"][..2], [65504.0, 1.0]);
+    // Glass: the first composite's gain, applied again (both passes are the first output).
+    let gain = r0[1] + t0[1];
+    assert!(close(parts[0].channels["G"][2], gain * gain));
 }
 
 #[test]

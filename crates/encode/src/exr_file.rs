@@ -319,6 +319,7 @@ pub(crate) fn write_exr_output(
         bytes,
         encoding,
         half_overflow: report.half_overflow,
+        first_half_overflow: report.first_half_overflow,
         kept_channels,
     })
 }
