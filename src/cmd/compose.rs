@@ -17,7 +17,7 @@ use glassdb_compose::{
 use glassdb_encode::{ExrDataType, OutputOptions, parse_exr_compression};
 use glassdb_pass::PngBits;
 use glassdb_registry::{ColourBasis, Registry};
-use glassdb_sequence::{FrameDone, FrameOutcome, FramesReport, SequenceOptions};
+use glassdb_sequence::{FrameDone, FrameOutcome, FramesReport, SequenceOptions, SequenceProgress};
 
 use crate::cmd::inputs::{FrameInputArgs, split_layer};
 use crate::cmd::progress::Spinner;
@@ -454,8 +454,15 @@ fn run_sequence(
     let options = SequenceOptions {
         skip_existing: args.skip_existing,
     };
-    let outcomes =
-        glassdb_sequence::compose_sequence(job, &frames, settings, luts, options, &on_done)?;
+    let progress = std::sync::Arc::new(SequenceProgress::new(job, &frames));
+    // A stop by a signal still writes the report: what was finished, what it interrupted.
+    let _report_on_stop = args
+        .report
+        .clone()
+        .map(|path| glassdb_io::on_stop(report_on_stop(path, progress.clone())));
+    let outcomes = glassdb_sequence::compose_sequence(
+        job, &frames, settings, luts, options, &progress, &on_done,
+    )?;
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -463,6 +470,31 @@ fn run_sequence(
         FramesReport::from_outcomes(&outcomes).write(report)?;
     }
     report_sequence(args, &outcomes, frames.len(), luts, settings)
+}
+
+/// Writes the frames report of a sequence stopped by a signal (the exit code's).
+fn report_on_stop(
+    path: PathBuf,
+    progress: std::sync::Arc<SequenceProgress>,
+) -> impl FnOnce(i32) + Send {
+    move |code| {
+        let signal = super::stop_signal_name(code);
+        let report = progress.stopped_report(signal);
+        match report.write(&path) {
+            Ok(()) => eprintln!(
+                "wrote {} (stopped by {signal}: {} frame(s) composed, {} skipped, {} failed, interrupted: {:?})",
+                path.display(),
+                report.composed,
+                report.skipped,
+                report.failed.len(),
+                report.interrupted
+            ),
+            Err(e) => eprintln!(
+                "error: cannot write the frames report: {}",
+                glassdb_io::ErrorChain(&e)
+            ),
+        }
+    }
 }
 
 /// The end of a sequence: each frame's stats when asked, what was written and skipped, and

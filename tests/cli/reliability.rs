@@ -533,16 +533,29 @@ fn start_compose(dir: &Path, out: &Path) -> Child {
 /// exists. Returns the exit code, or `None` when compose finished before the signal could be
 /// sent (the test then tries again with a larger image).
 fn stop_while_writing(dir: &Path, out: &Path, signal: &str) -> Option<i32> {
-    let mut child = start_compose(dir, out);
+    let writing = || {
+        names(dir)
+            .iter()
+            .any(|n| n.starts_with(glassdb_io::TEMP_PREFIX))
+    };
+    let stopped = signal_when(start_compose(dir, out), writing, signal);
+    if stopped.is_none() {
+        let _ = std::fs::remove_file(out);
+    }
+    stopped.map(|(code, _)| code).unwrap_or(None)
+}
+
+/// Sends `signal` to `child` once `ready` says so, and waits for it. Returns its exit code and
+/// stderr, or `None` when it finished (successfully) before the signal could be sent.
+fn signal_when(
+    mut child: Child,
+    ready: impl Fn() -> bool,
+    signal: &str,
+) -> Option<(Option<i32>, String)> {
     let start = Instant::now();
     let mut sent = false;
     loop {
         if let Some(status) = child.try_wait().unwrap() {
-            if !sent {
-                assert!(status.success(), "compose failed: {status}");
-                let _ = std::fs::remove_file(out);
-                return None;
-            }
             let mut stderr = String::new();
             use std::io::Read;
             child
@@ -552,12 +565,13 @@ fn stop_while_writing(dir: &Path, out: &Path, signal: &str) -> Option<i32> {
                 .read_to_string(&mut stderr)
                 .unwrap();
             assert!(!stderr.contains("panicked"), "{stderr}");
-            return status.code();
+            if !sent {
+                assert!(status.success(), "compose failed: {stderr}");
+                return None;
+            }
+            return Some((status.code(), stderr));
         }
-        let writing = names(dir)
-            .iter()
-            .any(|n| n.starts_with(glassdb_io::TEMP_PREFIX));
-        if writing && !sent {
+        if !sent && ready() {
             let status = Command::new("kill")
                 .arg(format!("-{signal}"))
                 .arg(child.id().to_string())
@@ -609,6 +623,93 @@ fn a_stopped_compose_leaves_no_temporary_file_and_no_output() {
         assert_eq!(got, code, "exit code after SIG{signal}");
         assert!(!out.exists(), "SIG{signal}: the unfinished output landed");
         assert_no_temporaries(d);
+    }
+}
+
+/// Runs a sequence of `frames` frames of the slow inputs in `dir` (hard links `trans.0001.exr`,
+/// …) with `--report`, and sends `signal` once the first frame's output has landed. Returns the
+/// exit code and stderr, or `None` when the sequence finished before the signal was sent.
+fn stop_a_sequence(dir: &Path, frames: u32, signal: &str) -> Option<(Option<i32>, String)> {
+    for f in 1..=frames {
+        for (name, ext) in [("trans", "exr"), ("refl", "exr"), ("mask", "png")] {
+            let link = dir.join(format!("{name}.{f:04}.{ext}"));
+            if !link.exists() {
+                std::fs::hard_link(dir.join(format!("{name}.{ext}")), link).unwrap();
+            }
+        }
+    }
+    let child = compose()
+        .current_dir(dir)
+        .args(["--refl", "refl.####.exr", "--trans", "trans.####.exr"])
+        .args(["--mask", "mask.####.png", "--data-type", "float"])
+        .args([
+            "--zip-level",
+            "9",
+            "-o",
+            "out.####.exr",
+            "--report",
+            "r.json",
+        ])
+        .arg("--frames")
+        .arg(format!("1-{frames}"))
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn compose");
+    let landed = || names(dir).iter().any(|n| n.starts_with("out."));
+    signal_when(child, landed, signal)
+}
+
+#[test]
+fn a_stopped_sequence_writes_its_report() {
+    // The report says what a stopped run did: the frames finished (their outputs complete on
+    // disk), the ones in flight (interrupted: no output), the ones never started, the signal;
+    // and compose exits with 128 + the signal's number. (It was not written at all.)
+    for (signal, code) in [("TERM", 143), ("INT", 130)] {
+        if signal == "INT" && sigint_ignored() {
+            eprintln!("SIGINT is ignored by this test process and so by compose: not sent");
+            continue;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        slow_compose_inputs(d, 256, 256);
+        let mut frames = 16;
+        let (got, stderr) = loop {
+            if let Some(stopped) = stop_a_sequence(d, frames, signal) {
+                break stopped;
+            }
+            assert!(frames < 1024, "compose always finished before SIG{signal}");
+            for n in names(d).iter().filter(|n| n.starts_with("out.")) {
+                std::fs::remove_file(d.join(n)).unwrap();
+            }
+            frames *= 4;
+        };
+        assert_eq!(got, Some(code), "exit code after SIG{signal}: {stderr}");
+        assert!(stderr.contains("wrote r.json"), "{stderr}");
+        assert_no_temporaries(d);
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("r.json")).unwrap()).unwrap();
+        assert_eq!(report["stopped_by"], format!("SIG{signal}"));
+        let entries = report["frames"].as_array().unwrap();
+        let numbers: Vec<u64> = entries
+            .iter()
+            .map(|e| e["frame"].as_u64().unwrap())
+            .collect();
+        assert_eq!(numbers, (1..=u64::from(frames)).collect::<Vec<_>>());
+        let mut interrupted = Vec::new();
+        for e in entries {
+            let out = d.join(e["output"].as_str().unwrap());
+            match e["status"].as_str().unwrap() {
+                "composed" => assert!(out.exists() && e["seconds"]["encode"].is_number(), "{e}"),
+                "interrupted" => interrupted.push(e["frame"].clone()),
+                "not-started" => assert!(!out.exists(), "{e}"),
+                other => panic!("frame status {other} in a stopped run: {e}"),
+            }
+        }
+        assert!(report["composed"].as_u64().unwrap() >= 1, "{report}");
+        assert_eq!(report["interrupted"], serde_json::Value::from(interrupted));
+        assert!(report["interrupted"].as_array().unwrap().len() <= 2);
     }
 }
 
