@@ -762,3 +762,63 @@ fn errors_quote_huge_input_values_bounded() {
     let said = fails(glassdb().arg("spectral").arg(&spectral));
     assert!(said.len() < 1000, "{} bytes: {:.300}", said.len(), said);
 }
+
+/// Camera and planes files quote what they read bounded too: serde_json's own message
+/// (`invalid type: string "…"` quotes the value whole), a planes file's `format`, a camera's
+/// frame keys given twice (`"1"` and `"000…01"`).
+#[test]
+fn camera_and_planes_errors_quote_huge_values_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let huge = "x".repeat(100_000);
+    let camera = std::fs::read_to_string(repo_path("fixtures/scene/camera.json")).unwrap();
+    let cameras = [
+        serde_json::json!({"origin": huge, "target": [0, 0, 0], "fov_x_deg": 50, "width": 8, "height": 8})
+            .to_string(),
+        serde_json::json!({"frames": {"1": huge}}).to_string(),
+        format!(r#"{{"frames": {{"1": {camera}, "{}1": {camera}}}}}"#, "0".repeat(100_000)),
+    ];
+    for (k, text) in cameras.iter().enumerate() {
+        let cam = write_file(d, &format!("camera{k}.json"), text.as_bytes());
+        let said = fails(
+            glassdb()
+                .arg("mask")
+                .arg(repo_path("fixtures/scene/room.obj"))
+                .arg("--camera")
+                .arg(&cam)
+                .args(["--glass", "Clear_6mm=1", "-o"])
+                .arg(d.join("m.png")),
+        );
+        assert!(said.len() < 1000, "{} bytes: {:.300}", said.len(), said);
+        assert!(said.contains("bytes)"), "{said}");
+    }
+    let planes = [
+        serde_json::json!({"format": "glassdb-planes/1", "planes": [huge]}),
+        {
+            let atrium = repo_path("fixtures/atrium/virtual/planes.json");
+            let mut planes: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(atrium).unwrap()).unwrap();
+            planes["format"] = huge.clone().into();
+            planes
+        },
+    ];
+    for (k, json) in planes.iter().enumerate() {
+        let file = write_file(d, &format!("planes{k}.json"), json.to_string().as_bytes());
+        let a = |f: &str| repo_path(&format!("fixtures/atrium/{f}"));
+        let said = fails(
+            compose()
+                .args(["--refl".as_ref(), a("refl_0.exr").as_os_str()])
+                .args(["--trans".as_ref(), a("trans.exr").as_os_str()])
+                .args(["--mask".as_ref(), a("mask.png").as_os_str()])
+                .arg("--planes")
+                .arg(&file)
+                .arg("-o")
+                .arg(d.join("o.png")),
+        );
+        assert!(said.len() < 1000, "{} bytes: {:.300}", said.len(), said);
+        assert!(
+            said.contains("planes file") && said.contains("bytes)"),
+            "{said}"
+        );
+    }
+}

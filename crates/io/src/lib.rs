@@ -46,7 +46,7 @@ pub use registry::{
 pub mod progress;
 mod quote;
 pub use progress::{NoProgress, Progress, StageLog};
-pub use quote::{MAX_QUOTED_CHARS, Quoted, backticked, bounded_message, quoted};
+pub use quote::{BoundedError, MAX_QUOTED_CHARS, Quoted, backticked, bounded_message, quoted};
 
 /// Displays an error with its causes as `outer: cause: root`, as `anyhow`'s `{:#}` does, for
 /// messages that are printed or written without going through `anyhow`.
