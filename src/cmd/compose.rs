@@ -17,7 +17,7 @@ use glassdb_compose::{
 use glassdb_encode::{ExrDataType, OutputOptions, parse_exr_compression};
 use glassdb_pass::PngBits;
 use glassdb_registry::{ColourBasis, Registry};
-use glassdb_sequence::{FrameDone, FrameOutcome, FramesReport, SequenceOptions};
+use glassdb_sequence::{FrameDone, FrameOutcome, FramesReport, SequenceOptions, SequenceProgress};
 
 use crate::cmd::inputs::FrameInputArgs;
 use crate::cmd::progress::Spinner;
@@ -302,8 +302,21 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
 
 fn report_nonfinite(r: &FrameReport, label: &str) {
     if r.output.half_overflow > 0 {
+        let first = r
+            .output
+            .first_half_overflow
+            .as_ref()
+            .map_or(String::new(), |s| {
+                format!(
+                    " (the first at pixel ({}, {}), channel {}: {})",
+                    s.x,
+                    s.y,
+                    glassdb_io::quoted(&s.channel),
+                    s.value
+                )
+            });
         eprintln!(
-            "warning: {label}{} output samples exceed the half-float range (±65504) and were stored as infinite; write float (--data-type float) to keep them",
+            "warning: {label}{} output samples exceed the half-float range and were clamped to ±65504, the largest half{first}; write float (--data-type float) to keep them",
             r.output.half_overflow
         );
     }
@@ -420,8 +433,15 @@ fn run_sequence(
     let options = SequenceOptions {
         skip_existing: args.skip_existing,
     };
-    let outcomes =
-        glassdb_sequence::compose_sequence(job, &frames, settings, luts, options, &on_done)?;
+    let progress = std::sync::Arc::new(SequenceProgress::new(job, &frames));
+    // A stop by a signal still writes the report: what was finished, what it interrupted.
+    let _report_on_stop = args
+        .report
+        .clone()
+        .map(|path| glassdb_io::on_stop(report_on_stop(path, progress.clone())));
+    let outcomes = glassdb_sequence::compose_sequence(
+        job, &frames, settings, luts, options, &progress, &on_done,
+    )?;
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -429,6 +449,31 @@ fn run_sequence(
         FramesReport::from_outcomes(&outcomes).write(report)?;
     }
     report_sequence(args, &outcomes, frames.len(), luts, settings)
+}
+
+/// Writes the frames report of a sequence stopped by a signal (the exit code's).
+fn report_on_stop(
+    path: PathBuf,
+    progress: std::sync::Arc<SequenceProgress>,
+) -> impl FnOnce(i32) + Send {
+    move |code| {
+        let signal = super::stop_signal_name(code);
+        let report = progress.stopped_report(signal);
+        match report.write(&path) {
+            Ok(()) => eprintln!(
+                "wrote {} (stopped by {signal}: {} frame(s) composed, {} skipped, {} failed, interrupted: {:?})",
+                path.display(),
+                report.composed,
+                report.skipped,
+                report.failed.len(),
+                report.interrupted
+            ),
+            Err(e) => eprintln!(
+                "error: cannot write the frames report: {}",
+                glassdb_io::ErrorChain(&e)
+            ),
+        }
+    }
 }
 
 /// The end of a sequence: each frame's stats when asked, what was written and skipped, and

@@ -89,11 +89,7 @@ fn install_signal_cleanup() {
         .name("signals".into())
         .spawn(move || {
             if let Some(signal) = signals.forever().next() {
-                let name = match signal {
-                    SIGINT => "SIGINT",
-                    SIGTERM => "SIGTERM",
-                    _ => "SIGHUP",
-                };
+                let name = stop_signal_name(128 + signal);
                 eprintln!("stopped by {name}: unfinished outputs removed");
                 glassdb_io::exit_removing_temporaries(128 + signal);
             }
@@ -105,6 +101,16 @@ fn install_signal_cleanup() {
 
 #[cfg(not(unix))]
 fn install_signal_cleanup() {}
+
+/// The name of the signal a stop by which exits with `code` (128 + its number).
+pub fn stop_signal_name(code: i32) -> &'static str {
+    match code - 128 {
+        1 => "SIGHUP",
+        2 => "SIGINT",
+        15 => "SIGTERM",
+        _ => "a signal",
+    }
+}
 
 /// Turns a subcommand's result into the process exit code, printing the whole error chain and
 /// the hints that say which flag or command fixes it. The code follows the error's kind:

@@ -474,6 +474,25 @@ fn missing_and_old_blender_are_refused() {
 }
 
 #[test]
+fn a_blender_that_writes_nothing_is_named_with_its_log() {
+    // It once said "cannot move …/scene.obj: No such file or directory".
+    let t = tempfile::tempdir().unwrap();
+    let blend = blend_stub(t.path());
+    let out = t.path().join("out");
+    let silent = fake_blender(t.path(), "3.4.1", "exit 0");
+    fails_naming(
+        &mut render_with(&silent, &blend, &out, &[]),
+        &[
+            "Blender 3.4.1",
+            &silent.display().to_string(),
+            "exited without an error",
+            "wrote no scene export: scene.obj, scene.mtl, camera.json, export.json missing",
+            &out.join("blender.log").display().to_string(),
+        ],
+    );
+}
+
+#[test]
 fn python_without_bpy_is_refused() {
     let t = tempfile::tempdir().unwrap();
     let blend = blend_stub(t.path());

@@ -85,6 +85,21 @@ pub enum BlenderError {
         /// The end of the log.
         tail: String,
     },
+    /// Blender exited without an error but did not write what the step asked of it (a stand-in
+    /// or a broken install that ignores the script).
+    #[error(
+        "{blender} exited without an error but wrote no scene export: {missing} missing in {dir} (its log: {log})"
+    )]
+    NothingWritten {
+        /// The Blender program run, with its version (`Blender 3.4.1 (/usr/bin/blender)`).
+        blender: String,
+        /// The files missing, comma-separated.
+        missing: String,
+        /// Where they should be.
+        dir: PathBuf,
+        /// Blender's log.
+        log: PathBuf,
+    },
     /// Blender ran longer than allowed and was stopped.
     #[error(
         "Blender ({step}) on {blend} took longer than {seconds} s and was stopped (log: {log})"
@@ -174,8 +189,8 @@ impl BlenderError {
 }
 
 impl BlenderError {
-    /// The class of this error: a wrapped error's own class; a Blender missing or too old is
-    /// unsupported, one that does not finish in time a limit, a file of the run that cannot
+    /// The class of this error: a wrapped error's own class; a Blender missing, too old or
+    /// writing nothing is unsupported, one that does not finish in time a limit, a file of the run that cannot
     /// be made or moved (or Blender failing) I/O; anything else is a scene, a render or an
     /// option to fix.
     pub fn kind(&self) -> glassdb_io::ErrorKind {
@@ -191,7 +206,8 @@ impl BlenderError {
             BlenderError::NotFound { .. }
             | BlenderError::NoBpyModule { .. }
             | BlenderError::VersionUnreadable { .. }
-            | BlenderError::TooOld { .. } => ErrorKind::Unsupported,
+            | BlenderError::TooOld { .. }
+            | BlenderError::NothingWritten { .. } => ErrorKind::Unsupported,
             BlenderError::VersionTimedOut { .. } | BlenderError::TimedOut { .. } => {
                 ErrorKind::Limits
             }

@@ -269,7 +269,24 @@ pub fn export_scene(work: &Workspace<'_>) -> Result<ExportInfo, BlenderError> {
         args.extend(["--resolution".into(), r]);
     }
     work.run("export", args)?;
-    for name in ["scene.obj", "scene.mtl", "camera.json", "export.json"] {
+    let names = ["scene.obj", "scene.mtl", "camera.json", "export.json"];
+    let missing: Vec<&str> = names
+        .into_iter()
+        .filter(|n| !export_dir.join(n).is_file())
+        .collect();
+    if !missing.is_empty() {
+        return Err(BlenderError::NothingWritten {
+            blender: format!(
+                "Blender {} ({})",
+                work.blender.version,
+                work.blender.path.display()
+            ),
+            missing: missing.join(", "),
+            dir: export_dir,
+            log: work.log.clone(),
+        });
+    }
+    for name in names {
         let from = export_dir.join(name);
         std::fs::rename(&from, work.dir.join(name)).map_err(BlenderError::io("move", &from))?;
     }

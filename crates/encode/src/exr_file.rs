@@ -140,12 +140,8 @@ pub(crate) fn exr_output(
             (file.attributes, parts, kept)
         }
     };
-    for (name, value) in &opts.provenance {
-        if let (Some(name), Some(value)) = (exr_text(name), exr_text(value)) {
-            attributes.other.insert(name, AttributeValue::Text(value));
-        }
-    }
     let mut parts = parts;
+    replace_provenance(&mut attributes, &mut parts, &opts.provenance);
     if let Some(space) = tag_space {
         tag_colour(&mut attributes, &mut parts, space);
     }
@@ -157,6 +153,30 @@ pub(crate) fn exr_output(
         },
         kept,
     )
+}
+
+/// The prefix of glassdb's own attributes ([`OutputOptions::provenance`]).
+const PROVENANCE_PREFIX: &str = "glassdb/";
+
+/// Sets glassdb's provenance on the output's shared attributes. The carried file's own
+/// `glassdb/*` attributes (a previous composite's, in any part) describe the run that wrote it,
+/// not this one: they are removed, so the provenance appears once and is this run's (the exr
+/// crate refuses a name both shared and a part's own).
+fn replace_provenance(
+    attributes: &mut ExrImageAttributes,
+    parts: &mut [ExrPartOut],
+    provenance: &[(String, String)],
+) {
+    let ours = |name: &Text| name.to_string().starts_with(PROVENANCE_PREFIX);
+    attributes.other.retain(|name, _| !ours(name));
+    for part in parts.iter_mut() {
+        part.attributes.other.retain(|name, _| !ours(name));
+    }
+    for (name, value) in provenance {
+        if let (Some(name), Some(value)) = (exr_text(name), exr_text(value)) {
+            attributes.other.insert(name, AttributeValue::Text(value));
+        }
+    }
 }
 
 /// Tags the output with `space`: `chromaticities` (shared by every part), and
@@ -299,6 +319,7 @@ pub(crate) fn write_exr_output(
         bytes,
         encoding,
         half_overflow: report.half_overflow,
+        first_half_overflow: report.first_half_overflow,
         kept_channels,
     })
 }

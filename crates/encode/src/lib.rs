@@ -81,6 +81,7 @@ pub struct OutputOptions {
     /// channels instead of replacing the transmission pass's RGB.
     pub output_layer: Option<String>,
     /// Attributes glassdb adds to EXR output (name, text): its version, the registry's hash.
+    /// Names start with `glassdb/`; those the transmission file carries are replaced.
     pub provenance: Vec<(String, String)>,
 }
 
@@ -149,8 +150,11 @@ pub struct WrittenOutput {
     pub encoding: String,
     /// Its size.
     pub bytes: u64,
-    /// Finite samples too large for half float, written as ±Inf (half output only).
+    /// Finite samples too large for half float, written as ±65504, the largest finite half
+    /// (half output only).
     pub half_overflow: u64,
+    /// The first of them: its channel, pixel and value.
+    pub first_half_overflow: Option<glassdb_image::ClampedSample>,
     /// Channels and parts carried over from the transmission file besides the composite.
     pub kept_channels: usize,
 }
@@ -200,6 +204,7 @@ pub fn write_output(
         encoding: written.encoding,
         bytes: written.bytes,
         half_overflow: written.half_overflow,
+        first_half_overflow: written.first_half_overflow,
         kept_channels: written.kept_channels,
     })
 }
@@ -209,6 +214,7 @@ pub(crate) struct Written {
     pub(crate) bytes: u64,
     pub(crate) encoding: String,
     pub(crate) half_overflow: u64,
+    pub(crate) first_half_overflow: Option<glassdb_image::ClampedSample>,
     pub(crate) kept_channels: usize,
 }
 

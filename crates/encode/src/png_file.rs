@@ -59,6 +59,7 @@ pub(crate) fn write_png_output(
         bytes,
         encoding,
         half_overflow: 0,
+        first_half_overflow: None,
         kept_channels: 0,
     })
 }

@@ -39,8 +39,8 @@ pub use exr_read::{
     read_exr_headers, read_exr_text_attributes,
 };
 pub use exr_write::{
-    ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport, PlaneSamples,
-    encode_exr_f32, write_exr_image, write_exr_planes,
+    ClampedSample, ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport,
+    PlaneSamples, encode_exr_f32, write_exr_image, write_exr_planes,
 };
 pub use exr_zip::{DEFAULT_ZIP_LEVEL, zip_block_lines};
 pub use memory::ReadMemory;

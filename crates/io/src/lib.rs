@@ -7,7 +7,7 @@
 //!   each kind of file in [`limits`].
 //! - [`protect_inputs`] and [`exit_removing_temporaries`]: the process-wide records that keep
 //!   every file read safe from the outputs and let a signal handler remove the unfinished
-//!   temporary files (docs/reliability.md).
+//!   temporary files (docs/reliability.md); [`on_stop`]: what a stop still writes.
 //! - [`ChildGroup`]: a program started in a process group of its own, stopped with everything
 //!   it started on a timeout or when the process is stopped.
 //! - [`frames`]: frame patterns and frame lists of animations.
@@ -40,11 +40,13 @@ pub use output::{
     OutputError, StagedOutput, SyncingFile, create_output_dirs, refuse_input_as_output,
     write_atomic, write_bytes_atomic,
 };
-pub use registry::{TEMP_PREFIX, declare_inputs, exit_removing_temporaries, protect_inputs};
+pub use registry::{
+    OnStop, TEMP_PREFIX, declare_inputs, exit_removing_temporaries, on_stop, protect_inputs,
+};
 pub mod progress;
 mod quote;
 pub use progress::{NoProgress, Progress, StageLog};
-pub use quote::{MAX_QUOTED_CHARS, Quoted, backticked, bounded_message, quoted};
+pub use quote::{BoundedError, MAX_QUOTED_CHARS, Quoted, backticked, bounded_message, quoted};
 
 /// Displays an error with its causes as `outer: cause: root`, as `anyhow`'s `{:#}` does, for
 /// messages that are printed or written without going through `anyhow`.

@@ -115,8 +115,8 @@ impl PlaneBoundsFile {
         };
         if file.format != PLANE_BOUNDS_FORMAT {
             return Err(bad(format!(
-                "format {:?} is not {PLANE_BOUNDS_FORMAT:?}",
-                file.format
+                "format {} is not {PLANE_BOUNDS_FORMAT:?}",
+                glassdb_io::quoted(&file.format)
             )));
         }
         for p in &file.planes {

@@ -121,9 +121,9 @@ pub enum SceneError {
     PlanesJson {
         /// The planes file.
         path: PathBuf,
-        /// serde's error (line and column).
+        /// serde's error (line and column), shown bounded.
         #[source]
-        source: serde_json::Error,
+        source: glassdb_io::BoundedError<serde_json::Error>,
     },
     /// A `planes.json` describing another number of planes than the reflection passes given.
     #[error(
@@ -142,9 +142,9 @@ pub enum SceneError {
     BoundsJson {
         /// The plane-bounds file.
         path: PathBuf,
-        /// serde's error (line and column).
+        /// serde's error (line and column), shown bounded.
         #[source]
-        source: serde_json::Error,
+        source: glassdb_io::BoundedError<serde_json::Error>,
     },
     /// A plane-bounds file with a wrong format tag or a rectangle outside its frame.
     #[error("plane bounds file {path}: {message}")]

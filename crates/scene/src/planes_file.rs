@@ -74,8 +74,8 @@ impl PlanesFile {
             read_json_file(path, |path, source| SceneError::PlanesJson { path, source })?;
         if file.format != PLANES_FORMAT {
             return Err(bad(format!(
-                "format {:?} is not {PLANES_FORMAT:?}",
-                file.format
+                "format {} is not {PLANES_FORMAT:?}",
+                glassdb_io::quoted(&file.format)
             )));
         }
         if file.planes.is_empty() {
@@ -137,7 +137,10 @@ pub fn sides_from_planes_json(
 /// error of a file that is not valid JSON of that shape (each file kind has its variant).
 pub(crate) fn read_json_file<T: serde::de::DeserializeOwned>(
     path: &Path,
-    json_error: impl FnOnce(std::path::PathBuf, serde_json::Error) -> SceneError,
+    json_error: impl FnOnce(
+        std::path::PathBuf,
+        glassdb_io::BoundedError<serde_json::Error>,
+    ) -> SceneError,
 ) -> Result<T, SceneError> {
     let text = glassdb_io::read_input_string(path, glassdb_io::limits::JSON).map_err(|source| {
         SceneError::Read {
@@ -145,7 +148,8 @@ pub(crate) fn read_json_file<T: serde::de::DeserializeOwned>(
             source,
         }
     })?;
-    serde_json::from_str(&text).map_err(|source| json_error(path.to_path_buf(), source))
+    serde_json::from_str(&text)
+        .map_err(|source| json_error(path.to_path_buf(), glassdb_io::BoundedError(source)))
 }
 
 #[cfg(test)]

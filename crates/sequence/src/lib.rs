@@ -22,7 +22,7 @@ use glassdb_compose::{
 };
 use glassdb_io::ErrorKind;
 
-pub use report::FramesReport;
+pub use report::{FramesReport, SequenceProgress};
 
 /// Why a frame of a sequence, or the sequence itself, failed.
 #[derive(Debug, thiserror::Error)]
@@ -169,12 +169,14 @@ pub const FRAMES_IN_FLIGHT: usize = 2;
 /// completion order). Returns the outcomes in frame order. The frames in flight share
 /// `settings.max_memory`: a frame whose estimate does not fit beside the other's waits for it
 /// (so two large frames run one after the other), and a frame over the whole limit fails.
+/// `progress` (made for `pattern` and `frames`) follows the frames as they start and end.
 pub fn compose_sequence(
     pattern: &ComposeJob,
     frames: &[u32],
     settings: &ComposeSettings,
     luts: &RegistryLuts,
     options: SequenceOptions,
+    progress: &SequenceProgress,
     on_done: &(dyn Fn(&FrameOutcome) + Sync),
 ) -> Result<Vec<FrameOutcome>, SequenceError> {
     if !glassdb_io::is_frame_pattern(&pattern.output) && frames.len() > 1 {
@@ -192,7 +194,9 @@ pub fn compose_sequence(
                     let k = next.fetch_add(1, Ordering::Relaxed);
                     let Some(&frame) = frames.get(k) else { break };
                     let start = Instant::now();
-                    let (job, result) = match pattern.for_frame(frame) {
+                    let job = pattern.for_frame(frame);
+                    progress.start(frame, job.as_ref().ok());
+                    let (job, result) = match job {
                         Ok(job) => {
                             let result = compose_or_skip(&job, settings, luts, &budget, options);
                             (Some(job), result)
@@ -205,6 +209,7 @@ pub fn compose_sequence(
                         result,
                         wall: start.elapsed(),
                     };
+                    progress.finish(&outcome);
                     on_done(&outcome);
                     if let Ok(mut r) = results.lock() {
                         r.push(outcome);

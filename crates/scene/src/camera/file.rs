@@ -138,7 +138,7 @@ impl CameraSource {
                 let spec = CameraSpec::deserialize(value).map_err(|e| SceneError::BadCamera {
                     path: path.clone(),
                     frame: Some(f),
-                    message: e.to_string(),
+                    message: glassdb_io::bounded_message(&e.to_string()),
                 })?;
                 Camera::from_spec(&spec, path, Some(f))
             }
@@ -186,8 +186,13 @@ fn parse_camera_json(
         frame,
         message,
     };
-    let json_err =
-        |e: serde_json::Error| bad(format!("line {}, column {}: {e}", e.line(), e.column()));
+    let json_err = |e: serde_json::Error| {
+        bad(glassdb_io::bounded_message(&format!(
+            "line {}, column {}: {e}",
+            e.line(),
+            e.column()
+        )))
+    };
     let value: Value = serde_json::from_str(text).map_err(json_err)?;
     let animated = matches!(&value, Value::Object(m) if m.contains_key("frames"));
     drop(value);
@@ -217,7 +222,9 @@ fn parse_camera_json(
             })?;
         if let Some(first) = keys.get(&number) {
             return Err(bad(format!(
-                "frame {number} is given twice in \"frames\" (keys {first:?} and {key:?})"
+                "frame {number} is given twice in \"frames\" (keys {} and {})",
+                glassdb_io::quoted(first),
+                glassdb_io::quoted(&key)
             )));
         }
         keys.insert(number, key);
