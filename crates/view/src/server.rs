@@ -172,7 +172,7 @@ impl ViewServer {
                 403,
                 &format!(
                     "this viewer answers requests for localhost, 127.0.0.1, [::1] or the \
-                     address it was started on (--bind), not for Host {}",
+                     address it was started on, not for Host {}",
                     quoted(host)
                 ),
             ));
