@@ -5,7 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::util::{compose, fails, ok, oracle_python, read_exr_planes, repo_path, run, run_oracle};
+use crate::util::{
+    atrium_compose, atrium_refl, compose, fails, ok, oracle_python, read_exr_planes, repo_path,
+    run, run_oracle,
+};
 
 /// The atrium's passes copied as frames `frames` of a sequence in `dir`
 /// (`refl_K.####.exr`, `trans.####.exr`, `mask.####.png`), as a renderer would write them.
@@ -35,32 +38,6 @@ fn compose_frames(dir: &Path, frames: &str) -> std::process::Command {
         .arg(repo_path("fixtures/atrium/virtual/planes.json"))
         .args(["-o", "out.####.exr", "--frames", frames]);
     c
-}
-
-/// `compose` of the atrium's transmission pass and mask (with its planes.json) with the
-/// reflection passes `refl`, into `out`.
-fn atrium_compose(refl: &[PathBuf], out: &Path) -> std::process::Command {
-    let a = repo_path("fixtures/atrium");
-    let mut c = compose();
-    for r in refl {
-        c.arg("--refl").arg(r);
-    }
-    c.arg("--trans")
-        .arg(a.join("trans.exr"))
-        .arg("--mask")
-        .arg(a.join("mask.png"))
-        .arg("--planes")
-        .arg(a.join("virtual/planes.json"))
-        .arg("-o")
-        .arg(out);
-    c
-}
-
-/// The atrium's three reflection passes.
-fn atrium_refl() -> Vec<PathBuf> {
-    (0..3)
-        .map(|k| repo_path(&format!("fixtures/atrium/refl_{k}.exr")))
-        .collect()
 }
 
 fn json(path: &Path) -> serde_json::Value {
