@@ -30,6 +30,10 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fixture_scene  # noqa: E402
+from fixture_scene import set_use_nodes  # noqa: E402
+
 WIDTH, HEIGHT = 64, 48
 SAMPLES = 4
 BORDER = (0.25, 0.75, 0.25, 0.75)  # min x, max x, min y, max y
@@ -39,10 +43,7 @@ OUTPUTS = ("multilayer.exr", "border.exr", "border_crop.exr", "rgba.exr")
 
 def parse_args(argv):
     """Arguments after `--` (inside blender) or all of argv[1:] (plain Python / bpy module)."""
-    if "--" in argv:
-        argv = argv[argv.index("--") + 1:]
-    else:
-        argv = argv[1:]
+    argv = fixture_scene.script_args(argv)
     out, describe = None, False
     i = 0
     while i < len(argv):
@@ -78,13 +79,6 @@ def render_all(out_dir):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     version = tuple(bpy.app.version)
     scene = bpy.context.scene
-
-    def set_use_nodes(idblock):
-        # Blender 5.0 deprecates use_nodes: new materials and worlds always have a node tree.
-        if version < (5, 0, 0):
-            idblock.use_nodes = True
-        if idblock.node_tree is None:
-            sys.exit("%s has no node tree" % idblock.name)
 
     def add_facing_aov(nt, at_x=-200):
         """AOV `facing` = |N . I| from a Geometry node."""
@@ -167,42 +161,16 @@ def render_all(out_dir):
     scene.camera = cam
 
     # World: grey.
-    world = bpy.data.worlds.new("World")
-    world.color = (0.5, 0.5, 0.5)
-    set_use_nodes(world)
-    bg = world.node_tree.nodes.get("Background")
-    if bg is None:
-        nt = world.node_tree
-        nt.nodes.clear()
-        bg = nt.nodes.new("ShaderNodeBackground")
-        wo = nt.nodes.new("ShaderNodeOutputWorld")
-        nt.links.new(bg.outputs["Background"], wo.inputs["Surface"])
-    bg.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-    bg.inputs["Strength"].default_value = 1.0
-    scene.world = world
+    fixture_scene.grey_world(scene)
 
     # Render settings.
-    r = scene.render
-    r.engine = "CYCLES"
-    scene.cycles.device = "CPU"
+    r = fixture_scene.fixed_cycles(scene)
     scene.cycles.samples = SAMPLES
-    scene.cycles.seed = 0
-    scene.cycles.use_animated_seed = False
-    scene.cycles.use_denoising = False
-    if hasattr(scene.cycles, "use_adaptive_sampling"):
-        scene.cycles.use_adaptive_sampling = False
-    r.resolution_x, r.resolution_y, r.resolution_percentage = WIDTH, HEIGHT, 100
+    r.resolution_x, r.resolution_y = WIDTH, HEIGHT
     r.film_transparent = True
-    r.threads_mode = "FIXED"
-    r.threads = 2
-    r.use_compositing = False
-    r.use_sequencer = False
-    r.use_file_extension = True
 
     # Passes.
     vl = scene.view_layers[0]
-    if hasattr(vl, "cycles"):
-        vl.cycles.use_denoising = False
     vl.use_pass_combined = True
     vl.use_pass_z = True
     vl.use_pass_normal = True
@@ -221,12 +189,7 @@ def render_all(out_dir):
     im = r.image_settings
 
     def set_format(multilayer):
-        if hasattr(im, "media_type"):  # Blender 5.0: media type first, then the format
-            im.media_type = "MULTI_LAYER_IMAGE" if multilayer else "IMAGE"
-        im.file_format = "OPEN_EXR_MULTILAYER" if multilayer else "OPEN_EXR"
-        im.color_mode = "RGBA"
-        im.color_depth = "16"
-        im.exr_codec = "ZIP"
+        fixture_scene.set_exr_format(im, multilayer=multilayer, half=True)
 
     def render_to(name, multilayer, border, crop):
         set_format(multilayer)
