@@ -6,6 +6,7 @@ Imported by make_mask_fixtures.py, make_pass_fixtures.py and make_reflection_pas
 puts this folder on `sys.path`). Licence: same as the project, MIT OR Apache-2.0.
 """
 
+import json
 import os
 import sys
 
@@ -108,3 +109,11 @@ def fixed_cycles(scene):
     if hasattr(vl, "cycles"):
         vl.cycles.use_denoising = False
     return r
+
+
+def write_json(path, doc):
+    """Writes `doc` to `path` as JSON indented by one space, with a final newline, and says so."""
+    with open(path, "w") as fh:
+        json.dump(doc, fh, indent=1)
+        fh.write("\n")
+    print("wrote", path)

@@ -656,10 +656,7 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
     }
     if space_info is not None:
         info["working_space"] = space_info
-    with open(os.path.join(out_dir, "check.json"), "w") as fh:
-        json.dump(info, fh, indent=1)
-        fh.write("\n")
-    print("wrote", os.path.join(out_dir, "check.json"))
+    fixture_scene.write_json(os.path.join(out_dir, "check.json"), info)
 
 
 # --------------------------------------------------------------------------------------------
@@ -1131,10 +1128,7 @@ def check_all(out_dir, geo_dir):
     report["files"] = files
     report["problems"] = problems
     path = os.path.join(out_dir, "check.json")
-    with open(path, "w") as fh:
-        json.dump(report, fh, indent=1)
-        fh.write("\n")
-    print("wrote", path)
+    fixture_scene.write_json(path, report)
     if problems:
         sys.exit("check failed: " + "; ".join(problems))
 

@@ -263,10 +263,7 @@ def render_all(out_dir):
             "rgba.exr": {"format": "OPEN_EXR", "use_border": False},
         },
     }
-    with open(os.path.join(out_dir, "layout.json"), "w") as f:
-        json.dump(info, f, indent=1)
-        f.write("\n")
-    print("wrote", os.path.join(out_dir, "layout.json"))
+    fixture_scene.write_json(os.path.join(out_dir, "layout.json"), info)
 
 
 # --------------------------------------------------------------------------------------------
@@ -518,10 +515,7 @@ def describe_all(out_dir):
         k: rgba[k] for k in ("channels_used", "combined_nonzero_pixels", "alpha") if k in rgba}
     if rgba["combined_nonzero_pixels"] == 0:
         problems.append("rgba.exr: all zero")
-    with open(path, "w") as f:
-        json.dump(layout, f, indent=1)
-        f.write("\n")
-    print("wrote", path)
+    fixture_scene.write_json(path, layout)
     if problems:
         sys.exit("blank render: " + "; ".join(problems))
 

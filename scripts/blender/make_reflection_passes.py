@@ -379,10 +379,7 @@ def render_reflections(out_dir, geo_dir, scratch, working_space=None):
             add.inputs[1].default_value = -p["d"]
         render_to(scratch, "refl_index_%d.exr" % k)
     info["check_ids"] = CHECK_IDS
-    with open(os.path.join(scratch, "reflection_info.json"), "w") as fh:
-        json.dump(info, fh, indent=1)
-        fh.write("\n")
-    print("wrote", os.path.join(scratch, "reflection_info.json"))
+    fixture_scene.write_json(os.path.join(scratch, "reflection_info.json"), info)
 
 
 # --------------------------------------------------------------------------------------------
