@@ -117,3 +117,24 @@ def write_json(path, doc):
         json.dump(doc, fh, indent=1)
         fh.write("\n")
     print("wrote", path)
+
+
+def render_still(scene, directory, name):
+    """Renders the scene's current frame to `directory/name` and returns the file's size.
+    Blender decides whether a still's name gets a frame number (versions differ), so it renders
+    to a scratch stem and moves the one file written there."""
+    import bpy
+
+    stem = "_render_" + name.split(".")[0]
+    for old in os.listdir(directory):
+        if old.startswith(stem):
+            os.remove(os.path.join(directory, old))
+    scene.render.filepath = os.path.join(directory, stem)
+    bpy.ops.render.render(write_still=True)
+    written = [f for f in os.listdir(directory) if f.startswith(stem)]
+    if len(written) != 1:
+        sys.exit("render of %s wrote %r" % (name, written))
+    path = os.path.join(directory, name)
+    os.replace(os.path.join(directory, written[0]), path)
+    print("wrote", path, os.path.getsize(path))
+    return os.path.getsize(path)

@@ -459,20 +459,8 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
         fixture_scene.set_exr_format(im, multilayer=True, half=half)
 
     def render_to(name, frame):
-        # Blender decides whether a still's name gets a frame number (versions differ), so
-        # render to a scratch stem and move the one file written there.
-        stem = "_render_" + name.split(".")[0]
-        for old in os.listdir(out_dir):
-            if old.startswith(stem):
-                os.remove(os.path.join(out_dir, old))
-        r.filepath = os.path.join(out_dir, stem)
         scene.frame_set(frame)
-        bpy.ops.render.render(write_still=True)
-        written = [f for f in os.listdir(out_dir) if f.startswith(stem)]
-        if len(written) != 1:
-            sys.exit("render of %s wrote %r" % (name, written))
-        os.replace(os.path.join(out_dir, written[0]), os.path.join(out_dir, name))
-        print("wrote", os.path.join(out_dir, name), os.path.getsize(os.path.join(out_dir, name)))
+        fixture_scene.render_still(scene, out_dir, name)
 
     # Geometry and cameras, from Blender's own data.
     def f32_rows(m):

@@ -196,20 +196,8 @@ def render_all(out_dir):
         r.use_border = border
         r.use_crop_to_border = crop
         r.border_min_x, r.border_max_x, r.border_min_y, r.border_max_y = BORDER
-        # Blender decides whether a still's name gets a frame number (versions differ), so
-        # render to a scratch stem and move the one file written there.
-        stem = "_render_" + os.path.splitext(name)[0]
-        for old in os.listdir(out_dir):
-            if old.startswith(stem):
-                os.remove(os.path.join(out_dir, old))
-        r.filepath = os.path.join(out_dir, stem)
         scene.frame_set(1)
-        bpy.ops.render.render(write_still=True)
-        written = [f for f in os.listdir(out_dir) if f.startswith(stem)]
-        if len(written) != 1:
-            sys.exit("render of %s wrote %r" % (name, written))
-        os.replace(os.path.join(out_dir, written[0]), os.path.join(out_dir, name))
-        print("wrote", os.path.join(out_dir, name), os.path.getsize(os.path.join(out_dir, name)))
+        fixture_scene.render_still(scene, out_dir, name)
 
     render_to("multilayer.exr", True, False, False)
     render_to("border.exr", True, True, False)

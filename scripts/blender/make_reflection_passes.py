@@ -194,19 +194,7 @@ def render_reflections(out_dir, geo_dir, scratch, working_space=None):
     fixture_scene.set_exr_format(im, multilayer=True, half=True)
 
     def render_to(directory, name):
-        stem = "_render_" + name.split(".")[0]
-        for old in os.listdir(directory):
-            if old.startswith(stem):
-                os.remove(os.path.join(directory, old))
-        r.filepath = os.path.join(directory, stem)
-        bpy.ops.render.render(write_still=True)
-        written = [f for f in os.listdir(directory) if f.startswith(stem)]
-        if len(written) != 1:
-            sys.exit("render of %s wrote %r" % (name, written))
-        path = os.path.join(directory, name)
-        os.replace(os.path.join(directory, written[0]), path)
-        print("wrote", path, os.path.getsize(path))
-        return os.path.getsize(path)
+        return fixture_scene.render_still(scene, directory, name)
 
     glass = [bpy.data.objects[name] for name, _m, _i, plane, _g in mmf.OBJECTS
              if plane is not None]
