@@ -7,7 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::util::{
-    compose, fails, fails_naming, ok, oracle_python, read_exr_planes, repo_path, run, run_oracle,
+    atrium_compose, atrium_refl, compose, fails, fails_naming, ok, oracle_python, read_exr_planes,
+    repo_path, run, run_oracle,
 };
 
 /// The atrium's passes copied as frames `frames` of a sequence in `dir`
@@ -43,32 +44,6 @@ fn compose_frames_to(dir: &Path, frames: &str, output: &str) -> std::process::Co
         .arg(repo_path("fixtures/atrium/virtual/planes.json"))
         .args(["-o", output, "--frames", frames]);
     c
-}
-
-/// `compose` of the atrium's transmission pass and mask (with its planes.json) with the
-/// reflection passes `refl`, into `out`.
-fn atrium_compose(refl: &[PathBuf], out: &Path) -> std::process::Command {
-    let a = repo_path("fixtures/atrium");
-    let mut c = compose();
-    for r in refl {
-        c.arg("--refl").arg(r);
-    }
-    c.arg("--trans")
-        .arg(a.join("trans.exr"))
-        .arg("--mask")
-        .arg(a.join("mask.png"))
-        .arg("--planes")
-        .arg(a.join("virtual/planes.json"))
-        .arg("-o")
-        .arg(out);
-    c
-}
-
-/// The atrium's three reflection passes.
-fn atrium_refl() -> Vec<PathBuf> {
-    (0..3)
-        .map(|k| repo_path(&format!("fixtures/atrium/refl_{k}.exr")))
-        .collect()
 }
 
 fn json(path: &Path) -> serde_json::Value {

@@ -14,7 +14,7 @@ use crate::util::{
 
 #[path = "../../crates/fit/tests/common/inputs.rs"]
 mod inputs;
-use inputs::{gaussian, r_plus_t_above_one_csv};
+use inputs::{gaussian, r_plus_t_above_one_csv, r_plus_t_csv};
 
 const CLEAR: &str = "data/angles/clear_6mm_fresnel.csv";
 const BRONZE: &str = "data/angles/bronze_coated_window4.csv";
@@ -423,21 +423,7 @@ fn strict_mode_fails_on_a_physical_violation() {
     let dir = tempfile::tempdir().unwrap();
     // R + T = 1.001: within the fit file's tolerance (0.002 per curve), so a warning, and an
     // error only with --strict.
-    let rows: String = (0..=9)
-        .map(|i| {
-            format!(
-                "{},{},{}\n",
-                i * 10,
-                0.1 + 0.001 * i as f64,
-                0.901 - 0.001 * i as f64
-            )
-        })
-        .collect();
-    let p = write_file(
-        dir.path(),
-        "small.csv",
-        format!("angle_deg,R,T\n{rows}").as_bytes(),
-    );
+    let p = write_file(dir.path(), "small.csv", r_plus_t_csv(0.901).as_bytes());
     let (res, _, stderr) = run(glassdb().arg("fit").arg(&p));
     assert!(res.status.success(), "{stderr}");
     assert!(stderr.contains("r + t > 1"), "{stderr}");

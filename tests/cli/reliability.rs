@@ -10,7 +10,7 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::util::{
-    assert_names, compose, fails, glassdb, ok, registry_build, repo_path, write_file,
+    assert_names, compose, fails, glassdb, names, ok, registry_build, repo_path, write_file,
 };
 
 /// Runs `cmd` (no standard input) and returns its output, failing the test if it runs longer
@@ -52,16 +52,6 @@ fn refused_within(cmd: &mut Command, limit: Duration, parts: &[&str]) -> String 
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_names(&stderr, parts);
     stderr
-}
-
-/// The names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// Asserts that no `.glassdb-tmp-*` file is left in `dir`.

@@ -346,3 +346,39 @@ pub fn example_copy() -> tempfile::TempDir {
     }
     dir
 }
+
+/// `compose` of the atrium's transmission pass and mask (with its planes.json) with the
+/// reflection passes `refl`, into `out`.
+pub fn atrium_compose(refl: &[PathBuf], out: &Path) -> Command {
+    let a = repo_path("fixtures/atrium");
+    let mut c = compose();
+    for r in refl {
+        c.arg("--refl").arg(r);
+    }
+    c.arg("--trans")
+        .arg(a.join("trans.exr"))
+        .arg("--mask")
+        .arg(a.join("mask.png"))
+        .arg("--planes")
+        .arg(a.join("virtual/planes.json"))
+        .arg("-o")
+        .arg(out);
+    c
+}
+
+/// The atrium's three reflection passes.
+pub fn atrium_refl() -> Vec<PathBuf> {
+    (0..3)
+        .map(|k| repo_path(&format!("fixtures/atrium/refl_{k}.exr")))
+        .collect()
+}
+
+/// The names in `dir`, sorted.
+pub fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}

@@ -181,6 +181,37 @@ struct Score {
     refused: usize,
 }
 
+/// Scores one typo case `(sparse, kind)` with the three screens: the shipped one (counting
+/// whether it refuses the table), leave-one-out and the suspects. True when the shipped screen
+/// found nothing (a miss).
+fn score_case(
+    scores: &mut BTreeMap<(bool, usize, usize), Score>,
+    (sparse, k): (bool, usize),
+    typo: &Rows,
+    want: &[(Quantity, f64)],
+    line: u64,
+) -> bool {
+    let text = csv(typo);
+    let s = scores.entry((sparse, k, 0)).or_default();
+    let found = s.exact + s.extra;
+    s.refused += usize::from(refused(&text));
+    score(s, &shipped(&text), want, line);
+    let missed = s.exact + s.extra == found;
+    score(
+        scores.entry((sparse, k, 1)).or_default(),
+        &leave_one_out(typo),
+        want,
+        line,
+    );
+    score(
+        scores.entry((sparse, k, 2)).or_default(),
+        &suspects(&text),
+        want,
+        line,
+    );
+    missed
+}
+
 /// True when `glassdb fit`'s defaults refuse the table (any check).
 fn refused(text: &str) -> bool {
     match parse_angle_table(text.as_bytes(), Path::new("t.csv"), "t", false) {
@@ -318,30 +349,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     }
                     *cell = Some(v * factor);
                     let want = [(q, rows[i].0)];
-                    let text = csv(&typo);
-                    let s = scores.entry((sparse, k, 0)).or_default();
-                    let found = s.exact + s.extra;
-                    s.refused += usize::from(refused(&text));
-                    score(s, &shipped(&text), &want, line);
-                    if list_misses && s.exact + s.extra == found {
+                    let missed = score_case(&mut scores, (sparse, k), &typo, &want, line);
+                    if list_misses && missed {
                         eprintln!(
                             "screen misses: {name}: {} {}° {v} × {factor}",
                             q.name(),
                             rows[i].0
                         );
                     }
-                    score(
-                        scores.entry((sparse, k, 1)).or_default(),
-                        &leave_one_out(&typo),
-                        &want,
-                        line,
-                    );
-                    score(
-                        scores.entry((sparse, k, 2)).or_default(),
-                        &suspects(&text),
-                        &want,
-                        line,
-                    );
                 }
             }
             let (a, r, t) = rows[i];
@@ -351,27 +366,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let mut typo = rows.clone();
                 typo[i] = (a, Some(t), Some(r));
                 let want = [(Quantity::Reflectance, a), (Quantity::Transmittance, a)];
-                let text = csv(&typo);
-                let k = kinds.len();
-                let s = scores.entry((sparse, k, 0)).or_default();
-                let found = s.exact + s.extra;
-                s.refused += usize::from(refused(&text));
-                score(s, &shipped(&text), &want, line);
-                if list_misses && s.exact + s.extra == found {
+                let missed = score_case(&mut scores, (sparse, kinds.len()), &typo, &want, line);
+                if list_misses && missed {
                     eprintln!("screen misses: {name}: R and T swapped at {a}° (R {r}, T {t})");
                 }
-                score(
-                    scores.entry((sparse, k, 1)).or_default(),
-                    &leave_one_out(&typo),
-                    &want,
-                    line,
-                );
-                score(
-                    scores.entry((sparse, k, 2)).or_default(),
-                    &suspects(&text),
-                    &want,
-                    line,
-                );
             }
         }
     }

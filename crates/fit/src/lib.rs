@@ -16,16 +16,18 @@
 //!   [`CurveFit::eval_angle_deg`] / [`CosPolynomial::eval`] to use it.
 //!
 //! Modules, each importing only those listed before it: `dd`, `model`, `physical`, `sniff`,
-//! `screen`, `error`, `table`, `solve`, `glass`, `file`.
+//! `screen`, `error`, `prepared`, `chebyshev`, `table`, `solve`, `glass`, `file`.
 
 #![warn(missing_docs)]
 
+mod chebyshev;
 mod dd;
 mod error;
 mod file;
 mod glass;
 mod model;
 mod physical;
+mod prepared;
 mod screen;
 mod sniff;
 mod solve;

@@ -162,7 +162,6 @@ fn read_rows(
     default_name: &str,
     percent: bool,
 ) -> Result<(Vec<String>, Vec<Row>), FitError> {
-    let p = || path.to_path_buf();
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
@@ -170,8 +169,47 @@ fn read_rows(
         .comment(Some(b'#'))
         .flexible(false)
         .from_reader(bytes);
+    let headers = rdr
+        .byte_headers()
+        .map_err(|e| csv_error(path.to_path_buf(), e))?
+        .clone();
+    let (names, columns) = read_header(&headers, path)?;
+    let reader = RowReader {
+        path,
+        names: &names,
+        columns,
+        default_name,
+        percent,
+    };
+    let mut rows = Vec::new();
+    let mut record = csv::ByteRecord::new();
+    while rdr
+        .read_byte_record(&mut record)
+        .map_err(|e| csv_error(path.to_path_buf(), e))?
+    {
+        rows.push(reader.row(&record)?);
+    }
+    if rows.is_empty() {
+        return Err(FitError::NoRows {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok((names, rows))
+}
 
-    let headers = rdr.byte_headers().map_err(|e| csv_error(p(), e))?.clone();
+/// Where the table's columns stand (0-based).
+#[derive(Clone, Copy)]
+struct Columns {
+    angle: usize,
+    r: Option<usize>,
+    t: Option<usize>,
+    glass: Option<usize>,
+}
+
+/// The header's names and where the columns stand: every name known and given once, an angle
+/// column and an R and/or a T column.
+fn read_header(headers: &csv::ByteRecord, path: &Path) -> Result<(Vec<String>, Columns), FitError> {
+    let p = || path.to_path_buf();
     if headers.is_empty() || (headers.len() == 1 && headers[0].iter().all(u8::is_ascii_whitespace))
     {
         return Err(FitError::EmptyFile { path: p() });
@@ -203,7 +241,7 @@ fn read_rows(
         names.push(name);
     }
     let found = names.join(", ");
-    let Some(angle_col) = cols[Field::Angle as usize] else {
+    let Some(angle) = cols[Field::Angle as usize] else {
         return Err(FitError::MissingColumn {
             path: p(),
             line: header_line,
@@ -211,12 +249,13 @@ fn read_rows(
             found,
         });
     };
-    let (r_col, t_col, glass_col) = (
-        cols[Field::R as usize],
-        cols[Field::T as usize],
-        cols[Field::Glass as usize],
-    );
-    if r_col.is_none() && t_col.is_none() {
+    let columns = Columns {
+        angle,
+        r: cols[Field::R as usize],
+        t: cols[Field::T as usize],
+        glass: cols[Field::Glass as usize],
+    };
+    if columns.r.is_none() && columns.t.is_none() {
         return Err(FitError::MissingColumn {
             path: p(),
             line: header_line,
@@ -224,123 +263,145 @@ fn read_rows(
             found,
         });
     }
+    Ok((names, columns))
+}
 
-    let mut rows = Vec::new();
-    let mut record = csv::ByteRecord::new();
-    loop {
-        match rdr.read_byte_record(&mut record) {
-            Ok(true) => {}
-            Ok(false) => break,
-            Err(e) => return Err(csv_error(p(), e)),
-        }
+/// Reads the data rows of one table: what an error names (file, header names) and how the
+/// cells are read.
+struct RowReader<'a> {
+    path: &'a Path,
+    names: &'a [String],
+    columns: Columns,
+    default_name: &'a str,
+    percent: bool,
+}
+
+impl RowReader<'_> {
+    /// One data row: the angle within 0–90°, R and T (when given) not negative (nor above 100
+    /// with `percent`), the glass named.
+    fn row(&self, record: &csv::ByteRecord) -> Result<Row, FitError> {
         let line = record.position().map(|pos| pos.line()).unwrap_or(0);
-        let cell = |col: usize| -> Result<&str, FitError> {
-            let raw = record.get(col).unwrap_or(b"");
-            std::str::from_utf8(raw)
-                .map(str::trim)
-                .map_err(|_| FitError::NotANumber {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header: names.get(col).cloned().unwrap_or_default(),
-                    value: String::from_utf8_lossy(raw).into_owned(),
-                })
-        };
-        let number = |col: usize, text: &str| -> Result<f64, FitError> {
-            let header = names.get(col).cloned().unwrap_or_default();
-            let v: f64 = text.parse().map_err(|_| FitError::NotANumber {
-                path: p(),
-                line,
-                column: col + 1,
-                header: header.clone(),
-                value: text.to_string(),
-            })?;
-            if !v.is_finite() {
-                return Err(FitError::NotFinite {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header,
-                    value: text.to_string(),
-                });
-            }
-            Ok(v)
-        };
-        let angle_text = cell(angle_col)?;
+        let col = self.columns.angle;
+        let angle_text = self.cell(record, line, col)?;
         if angle_text.is_empty() {
             return Err(FitError::EmptyCell {
-                path: p(),
+                path: self.path.to_path_buf(),
                 line,
-                column: angle_col + 1,
-                header: names[angle_col].clone(),
+                column: col + 1,
+                header: self.names[col].clone(),
             });
         }
-        let angle_deg = number(angle_col, angle_text)?;
+        let angle_deg = self.number(line, col, angle_text)?;
         if !(0.0..=90.0).contains(&angle_deg) {
             return Err(FitError::AngleOutOfRange {
-                path: p(),
+                path: self.path.to_path_buf(),
                 line,
-                column: angle_col + 1,
-                header: names[angle_col].clone(),
+                column: col + 1,
+                header: self.names[col].clone(),
                 value: angle_deg,
             });
         }
-        let value = |col: Option<usize>| -> Result<Option<Cell>, FitError> {
-            let Some(col) = col else { return Ok(None) };
-            let text = cell(col)?;
-            if text.is_empty() {
-                return Ok(None);
-            }
-            let v = number(col, text)?;
-            let (top, range) = if percent {
-                (100.0, "0–100 (percent)")
-            } else {
-                (f64::INFINITY, "0–1")
-            };
-            if v < 0.0 || v > top {
-                return Err(FitError::ValueOutOfRange {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header: names[col].clone(),
-                    value: v,
-                    range,
-                });
-            }
-            Ok(Some(Cell {
-                value: v,
-                line,
-                column: col,
-            }))
-        };
-        let r = value(r_col)?;
-        let t = value(t_col)?;
-        let glass = match glass_col {
+        let r = self.value(record, line, self.columns.r)?;
+        let t = self.value(record, line, self.columns.t)?;
+        let glass = match self.columns.glass {
             Some(col) => {
-                let name = cell(col)?;
+                let name = self.cell(record, line, col)?;
                 if name.is_empty() {
                     return Err(FitError::EmptyGlassName {
-                        path: p(),
+                        path: self.path.to_path_buf(),
                         line,
                         column: col + 1,
                     });
                 }
                 name.to_string()
             }
-            None => default_name.to_string(),
+            None => self.default_name.to_string(),
         };
-        rows.push(Row {
+        Ok(Row {
             glass,
             angle_deg,
             line,
             r,
             t,
-        });
+        })
     }
-    if rows.is_empty() {
-        return Err(FitError::NoRows { path: p() });
+
+    /// The text of a cell, trimmed; not UTF-8 is not a number.
+    fn cell<'r>(
+        &self,
+        record: &'r csv::ByteRecord,
+        line: u64,
+        col: usize,
+    ) -> Result<&'r str, FitError> {
+        let raw = record.get(col).unwrap_or(b"");
+        std::str::from_utf8(raw)
+            .map(str::trim)
+            .map_err(|_| FitError::NotANumber {
+                path: self.path.to_path_buf(),
+                line,
+                column: col + 1,
+                header: self.names.get(col).cloned().unwrap_or_default(),
+                value: String::from_utf8_lossy(raw).into_owned(),
+            })
     }
-    Ok((names, rows))
+
+    /// A cell's text as a finite number.
+    fn number(&self, line: u64, col: usize, text: &str) -> Result<f64, FitError> {
+        let header = self.names.get(col).cloned().unwrap_or_default();
+        let v: f64 = text.parse().map_err(|_| FitError::NotANumber {
+            path: self.path.to_path_buf(),
+            line,
+            column: col + 1,
+            header: header.clone(),
+            value: text.to_string(),
+        })?;
+        if !v.is_finite() {
+            return Err(FitError::NotFinite {
+                path: self.path.to_path_buf(),
+                line,
+                column: col + 1,
+                header,
+                value: text.to_string(),
+            });
+        }
+        Ok(v)
+    }
+
+    /// An R or T cell of column `col` (none when the column or the cell is empty), within its
+    /// range.
+    fn value(
+        &self,
+        record: &csv::ByteRecord,
+        line: u64,
+        col: Option<usize>,
+    ) -> Result<Option<Cell>, FitError> {
+        let Some(col) = col else { return Ok(None) };
+        let text = self.cell(record, line, col)?;
+        if text.is_empty() {
+            return Ok(None);
+        }
+        let v = self.number(line, col, text)?;
+        let (top, range) = if self.percent {
+            (100.0, "0–100 (percent)")
+        } else {
+            (f64::INFINITY, "0–1")
+        };
+        if v < 0.0 || v > top {
+            return Err(FitError::ValueOutOfRange {
+                path: self.path.to_path_buf(),
+                line,
+                column: col + 1,
+                header: self.names[col].clone(),
+                value: v,
+                range,
+            });
+        }
+        Ok(Some(Cell {
+            value: v,
+            line,
+            column: col,
+        }))
+    }
 }
 
 /// The unit of the R and T cells, judged on the whole table: without `percent`, a table whose

@@ -9,7 +9,8 @@ use exr::block::chunk::Chunk;
 use exr::meta::header::Header;
 use rayon::prelude::*;
 
-use crate::exr_read::{ExrPart, ExrSampleType, guarded, incomplete};
+use crate::exr_header::{ExrPart, ExrSampleType};
+use crate::exr_read::{guarded, incomplete};
 use crate::guard::catch_codec_panic;
 use crate::{Codec, ImageError};
 

@@ -10,6 +10,7 @@
 
 mod error;
 mod exr_bands;
+mod exr_header;
 mod exr_layers;
 pub mod exr_read;
 mod exr_write;
@@ -28,15 +29,17 @@ pub use exr::meta::header::{
     ImageAttributes as ExrImageAttributes, LayerAttributes as ExrLayerAttributes,
 };
 pub use exr::prelude::FlatSamples;
+pub use exr_header::{
+    ExrChannelInfo, ExrColourTag, ExrHeaders, ExrPart, ExrSampleType, MAX_EXR_PARTS,
+    read_exr_header_info, read_exr_headers, read_exr_text_attributes,
+};
 pub use exr_layers::{
     ChannelMatch, LayerChoiceError, RgbLayer, all_channel_names, choose_rgb_layer, find_channel,
     plane_layers, rgb_layers,
 };
 pub use exr_read::{
-    ExactExr, ExactPart, ExrChannelInfo, ExrColourTag, ExrHeaders, ExrPart, ExrSampleType,
-    MAX_EXR_PARTS, check_exr_readable, read_exr_attributes, read_exr_channel_rows,
-    read_exr_channel_rows_from, read_exr_channels, read_exr_exact, read_exr_header_info,
-    read_exr_headers, read_exr_text_attributes,
+    ExactExr, ExactPart, check_exr_readable, read_exr_attributes, read_exr_channel_rows,
+    read_exr_channel_rows_from, read_exr_channels, read_exr_exact,
 };
 pub use exr_write::{
     ClampedSample, ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport,

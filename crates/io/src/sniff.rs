@@ -2,8 +2,9 @@
 //! database): named from its signature, so that the reader's message says what the file is
 //! instead of echoing its bytes as a bad header or cell.
 
-/// How many leading bytes [`binary_kind`] looks at.
-const SNIFF_BYTES: usize = 8192;
+/// How many leading bytes the sniffers look at ([`binary_kind`], and the spectral readers' look
+/// for markup).
+pub const SNIFF_BYTES: usize = 8192;
 
 /// Known binary signatures and what they usually are.
 const SIGNATURES: &[(&[u8], &str)] = &[

@@ -14,6 +14,7 @@
 
 #![warn(missing_docs)]
 
+mod aov;
 mod channels;
 mod cos_code;
 mod cryptomatte;

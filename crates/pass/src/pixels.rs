@@ -50,14 +50,7 @@ impl LinearImage {
     /// Straight alpha (PNG's convention) to premultiplied (EXR's and the compositor's):
     /// colour × alpha. Without alpha nothing changes.
     pub fn premultiply(&mut self) {
-        if let Some(alpha) = &self.alpha {
-            for plane in &mut self.rgb {
-                plane
-                    .par_iter_mut()
-                    .zip(alpha.par_iter())
-                    .for_each(|(c, &a)| *c *= a);
-            }
-        }
+        self.with_alpha(|c, a| *c *= a);
     }
 
     /// Premultiplied to straight alpha, for PNG output: colour ÷ alpha where alpha > 0;
@@ -65,16 +58,22 @@ impl LinearImage {
     /// `--unpremult` does (light with no coverage, e.g. a reflection on a transparent
     /// background, cannot be stored straight).
     pub fn unpremultiply(&mut self) {
+        self.with_alpha(|c, a| {
+            if a > 0.0 {
+                *c /= a;
+            }
+        });
+    }
+
+    /// `f(colour, alpha)` on every colour sample with its pixel's alpha, in parallel; nothing
+    /// without alpha.
+    fn with_alpha(&mut self, f: impl Fn(&mut f32, f32) + Sync + Send) {
         if let Some(alpha) = &self.alpha {
             for plane in &mut self.rgb {
                 plane
                     .par_iter_mut()
                     .zip(alpha.par_iter())
-                    .for_each(|(c, &a)| {
-                        if a > 0.0 {
-                            *c /= a;
-                        }
-                    });
+                    .for_each(|(c, &a)| f(c, a));
             }
         }
     }

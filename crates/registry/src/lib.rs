@@ -23,7 +23,9 @@ mod curves;
 mod error;
 mod normal;
 mod record;
+mod registry;
 mod unit;
+mod unit_builder;
 mod unit_record;
 mod validate;
 
@@ -42,11 +44,13 @@ pub use glassdb_fit::MAX_CURVE_TOLERANCE;
 /// The face of a pane a record's values are for (the `glassdb-side` crate's type).
 pub use glassdb_side::{Side, UnknownSide};
 pub use record::{
-    AngleCurve, AngleModelRecord, CHANNELS, ColourBasis, FileRef, GlassRecord, LuminousRecord,
-    ProductRecord, Provenance, Registry, RegistryTable, SCHEMA_VERSION,
-    SCHEMA_VERSION_BEFORE_UNITS, SCHEMA_VERSION_ONE_TABLE,
+    AngleCurve, AngleModelRecord, FileRef, GlassRecord, LuminousRecord, ProductRecord, Provenance,
 };
-pub use unit::{ChosenElement, UnitBuilder, UnitChoice};
+pub use registry::{
+    CHANNELS, ColourBasis, Registry, RegistryTable, SCHEMA_VERSION, SCHEMA_VERSION_BEFORE_UNITS,
+    SCHEMA_VERSION_ONE_TABLE,
+};
+pub use unit_builder::{ChosenElement, UnitBuilder, UnitChoice};
 pub use unit_record::{
     Absorptance, GapRecord, PaneGroupRecord, SystemValues, UnitElement, UnitLayerRecord, UnitRecord,
 };

@@ -6,7 +6,8 @@ use std::collections::BTreeMap;
 use glassdb_fit::MAX_CURVE_TOLERANCE;
 
 use crate::RegistryError;
-use crate::record::{AngleCurve, CHANNELS, GlassRecord, Registry, RegistryTable};
+use crate::record::{AngleCurve, GlassRecord};
+use crate::registry::{CHANNELS, Registry, RegistryTable};
 use crate::unit_record::{UnitElement, UnitRecord};
 use glassdb_side::Side;
 

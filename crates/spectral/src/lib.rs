@@ -30,6 +30,7 @@ mod read;
 mod read_csv;
 mod read_igsdb;
 mod sniff;
+mod spline;
 mod tables;
 mod window;
 

@@ -18,7 +18,8 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SpectralError;
-use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, sprague_kernel, validate};
+use crate::interp::{check_coverage, for_each_on_grid, sprague_kernel, validate};
+use crate::spline::spline_kernel;
 use crate::tables::{Table, tables};
 use glassdb_colour::{D65_XY, RgbSpace, cat02, xyz_to_rgb};
 
