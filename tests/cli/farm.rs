@@ -197,6 +197,21 @@ fn openjd_run(params: &[(&str, String)]) -> (std::process::Output, String) {
     (out, format!("{stdout}\n{stderr}"))
 }
 
+/// Asserts that the composites `frames` of `output` (a `####` pattern in `dir`), each made of a
+/// copy of the atrium's passes, are what `compose` makes of those passes by hand.
+fn assert_frames_are_atriums(dir: &Path, output: &str, frames: std::ops::RangeInclusive<u32>) {
+    let by_hand = dir.join("by_hand.exr");
+    ok(&mut atrium_compose(&atrium_refl(), &by_hand));
+    let want = read_exr_planes(&by_hand).channels;
+    for f in frames {
+        let got = read_exr_planes(&dir.join(output.replace("####", &format!("{f:04}"))));
+        assert!(
+            got.channels == want,
+            "frame {f} differs from compose by hand"
+        );
+    }
+}
+
 #[test]
 fn the_open_job_description_template_renders_then_composites_in_chunks() {
     let dir = tempfile::tempdir().unwrap();
@@ -234,17 +249,7 @@ fn the_open_job_description_template_renders_then_composites_in_chunks() {
         log.contains("Chunks run: 4"),
         "2 render + 2 composite chunks: {log}"
     );
-    // Each frame is what compose makes of the same passes by hand.
-    let by_hand = d.join("by_hand.exr");
-    ok(&mut atrium_compose(&atrium_refl(), &by_hand));
-    let want = read_exr_planes(&by_hand).channels;
-    for f in 1..=3 {
-        let got = read_exr_planes(&d.join(format!("composite/out.{f:04}.exr")));
-        assert!(
-            got.channels == want,
-            "frame {f} differs from compose by hand"
-        );
-    }
+    assert_frames_are_atriums(d, "composite/out.####.exr", 1..=3);
     let chunk = json(&d.join("reports/frames.1-2.json"));
     assert_eq!(
         statuses(&chunk),
@@ -413,6 +418,17 @@ fn docs_command(start: &str) -> String {
     command
 }
 
+/// Replaces the value after `key` (up to the next space) in a command of docs/farm.md with
+/// `value`, quoted: the values a test cannot take as written (240 frames in /shots/atrium).
+fn set_docs_value(command: &mut String, key: &str, value: &str) {
+    let at = command
+        .find(key)
+        .unwrap_or_else(|| panic!("no {key}: {command}"))
+        + key.len();
+    let end = command[at..].find(' ').map_or(command.len(), |e| at + e);
+    command.replace_range(at..end, &format!("'{value}'"));
+}
+
 #[test]
 fn the_docs_standalone_compose_runs_as_written() {
     // docs/farm.md's `compose …` as written, in a shot folder holding the atrium's passes as
@@ -450,18 +466,9 @@ fn the_docs_blender_shot_renders_then_composites_each_once() {
     std::fs::rename(&blend, d.join("scene.blend")).unwrap();
     let mut command = docs_command("openjd run integrations/farm/openjd/glassdb-blender.yaml");
     // The parameters a test cannot take as written (1-240 frames in /shots/atrium).
-    for (param, value) in [
-        ("Frames=", "1-2".to_string()),
-        ("ChunkSize=", "1".to_string()),
-        ("WorkDir=", d.display().to_string()),
-    ] {
-        let at = command
-            .find(param)
-            .unwrap_or_else(|| panic!("no {param}: {command}"))
-            + param.len();
-        let end = command[at..].find(' ').map_or(command.len(), |e| at + e);
-        command.replace_range(at..end, &format!("'{value}'"));
-    }
+    set_docs_value(&mut command, "Frames=", "1-2");
+    set_docs_value(&mut command, "ChunkSize=", "1");
+    set_docs_value(&mut command, "WorkDir=", &d.display().to_string());
     // A small, quick render: flags added to RenderArgs="…".
     let at = command.find("RenderArgs=\"").expect("RenderArgs") + "RenderArgs=\"".len();
     let close = at + command[at..].find('"').unwrap();
@@ -496,4 +503,198 @@ fn the_docs_blender_shot_renders_then_composites_each_once() {
         })
         .collect();
     assert_eq!(composites.len(), 2, "{composites:?}");
+}
+
+/// A one-node Slurm cluster on this machine, in `dir` (`scripts/slurm_local_cluster.sh`: its
+/// own munged, slurmctld and slurmd, as root); its daemons are stopped when it is dropped, a
+/// failed assertion included.
+struct LocalSlurm {
+    dir: PathBuf,
+}
+
+impl LocalSlurm {
+    /// Starts the cluster; a machine without Slurm, or a test run that is not root, fails here
+    /// with the script's message (install slurm-wlm and munge; run as root, as CI does).
+    fn start(dir: PathBuf) -> LocalSlurm {
+        std::fs::create_dir_all(&dir).unwrap();
+        // Made before the start, so that a half-started cluster is stopped too.
+        let cluster = LocalSlurm { dir };
+        let (out, stdout, stderr) = run(&mut cluster.script("start"));
+        assert!(
+            out.status.success(),
+            "the localhost Slurm cluster did not start (`bash scripts/test-all` installs \
+             slurm-wlm and munge, and CI runs it as root):\n{stdout}{stderr}"
+        );
+        cluster
+    }
+
+    fn script(&self, action: &str) -> std::process::Command {
+        let mut c = std::process::Command::new("bash");
+        c.arg(repo_path("scripts/slurm_local_cluster.sh"))
+            .arg(action)
+            .arg(&self.dir);
+        c
+    }
+
+    /// `program` run against this cluster (`SLURM_CONF`), with the Slurm tools and the built
+    /// `glassdb` on `PATH`, as a user who installed both would have them.
+    fn command(&self, program: &str) -> std::process::Command {
+        let bin = Path::new(env!("CARGO_BIN_EXE_glassdb")).parent().unwrap();
+        let path = std::env::var("PATH").unwrap_or_default();
+        let mut c = std::process::Command::new(program);
+        c.env("SLURM_CONF", self.dir.join("slurm.conf"))
+            .env("PATH", format!("{}:/usr/sbin:/sbin:{path}", bin.display()));
+        c
+    }
+
+    /// stdout of `program args…` against this cluster (a failure is part of the text).
+    fn query(&self, program: &str, args: &[&str]) -> String {
+        let (out, stdout, stderr) = run(self.command(program).args(args));
+        format!(
+            "$ {program} {}\n{stdout}{stderr}{}",
+            args.join(" "),
+            out.status
+        )
+    }
+
+    /// What to read when a job went wrong: the queue, the jobs, each task's output in
+    /// `work_dir` and the daemons' logs.
+    fn diagnosis(&self, jobs: &str, work_dir: &Path) -> String {
+        let mut text = self.query("squeue", &["-a"]);
+        text += &self.query("scontrol", &["-o", "show", "job", jobs]);
+        for entry in std::fs::read_dir(work_dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("slurm-")
+            {
+                let output = std::fs::read_to_string(&path).unwrap_or_default();
+                text += &format!("--- {}\n{output}", path.display());
+            }
+        }
+        text + &run(&mut self.script("logs")).1
+    }
+}
+
+impl Drop for LocalSlurm {
+    fn drop(&mut self) {
+        let (out, _, stderr) = run(&mut self.script("stop"));
+        if !out.status.success() {
+            eprintln!(
+                "stopping the Slurm cluster in {}: {stderr}",
+                self.dir.display()
+            );
+        }
+    }
+}
+
+/// (array task, state, start, end) of each task of a job array, by task.
+fn array_tasks(cluster: &LocalSlurm, job: &str) -> Vec<(u32, String, String, String)> {
+    let text = cluster.query("scontrol", &["-o", "show", "job", job]);
+    let mut tasks: Vec<_> = text
+        .lines()
+        .filter(|l| l.contains("ArrayTaskId="))
+        .map(|line| {
+            let field = |key: &str| {
+                line.split(' ')
+                    .find_map(|f| f.strip_prefix(key))
+                    .unwrap_or_else(|| panic!("no {key} in {line}"))
+                    .to_string()
+            };
+            let task = field("ArrayTaskId=").parse().unwrap();
+            (
+                task,
+                field("JobState="),
+                field("StartTime="),
+                field("EndTime="),
+            )
+        })
+        .collect();
+    tasks.sort();
+    tasks
+}
+
+#[test]
+fn the_docs_slurm_submission_runs_on_a_localhost_cluster() {
+    // docs/farm.md's `… integrations/farm/slurm/submit.sh --partition=render` as written, on a
+    // one-node cluster of this machine, but for frames 1-3 in chunks of 2 (the last chunk is
+    // one frame) in a shot folder of its own; its `render_passes.sh` copies the atrium's
+    // fixture passes per frame, standing in for a renderer.
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("shot");
+    std::fs::create_dir(&shot).unwrap();
+    let a = repo_path("fixtures/atrium");
+    crate::util::write_executable(
+        &shot,
+        "render_passes.sh",
+        &format!(
+            "#!/bin/sh\nset -e\nfor f in $(seq \"$1\" \"$2\"); do n=$(printf %04d $f)\n\
+             for p in refl_0 refl_1 refl_2 trans; do cp {a}/$p.exr $p.$n.exr; done\n\
+             cp {a}/mask.png mask.$n.png\ndone\n",
+            a = a.display()
+        ),
+    );
+    std::fs::copy(a.join("virtual/planes.json"), shot.join("planes.json")).unwrap();
+    let mut command = docs_command("FRAME_FIRST=");
+    set_docs_value(&mut command, "FRAME_LAST=", "3");
+    set_docs_value(&mut command, "CHUNK_SIZE=", "2");
+    set_docs_value(&mut command, "WORK_DIR=", &shot.display().to_string());
+
+    let cluster = LocalSlurm::start(dir.path().join("cluster"));
+    let submitted = std::time::Instant::now();
+    let mut submit = cluster.command("bash");
+    let stdout = ok(submit
+        .args(["-c", &command])
+        .current_dir(crate::util::repo_root()));
+    // submit.sh prints `render JOB composite JOB`.
+    let ids: Vec<&str> = stdout.split_whitespace().collect();
+    let [_, render, _, composite] = ids[..] else {
+        panic!("submit.sh printed {stdout:?}, not `render JOB composite JOB`");
+    };
+    let jobs = format!("{render},{composite}");
+    // Both arrays leave the queue within 3 minutes (about 12 s on an idle 2-core machine).
+    let limit = std::time::Duration::from_secs(180);
+    loop {
+        let queue = cluster.query("squeue", &["-h", "-j", &jobs]);
+        if queue.lines().count() == 2 && queue.ends_with("exit status: 0") {
+            break; // the command line and its status: no job left
+        }
+        assert!(
+            submitted.elapsed() < limit,
+            "the Slurm jobs {jobs} are still queued after {limit:?}:\n{}",
+            cluster.diagnosis(&jobs, &shot)
+        );
+        std::thread::sleep(std::time::Duration::from_millis(300));
+    }
+    eprintln!(
+        "Slurm: both arrays out of the queue {:.1} s after submission",
+        submitted.elapsed().as_secs_f64()
+    );
+
+    // Two tasks each, all completed; composite task K started when render task K had ended
+    // (aftercorr; the times are whole seconds).
+    let (renders, composites) = (
+        array_tasks(&cluster, render),
+        array_tasks(&cluster, composite),
+    );
+    let diagnosis = || cluster.diagnosis(&jobs, &shot);
+    assert_eq!(renders.len(), 2, "{renders:?}\n{}", diagnosis());
+    assert_eq!(composites.len(), 2, "{composites:?}\n{}", diagnosis());
+    for (r, c) in renders.iter().zip(&composites) {
+        assert!(
+            r.0 == c.0 && r.1 == "COMPLETED" && c.1 == "COMPLETED" && c.2 >= r.3,
+            "render task {r:?}, composite task {c:?}\n{}",
+            diagnosis()
+        );
+    }
+    // Every frame is what compose makes of the same passes by hand; each chunk's report says
+    // its frames were composed.
+    assert_frames_are_atriums(&shot, "comp/out.####.exr", 1..=3);
+    for (chunk, frames) in [("1-2", vec![1, 2]), ("3-3", vec![3])] {
+        let report = json(&shot.join(format!("reports/frames.{chunk}.json")));
+        let composed: Vec<(u64, String)> = frames.iter().map(|&f| (f, "composed".into())).collect();
+        assert_eq!(statuses(&report), composed, "{report}");
+    }
 }
