@@ -164,9 +164,9 @@ def export(opts):
         frames = [int(f) for f in opts["frames"].split(",")]
     else:
         frames = list(range(scene.frame_start, scene.frame_end + 1))
-    scene.frame_set(frames[0])
-    objects = exported_objects(scene)
     cameras = {}
+    # Every object rendered in some frame (one hidden at first and shown later too).
+    all_objects = []
     # Every frame's geometry; a frame whose objects differ from the first frame's (a moving
     # object, a sliding door, a deforming mesh) gets its own OBJ, scene.NNNN.obj.
     first_lines = None
@@ -176,6 +176,10 @@ def export(opts):
     for f in frames:
         scene.frame_set(f)
         cameras[str(f)] = camera_json(scene)
+        # Visibility is per frame: an object shown from frame 2 on (a car driving in) is in
+        # that frame's scene and mask, one hidden from then on is not.
+        objects = exported_objects(scene)
+        all_objects += [ob for ob in objects if ob not in all_objects]
         lines, names = scene_obj_lines(objects, materials)
         if first_lines is None:
             first_lines, first_names = lines, names
@@ -185,6 +189,7 @@ def export(opts):
         else:
             name = "scene.%04d.obj" % f
             moved = [n for n, block in names.items() if first_names.get(n) != block]
+            moved += [n for n in first_names if n not in names]
             moving[str(f)] = {"obj": name, "objects": moved}
         header = ["# glassdb_blender.py export of %s, frame %d, world coordinates (Z up)"
                   % (bpy.data.filepath, f), "mtllib scene.mtl"]
@@ -209,7 +214,7 @@ def export(opts):
         "file": bpy.data.filepath,
         "frames": frames,
         "materials": sorted(materials),
-        "objects": [ob.name for ob in objects],
+        "objects": [ob.name for ob in all_objects],
         # Frames whose geometry differs from the first frame's: their OBJ and what moved.
         "moving": moving,
     }

@@ -10,7 +10,8 @@ override only through `glassdb blender render`'s own flags.
   `Glass`, Principled BSDF with transmission 1) between the camera and the cube.
 - `animated`: the same window sliding along itself (a sliding door) over frames 1-3, the cube
   moving across the view, the light moving, and a red box on the camera's side that moves
-  (seen in the window's reflection); the camera is still. `--facts FILE` writes the frames.
+  (seen in the window's reflection), and a post in front of the window hidden from render in
+  frame 1 and shown from frame 2 on; the camera is still. `--facts FILE` writes the frames.
 
 Licence: same as the project, MIT OR Apache-2.0.
 """
@@ -71,6 +72,16 @@ if kind == "animated":
         box.location = start["Box_behind_camera"] + Vector((1.0 * k, 0.0, 0.0))
         for ob in (window, cube, light, box):
             ob.keyframe_insert("location", frame=f)
+    # A post between the camera and the window, hidden from render in frame 1 and shown from
+    # frame 2 on (a car driving in): it hides part of the glass only in frames 2-3.
+    door = centre + along * 0.4
+    bpy.ops.mesh.primitive_cube_add(size=0.2, location=eye + (door - eye) * 0.5)
+    post = bpy.context.active_object
+    post.name = "Post"
+    post.data.materials.append(red)
+    for f, hidden in ((1, True), (2, False)):
+        post.hide_render = hidden
+        post.keyframe_insert("hide_render", frame=f)
     scene.frame_set(1)
 
 bpy.ops.wm.save_as_mainfile(filepath=out)

@@ -834,7 +834,8 @@ fn a_scene_saved_with_blenders_defaults_renders_without_denoising() {
 #[test]
 fn animated_objects_lights_and_a_sliding_pane_composite_within_cycles_noise() {
     // Frames 1-3: the window slides along itself (a sliding door), the cube behind it and a box
-    // on the camera's side (seen in the reflection) move, the light moves; the camera is still.
+    // on the camera's side (seen in the reflection) move, the light moves, a post in front of
+    // the glass is hidden in frame 1 and shown from frame 2 on; the camera is still.
     // Once refused ("object Cube moves between frames"); now each frame whose objects moved
     // has its own scene, planes and mask.
     let dir = tempfile::tempdir().unwrap();
@@ -854,7 +855,7 @@ fn animated_objects_lights_and_a_sliding_pane_composite_within_cycles_noise() {
     let export = json(&run.join("export.json"));
     for f in ["2", "3"] {
         let moved = export["moving"][f]["objects"].as_array().unwrap();
-        for name in ["Window", "Cube", "Box_behind_camera"] {
+        for name in ["Window", "Cube", "Box_behind_camera", "Post"] {
             assert!(moved.iter().any(|m| m == name), "frame {f}: {export}");
         }
     }
