@@ -6,9 +6,12 @@
         for the new frame, and writes the canvas's RGBA bytes (rows top to bottom) to --out.
         Prints JSON: size, frames drawn, the product sets, the last swap's time, page errors.
 
-    viewer_driver.py bench URL --id ID --products 'P1|P2' [--repeat N]
+    viewer_driver.py bench URL --id ID --products 'P1|P2' [--repeat N] [--unit 'P1|GAP_MM:GAS|P2']
         Times product choices through the page's automation hook: from the choice to the new
-        frame drawn (a 1-pixel read-back finishes the drawing), and the page's load time.
+        frame drawn (a 1-pixel read-back finishes the drawing), and the page's load time. With
+        --unit, also units built on the page (the hook the builder's button calls) for glass ID,
+        the gap widened by 0.1 mm each time so that every build is new: from the request to the
+        frame on screen, and the server's share (stack engine, fit, table).
 
     viewer_driver.py rebind URL --name NAME
         A page of another site against the viewer at URL: Chromium resolves NAME to the
@@ -19,6 +22,22 @@
 
     viewer_driver.py export URL
         Opens the page, clicks its export button and prints JSON: the status line it shows.
+
+    viewer_driver.py unit URL --glass ID --panes 'P1|GAP_MM:GAS|P2' [--flip K] [--out FILE.rgba]
+        Builds a unit through the page's own controls: clicks glass ID in the list, chooses each
+        pane's catalog glass (by id) and each gap's width (typed; `nan` clears the box) and gas
+        on the unit builder, ticks "flip" of pane K (1: outer; repeatable), clicks "build" and
+        waits for its answer. Prints JSON: the builder's status line, the time from the click to
+        the frame on screen (and the server's share), the product sets, page errors; writes the
+        canvas to --out.
+
+    viewer_driver.py layout URL [--run JS ...] [--window WxH] [--screenshot FILE.png]
+        Opens the page, runs each JS snippet (awaited; `window.glassdb` hooks; what each returns,
+        or {"thrown": message}, is in `results`), and prints JSON
+        of what a designer sees: the window, the stage and the canvas's on-screen box, every
+        product and glass name whose text is cut (wider than the box it is shown in, or beyond
+        its list's edge) and whether it has a tooltip, and what lies on screen where the A/B
+        split line should be (the element there and its colour against the pixels beside it).
 
 Chromium runs as Debian ships it (/usr/bin/chromium, /usr/bin/chromedriver), WebGL2 on
 SwiftShader when there is no GPU.
@@ -138,6 +157,28 @@ def bench(args):
                     "return window.glassdb.choose(arguments[0], arguments[1])", args.id, p)
                 swaps.append(ms)
         swaps.sort()
+        units, unit_server = [], []
+        if args.unit:
+            driver.execute_script("window.glassdb.choose(arguments[0], 0)", args.id)
+            driver.set_script_timeout(args.timeout)
+            for k in range(args.repeat * 3):
+                elements = []
+                for part in args.unit.split("|"):
+                    if ":" in part:
+                        width, gas = part.split(":", 1)
+                        elements.append({"gap_mm": round(float(width) + 0.1 * k, 3), "gas": gas})
+                    else:
+                        elements.append({"glass": int(part)})
+                done = driver.execute_async_script(
+                    "const done = arguments[arguments.length - 1];"
+                    "window.glassdb.buildUnit(arguments[0]).then(done, (e) => done({error: String(e)}));",
+                    elements)
+                if "error" in done:
+                    raise SystemExit("building the unit: " + done["error"])
+                units.append(done["ms"])
+                unit_server.append(done["buildMs"])
+            units.sort()
+            unit_server.sort()
         print(json.dumps({
             "load_ms": load_ms,
             "page_ready_ms": page_ms,
@@ -146,6 +187,9 @@ def bench(args):
             "swap_ms_median": swaps[len(swaps) // 2],
             "swap_ms_min": swaps[0],
             "swap_ms_max": swaps[-1],
+            **({"units": len(units), "unit_ms_median": units[len(units) // 2], "unit_ms_min": units[0],
+                "unit_ms_max": units[-1], "unit_server_ms_median": unit_server[len(unit_server) // 2]}
+               if units else {}),
             "renderer": renderer(driver),
         }))
     finally:
@@ -188,6 +232,120 @@ def export(args):
         driver.quit()
 
 
+LAYOUT_JS = r"""
+const done = arguments[arguments.length - 1];
+(async () => {
+  const results = [];
+  for (const js of arguments[0]) {
+    try {
+      results.push(await (new Function('return (async () => {' + js + '})()'))());
+    } catch (e) {
+      results.push({thrown: String(e.message || e)});
+    }
+  }
+  await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+  const box = (el) => { if (!el) return null; const r = el.getBoundingClientRect();
+    return {left: r.left, top: r.top, width: r.width, height: r.height, right: r.right, bottom: r.bottom}; };
+  const canvas = document.getElementById('view-canvas');
+  const names = [];
+  for (const list of ['products', 'glasses']) {
+    const ul = document.getElementById(list);
+    const edge = ul.getBoundingClientRect().right;
+    for (const el of ul.querySelectorAll('li .name')) {
+      const r = el.getBoundingClientRect();
+      const li = el.closest('li');
+      const text = el.firstChild ? el.firstChild.textContent : el.textContent;
+      names.push({list, text, cut: el.scrollWidth > el.clientWidth + 1 || r.right > edge + 0.5
+          || ul.scrollWidth > ul.clientWidth + 1,
+        tooltip: (li.title || '').includes(text) || (el.title || '').includes(text)});
+    }
+  }
+  const scene = window.glassdb && window.glassdb.scene;
+  const c = box(canvas);
+  const split = window.glassdb && window.glassdb.split ? window.glassdb.split() : null;
+  let line = null;
+  if (split !== null && c) {
+    const x = c.left + split * c.width, y = c.top + c.height / 2;
+    const el = document.elementFromPoint(x, y);
+    const style = el ? getComputedStyle(el) : null;
+    line = {x, element: el ? (el.id || el.tagName) : null, background: style ? style.backgroundColor : null,
+      visible: !!el && el !== canvas && style.visibility !== 'hidden' && Number(style.opacity) > 0,
+      box: box(document.getElementById('split-line'))};
+  }
+  return {window: [window.innerWidth, window.innerHeight], stage: box(document.getElementById('stage')),
+    canvas: c, frame: scene ? [scene.width, scene.height] : null, names, split_line: line,
+    split_box: box(document.getElementById('split-line')), results,
+    products_text: [...document.querySelectorAll('#products li')].map((li) => li.innerText),
+    unit_status: document.getElementById('unit-status') ? document.getElementById('unit-status').innerText : null,
+    zoom: window.glassdb && window.glassdb.zoom ? window.glassdb.zoom() : null,
+    errors: window.glassdbErrors || []};
+})().then(done, (e) => done({error: String(e)}));
+"""
+
+
+def layout(args):
+    extra = [f"--window-size={args.window.replace('x', ',')}"] if args.window else []
+    driver = browser(args.gpu, extra)
+    try:
+        driver.set_script_timeout(args.timeout)
+        driver.get(args.url)
+        wait_ready(driver, args.timeout)
+        report = driver.execute_async_script(LAYOUT_JS, args.run)
+        if args.screenshot:
+            driver.save_screenshot(args.screenshot)
+        print(json.dumps(report))
+    finally:
+        driver.quit()
+
+
+def build_unit(args):
+    from selenium.webdriver.support.ui import Select
+    driver = browser(args.gpu)
+    try:
+        driver.get(args.url)
+        wait_ready(driver, args.timeout)
+        driver.find_element(By.CSS_SELECTOR, f'#glasses li[data-id="{args.glass}"]').click()
+        parts = args.panes.split("|")
+        # The builder starts as pane, gap, pane; add gap + pane pairs for more panes.
+        while len(driver.find_elements(By.CSS_SELECTOR, "#unit-elements > li")) < len(parts):
+            driver.find_element(By.ID, "unit-add-pane").click()
+        items = driver.find_elements(By.CSS_SELECTOR, "#unit-elements > li")
+        pane = 0
+        for item, part in zip(items, parts):
+            if ":" in part:
+                width, gas = part.split(":", 1)
+                box = item.find_element(By.CSS_SELECTOR, "input.unit-gap")
+                box.clear()
+                if width != "nan":
+                    box.send_keys(width)
+                Select(item.find_element(By.CSS_SELECTOR, "select.unit-gas")).select_by_value(gas)
+            else:
+                pane += 1
+                Select(item.find_element(By.CSS_SELECTOR, "select.unit-glass")).select_by_value(part)
+                if pane in args.flip:
+                    item.find_element(By.CSS_SELECTOR, "input.unit-flip").click()
+        before = drawn(driver)
+        driver.find_element(By.ID, "unit-build").click()
+        WebDriverWait(driver, args.timeout).until(
+            lambda d: d.find_element(By.ID, "unit-status").text not in ("", "building…"))
+        said = driver.find_element(By.ID, "unit-status").text
+        if args.out:
+            pixels = base64.b64decode(driver.execute_script("return window.glassdb.readPixels()"))
+            with open(args.out, "wb") as f:
+                f.write(pixels)
+        print(json.dumps({
+            "status": said,
+            "status_class": driver.find_element(By.ID, "unit-status").get_attribute("class"),
+            "unit": driver.execute_script("return window.glassdb.lastUnit()"),
+            "drawn": drawn(driver) - before,
+            "products": driver.execute_script("return window.glassdbProducts()"),
+            "errors": driver.execute_script("return window.glassdbErrors"),
+            "renderer": renderer(driver),
+        }))
+    finally:
+        driver.quit()
+
+
 def main():
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -200,16 +358,29 @@ def main():
     b.add_argument("--id", type=int, required=True)
     b.add_argument("--products", required=True, help="product names separated by |")
     b.add_argument("--repeat", type=int, default=5)
+    b.add_argument("--unit", help="also time units built on the page: 'P1|GAP_MM:GAS|P2' (catalog ids)")
     r = sub.add_parser("rebind")
     r.add_argument("url")
     r.add_argument("--name", required=True)
     e = sub.add_parser("export")
     e.add_argument("url")
-    for p in (c, b, r, e):
+    un = sub.add_parser("unit")
+    un.add_argument("url")
+    un.add_argument("--glass", type=int, required=True)
+    un.add_argument("--panes", required=True)
+    un.add_argument("--flip", type=int, action="append", default=[])
+    un.add_argument("--out")
+    lay = sub.add_parser("layout")
+    lay.add_argument("url")
+    lay.add_argument("--run", action="append", default=[], help="JS to run (awaited) before measuring")
+    lay.add_argument("--window", help="window size WxH (default 1400x1000)")
+    lay.add_argument("--screenshot", help="also save the window as this PNG")
+    for p in (c, b, r, e, lay, un):
         p.add_argument("--timeout", type=float, default=60)
         p.add_argument("--gpu", action="store_true", help="use the machine's GPU, not SwiftShader")
     args = ap.parse_args()
-    {"check": check, "bench": bench, "rebind": rebind, "export": export}[args.cmd](args)
+    {"check": check, "bench": bench, "rebind": rebind, "export": export,
+     "layout": layout, "unit": build_unit}[args.cmd](args)
 
 
 if __name__ == "__main__":

@@ -1,9 +1,10 @@
 #!/bin/bash
-# Runs integrations/farm/slurm/ on a one-node Slurm cluster on this machine (not in CI): writes a
-# slurm.conf for localhost in a temporary directory, starts munged, slurmctld and slurmd (as
-# root), submits the render and composite job arrays for frames 1-FRAMES of the atrium (the
-# render step copies the fixture passes per frame, standing in for a renderer), waits, checks
-# every frame and report, prints the timings, and stops the daemons it started.
+# Times integrations/farm/slurm/ on a one-node Slurm cluster on this machine
+# (scripts/slurm_local_cluster.sh, as root; the test suite runs docs/farm.md's command on the
+# same cluster, farm::the_docs_slurm_submission_runs_on_a_localhost_cluster): submits the
+# render and composite job arrays for frames 1-FRAMES of the atrium (the render step copies the
+# fixture passes per frame, standing in for a renderer), waits, checks every frame and report,
+# prints the timings, and stops the daemons it started.
 #   sudo bash scripts/slurm_local_test.sh [FRAMES=12] [CHUNK=4]
 # Needs Debian's slurm-wlm and munge, and a release build (cargo build --release).
 set -euo pipefail
@@ -12,64 +13,17 @@ CHUNK=${2:-4}
 repo=$(cd "$(dirname "$0")/.." && pwd)
 glassdb=${GLASSDB:-${CARGO_TARGET_DIR:-$repo/target}/release/glassdb}
 [ -x "$glassdb" ] || { echo "no $glassdb: cargo build --release first" >&2; exit 1; }
-[ "$(id -u)" = 0 ] || { echo "run as root (slurmd starts jobs as their user)" >&2; exit 1; }
 D=$(mktemp -d /tmp/glassdb-slurm.XXXXXX)
-pids=()
+mkdir -p "$D/shot"
 cleanup() {
-    for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-    sleep 1
+    bash "$repo/scripts/slurm_local_cluster.sh" stop "$D/cluster"
     echo "logs and outputs left in $D"
 }
 trap cleanup EXIT
-mkdir -p "$D/state" "$D/spool" "$D/shot" "$D/munge"
-host=$(hostname -s)
-
-# munge: its own key, socket and files under $D.
-dd if=/dev/urandom bs=1 count=1024 of="$D/munge/munge.key" status=none
-chmod 600 "$D/munge/munge.key"
-munged --force --key-file="$D/munge/munge.key" --socket="$D/munge/munge.sock" \
-    --pid-file="$D/munge/munged.pid" --log-file="$D/munge/munged.log" \
-    --seed-file="$D/munge/munged.seed"
-sleep 1
-pids+=("$(cat "$D/munge/munged.pid")")
-
-cpus=$(nproc)
-mem=$(($(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 / 2))
-cat >"$D/slurm.conf" <<CONF
-ClusterName=glassdb-local
-SlurmctldHost=$host(127.0.0.1)
-SlurmUser=root
-SlurmdUser=root
-AuthType=auth/munge
-CredType=cred/munge
-AuthInfo=socket=$D/munge/munge.sock
-StateSaveLocation=$D/state
-SlurmdSpoolDir=$D/spool
-SlurmctldPidFile=$D/slurmctld.pid
-SlurmdPidFile=$D/slurmd.pid
-SlurmctldLogFile=$D/slurmctld.log
-SlurmdLogFile=$D/slurmd.log
-SlurmctldPort=16817
-SlurmdPort=16818
-ProctrackType=proctrack/linuxproc
-TaskPlugin=task/none
-JobAcctGatherType=jobacct_gather/none
-AccountingStorageType=accounting_storage/none
-JobCompType=jobcomp/none
-MpiDefault=none
-SchedulerType=sched/backfill
-SelectType=select/cons_tres
-SelectTypeParameters=CR_CPU
-ReturnToService=2
-NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$mem State=UNKNOWN
-PartitionName=local Nodes=ALL Default=YES MaxTime=INFINITE State=UP
-CONF
-export SLURM_CONF=$D/slurm.conf
-slurmctld -i
-slurmd
-for _ in $(seq 50); do [ -s "$D/slurmctld.pid" ] && [ -s "$D/slurmd.pid" ] && break; sleep 0.2; done
-pids+=("$(cat "$D/slurmctld.pid")" "$(cat "$D/slurmd.pid")")
-for _ in $(seq 50); do sinfo -h -o %T | grep -q idle && break; sleep 0.5; done
+# The one-node cluster (partition `render`) the test suite's Slurm test runs on.
+mkdir -p "$D/cluster"
+bash "$repo/scripts/slurm_local_cluster.sh" start "$D/cluster"
+export SLURM_CONF=$D/cluster/slurm.conf
 sinfo
 
 a=$repo/fixtures/atrium

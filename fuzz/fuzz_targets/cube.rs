@@ -4,6 +4,6 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {
-        let _ = glassdb_compose::view::CubeLut::parse(text, std::path::Path::new("fuzz.cube"));
+        let _ = glassdb_colour::CubeLut::parse(text, std::path::Path::new("fuzz.cube"));
     }
 });

@@ -119,6 +119,41 @@ def exported_objects(scene):
     return [ob for ob in scene.objects if ob.type in MESH_TYPES and not ob.hide_render]
 
 
+def scene_obj_lines(objects, materials):
+    """The OBJ body (vertices in world coordinates, faces by material) of `objects` as
+    evaluated now, and each object's own lines by name (to say which moved); adds the
+    materials used to `materials`."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    lines = []
+    blocks = {}
+    base = 1
+    for ob in objects:
+        ev = ob.evaluated_get(depsgraph)
+        mesh = ev.to_mesh()
+        if mesh is None:
+            continue
+        m = ev.matrix_world
+        block = ["o %s" % ob.name.replace(" ", "_")]
+        for v in mesh.vertices:
+            p = m @ v.co
+            block.append("v %r %r %r" % (p.x, p.y, p.z))
+        names = [s.material.name if s.material else None for s in ev.material_slots]
+        current = "unset"
+        for poly in mesh.polygons:
+            name = names[poly.material_index] if poly.material_index < len(names) else None
+            name = name or "glassdb_no_material"
+            if name != current:
+                block.append("usemtl %s" % name)
+                materials.add(name)
+                current = name
+            block.append("f " + " ".join(str(base + i) for i in poly.vertices))
+        base += len(mesh.vertices)
+        ev.to_mesh_clear()
+        lines += block
+        blocks[ob.name] = [l for l in block if l.startswith("v ")]
+    return lines, blocks
+
+
 def export(opts):
     out = opts.get("out") or fail("export needs --out DIR")
     scene = bpy.context.scene
@@ -129,51 +164,41 @@ def export(opts):
         frames = [int(f) for f in opts["frames"].split(",")]
     else:
         frames = list(range(scene.frame_start, scene.frame_end + 1))
-    scene.frame_set(frames[0])
-    objects = exported_objects(scene)
-    matrices = {ob.name: [list(r) for r in ob.matrix_world] for ob in objects}
     cameras = {}
+    # Every object rendered in some frame (one hidden at first and shown later too).
+    all_objects = []
+    # Every frame's geometry; a frame whose objects differ from the first frame's (a moving
+    # object, a sliding door, a deforming mesh) gets its own OBJ, scene.NNNN.obj.
+    first_lines = None
+    moving = {}
+    materials = set()
+    os.makedirs(out, exist_ok=True)
     for f in frames:
         scene.frame_set(f)
         cameras[str(f)] = camera_json(scene)
-        for ob in objects:
-            if [list(r) for r in ob.matrix_world] != matrices[ob.name]:
-                fail("object %s moves between frames %d and %d: glassdb blender renders a "
-                     "moving camera in a still scene" % (ob.name, frames[0], f))
-    scene.frame_set(frames[0])
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    materials = set()
-    lines = ["# glassdb_blender.py export of %s, frame %d, world coordinates (Z up)"
-             % (bpy.data.filepath, frames[0]), "mtllib scene.mtl"]
-    base = 1
-    for ob in objects:
-        ev = ob.evaluated_get(depsgraph)
-        mesh = ev.to_mesh()
-        if mesh is None:
+        # Visibility is per frame: an object shown from frame 2 on (a car driving in) is in
+        # that frame's scene and mask, one hidden from then on is not.
+        objects = exported_objects(scene)
+        all_objects += [ob for ob in objects if ob not in all_objects]
+        lines, names = scene_obj_lines(objects, materials)
+        if first_lines is None:
+            first_lines, first_names = lines, names
+            name = "scene.obj"
+        elif lines == first_lines:
             continue
-        m = ev.matrix_world
-        lines.append("o %s" % ob.name.replace(" ", "_"))
-        for v in mesh.vertices:
-            p = m @ v.co
-            lines.append("v %r %r %r" % (p.x, p.y, p.z))
-        names = [s.material.name if s.material else None for s in ev.material_slots]
-        current = "unset"
-        for poly in mesh.polygons:
-            name = names[poly.material_index] if poly.material_index < len(names) else None
-            name = name or "glassdb_no_material"
-            if name != current:
-                lines.append("usemtl %s" % name)
-                materials.add(name)
-                current = name
-            lines.append("f " + " ".join(str(base + i) for i in poly.vertices))
-        base += len(mesh.vertices)
-        ev.to_mesh_clear()
+        else:
+            name = "scene.%04d.obj" % f
+            moved = [n for n, block in names.items() if first_names.get(n) != block]
+            moved += [n for n in first_names if n not in names]
+            moving[str(f)] = {"obj": name, "objects": moved}
+        header = ["# glassdb_blender.py export of %s, frame %d, world coordinates (Z up)"
+                  % (bpy.data.filepath, f), "mtllib scene.mtl"]
+        with open(os.path.join(out, name), "w") as fh:
+            fh.write("\n".join(header + lines) + "\n")
+    scene.frame_set(frames[0])
     for name in materials:
         if any(c.isspace() for c in name):
             fail("material %r has a space in its name, which an OBJ file cannot hold" % name)
-    os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, "scene.obj"), "w") as fh:
-        fh.write("\n".join(lines) + "\n")
     with open(os.path.join(out, "scene.mtl"), "w") as fh:
         for name in sorted(materials):
             fh.write("newmtl %s\nKd 0.8 0.8 0.8\n\n" % name)
@@ -182,16 +207,23 @@ def export(opts):
         fh.write("\n")
     info = {
         "blender": bpy.app.version_string,
+        # Settings the passes override (render's honest_passes), as the scene has them.
+        "denoising": bool(scene.cycles.use_denoising),
+        "motion_blur": bool(scene.render.use_motion_blur),
         "blender_version": list(bpy.app.version),
         "file": bpy.data.filepath,
         "frames": frames,
         "materials": sorted(materials),
-        "objects": [ob.name for ob in objects],
+        "objects": [ob.name for ob in all_objects],
+        # Frames whose geometry differs from the first frame's: their OBJ and what moved.
+        "moving": moving,
     }
     with open(os.path.join(out, "export.json"), "w") as fh:
         json.dump(info, fh, indent=1)
         fh.write("\n")
     print("glassdb_blender: exported %d objects, %d frames" % (len(objects), len(frames)))
+    for f, m in moving.items():
+        print("glassdb_blender: frame %s: %s moved (%s)" % (f, ", ".join(m["objects"]), m["obj"]))
 
 
 def output_node(nt):
@@ -417,6 +449,19 @@ def reflection_matrix(plane):
     return Matrix(rows)
 
 
+def honest_passes(scene):
+    """Cycles' denoiser and motion blur off, whatever the scene says: the passes must carry
+    Cycles' own noise (the composite's and the reference's error are compared with it; and
+    Debian's Blender has no OpenImageDenoise), and glassdb's masks are of the frame's instant.
+    glassdb records what was overridden (export.json says what the scene had)."""
+    if scene.cycles.use_denoising:
+        print("glassdb_blender: denoising off for the passes (the scene denoises)")
+    scene.cycles.use_denoising = False
+    if scene.render.use_motion_blur:
+        print("glassdb_blender: motion blur off for the passes (the masks are of the frame's instant)")
+    scene.render.use_motion_blur = False
+
+
 def render(opts):
     path = opts.get("job") or fail("render needs --job FILE")
     with open(path) as fh:
@@ -433,6 +478,7 @@ def render(opts):
     if job.get("threads"):
         scene.render.threads_mode = "FIXED"
         scene.render.threads = int(job["threads"])
+    honest_passes(scene)
     set_exr_output(scene)
     glass_by_name = {g["material"]: g for g in job["glass"]}
     missing = [m for m in glass_by_name if m not in bpy.data.materials]

@@ -48,6 +48,10 @@ import os
 import struct
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fixture_scene  # noqa: E402
+from fixture_scene import set_use_nodes  # noqa: E402
+
 # --------------------------------------------------------------------------------------------
 # The scene, as plain data (metres, z up). Every coordinate is a multiple of 1/8, so it is
 # exact in Blender's float32 and in the OBJ text.
@@ -223,35 +227,13 @@ def cameras_text(frames):
 # --------------------------------------------------------------------------------------------
 
 def parse_args(argv):
-    if "--" in argv:
-        argv = argv[argv.index("--") + 1:]
-    else:
-        argv = argv[1:]
-    opts = {"out": None, "geometry": None, "write_geometry": False, "mode": "render",
-            "working_space": None}
-    i = 0
-    while i < len(argv):
-        a = argv[i]
-        if a in ("--out", "--geometry") and i + 1 < len(argv):
-            opts[a[2:]] = os.path.abspath(argv[i + 1])
-            i += 2
-            continue
-        if a == "--working-space" and i + 1 < len(argv):
-            opts["working_space"] = argv[i + 1]
-            i += 2
-            continue
-        if a == "--write-geometry":
-            opts["write_geometry"] = True
-        elif a == "--check":
-            opts["mode"] = "check"
-        elif a == "--preview":
-            opts["mode"] = "preview"
-        elif a in ("-h", "--help"):
-            print(__doc__)
-            sys.exit(0)
-        else:
-            sys.exit("make_mask_fixtures.py: unknown argument %r" % a)
-        i += 1
+    opts = fixture_scene.parse_options(
+        argv, "make_mask_fixtures.py", __doc__,
+        {"out": None, "geometry": None, "write_geometry": False, "mode": "render",
+         "working_space": None},
+        paths=("out", "geometry"), values=("working-space",),
+        flags={"--write-geometry": ("write_geometry", True), "--check": ("mode", "check"),
+               "--preview": ("mode", "preview")})
     if opts["mode"] != "preview" and not (opts["out"] and opts["geometry"]):
         sys.exit("make_mask_fixtures.py: --out DIR and --geometry DIR are required")
     return opts
@@ -309,13 +291,6 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     version = tuple(bpy.app.version)
     scene = bpy.context.scene
-
-    def set_use_nodes(idblock):
-        # Blender 5.0 deprecates use_nodes: new materials and worlds always have a node tree.
-        if version < (5, 0, 0):
-            idblock.use_nodes = True
-        if idblock.node_tree is None:
-            sys.exit("%s has no node tree" % idblock.name)
 
     def aov_out(nt, name, location):
         aov = nt.nodes.new("ShaderNodeOutputAOV")
@@ -405,19 +380,7 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
     scene.collection.objects.link(sun)
 
     # World: grey.
-    world = bpy.data.worlds.new("World")
-    world.color = (0.5, 0.5, 0.5)
-    set_use_nodes(world)
-    bg = world.node_tree.nodes.get("Background")
-    if bg is None:
-        nt = world.node_tree
-        nt.nodes.clear()
-        bg = nt.nodes.new("ShaderNodeBackground")
-        wo = nt.nodes.new("ShaderNodeOutputWorld")
-        nt.links.new(bg.outputs["Background"], wo.inputs["Surface"])
-    bg.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-    bg.inputs["Strength"].default_value = 1.0
-    scene.world = world
+    bg = fixture_scene.grey_world(scene)
 
     # Camera, keyframed on frames 1-3 (linear; at the keyed frames the value is the key's).
     cam_data = bpy.data.cameras.new("Camera")
@@ -458,25 +421,10 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
         space_info = set_working_space(bpy, working_space, mats)
 
     # Render settings common to all renders.
-    r = scene.render
-    r.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.seed = 0
-    scene.cycles.use_animated_seed = False
-    scene.cycles.use_denoising = False
-    if hasattr(scene.cycles, "use_adaptive_sampling"):
-        scene.cycles.use_adaptive_sampling = False
-    r.resolution_percentage = 100
+    r = fixture_scene.fixed_cycles(scene)
     r.film_transparent = False
-    r.threads_mode = "FIXED"
-    r.threads = 2
-    r.use_compositing = False
-    r.use_sequencer = False
-    r.use_file_extension = True
     r.use_border = False
     vl = scene.view_layers[0]
-    if hasattr(vl, "cycles"):
-        vl.cycles.use_denoising = False
 
     def set_resolution(w, h, aspx, aspy):
         r.resolution_x, r.resolution_y = w, h
@@ -508,28 +456,11 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
     im = r.image_settings
 
     def set_format(half):
-        if hasattr(im, "media_type"):  # Blender 5.0: media type first, then the format
-            im.media_type = "MULTI_LAYER_IMAGE"
-        im.file_format = "OPEN_EXR_MULTILAYER"
-        im.color_mode = "RGBA"
-        im.color_depth = "16" if half else "32"
-        im.exr_codec = "ZIP"
+        fixture_scene.set_exr_format(im, multilayer=True, half=half)
 
     def render_to(name, frame):
-        # Blender decides whether a still's name gets a frame number (versions differ), so
-        # render to a scratch stem and move the one file written there.
-        stem = "_render_" + name.split(".")[0]
-        for old in os.listdir(out_dir):
-            if old.startswith(stem):
-                os.remove(os.path.join(out_dir, old))
-        r.filepath = os.path.join(out_dir, stem)
         scene.frame_set(frame)
-        bpy.ops.render.render(write_still=True)
-        written = [f for f in os.listdir(out_dir) if f.startswith(stem)]
-        if len(written) != 1:
-            sys.exit("render of %s wrote %r" % (name, written))
-        os.replace(os.path.join(out_dir, written[0]), os.path.join(out_dir, name))
-        print("wrote", os.path.join(out_dir, name), os.path.getsize(os.path.join(out_dir, name)))
+        fixture_scene.render_still(scene, out_dir, name)
 
     # Geometry and cameras, from Blender's own data.
     def f32_rows(m):
@@ -713,10 +644,7 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
     }
     if space_info is not None:
         info["working_space"] = space_info
-    with open(os.path.join(out_dir, "check.json"), "w") as fh:
-        json.dump(info, fh, indent=1)
-        fh.write("\n")
-    print("wrote", os.path.join(out_dir, "check.json"))
+    fixture_scene.write_json(os.path.join(out_dir, "check.json"), info)
 
 
 # --------------------------------------------------------------------------------------------
@@ -1188,10 +1116,7 @@ def check_all(out_dir, geo_dir):
     report["files"] = files
     report["problems"] = problems
     path = os.path.join(out_dir, "check.json")
-    with open(path, "w") as fh:
-        json.dump(report, fh, indent=1)
-        fh.write("\n")
-    print("wrote", path)
+    fixture_scene.write_json(path, report)
     if problems:
         sys.exit("check failed: " + "; ".join(problems))
 

@@ -30,6 +30,10 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fixture_scene  # noqa: E402
+from fixture_scene import set_use_nodes  # noqa: E402
+
 WIDTH, HEIGHT = 64, 48
 SAMPLES = 4
 BORDER = (0.25, 0.75, 0.25, 0.75)  # min x, max x, min y, max y
@@ -39,10 +43,7 @@ OUTPUTS = ("multilayer.exr", "border.exr", "border_crop.exr", "rgba.exr")
 
 def parse_args(argv):
     """Arguments after `--` (inside blender) or all of argv[1:] (plain Python / bpy module)."""
-    if "--" in argv:
-        argv = argv[argv.index("--") + 1:]
-    else:
-        argv = argv[1:]
+    argv = fixture_scene.script_args(argv)
     out, describe = None, False
     i = 0
     while i < len(argv):
@@ -78,13 +79,6 @@ def render_all(out_dir):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     version = tuple(bpy.app.version)
     scene = bpy.context.scene
-
-    def set_use_nodes(idblock):
-        # Blender 5.0 deprecates use_nodes: new materials and worlds always have a node tree.
-        if version < (5, 0, 0):
-            idblock.use_nodes = True
-        if idblock.node_tree is None:
-            sys.exit("%s has no node tree" % idblock.name)
 
     def add_facing_aov(nt, at_x=-200):
         """AOV `facing` = |N . I| from a Geometry node."""
@@ -167,42 +161,16 @@ def render_all(out_dir):
     scene.camera = cam
 
     # World: grey.
-    world = bpy.data.worlds.new("World")
-    world.color = (0.5, 0.5, 0.5)
-    set_use_nodes(world)
-    bg = world.node_tree.nodes.get("Background")
-    if bg is None:
-        nt = world.node_tree
-        nt.nodes.clear()
-        bg = nt.nodes.new("ShaderNodeBackground")
-        wo = nt.nodes.new("ShaderNodeOutputWorld")
-        nt.links.new(bg.outputs["Background"], wo.inputs["Surface"])
-    bg.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-    bg.inputs["Strength"].default_value = 1.0
-    scene.world = world
+    fixture_scene.grey_world(scene)
 
     # Render settings.
-    r = scene.render
-    r.engine = "CYCLES"
-    scene.cycles.device = "CPU"
+    r = fixture_scene.fixed_cycles(scene)
     scene.cycles.samples = SAMPLES
-    scene.cycles.seed = 0
-    scene.cycles.use_animated_seed = False
-    scene.cycles.use_denoising = False
-    if hasattr(scene.cycles, "use_adaptive_sampling"):
-        scene.cycles.use_adaptive_sampling = False
-    r.resolution_x, r.resolution_y, r.resolution_percentage = WIDTH, HEIGHT, 100
+    r.resolution_x, r.resolution_y = WIDTH, HEIGHT
     r.film_transparent = True
-    r.threads_mode = "FIXED"
-    r.threads = 2
-    r.use_compositing = False
-    r.use_sequencer = False
-    r.use_file_extension = True
 
     # Passes.
     vl = scene.view_layers[0]
-    if hasattr(vl, "cycles"):
-        vl.cycles.use_denoising = False
     vl.use_pass_combined = True
     vl.use_pass_z = True
     vl.use_pass_normal = True
@@ -221,32 +189,15 @@ def render_all(out_dir):
     im = r.image_settings
 
     def set_format(multilayer):
-        if hasattr(im, "media_type"):  # Blender 5.0: media type first, then the format
-            im.media_type = "MULTI_LAYER_IMAGE" if multilayer else "IMAGE"
-        im.file_format = "OPEN_EXR_MULTILAYER" if multilayer else "OPEN_EXR"
-        im.color_mode = "RGBA"
-        im.color_depth = "16"
-        im.exr_codec = "ZIP"
+        fixture_scene.set_exr_format(im, multilayer=multilayer, half=True)
 
     def render_to(name, multilayer, border, crop):
         set_format(multilayer)
         r.use_border = border
         r.use_crop_to_border = crop
         r.border_min_x, r.border_max_x, r.border_min_y, r.border_max_y = BORDER
-        # Blender decides whether a still's name gets a frame number (versions differ), so
-        # render to a scratch stem and move the one file written there.
-        stem = "_render_" + os.path.splitext(name)[0]
-        for old in os.listdir(out_dir):
-            if old.startswith(stem):
-                os.remove(os.path.join(out_dir, old))
-        r.filepath = os.path.join(out_dir, stem)
         scene.frame_set(1)
-        bpy.ops.render.render(write_still=True)
-        written = [f for f in os.listdir(out_dir) if f.startswith(stem)]
-        if len(written) != 1:
-            sys.exit("render of %s wrote %r" % (name, written))
-        os.replace(os.path.join(out_dir, written[0]), os.path.join(out_dir, name))
-        print("wrote", os.path.join(out_dir, name), os.path.getsize(os.path.join(out_dir, name)))
+        fixture_scene.render_still(scene, out_dir, name)
 
     render_to("multilayer.exr", True, False, False)
     render_to("border.exr", True, True, False)
@@ -300,10 +251,7 @@ def render_all(out_dir):
             "rgba.exr": {"format": "OPEN_EXR", "use_border": False},
         },
     }
-    with open(os.path.join(out_dir, "layout.json"), "w") as f:
-        json.dump(info, f, indent=1)
-        f.write("\n")
-    print("wrote", os.path.join(out_dir, "layout.json"))
+    fixture_scene.write_json(os.path.join(out_dir, "layout.json"), info)
 
 
 # --------------------------------------------------------------------------------------------
@@ -555,10 +503,7 @@ def describe_all(out_dir):
         k: rgba[k] for k in ("channels_used", "combined_nonzero_pixels", "alpha") if k in rgba}
     if rgba["combined_nonzero_pixels"] == 0:
         problems.append("rgba.exr: all zero")
-    with open(path, "w") as f:
-        json.dump(layout, f, indent=1)
-        f.write("\n")
-    print("wrote", path)
+    fixture_scene.write_json(path, layout)
     if problems:
         sys.exit("blank render: " + "; ".join(problems))
 

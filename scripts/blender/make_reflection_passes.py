@@ -69,6 +69,7 @@ import sys
 
 sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fixture_scene  # noqa: E402
 import make_mask_fixtures as mmf  # noqa: E402
 
 PLANES = (0, 1, 2)
@@ -79,31 +80,12 @@ REFL_NAME = "refl_%d.%04d.exr"
 
 
 def parse_args(argv):
-    if "--" in argv:
-        argv = argv[argv.index("--") + 1:]
-    else:
-        argv = argv[1:]
-    opts = {"out": None, "geometry": None, "scratch": None, "mode": "render",
-            "working_space": None}
-    i = 0
-    while i < len(argv):
-        a = argv[i]
-        if a in ("--out", "--geometry", "--scratch") and i + 1 < len(argv):
-            opts[a[2:]] = os.path.abspath(argv[i + 1])
-            i += 2
-            continue
-        if a == "--working-space" and i + 1 < len(argv):
-            opts["working_space"] = argv[i + 1]
-            i += 2
-            continue
-        if a == "--check":
-            opts["mode"] = "check"
-        elif a in ("-h", "--help"):
-            print(__doc__)
-            sys.exit(0)
-        else:
-            sys.exit("make_reflection_passes.py: unknown argument %r" % a)
-        i += 1
+    opts = fixture_scene.parse_options(
+        argv, "make_reflection_passes.py", __doc__,
+        {"out": None, "geometry": None, "scratch": None, "mode": "render",
+         "working_space": None},
+        paths=("out", "geometry", "scratch"), values=("working-space",),
+        flags={"--check": ("mode", "check")})
     if not (opts["out"] and opts["geometry"] and opts["scratch"]):
         sys.exit("make_reflection_passes.py: --out DIR, --geometry DIR and --scratch DIR are "
                  "required")
@@ -209,30 +191,10 @@ def render_reflections(out_dir, geo_dir, scratch, working_space=None):
     scene.cycles.film_exposure = 1.0
     im = r.image_settings
 
-    def set_format():
-        if hasattr(im, "media_type"):  # Blender 5.0: media type first, then the format
-            im.media_type = "MULTI_LAYER_IMAGE"
-        im.file_format = "OPEN_EXR_MULTILAYER"
-        im.color_mode = "RGBA"
-        im.color_depth = "16"
-        im.exr_codec = "ZIP"
-
-    set_format()
+    fixture_scene.set_exr_format(im, multilayer=True, half=True)
 
     def render_to(directory, name):
-        stem = "_render_" + name.split(".")[0]
-        for old in os.listdir(directory):
-            if old.startswith(stem):
-                os.remove(os.path.join(directory, old))
-        r.filepath = os.path.join(directory, stem)
-        bpy.ops.render.render(write_still=True)
-        written = [f for f in os.listdir(directory) if f.startswith(stem)]
-        if len(written) != 1:
-            sys.exit("render of %s wrote %r" % (name, written))
-        path = os.path.join(directory, name)
-        os.replace(os.path.join(directory, written[0]), path)
-        print("wrote", path, os.path.getsize(path))
-        return os.path.getsize(path)
+        return fixture_scene.render_still(scene, directory, name)
 
     glass = [bpy.data.objects[name] for name, _m, _i, plane, _g in mmf.OBJECTS
              if plane is not None]
@@ -405,10 +367,7 @@ def render_reflections(out_dir, geo_dir, scratch, working_space=None):
             add.inputs[1].default_value = -p["d"]
         render_to(scratch, "refl_index_%d.exr" % k)
     info["check_ids"] = CHECK_IDS
-    with open(os.path.join(scratch, "reflection_info.json"), "w") as fh:
-        json.dump(info, fh, indent=1)
-        fh.write("\n")
-    print("wrote", os.path.join(scratch, "reflection_info.json"))
+    fixture_scene.write_json(os.path.join(scratch, "reflection_info.json"), info)
 
 
 # --------------------------------------------------------------------------------------------

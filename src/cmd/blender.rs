@@ -74,6 +74,10 @@ pub struct RenderArgs {
     /// as DIR/reference.####.exr, for validation.
     #[arg(long)]
     pub reference: bool,
+    /// Stop after the passes, masks and run record: `glassdb blender compose DIR` composites
+    /// them (a farm's render step, then its composite step).
+    #[arg(long)]
+    pub no_composite: bool,
 }
 
 #[derive(ClapArgs, Debug)]
@@ -161,6 +165,7 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         threads: a.threads,
         reference: a.reference,
         mask_samples: a.mask_samples,
+        composite: !a.no_composite,
     };
     let spinner = Spinner::on_terminal("blender");
     let report = glassdb_blender::render(&request, &registry, &spinner)?;
@@ -178,7 +183,19 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    print_composites(&a.out_dir, &report.compose);
+    for o in &report.record.overrides {
+        outln!("passes: {o}");
+    }
+    if request.composite {
+        print_composites(&a.out_dir, &report.compose);
+    } else {
+        outln!(
+            "passes, masks and {} ready in {}; composite with: glassdb blender compose {}",
+            glassdb_blender::job::RECORD_NAME,
+            a.out_dir.display(),
+            a.out_dir.display()
+        );
+    }
     outln!(
         "Blender export {:.2} s, passes {:.2} s{}; planes and masks {:.3} s",
         report.export_s,

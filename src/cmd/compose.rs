@@ -8,18 +8,18 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::bail;
-use glassdb_compose::colour::RegistryLuts;
-use glassdb_compose::frames_report::FramesReport;
-use glassdb_compose::io::{ExrDataType, OutputOptions, parse_exr_compression};
-use glassdb_compose::pixels::PngBits;
-use glassdb_compose::sequence::{self, FrameDone, FrameOutcome, SequenceOptions};
-use glassdb_compose::view::ViewTransform;
+use glassdb_colour::DisplayView;
+use glassdb_compose::colour::{RegistryLuts, SpaceSource};
 use glassdb_compose::{
-    ComposeSettings, FrameReport, OutsidePolicy, UnknownIds, compose_frame_with_progress,
+    ComposeJob, ComposeSettings, FrameReport, OutsidePolicy, UnknownIds,
+    compose_frame_with_progress,
 };
+use glassdb_encode::{ExrDataType, OutputOptions, parse_exr_compression};
+use glassdb_pass::PngBits;
 use glassdb_registry::{ColourBasis, Registry};
+use glassdb_sequence::{FrameDone, FrameOutcome, FramesReport, SequenceOptions, SequenceProgress};
 
-use crate::cmd::inputs::{FrameInputArgs, split_layer};
+use crate::cmd::inputs::FrameInputArgs;
 use crate::cmd::progress::Spinner;
 
 #[derive(Debug, clap::Args)]
@@ -30,9 +30,10 @@ pub struct Args {
     /// from data/catalog.toml).
     #[arg(long, value_name = "JSON")]
     pub registry: Option<PathBuf>,
-    /// Output, .exr or .png (default: beside the transmission pass, `<name>.composite.<ext>`).
-    #[arg(short, long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
+    /// Output, .exr or .png (required: a default beside the passes would write into a render
+    /// or source folder); with --frames, a pattern with ####.
+    #[arg(short, long, value_name = "FILE", required = true)]
+    pub output: PathBuf,
     /// Glass pixels of a plane that its (cropped) reflection pass does not cover: refuse
     /// (`error`), composite them without reflection (`no-reflection`), or leave them as the
     /// transmission pass (`transmission`).
@@ -122,24 +123,6 @@ pub enum DitherArg {
     None,
 }
 
-/// `t.exr` → `t.composite.exr` (PNG passes give a PNG), beside the transmission pass.
-fn default_output(trans: &Path) -> PathBuf {
-    let stem = trans
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let ext = match trans
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("png") => "png",
-        _ => "exr",
-    };
-    trans.with_file_name(format!("{stem}.composite.{ext}"))
-}
-
 /// The registry at `path`, or the bundled one, with the label outputs and messages name it by.
 pub(crate) fn load_registry(path: Option<&Path>) -> anyhow::Result<(Registry, String)> {
     Ok(match path {
@@ -157,13 +140,37 @@ pub(crate) fn load_registry(path: Option<&Path>) -> anyhow::Result<(Registry, St
 fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)> {
     let (registry, label) = load_registry(args.registry.as_deref())?;
     let luts = RegistryLuts::new(&registry);
-    let registry_sha256 = registry.content_sha256()?;
     if let Some(id) = args.glass
         && registry.default_table().glass(id).is_none()
     {
         bail!("--glass {id}: {label} has no glass with id {id}");
     }
-    let output = OutputOptions {
+    let output = output_options(args, &registry, &label)?;
+    let outside = match args.outside_pass {
+        OutsideArg::Error => OutsidePolicy::Error,
+        OutsideArg::NoReflection => OutsidePolicy::NoReflection,
+        OutsideArg::Transmission => OutsidePolicy::Transmission,
+    };
+    let unknown = match args.unknown {
+        UnknownArg::Error => UnknownIds::Error,
+        UnknownArg::Passthrough => UnknownIds::Passthrough,
+    };
+    let mut decode = args.inputs.decode_settings(outside, unknown, label)?;
+    // A binary mask's glass (--glass).
+    decode.mask.binary_glass_id = args.glass;
+    let settings = ComposeSettings {
+        decode,
+        plane_sides: args.inputs.plane_sides()?,
+        output,
+    };
+    Ok((settings, luts))
+}
+
+/// How the composite is written: the encoding flags, the view, and glassdb's provenance (its
+/// version, the registry and its hash).
+fn output_options(args: &Args, registry: &Registry, label: &str) -> anyhow::Result<OutputOptions> {
+    let registry_sha256 = registry.content_sha256()?;
+    Ok(OutputOptions {
         exr_data_type: args.data_type.map(|d| match d {
             DataTypeArg::Half => ExrDataType::Half,
             DataTypeArg::Float => ExrDataType::Float,
@@ -185,7 +192,7 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)>
         view: args
             .view
             .as_deref()
-            .map(ViewTransform::from_arg)
+            .map(DisplayView::from_arg)
             .transpose()?,
         keep_channels: args.keep_channels == KeepArg::All,
         output_layer: args.output_layer.clone(),
@@ -194,32 +201,10 @@ fn settings_from(args: &Args) -> anyhow::Result<(ComposeSettings, RegistryLuts)>
                 "glassdb/version".to_string(),
                 env!("CARGO_PKG_VERSION").to_string(),
             ),
-            ("glassdb/registry".to_string(), label.clone()),
+            ("glassdb/registry".to_string(), label.to_string()),
             ("glassdb/registrySha256".to_string(), registry_sha256),
         ],
-    };
-    let outside = match args.outside_pass {
-        OutsideArg::Error => OutsidePolicy::Error,
-        OutsideArg::NoReflection => OutsidePolicy::NoReflection,
-        OutsideArg::Transmission => OutsidePolicy::Transmission,
-    };
-    let unknown = match args.unknown {
-        UnknownArg::Error => UnknownIds::Error,
-        UnknownArg::Passthrough => UnknownIds::Passthrough,
-    };
-    // Every input besides the passes and the mask: no output may replace one.
-    let protected = args.registry.iter().cloned().chain(
-        args.view
-            .as_deref()
-            .filter(|v| *v != "standard")
-            .map(PathBuf::from),
-    );
-    let mut settings = args
-        .inputs
-        .settings(outside, unknown, output, label, protected)?;
-    // A binary mask's glass (--glass).
-    settings.mask.binary_glass_id = args.glass;
-    Ok((settings, luts))
+    })
 }
 
 fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
@@ -259,9 +244,14 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
         ColourBasis::PaperRgb => " (the paper's CIE 1931 RGB, not a renderer's space)",
         ColourBasis::Space(_) => "",
     };
+    // The passes' space as the command line names how it was known.
+    let source = match &colour.space.source {
+        SpaceSource::Declared => "--input-space".to_string(),
+        other => other.to_string(),
+    };
     outln!(
-        "colour       passes in {}; registry table {}{table_note}",
-        colour.space,
+        "colour       passes in {} ({source}); registry table {}{table_note}",
+        glassdb_compose::colour::space_label(colour.space.space),
         colour.table.basis
     );
     if colour.converted_for_display {
@@ -312,8 +302,21 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
 
 fn report_nonfinite(r: &FrameReport, label: &str) {
     if r.output.half_overflow > 0 {
+        let first = r
+            .output
+            .first_half_overflow
+            .as_ref()
+            .map_or(String::new(), |s| {
+                format!(
+                    " (the first at pixel ({}, {}), channel {}: {})",
+                    s.x,
+                    s.y,
+                    glassdb_io::quoted(&s.channel),
+                    s.value
+                )
+            });
         eprintln!(
-            "warning: {label}{} output samples exceed the half-float range (±65504) and were stored as infinite; write float (--data-type float) to keep them",
+            "warning: {label}{} output samples exceed the half-float range and were clamped to ±65504, the largest half{first}; write float (--data-type float) to keep them",
             r.output.half_overflow
         );
     }
@@ -335,58 +338,85 @@ fn report_nonfinite(r: &FrameReport, label: &str) {
 pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     args.inputs.expand_plane_layers()?;
     let (settings, luts) = settings_from(&args)?;
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&split_layer(&args.inputs.trans).0));
-    let job = args.inputs.job(output);
-
-    let Some(frames_spec) = &args.inputs.frames else {
-        let spinner = Spinner::on_terminal("compose");
-        let report = compose_frame_with_progress(&job, &settings, &luts, &spinner)?;
-        spinner.finish();
-        report_nonfinite(&report, "");
-        if args.stats {
-            print_stats(&report, &luts, settings.max_memory);
-        }
-        outln!(
-            "wrote {} ({}×{}, {})",
-            report.output.path.display(),
-            report.width,
-            report.height,
-            report.output.encoding
-        );
-        return Ok(ExitCode::SUCCESS);
+    let job = ComposeJob {
+        inputs: args.inputs.files(),
+        output: args.output.clone(),
     };
+    match &args.inputs.frames {
+        None => run_frame(&args, &job, &settings, &luts),
+        Some(spec) => run_sequence(&args, spec, &job, &settings, &luts),
+    }
+}
 
-    let frames = sequence::parse_frames(frames_spec)?;
-    let bar = if std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(frames.len() as u64);
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} frames, {elapsed} elapsed, ETA {eta}",
-        ) {
-            bar.set_style(style);
+/// One frame, with a spinner naming its stage.
+fn run_frame(
+    args: &Args,
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    luts: &RegistryLuts,
+) -> anyhow::Result<ExitCode> {
+    let spinner = Spinner::on_terminal("compose");
+    let report = compose_frame_with_progress(job, settings, luts, &spinner)?;
+    spinner.finish();
+    report_nonfinite(&report, "");
+    if args.stats {
+        print_stats(&report, luts, settings.decode.max_memory);
+    }
+    outln!(
+        "wrote {} ({}×{}, {})",
+        report.output.path.display(),
+        report.width,
+        report.height,
+        report.output.encoding
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A bar over the frames of a sequence, on a terminal's stderr only.
+fn frames_bar(frames: usize) -> Option<indicatif::ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(frames as u64);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{bar:40} {pos}/{len} frames, {elapsed} elapsed, ETA {eta}",
+    ) {
+        bar.set_style(style);
+    }
+    Some(bar)
+}
+
+/// What a finished frame of a sequence says on stderr (besides its warnings, printed here):
+/// why it was composited again, or its error.
+fn frame_line(o: &FrameOutcome) -> Option<String> {
+    match &o.result {
+        Ok(FrameDone::Composed { report, replaced }) => {
+            report_nonfinite(report, &format!("frame {}: ", o.frame));
+            replaced
+                .as_ref()
+                .map(|why| format!("frame {}: composited again: {why}", o.frame))
         }
-        Some(bar)
-    } else {
-        None
-    };
+        Ok(FrameDone::Skipped) => None,
+        Err(e) => Some(format!(
+            "frame {}: error: {}",
+            o.frame,
+            glassdb_io::ErrorChain(e)
+        )),
+    }
+}
+
+/// Every frame of `spec`, two in flight, with a bar; the report when asked.
+fn run_sequence(
+    args: &Args,
+    spec: &str,
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    luts: &RegistryLuts,
+) -> anyhow::Result<ExitCode> {
+    let frames = glassdb_io::parse_frame_list(spec)?;
+    let bar = frames_bar(frames.len());
     let on_done = |o: &FrameOutcome| {
-        let line = match &o.result {
-            Ok(FrameDone::Composed { report, replaced }) => {
-                report_nonfinite(report, &format!("frame {}: ", o.frame));
-                replaced
-                    .as_ref()
-                    .map(|why| format!("frame {}: composited again: {why}", o.frame))
-            }
-            Ok(FrameDone::Skipped) => None,
-            Err(e) => Some(format!(
-                "frame {}: error: {}",
-                o.frame,
-                glassdb_io::ErrorChain(e)
-            )),
-        };
-        match (&bar, line) {
+        match (&bar, frame_line(o)) {
             (Some(b), Some(l)) => b.println(l),
             (None, Some(l)) => eprintln!("{l}"),
             _ => {}
@@ -397,25 +427,64 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     };
     if let Some(report) = &args.report {
         // The report is an output like the frames: it may not replace an input.
-        glassdb_io::refuse_input_as_output(
-            report,
-            settings
-                .protected
-                .iter()
-                .map(PathBuf::as_path)
-                .chain(job.inputs()),
-        )?;
+        glassdb_io::declare_inputs(job.inputs.paths());
+        glassdb_io::refuse_input_as_output(report)?;
     }
     let options = SequenceOptions {
         skip_existing: args.skip_existing,
     };
-    let outcomes = sequence::compose_sequence(&job, &frames, &settings, &luts, options, &on_done)?;
+    let progress = std::sync::Arc::new(SequenceProgress::new(job, &frames));
+    // A stop by a signal still writes the report: what was finished, what it interrupted.
+    let _report_on_stop = args
+        .report
+        .clone()
+        .map(|path| glassdb_io::on_stop(report_on_stop(path, progress.clone())));
+    let outcomes = glassdb_sequence::compose_sequence(
+        job, &frames, settings, luts, options, &progress, &on_done,
+    )?;
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
     if let Some(report) = &args.report {
         FramesReport::from_outcomes(&outcomes).write(report)?;
     }
+    report_sequence(args, &outcomes, frames.len(), luts, settings)
+}
+
+/// Writes the frames report of a sequence stopped by a signal (the exit code's).
+fn report_on_stop(
+    path: PathBuf,
+    progress: std::sync::Arc<SequenceProgress>,
+) -> impl FnOnce(i32) + Send {
+    move |code| {
+        let signal = super::stop_signal_name(code);
+        let report = progress.stopped_report(signal);
+        match report.write(&path) {
+            Ok(()) => eprintln!(
+                "wrote {} (stopped by {signal}: {} frame(s) composed, {} skipped, {} failed, interrupted: {:?})",
+                path.display(),
+                report.composed,
+                report.skipped,
+                report.failed.len(),
+                report.interrupted
+            ),
+            Err(e) => eprintln!(
+                "error: cannot write the frames report: {}",
+                glassdb_io::ErrorChain(&e)
+            ),
+        }
+    }
+}
+
+/// The end of a sequence: each frame's stats when asked, what was written and skipped, and
+/// the exit code (the failed frames listed).
+fn report_sequence(
+    args: &Args,
+    outcomes: &[FrameOutcome],
+    requested: usize,
+    luts: &RegistryLuts,
+    settings: &ComposeSettings,
+) -> anyhow::Result<ExitCode> {
     let failed: Vec<u32> = outcomes
         .iter()
         .filter(|o| o.result.is_err())
@@ -427,10 +496,10 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         .filter(|o| matches!(o.result, Ok(FrameDone::Skipped)))
         .count();
     if args.stats {
-        for o in &outcomes {
+        for o in outcomes {
             if let Some(r) = o.report() {
                 outln!("--- frame {}", o.frame);
-                print_stats(r, &luts, settings.max_memory);
+                print_stats(r, luts, settings.decode.max_memory);
             }
         }
     }
@@ -445,5 +514,5 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     if skipped > 0 {
         outln!("skipped {skipped} frame(s) whose output is complete");
     }
-    Ok(crate::cmd::frames_exit(&failed, frames.len()))
+    Ok(crate::cmd::frames_exit(&failed, requested))
 }

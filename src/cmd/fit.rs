@@ -7,8 +7,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use glassdb_fit::{
-    Basis, CurveFit, DEFAULT_MAX_DEGREE, DEFAULT_TOL, EXTRAPOLATION_MARGIN_DEG, FitFile,
-    FitOptions, GlassFit, Quantity,
+    Basis, CurveFit, DEFAULT_MAX_DEGREE, DEFAULT_TOL, EXTRAPOLATION_MARGIN_DEG, ExpectedFile,
+    FileContent, FitError, FitFile, FitOptions, GlassFit, GlassFitOptions, Quantity,
 };
 
 /// The basis names accepted by `--basis`.
@@ -55,8 +55,13 @@ pub struct FitArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Failed physical checks (r, t outside 0–1, r + t > 1) are errors, not warnings.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "force")]
     pub strict: bool,
+    /// Write the fit even when readings are inconsistent with their neighbours, or the fit
+    /// misses the data by more than 10 × --tol or fails a physical check over 0–90° (each
+    /// becomes a warning, kept in the JSON).
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -77,28 +82,31 @@ pub struct EvalArgs {
 pub fn run_fit(args: FitArgs) -> anyhow::Result<ExitCode> {
     let tables =
         glassdb_fit::read_angle_table(&args.table, args.percent).map_err(anyhow::Error::new)?;
-    let base = FitOptions {
+    let reflectance = FitOptions {
         degree: args.degree,
         tol: args.tol,
         max_degree: args.max_degree,
         basis: args.basis.map(Basis::from),
         quantity: Quantity::Reflectance,
     };
-    let t_opts = FitOptions {
-        quantity: Quantity::Transmittance,
-        ..base.clone()
+    let opts = GlassFitOptions {
+        transmittance: FitOptions {
+            quantity: Quantity::Transmittance,
+            ..reflectance.clone()
+        },
+        reflectance,
+        strict: args.strict,
+        force: args.force,
     };
     let mut file = FitFile::default();
     for table in &tables {
-        let fit = glassdb_fit::fit_glass(table, &base, &t_opts, args.strict)
-            .with_context(|| args.table.display().to_string())?;
-        file.glasses.push(fit);
+        file.glasses.push(glassdb_fit::fit_glass(table, &opts)?);
     }
     // What every reader of fit files refuses is not written: a curve beyond the physical range
     // by more than its tolerance (smaller violations are warnings, errors with --strict).
     file.validate(&args.table)?;
     if let Some(out) = &args.output {
-        glassdb_io::refuse_input_as_output(out, [args.table.as_path()])?;
+        glassdb_io::refuse_input_as_output(out)?;
         glassdb_io::write_bytes_atomic(out, file.to_json().as_bytes())?;
     }
     for g in &file.glasses {
@@ -385,4 +393,60 @@ pub fn run_eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
         out!("{s}");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The hint for a fit error: which command reads the file given, which flag answers the
+/// error (`super::hints` asks this for every [`FitError`] it has no hint of its own for).
+pub fn hint(e: &FitError) -> Option<String> {
+    const FORCE: &str =
+        "or pass --force to write the fit anyway, with the findings as warnings in it";
+    match e {
+        FitError::OtherFile {
+            path,
+            kind: FileContent::FitFile,
+            ..
+        } => Some(format!(
+            "a fit file is evaluated by `glassdb eval {}`; `glassdb fit` reads an angle table (CSV: angle_deg,R,T)",
+            path.display()
+        )),
+        FitError::OtherFile {
+            path,
+            kind: FileContent::AngleTable,
+            ..
+        } => Some(format!(
+            "fit the table first: `glassdb fit {} -o fits.json`, then `glassdb eval fits.json`",
+            path.display()
+        )),
+        FitError::OtherFile {
+            kind: FileContent::Binary(_),
+            expected,
+            ..
+        } => Some(match expected {
+            ExpectedFile::FitFile => "`glassdb eval` reads the JSON that `glassdb fit -o` writes".into(),
+            ExpectedFile::AngleTable => "`glassdb fit` reads an angle table: CSV text with columns angle_deg, R and/or T (docs/fit.md, \"Input\"); images are read by `compose` and `glassdb view`".into(),
+        }),
+        FitError::ValuesAboveOne { .. } => Some(
+            "correct those cells to fractions; a table in percent throughout takes --percent"
+                .into(),
+        ),
+        FitError::MixedUnits { .. } => Some(
+            "write every R and T column in the same unit (--percent reads them as percent)".into(),
+        ),
+        FitError::FractionsReadAsPercent { .. } => Some("drop --percent".into()),
+        FitError::InconsistentPoints { .. } | FitError::ReversedCurve { .. } => Some(format!(
+            "correct the readings named (docs/fit.md, \"Inconsistent points\"), {FORCE}"
+        )),
+        FitError::FarFromData { .. } => Some(format!(
+            "check the reading named; a higher degree (--degree, --max-degree) or the other --basis may follow the data; {FORCE}"
+        )),
+        FitError::UnphysicalFit {
+            beyond_data: true, ..
+        } => Some(format!(
+            "add a 90° row (R = 1, T = 0 at grazing incidence, for any glazing) so that the curve is not extrapolated there, {FORCE}"
+        )),
+        FitError::UnphysicalFit { .. } => Some(format!(
+            "a fixed --degree or the other --basis may stay physical; {FORCE}"
+        )),
+        _ => None,
+    }
 }

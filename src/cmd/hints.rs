@@ -2,12 +2,16 @@
 //! command fixes it. [`hints`] walks an error's whole cause chain and matches the library
 //! error variants that one flag or command answers; [`super::finish`] prints each as `hint:`.
 
+use glassdb_colour::CubeError;
 use glassdb_compose::ComposeError;
-use glassdb_fit::{FitError, OtherJson};
+use glassdb_encode::EncodeError;
+use glassdb_fit::{FileContent, FitError};
 use glassdb_mask::MaskError;
+use glassdb_pass::PassError;
 use glassdb_plot::PlotError;
 use glassdb_registry::RegistryError;
 use glassdb_scene::SceneError;
+use glassdb_sequence::SequenceError;
 use glassdb_spectral::SpectralError;
 use glassdb_view::ViewError;
 
@@ -22,6 +26,45 @@ pub fn hints(err: &anyhow::Error) -> Vec<String> {
         }
     }
     out
+}
+
+/// The kind of `err` (`glassdb_io::ErrorKind`): that of the first glassdb error in its cause
+/// chain, outermost first (each library's error knows the kind of what it wraps); `None` when
+/// no glassdb library made it (an argument the binary refused).
+pub fn kind(err: &anyhow::Error) -> Option<glassdb_io::ErrorKind> {
+    err.chain().find_map(error_kind)
+}
+
+/// The kind of one cause, if a glassdb library made it.
+fn error_kind(cause: &(dyn std::error::Error + 'static)) -> Option<glassdb_io::ErrorKind> {
+    macro_rules! kind_of {
+        ($($t:ty),* $(,)?) => {
+            $(if let Some(e) = cause.downcast_ref::<$t>() {
+                return Some(e.kind());
+            })*
+        };
+    }
+    kind_of!(
+        FitError,
+        SpectralError,
+        RegistryError,
+        MaskError,
+        SceneError,
+        ComposeError,
+        PassError,
+        EncodeError,
+        CubeError,
+        SequenceError,
+        ViewError,
+        PlotError,
+        glassdb_report::ReportError,
+        glassdb_blender::BlenderError,
+        glassdb_image::ImageError,
+        glassdb_io::InputError,
+        glassdb_io::OutputError,
+        glassdb_io::FrameError,
+    );
+    None
 }
 
 /// The error message followed by its hints in parentheses, on one line (for reports that list
@@ -54,6 +97,18 @@ fn hint(cause: &(dyn std::error::Error + 'static)) -> Option<String> {
     if let Some(e) = cause.downcast_ref::<ComposeError>() {
         return compose_hint(e);
     }
+    if let Some(e) = cause.downcast_ref::<PassError>() {
+        return pass_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<EncodeError>() {
+        return encode_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<CubeError>() {
+        return cube_hint(e);
+    }
+    if let Some(e) = cause.downcast_ref::<SequenceError>() {
+        return sequence_hint(e);
+    }
     if let Some(e) = cause.downcast_ref::<ViewError>() {
         return view_hint(e);
     }
@@ -63,10 +118,8 @@ fn hint(cause: &(dyn std::error::Error + 'static)) -> Option<String> {
     if let Some(e) = cause.downcast_ref::<glassdb_blender::BlenderError>() {
         return blender_hint(e);
     }
-    if let Some(glassdb_io::FrameError::List { .. }) =
-        cause.downcast_ref::<glassdb_io::FrameError>()
-    {
-        return Some("check --frames".into());
+    if let Some(e) = cause.downcast_ref::<glassdb_io::FrameError>() {
+        return frame_hint(e);
     }
     None
 }
@@ -90,20 +143,20 @@ fn fit_hint(e: &FitError) -> Option<String> {
             Some("if the table is in percent, pass --percent".into())
         }
         FitError::OtherFile {
-            kind: OtherJson::Registry,
+            kind: FileContent::Registry,
             ..
         } => Some(format!(
             "a registry is read by `glassdb registry show`, `glassdb registry check`, \
              `glassdb plot registry` and `glassdb compose --registry`; {FIT_FILES}"
         )),
         FitError::OtherFile {
-            kind: OtherJson::Planes,
+            kind: FileContent::Planes,
             ..
         } => Some(format!(
             "a planes file is read by `glassdb compose --planes` and `glassdb mask --planes`; \
              {FIT_FILES}"
         )),
-        _ => None,
+        _ => super::fit::hint(e),
     }
 }
 
@@ -157,7 +210,69 @@ fn scene_hint(e: &SceneError) -> Option<String> {
         SceneError::CameraNeedsFrame { .. } => {
             Some("choose the frames with --frames (e.g. 1-24)".into())
         }
+        SceneError::PlaneCountMismatch { .. } => {
+            Some("give one --refl per plane of --planes, in its order".into())
+        }
+        // Transparent wrappers: their `source` skips the wrapped error itself.
+        SceneError::Mask(e) => mask_hint(e),
+        SceneError::Frame(e) => frame_hint(e),
         _ => None,
+    }
+}
+
+fn frame_hint(e: &glassdb_io::FrameError) -> Option<String> {
+    match e {
+        glassdb_io::FrameError::List { .. } => Some("check --frames".into()),
+        glassdb_io::FrameError::NoPattern { .. } => None,
+    }
+}
+
+fn sequence_hint(e: &SequenceError) -> Option<String> {
+    match e {
+        // Transparent wrappers: their `source` skips the wrapped error itself.
+        SequenceError::Compose(e) => compose_hint(e),
+        SequenceError::Frame(e) => frame_hint(e),
+        _ => None,
+    }
+}
+
+fn pass_hint(e: &PassError) -> Option<String> {
+    match e {
+        PassError::AmbiguousLayer { .. } | PassError::LayerNotFound { .. } => Some(
+            "choose a layer with FILE.exr:LAYER, --trans-layer / --refl-layer, or --layer for \
+             every pass"
+                .into(),
+        ),
+        PassError::KeepChannels { .. } => {
+            Some("--keep-channels none writes only the composite".into())
+        }
+        _ => None,
+    }
+}
+
+fn encode_hint(e: &EncodeError) -> Option<String> {
+    match e {
+        EncodeError::BadLayerName { .. } => Some("check --output-layer".into()),
+        EncodeError::ViewOnExr { .. } => Some(
+            "write a .png (-o NAME.png) to see --view, or drop --view and apply the view to the \
+             EXR in your viewer or compositor (OCIO)"
+                .into(),
+        ),
+        EncodeError::ZipLevelNotApplicable { .. } | EncodeError::ZipLevelOutOfRange { .. } => {
+            Some("--zip-level sets it".into())
+        }
+        _ => None,
+    }
+}
+
+fn cube_hint(e: &CubeError) -> Option<String> {
+    match e {
+        CubeError::Syntax { .. } | CubeError::Invalid { .. } | CubeError::TooLarge { .. } => Some(
+            "--view takes `standard` or a .cube LUT, e.g. baked by ociobakelut --format \
+             resolve_cube (docs/colour.md)"
+                .into(),
+        ),
+        CubeError::Read { .. } => None,
     }
 }
 
@@ -165,13 +280,8 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
     match e {
         // Transparent wrappers: their `source` skips the wrapped error itself.
         ComposeError::Mask(e) => mask_hint(e),
-        ComposeError::Registry(e) => registry_hint(e),
-        ComposeError::PlanesFile(e) => scene_hint(e),
-        ComposeError::AmbiguousLayer { .. } | ComposeError::LayerNotFound { .. } => Some(
-            "choose a layer with FILE.exr:LAYER, --trans-layer / --refl-layer, or --layer for \
-             every pass"
-                .into(),
-        ),
+        ComposeError::Pass(e) => pass_hint(e),
+        ComposeError::Encode(e) => encode_hint(e),
         ComposeError::DisplayWindowMismatch { .. } => Some(
             "render every pass and the mask with the same resolution (a render border or crop \
              may change the data window, not the display window)"
@@ -186,10 +296,6 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
              --outside-pass no-reflection or --outside-pass transmission"
                 .into(),
         ),
-        ComposeError::KeepChannels { .. } => {
-            Some("--keep-channels none writes only the composite".into())
-        }
-        ComposeError::BadLayerName { .. } => Some("check --output-layer".into()),
         ComposeError::UnknownIds { .. } => Some(
             "add them to the registry, or pass --unknown passthrough to leave those pixels as \
              the transmission pass"
@@ -199,22 +305,6 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
             Some("repeat --refl: the k-th is the pass of plane k".into())
         }
         ComposeError::NoReflectionPass => Some("give one with --refl".into()),
-        ComposeError::PlaneCountMismatch { .. } => {
-            Some("give one --refl per plane of --planes, in its order".into())
-        }
-        ComposeError::FrameList { .. } => Some("check --frames".into()),
-        ComposeError::ViewOnExr { .. } => Some(
-            "write a .png (-o NAME.png) to see --view, or drop --view and apply the view to the \
-             EXR in your viewer or compositor (OCIO)"
-                .into(),
-        ),
-        ComposeError::CubeSyntax { .. }
-        | ComposeError::CubeInvalid { .. }
-        | ComposeError::CubeTooLarge { .. } => Some(
-            "--view takes `standard` or a .cube LUT, e.g. baked by ociobakelut --format \
-             resolve_cube (docs/colour.md)"
-                .into(),
-        ),
         ComposeError::UnsupportedPassSpace { .. } | ComposeError::ConflictingColourTags { .. } => {
             Some(
                 "if the pixels are scene-linear RGB, say in which space with --input-space \
@@ -246,9 +336,6 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
                     ""
                 }
             ))
-        }
-        ComposeError::ZipLevelNotApplicable { .. } | ComposeError::ZipLevelOutOfRange { .. } => {
-            Some("--zip-level sets it".into())
         }
         _ => None,
     }
@@ -292,9 +379,9 @@ fn view_hint(e: &ViewError) -> Option<String> {
              pass over the whole pane"
                 .into(),
         ),
-        ViewError::Compose(ComposeError::AmbiguousLayer { .. } | ComposeError::LayerNotFound { .. }) => {
-            Some("choose a layer with FILE.exr:LAYER or --layer".into())
-        }
+        ViewError::Compose(ComposeError::Pass(
+            PassError::AmbiguousLayer { .. } | PassError::LayerNotFound { .. },
+        )) => Some("choose a layer with FILE.exr:LAYER or --layer".into()),
         ViewError::Compose(c) => compose_hint(c),
         ViewError::Bind { source, .. } => match source.kind() {
             std::io::ErrorKind::AddrInUse => Some(
@@ -325,7 +412,14 @@ fn view_hint(e: &ViewError) -> Option<String> {
         ViewError::MaskKindChanges { .. } => {
             Some("write every frame's mask the same way (8-bit PNG, 16-bit PNG or EXR)".into())
         }
+        ViewError::Frame(e) => frame_hint(e),
         ViewError::GlassSpec { .. }
+        | ViewError::NoFrames
+        | ViewError::NoSuchFrame { .. }
+        | ViewError::UnitCatalog(_)
+        | ViewError::Unit(_)
+        | ViewError::UnitPanicked
+        | ViewError::UnitRequest { .. }
         | ViewError::UnknownGlassId { .. }
         | ViewError::ExportDir { .. }
         | ViewError::ExportNotAFolder { .. }

@@ -6,17 +6,14 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use glassdb_compose::io::{OutputOptions, PassReadOptions};
-use glassdb_compose::pixels::InputTransfer;
-use glassdb_compose::{
-    ComposeJob, ComposeSettings, InputLayers, OutsidePolicy, UnknownIds, sequence,
-};
+use glassdb_colour::RgbSpace;
+use glassdb_compose::{DecodeSettings, FrameFiles, InputLayers, OutsidePolicy, UnknownIds};
 use glassdb_mask::{
     AovWeighting, CosSource, CryptomatteOptions, ExrMaskChannels, GlassMapping, GlassNames,
     MaskReadOptions, PlaneSource,
 };
-use glassdb_registry::Side;
-use glassdb_spectral::RgbSpace;
+use glassdb_pass::{InputTransfer, PassReadOptions};
+use glassdb_side::Side;
 
 #[derive(Debug, clap::Args)]
 pub struct FrameInputArgs {
@@ -121,38 +118,34 @@ pub enum AovsArg {
 const PLANE_MATCH_DEG: f64 = 10.0;
 
 impl FrameInputArgs {
-    /// The files of the frame (layers split off), writing to `output`.
-    pub fn job(&self, output: PathBuf) -> ComposeJob {
-        ComposeJob {
+    /// The files of the frame (layers split off).
+    pub fn files(&self) -> FrameFiles {
+        FrameFiles {
             refl: self.refl.iter().map(|r| split_layer(r).0).collect(),
             trans: split_layer(&self.trans).0,
             mask: split_layer(&self.mask).0,
-            output,
         }
     }
 
-    /// The settings of a frame read from these inputs (passes, layers, mask, planes' sides,
-    /// space, memory limit), with the rest as given. No output may replace a file of
-    /// `protected` (the registry, a view, …) or of [`FrameInputArgs::side_inputs`].
-    pub fn settings(
+    /// How a frame is read from these inputs (passes, layers, mask, space, memory limit), with
+    /// the rest as given. Declares the inputs besides the passes and the mask
+    /// ([`FrameInputArgs::side_inputs`]): no output may replace one.
+    pub fn decode_settings(
         &self,
         outside: OutsidePolicy,
         unknown: UnknownIds,
-        output: OutputOptions,
         registry_label: String,
-        protected: impl IntoIterator<Item = PathBuf>,
-    ) -> anyhow::Result<ComposeSettings> {
-        Ok(ComposeSettings {
+    ) -> anyhow::Result<DecodeSettings> {
+        let side_inputs: Vec<PathBuf> = self.side_inputs().collect();
+        glassdb_io::declare_inputs(side_inputs.iter().map(PathBuf::as_path));
+        Ok(DecodeSettings {
             pass: self.pass_options(),
             layers: self.layers(),
             mask: self.mask_options()?,
-            outside,
-            plane_sides: self.plane_sides()?,
-            unknown,
-            output,
-            registry_label,
-            protected: protected.into_iter().chain(self.side_inputs()).collect(),
             input_space: self.input_space,
+            unknown,
+            outside,
+            registry_label,
             max_memory: self.max_memory(),
         })
     }
@@ -207,7 +200,7 @@ impl FrameInputArgs {
     pub fn plane_sides(&self) -> anyhow::Result<BTreeMap<usize, Side>> {
         let passes = self.refl.len();
         let mut sides = match &self.planes {
-            Some(p) => glassdb_compose::sides_from_planes_json(p, passes)?,
+            Some(p) => glassdb_scene::sides_from_planes_json(p, passes)?,
             None => Default::default(),
         };
         for spec in &self.side {
@@ -236,7 +229,7 @@ impl FrameInputArgs {
     /// The frames of --frames (none without it).
     pub fn frame_numbers(&self) -> anyhow::Result<Vec<u32>> {
         Ok(match &self.frames {
-            Some(spec) => sequence::parse_frames(spec)?,
+            Some(spec) => glassdb_io::parse_frame_list(spec)?,
             None => Vec::new(),
         })
     }
@@ -253,9 +246,9 @@ impl FrameInputArgs {
             return Ok(());
         }
         let candidates: Vec<PathBuf> = match &self.frames {
-            Some(spec) if glassdb_io::is_frame_pattern(refl) => sequence::parse_frames(spec)?
+            Some(spec) if glassdb_io::is_frame_pattern(refl) => glassdb_io::parse_frame_list(spec)?
                 .into_iter()
-                .filter_map(|f| sequence::expand(refl, f).ok())
+                .filter_map(|f| glassdb_io::expand_frame_pattern(refl, f).ok())
                 .filter(|p| p.is_file())
                 .take(1)
                 .collect(),
@@ -266,7 +259,7 @@ impl FrameInputArgs {
         };
         // A file that cannot be read is reported by the frame that reads it, after the other
         // inputs' checks; only misnumbered plane layers are this function's to report.
-        match glassdb_compose::io::plane_layers_of(first, self.max_pixels) {
+        match glassdb_pass::plane_layers_of(first, self.max_pixels) {
             Ok(Some(layers)) => {
                 let file = refl.to_string_lossy().into_owned();
                 self.refl = layers
@@ -275,7 +268,7 @@ impl FrameInputArgs {
                     .collect();
                 Ok(())
             }
-            Err(e @ glassdb_compose::ComposeError::PlaneLayers { .. }) => Err(e.into()),
+            Err(e @ glassdb_pass::PassError::PlaneLayers { .. }) => Err(e.into()),
             Ok(None) | Err(_) => Ok(()),
         }
     }

@@ -39,6 +39,10 @@ use std::process::ExitCode;
 /// Exit code for a run that failed on its input or output (clap uses 2 for usage errors).
 pub const EXIT_FAILURE: u8 = 1;
 
+/// Exit code for a run that failed inside glassdb (an error of kind internal: a caught panic),
+/// `EX_SOFTWARE` of sysexits.h: the input is not to blame, and a retry will not help.
+pub const EXIT_INTERNAL: u8 = 70;
+
 /// What every binary does first (docs/reliability.md): protect each file it reads from its
 /// outputs, and on SIGINT, SIGTERM or SIGHUP remove the unfinished outputs' temporary files
 /// and exit with 128 + the signal's number (130, 143, 129).
@@ -85,11 +89,7 @@ fn install_signal_cleanup() {
         .name("signals".into())
         .spawn(move || {
             if let Some(signal) = signals.forever().next() {
-                let name = match signal {
-                    SIGINT => "SIGINT",
-                    SIGTERM => "SIGTERM",
-                    _ => "SIGHUP",
-                };
+                let name = stop_signal_name(128 + signal);
                 eprintln!("stopped by {name}: unfinished outputs removed");
                 glassdb_io::exit_removing_temporaries(128 + signal);
             }
@@ -102,8 +102,20 @@ fn install_signal_cleanup() {
 #[cfg(not(unix))]
 fn install_signal_cleanup() {}
 
+/// The name of the signal a stop by which exits with `code` (128 + its number).
+pub fn stop_signal_name(code: i32) -> &'static str {
+    match code - 128 {
+        1 => "SIGHUP",
+        2 => "SIGINT",
+        15 => "SIGTERM",
+        _ => "a signal",
+    }
+}
+
 /// Turns a subcommand's result into the process exit code, printing the whole error chain and
-/// the hints that say which flag or command fixes it.
+/// the hints that say which flag or command fixes it. The code follows the error's kind:
+/// [`EXIT_INTERNAL`] for glassdb's own failure, [`EXIT_FAILURE`] for everything a user can act
+/// on (the input, an option, a limit, the files).
 pub fn finish(result: anyhow::Result<ExitCode>) -> ExitCode {
     match result {
         Ok(code) => code,
@@ -112,7 +124,16 @@ pub fn finish(result: anyhow::Result<ExitCode>) -> ExitCode {
             for hint in hints::hints(&err) {
                 eprintln!("hint: {hint}");
             }
-            ExitCode::from(EXIT_FAILURE)
+            match hints::kind(&err) {
+                Some(glassdb_io::ErrorKind::Internal) => {
+                    eprintln!(
+                        "hint: this is a bug of glassdb's, not a problem of the input: please \
+                         report it with the command and its files"
+                    );
+                    ExitCode::from(EXIT_INTERNAL)
+                }
+                _ => ExitCode::from(EXIT_FAILURE),
+            }
         }
     }
 }

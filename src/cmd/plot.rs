@@ -173,7 +173,8 @@ fn output_path(out: &OutputArgs, input: &Path, kind: &str) -> PathBuf {
 }
 
 fn write<F: Figure>(fig: &F, output: &Path, inputs: &[&Path]) -> anyhow::Result<ExitCode> {
-    glassdb_io::refuse_input_as_output(output, inputs.iter().copied())?;
+    glassdb_io::declare_inputs(inputs.iter().copied());
+    glassdb_io::refuse_input_as_output(output)?;
     let format =
         save(fig, output).with_context(|| format!("cannot plot to {}", output.display()))?;
     let (w, h) = fig.size();
@@ -183,7 +184,7 @@ fn write<F: Figure>(fig: &F, output: &Path, inputs: &[&Path]) -> anyhow::Result<
 
 /// True when the file looks like JSON (first non-blank byte `{`).
 fn looks_like_json(path: &Path) -> anyhow::Result<bool> {
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::ANGLE_TABLE)
+    let bytes = glassdb_io::read_input(path, glassdb_fit::ANGLE_TABLE_FILE)
         .with_context(|| format!("cannot read {}", path.display()))?;
     Ok(bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{'))
 }

@@ -32,6 +32,9 @@ pub enum Command {
 }
 
 #[derive(Debug, clap::Args)]
+// clap's own usage line in an error lists the options given as if required
+// (`--space <SPACE[,SPACE...]>` after a mistyped `-o`): this one says what is required.
+#[command(override_usage = "glassdb registry build <CATALOG> --output <OUTPUT> [OPTIONS]")]
 pub struct BuildArgs {
     /// The catalog (`[[glass]]` tables; paths in it are relative to it).
     pub catalog: PathBuf,
@@ -68,7 +71,7 @@ pub struct BuildArgs {
     /// RGB working space(s) for --method colorimetric, comma-separated: srgb (alias rec709),
     /// rec2020, acescg, aces2065-1, display-p3, xyz. One table per space, the first the
     /// default; compose picks the one its passes are in. Default: srgb.
-    #[arg(long, value_name = "SPACE[,SPACE...]")]
+    #[arg(long, value_name = "SPACES")]
     pub space: Option<String>,
     /// Hold end values where a spectrum does not cover the method's range (else an error).
     #[arg(long)]
@@ -203,7 +206,8 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
             .iter()
             .filter_map(|l| l.split_once('=').map(|(_, i)| PathBuf::from(i))),
     );
-    glassdb_io::refuse_input_as_output(&a.output, inputs.iter().map(PathBuf::as_path))?;
+    glassdb_io::declare_inputs(inputs.iter().map(PathBuf::as_path));
+    glassdb_io::refuse_input_as_output(&a.output)?;
     let opts = BuildOptions {
         tables,
         lights,

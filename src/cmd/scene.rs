@@ -2,17 +2,18 @@
 //! mask) from an OBJ scene (docs/scene.md). All logic lives in `glassdb_scene`; this module
 //! parses arguments and formats output.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
 use glassdb_io::Progress;
-use glassdb_mask::{MaskFormat, write_mask};
+use glassdb_mask::MaskFormat;
 use glassdb_scene::{
-    Camera, CameraSource, CosEncoding, CosMode, GlassMapping, MaskScene, MirrorRequest,
-    PlaneBoundsFile, PlaneSource, PlaneTolerance, PlanesFile, RasterOptions, SceneWarning,
-    build_mask_scene, load_obj, rasterize, to_mask_image, write_virtual_scenes,
+    CameraSource, CosMode, GlassMapping, MaskJob, MaskPlanes, MaskScene, MirrorRequest,
+    PlaneTolerance, RasterOptions, Scene, SceneWarning, label_scene, load_obj, mask_frame,
+    mask_frames, write_virtual_scenes,
 };
 
 use crate::cmd::progress::Spinner;
@@ -242,32 +243,63 @@ fn mask_format(output: &Path, format: Option<FormatArg>) -> anyhow::Result<MaskF
     }
 }
 
-pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
-    let format = mask_format(&args.output, args.format)?;
-    if args.samples >= 2 && !matches!(format, MaskFormat::Exr | MaskFormat::Binary) {
-        bail!(
-            "--samples {} makes a coverage channel, which only an EXR or a binary mask holds: \
-             write a .exr or use --format binary",
-            args.samples
-        );
+/// The checks of `glassdb mask`'s arguments (each error names its flag), and what they ask
+/// for: the mask format, the raster options, the glass mappings, the camera and its frames.
+struct MaskArgsChecked {
+    format: MaskFormat,
+    options: RasterOptions,
+    mappings: Vec<GlassMapping>,
+    source: CameraSource,
+    frames: Option<Vec<u32>>,
+}
+
+impl MaskArgsChecked {
+    fn of(args: &MaskArgs) -> anyhow::Result<MaskArgsChecked> {
+        let format = mask_format(&args.output, args.format)?;
+        if args.samples >= 2 && !matches!(format, MaskFormat::Exr | MaskFormat::Binary) {
+            bail!(
+                "--samples {} makes a coverage channel, which only an EXR or a binary mask holds: \
+                 write a .exr or use --format binary",
+                args.samples
+            );
+        }
+        let cos = match (args.cos, args.mesh) {
+            (CosArg::Exact, None) => CosMode::Exact,
+            (CosArg::Exact, Some(_)) => bail!("--mesh only applies to --cos gouraud"),
+            (CosArg::Gouraud, mesh) => CosMode::Gouraud {
+                mesh: mesh.unwrap_or(8),
+            },
+        };
+        let options = RasterOptions {
+            cos,
+            samples: args.samples,
+        };
+        glassdb_scene::raster::check_options(&options).map_err(anyhow::Error::new)?;
+        let mappings = args
+            .glass
+            .iter()
+            .map(|g| GlassMapping::parse(g))
+            .collect::<Result<Vec<_>, _>>()?;
+        check_mappings(&mappings, format)?;
+        let source = CameraSource::open(&args.camera)?;
+        let frames = match (&args.frames, source.frames()) {
+            (Some(spec), _) => Some(glassdb_io::parse_frame_list(spec)?),
+            (None, in_file) => in_file,
+        };
+        check_frame_patterns(args, &source, frames.as_deref())?;
+        Ok(MaskArgsChecked {
+            format,
+            options,
+            mappings,
+            source,
+            frames,
+        })
     }
-    let cos = match (args.cos, args.mesh) {
-        (CosArg::Exact, None) => CosMode::Exact,
-        (CosArg::Exact, Some(_)) => bail!("--mesh only applies to --cos gouraud"),
-        (CosArg::Gouraud, mesh) => CosMode::Gouraud {
-            mesh: mesh.unwrap_or(8),
-        },
-    };
-    let options = RasterOptions {
-        cos,
-        samples: args.samples,
-    };
-    glassdb_scene::raster::check_options(&options).map_err(anyhow::Error::new)?;
-    let mappings = args
-        .glass
-        .iter()
-        .map(|g| GlassMapping::parse(g))
-        .collect::<Result<Vec<_>, _>>()?;
+}
+
+/// The glass mappings fit the mask format: ids of an 8-bit PNG up to 255, one glass in a
+/// binary mask.
+fn check_mappings(mappings: &[GlassMapping], format: MaskFormat) -> anyhow::Result<()> {
     if format == MaskFormat::Png8
         && let Some(m) = mappings.iter().find(|m| m.id > 255)
     {
@@ -284,12 +316,17 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             mappings.len()
         );
     }
-    let source = CameraSource::open(&args.camera)?;
-    let frames = match (&args.frames, source.frames()) {
-        (Some(spec), _) => Some(glassdb_io::parse_frame_list(spec)?),
-        (None, in_file) => in_file,
-    };
-    match &frames {
+    Ok(())
+}
+
+/// Frames and `####` agree: an animated camera needs frames, a pattern needs frames, several
+/// frames need a pattern, and -o and --bounds both have one or neither.
+fn check_frame_patterns(
+    args: &MaskArgs,
+    source: &CameraSource,
+    frames: Option<&[u32]>,
+) -> anyhow::Result<()> {
+    match frames {
         None if source.is_animated() => bail!(
             "the camera {} has one file per frame: choose the frames with --frames (e.g. 1-24)",
             args.camera.display()
@@ -314,21 +351,22 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
             args.output.display()
         );
     }
-    // Every file the mask is made from: the OBJ, its material libraries, the planes file and
-    // the camera (of each frame). No output may replace one.
-    let mut inputs: Vec<PathBuf> = vec![args.scene.clone()];
-    inputs.extend(args.planes.iter().cloned());
-    let refuse_inputs = |output: &Path, camera: &Path, inputs: &[PathBuf]| {
-        glassdb_io::refuse_input_as_output(
-            output,
-            inputs
-                .iter()
-                .map(PathBuf::as_path)
-                .chain(std::iter::once(camera)),
-        )
-    };
-    if frames.is_none() {
-        refuse_inputs(&args.output, &args.camera, &inputs)?;
+    Ok(())
+}
+
+pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
+    let checked = MaskArgsChecked::of(&args)?;
+    // Every file the mask is made from: the OBJ, its material libraries (declared as it is
+    // read), the planes file and the camera (of each frame, as it is read). No output may
+    // replace one.
+    glassdb_io::declare_inputs(
+        [args.scene.as_path(), args.camera.as_path()]
+            .into_iter()
+            .chain(args.planes.as_deref()),
+    );
+    let single = checked.frames.is_none();
+    if single {
+        glassdb_io::refuse_input_as_output(&args.output)?;
     }
 
     let spinner = Spinner::on_terminal("mask");
@@ -336,39 +374,23 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
     let t0 = Instant::now();
     let scene = load_obj(&args.scene)?;
     spinner.suspend(|| print_warnings(&scene.warnings));
-    inputs.extend(scene.input_files());
-    if frames.is_none() {
-        refuse_inputs(&args.output, &args.camera, &inputs)?;
+    if single {
+        glassdb_io::refuse_input_as_output(&args.output)?;
     }
-    let source_planes = match &args.planes {
-        Some(p) => {
-            let file = PlanesFile::load(p)?;
-            let mut tolerance = file.tolerance();
-            tolerance.angle_deg = args.angle_tolerance_deg.max(tolerance.angle_deg);
-            if let Some(d) = args.distance_tolerance {
-                tolerance.distance = d;
-            }
-            PlaneSource::Given {
-                planes: file.planes(),
-                tolerance,
-            }
-        }
-        None => {
-            let mut tolerance = PlaneTolerance::default_for(&scene);
-            tolerance.angle_deg = args.angle_tolerance_deg;
-            if let Some(d) = args.distance_tolerance {
-                tolerance.distance = d;
-            }
-            PlaneSource::Detect(tolerance)
-        }
+    let planes = match &args.planes {
+        Some(path) => MaskPlanes::File {
+            path: path.clone(),
+            angle_deg: args.angle_tolerance_deg,
+            distance: args.distance_tolerance,
+        },
+        None => MaskPlanes::Detect {
+            angle_deg: args.angle_tolerance_deg,
+            distance: args.distance_tolerance,
+        },
     };
     spinner.stage("label glass planes");
-    let labelled = build_mask_scene(
-        &scene,
-        &mappings,
-        &source_planes,
-        matches!(cos, CosMode::Gouraud { .. }),
-    )?;
+    let gouraud = matches!(checked.options.cos, CosMode::Gouraud { .. });
+    let labelled = label_scene(&scene, &checked.mappings, &planes, gouraud)?;
     spinner.suspend(|| {
         for p in &labelled.unmatched_patterns {
             eprintln!("warning: --glass {p} matches no material with faces");
@@ -377,36 +399,59 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
     let t_load = t0.elapsed();
     let job = MaskJob {
         labelled: &labelled,
-        options: &options,
-        format,
+        cameras: &checked.source,
+        options: checked.options,
+        format: checked.format,
+        output: args.output.clone(),
+        bounds: args.bounds.clone(),
     };
+    let summary = MaskSummary {
+        args: &args,
+        scene: &scene,
+        labelled: &labelled,
+        t_load,
+    };
+    match &checked.frames {
+        None => summary.single(&job, &spinner),
+        Some(frames) => summary.frames(&job, frames, &spinner),
+    }
+}
 
-    let Some(frames) = frames else {
-        let camera = source.camera(None)?;
-        let t1 = Instant::now();
-        if let Some(bounds) = &args.bounds {
-            refuse_inputs(bounds, &args.camera, &inputs)?;
+/// What `glassdb mask` prints of its scene and masks.
+struct MaskSummary<'a> {
+    args: &'a MaskArgs,
+    scene: &'a Scene,
+    labelled: &'a MaskScene,
+    t_load: std::time::Duration,
+}
+
+impl MaskSummary<'_> {
+    /// `N plane(s)`: `""` or `"s"`.
+    fn plural(&self) -> &'static str {
+        if self.labelled.planes.len() == 1 {
+            ""
+        } else {
+            "s"
         }
-        let mask = job.render(
-            &camera,
-            &args.output,
-            args.bounds.as_deref(),
-            None,
-            &spinner,
-        )?;
+    }
+
+    /// One mask, and what it holds.
+    fn single(&self, job: &MaskJob<'_>, spinner: &Spinner) -> anyhow::Result<ExitCode> {
+        let t1 = Instant::now();
+        let mask = mask_frame(job, None, spinner)?;
         let t_raster = t1.elapsed();
         spinner.finish();
         outln!(
             "{}x{} mask of {} ({} triangles, {} glass on {} plane{}; {} in view) -> {}",
             mask.width,
             mask.height,
-            args.scene.display(),
-            scene.triangle_count(),
-            labelled.glass_triangles,
-            labelled.planes.len(),
-            if labelled.planes.len() == 1 { "" } else { "s" },
+            self.args.scene.display(),
+            self.scene.triangle_count(),
+            self.labelled.glass_triangles,
+            self.labelled.planes.len(),
+            self.plural(),
             mask.drawn,
-            args.output.display()
+            self.args.output.display()
         );
         if mask.id_pixels.is_empty() {
             outln!("no glass is visible from this camera");
@@ -416,128 +461,65 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         }
         outln!(
             "load {:.3} s, rasterise {:.3} s",
-            t_load.as_secs_f64(),
+            self.t_load.as_secs_f64(),
             t_raster.as_secs_f64()
         );
-        return Ok(ExitCode::SUCCESS);
-    };
-
-    // An animation: the scene is labelled once; each frame has its own camera and output. A
-    // frame that fails is reported and the others go on.
-    let frame_count = frames.len() as u64;
-    spinner.suspend(|| {
-        outln!(
-            "{} ({} triangles, {} glass on {} plane{}), {} frame(s)",
-            args.scene.display(),
-            scene.triangle_count(),
-            labelled.glass_triangles,
-            labelled.planes.len(),
-            if labelled.planes.len() == 1 { "" } else { "s" },
-            frames.len()
-        )
-    });
-    let t1 = Instant::now();
-    let mut failed: Vec<u32> = Vec::new();
-    for (k, &frame) in frames.iter().enumerate() {
-        spinner.step(k as u64, frame_count);
-        let result = (|| -> anyhow::Result<(PathBuf, FrameMask)> {
-            let output = if glassdb_io::is_frame_pattern(&args.output) {
-                glassdb_io::expand_frame_pattern(&args.output, frame)?
-            } else {
-                args.output.clone()
-            };
-            let camera_path = source.path(Some(frame));
-            refuse_inputs(&output, &camera_path, &inputs)?;
-            let bounds = match &args.bounds {
-                Some(b) if glassdb_io::is_frame_pattern(b) => {
-                    Some(glassdb_io::expand_frame_pattern(b, frame)?)
-                }
-                other => other.clone(),
-            };
-            if let Some(b) = &bounds {
-                refuse_inputs(b, &camera_path, &inputs)?;
-            }
-            let camera = source.camera(Some(frame))?;
-            let mask = job.render(&camera, &output, bounds.as_deref(), Some(frame), &spinner)?;
-            Ok((output, mask))
-        })();
-        match result {
-            Ok((output, mask)) => {
-                let glass: u64 = mask.id_pixels.values().sum();
-                spinner.suspend(|| {
-                    outln!(
-                        "frame {frame}: {}x{}, {glass} glass pixels -> {}",
-                        mask.width,
-                        mask.height,
-                        output.display()
-                    )
-                });
-            }
-            Err(e) => {
-                spinner.suspend(|| {
-                    eprintln!(
-                        "frame {frame}: error: {}",
-                        crate::cmd::hints::with_hints(&e)
-                    )
-                });
-                failed.push(frame);
-            }
-        }
+        Ok(ExitCode::SUCCESS)
     }
-    spinner.finish();
-    outln!(
-        "load {:.3} s, rasterise and write {:.3} s",
-        t_load.as_secs_f64(),
-        t1.elapsed().as_secs_f64()
-    );
-    Ok(crate::cmd::frames_exit(&failed, frames.len()))
-}
 
-/// What one frame needs besides its camera: the labelled scene and the output settings.
-struct MaskJob<'a> {
-    labelled: &'a MaskScene,
-    options: &'a RasterOptions,
-    format: MaskFormat,
-}
-
-/// The facts of one written mask that the report prints.
-struct FrameMask {
-    width: u32,
-    height: u32,
-    drawn: usize,
-    id_pixels: std::collections::BTreeMap<u16, u64>,
-}
-
-impl MaskJob<'_> {
-    /// Rasterises the scene from `camera` and writes the mask to `output` (and its planes'
-    /// rectangles to `bounds`), telling `progress` of each stage.
-    fn render(
+    /// An animation: the scene is labelled once; each frame has its own camera and output. A
+    /// frame that fails is reported and the others go on.
+    fn frames(
         &self,
-        camera: &Camera,
-        output: &Path,
-        bounds: Option<&Path>,
-        frame: Option<u32>,
-        progress: &dyn Progress,
-    ) -> anyhow::Result<FrameMask> {
-        progress.stage("rasterise");
-        let out = rasterize(&self.labelled.raster, camera, self.options)?;
-        let drawn = out.triangles_drawn;
-        let encoding = match self.format {
-            MaskFormat::Png8 | MaskFormat::Binary => CosEncoding::Quantized8,
-            MaskFormat::Png16 => CosEncoding::Quantized16,
-            MaskFormat::Exr => CosEncoding::Float,
-        };
-        progress.stage("write");
-        let mask = to_mask_image(out, encoding);
-        write_mask(output, &mask, self.format)?;
-        if let Some(bounds) = bounds {
-            PlaneBoundsFile::from_mask(&mask, frame, &output.to_string_lossy()).write(bounds)?;
-        }
-        Ok(FrameMask {
-            width: mask.width,
-            height: mask.height,
-            drawn,
-            id_pixels: mask.id_pixel_counts(),
-        })
+        job: &MaskJob<'_>,
+        frames: &[u32],
+        spinner: &Spinner,
+    ) -> anyhow::Result<ExitCode> {
+        spinner.suspend(|| {
+            outln!(
+                "{} ({} triangles, {} glass on {} plane{}), {} frame(s)",
+                self.args.scene.display(),
+                self.scene.triangle_count(),
+                self.labelled.glass_triangles,
+                self.labelled.planes.len(),
+                self.plural(),
+                frames.len()
+            )
+        });
+        let t1 = Instant::now();
+        let mut failed: Vec<u32> = Vec::new();
+        mask_frames(job, frames, spinner, &mut |frame, result| {
+            match result {
+                Ok(mask) => {
+                    let glass: u64 = mask.id_pixels.values().sum();
+                    spinner.suspend(|| {
+                        outln!(
+                            "frame {frame}: {}x{}, {glass} glass pixels -> {}",
+                            mask.width,
+                            mask.height,
+                            mask.output.display()
+                        )
+                    });
+                }
+                Err(e) => {
+                    let e = anyhow::Error::new(e);
+                    spinner.suspend(|| {
+                        eprintln!(
+                            "frame {frame}: error: {}",
+                            crate::cmd::hints::with_hints(&e)
+                        )
+                    });
+                    failed.push(frame);
+                }
+            }
+            ControlFlow::Continue(())
+        });
+        spinner.finish();
+        outln!(
+            "load {:.3} s, rasterise and write {:.3} s",
+            self.t_load.as_secs_f64(),
+            t1.elapsed().as_secs_f64()
+        );
+        Ok(crate::cmd::frames_exit(&failed, frames.len()))
     }
 }

@@ -1,23 +1,27 @@
 //! `glassdb view`: the glass-swap viewer (docs/viewer.md). All logic lives in `glassdb_view`;
 //! this module parses arguments, prints the URL and serves, or writes an export and exits.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Context;
-use glassdb_compose::view::CubeLut;
-use glassdb_compose::{OutsidePolicy, UnknownIds};
+use anyhow::{Context, bail};
+use glassdb_colour::CubeLut;
+use glassdb_compose::{DecodeSettings, FrameFiles, OutsidePolicy, UnknownIds};
 use glassdb_view::export::ExportFolder;
 use glassdb_view::server::ViewServer;
-use glassdb_view::{Viewer, ViewerInputs};
+use glassdb_view::{Viewer, ViewerFrame, ViewerInputs};
 
 use crate::cmd::compose::load_registry;
-use crate::cmd::inputs::{FrameInputArgs, split_layer};
+use crate::cmd::inputs::FrameInputArgs;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
+    /// A `glassdb blender render` output folder: its frames, passes, masks and sides from its
+    /// glassdb-blender.json (instead of --trans, --refl and --mask).
+    #[arg(value_name = "DIR", conflicts_with = "FrameInputArgs")]
+    pub run_dir: Option<PathBuf>,
     #[command(flatten)]
-    pub inputs: FrameInputArgs,
+    pub inputs: Option<FrameInputArgs>,
     /// Registry JSON whose records are the candidate products and the glasses' first choice
     /// (default: the bundled registry, every product of data/catalog.toml).
     #[arg(long, value_name = "JSON", conflicts_with = "catalog")]
@@ -58,7 +62,6 @@ pub struct Args {
 }
 
 pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
-    args.inputs.expand_plane_layers()?;
     let (registry, label) = match &args.catalog {
         Some(catalog) => (
             registry_from_catalog(catalog)?,
@@ -70,32 +73,41 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         Some(c) => glassdb_registry::catalog_inputs(c).map_err(anyhow::Error::new)?,
         None => Vec::new(),
     };
-    let inputs = &args.inputs;
-    let settings = inputs.settings(
-        OutsidePolicy::Error,
-        UnknownIds::Error,
-        Default::default(),
-        label,
-        catalog_inputs
-            .into_iter()
-            .chain(args.registry.iter().cloned())
-            .chain(args.view.iter().cloned()),
-    )?;
-    let trans = split_layer(&inputs.trans).0;
-    // Never written (the viewer only decodes the inputs); the frame's memory estimate counts
-    // encoding it as the PNG the page shows.
-    let job = inputs.job(trans.with_extension("viewer.png"));
-    let frames = inputs.frame_numbers()?;
+    // The catalog's files: no export may replace one.
+    glassdb_io::declare_inputs(catalog_inputs.iter().map(PathBuf::as_path));
+    let (frames, settings) = match (&args.run_dir, &mut args.inputs) {
+        (Some(dir), _) => (
+            blender_run_frames(dir)?,
+            DecodeSettings {
+                registry_label: label,
+                ..DecodeSettings::default()
+            },
+        ),
+        (None, Some(inputs)) => {
+            inputs.expand_plane_layers()?;
+            let settings =
+                inputs.decode_settings(OutsidePolicy::Error, UnknownIds::Error, label)?;
+            let frames = ViewerFrame::sequence(
+                &inputs.files(),
+                &inputs.frame_numbers()?,
+                &inputs.plane_sides()?,
+            )?;
+            (frames, settings)
+        }
+        (None, None) => bail!(
+            "nothing to view: give a `glassdb blender render` output folder, or the passes and the mask (--trans, --refl, --mask)"
+        ),
+    };
     let viewer = Viewer::open(ViewerInputs {
-        job,
         frames,
         settings,
         registry,
-        views: args
+        display_views: args
             .view
             .iter()
             .map(|p| CubeLut::read(p))
             .collect::<Result<_, _>>()?,
+        unit_catalog: unit_catalog(args.catalog.as_deref()),
     })?;
     let choices = match &args.glass {
         Some(spec) => viewer.parse_choices(spec).context("--glass")?,
@@ -106,8 +118,14 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         force: args.force,
     };
     if let Some(dir) = &args.export {
-        glassdb_view::export::write_export(&viewer, &folder(dir), &choices, args.ev)?;
-        outln!("wrote {}", dir.join("index.html").display());
+        let summary =
+            glassdb_view::export::write_export(&viewer, &folder(dir), &choices, args.ev, &[])?;
+        outln!(
+            "wrote {} ({} files, {:.2} MB)",
+            dir.join("index.html").display(),
+            summary.files,
+            summary.bytes as f64 / 1e6
+        );
         return Ok(ExitCode::SUCCESS);
     }
     let export = args.export_dir.as_ref().map(folder);
@@ -143,9 +161,60 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The frames of a `glassdb blender render` output folder, from its run record: each frame's
+/// passes, mask and sides (the camera may see a plane from either side as it moves).
+fn blender_run_frames(dir: &Path) -> anyhow::Result<Vec<ViewerFrame>> {
+    let record_path = dir.join(glassdb_blender::job::RECORD_NAME);
+    if !dir.is_dir() {
+        bail!(
+            "{}: no such folder (glassdb view DIR opens a `glassdb blender render` output folder)",
+            dir.display()
+        );
+    }
+    if !record_path.is_file() {
+        bail!(
+            "{} holds no {}: it is not a `glassdb blender render` output folder (to view passes, give --trans, --refl and --mask)",
+            dir.display(),
+            glassdb_blender::job::RECORD_NAME
+        );
+    }
+    let record = glassdb_blender::RunRecord::load(dir)?;
+    if record.frames.is_empty() {
+        bail!(
+            "{}: the run records no frame",
+            dir.join(glassdb_blender::job::RECORD_NAME).display()
+        );
+    }
+    Ok(record
+        .frames
+        .iter()
+        .map(|f| ViewerFrame {
+            label: f.frame.to_string(),
+            files: FrameFiles {
+                refl: f.refl.iter().map(|r| dir.join(r)).collect(),
+                trans: dir.join(&f.trans),
+                mask: dir.join(&f.mask),
+            },
+            plane_sides: f.sides.iter().copied().enumerate().collect(),
+        })
+        .collect())
+}
+
+/// The catalog the page builds units from: --catalog, else the bundled catalog where this
+/// glassdb was built from (none when that source tree is gone: the page then builds no units).
+fn unit_catalog(catalog: Option<&Path>) -> Option<PathBuf> {
+    match catalog {
+        Some(c) => Some(c.to_path_buf()),
+        None => {
+            let bundled = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/catalog.toml");
+            bundled.is_file().then_some(bundled)
+        }
+    }
+}
+
 /// A registry built from `catalog` with the bundled registry's tables: its spectral method in
 /// each of its spaces, so that passes in any of those spaces find their table.
-fn registry_from_catalog(catalog: &std::path::Path) -> anyhow::Result<glassdb_registry::Registry> {
+fn registry_from_catalog(catalog: &Path) -> anyhow::Result<glassdb_registry::Registry> {
     let bundled = glassdb_registry::default_registry()?;
     let opts = glassdb_registry::BuildOptions::with_tables_of(&bundled);
     glassdb_registry::build_registry(catalog, &opts)

@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::util::{
-    compose, fails, glassdb, ok, read_exr_planes, repo_path, run_oracle, write_file,
+    atrium_compose, atrium_refl, compose, fails, glassdb, ok, read_exr_planes, repo_path,
+    run_oracle, write_file,
 };
 
 const ALL_SPACES: [&str; 6] = [
@@ -305,22 +306,8 @@ fn an_acescg_blender_render_composites_with_the_acescg_table_without_a_flag() {
 fn untagged_passes_are_rec709_and_say_so() {
     // The bundled atrium (Mitsuba's EXRs carry no colour tag).
     let dir = tempfile::tempdir().unwrap();
-    let atrium = repo_path("fixtures/atrium");
     let out = dir.path().join("a.exr");
-    let mut c = compose();
-    for k in 0..3 {
-        c.arg("--refl").arg(atrium.join(format!("refl_{k}.exr")));
-    }
-    let stats = ok(c
-        .arg("--trans")
-        .arg(atrium.join("trans.exr"))
-        .arg("--mask")
-        .arg(atrium.join("mask.png"))
-        .arg("--planes")
-        .arg(atrium.join("virtual/planes.json"))
-        .arg("--stats")
-        .arg("-o")
-        .arg(&out));
+    let stats = ok(atrium_compose(&atrium_refl(), &out).arg("--stats"));
     assert!(
         stats.contains(
             "passes in linear Rec.709 [srgb] (no colour tag, taken as linear Rec.709); registry table srgb"

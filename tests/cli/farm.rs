@@ -1,11 +1,15 @@
 //! Frames on a farm (docs/farm.md): `--skip-existing`, `--report frames.json`, the exit code of
-//! a sequence with failed frames, and the Open Job Description template of
-//! `integrations/farm/` run by `openjd run` (its render step copies the atrium's fixture passes
-//! per frame, standing in for a renderer).
+//! a sequence with failed frames, the output folders compose creates, and the Open Job
+//! Description templates of `integrations/farm/` run by `openjd run`: the compose template (its
+//! render step copies the atrium's fixture passes per frame, standing in for a renderer) and
+//! the Blender shot's, and docs/farm.md's commands as written.
 
 use std::path::{Path, PathBuf};
 
-use crate::util::{compose, fails, ok, oracle_python, read_exr_planes, repo_path, run, run_oracle};
+use crate::util::{
+    atrium_compose, atrium_refl, compose, fails, fails_naming, ok, oracle_python, read_exr_planes,
+    repo_path, run, run_oracle,
+};
 
 /// The atrium's passes copied as frames `frames` of a sequence in `dir`
 /// (`refl_K.####.exr`, `trans.####.exr`, `mask.####.png`), as a renderer would write them.
@@ -25,6 +29,11 @@ fn atrium_frames(dir: &Path, frames: &[u32]) {
 
 /// `compose` over the frame sequence in `dir` into `out.####.exr`.
 fn compose_frames(dir: &Path, frames: &str) -> std::process::Command {
+    compose_frames_to(dir, frames, "out.####.exr")
+}
+
+/// `compose` over the frame sequence in `dir` into `output`.
+fn compose_frames_to(dir: &Path, frames: &str, output: &str) -> std::process::Command {
     let mut c = compose();
     c.current_dir(dir);
     for k in 0..3 {
@@ -33,34 +42,8 @@ fn compose_frames(dir: &Path, frames: &str) -> std::process::Command {
     c.args(["--trans", "trans.####.exr", "--mask", "mask.####.png"])
         .arg("--planes")
         .arg(repo_path("fixtures/atrium/virtual/planes.json"))
-        .args(["-o", "out.####.exr", "--frames", frames]);
+        .args(["-o", output, "--frames", frames]);
     c
-}
-
-/// `compose` of the atrium's transmission pass and mask (with its planes.json) with the
-/// reflection passes `refl`, into `out`.
-fn atrium_compose(refl: &[PathBuf], out: &Path) -> std::process::Command {
-    let a = repo_path("fixtures/atrium");
-    let mut c = compose();
-    for r in refl {
-        c.arg("--refl").arg(r);
-    }
-    c.arg("--trans")
-        .arg(a.join("trans.exr"))
-        .arg("--mask")
-        .arg(a.join("mask.png"))
-        .arg("--planes")
-        .arg(a.join("virtual/planes.json"))
-        .arg("-o")
-        .arg(out);
-    c
-}
-
-/// The atrium's three reflection passes.
-fn atrium_refl() -> Vec<PathBuf> {
-    (0..3)
-        .map(|k| repo_path(&format!("fixtures/atrium/refl_{k}.exr")))
-        .collect()
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -214,6 +197,21 @@ fn openjd_run(params: &[(&str, String)]) -> (std::process::Output, String) {
     (out, format!("{stdout}\n{stderr}"))
 }
 
+/// Asserts that the composites `frames` of `output` (a `####` pattern in `dir`), each made of a
+/// copy of the atrium's passes, are what `compose` makes of those passes by hand.
+fn assert_frames_are_atriums(dir: &Path, output: &str, frames: std::ops::RangeInclusive<u32>) {
+    let by_hand = dir.join("by_hand.exr");
+    ok(&mut atrium_compose(&atrium_refl(), &by_hand));
+    let want = read_exr_planes(&by_hand).channels;
+    for f in frames {
+        let got = read_exr_planes(&dir.join(output.replace("####", &format!("{f:04}"))));
+        assert!(
+            got.channels == want,
+            "frame {f} differs from compose by hand"
+        );
+    }
+}
+
 #[test]
 fn the_open_job_description_template_renders_then_composites_in_chunks() {
     let dir = tempfile::tempdir().unwrap();
@@ -251,17 +249,7 @@ fn the_open_job_description_template_renders_then_composites_in_chunks() {
         log.contains("Chunks run: 4"),
         "2 render + 2 composite chunks: {log}"
     );
-    // Each frame is what compose makes of the same passes by hand.
-    let by_hand = d.join("by_hand.exr");
-    ok(&mut atrium_compose(&atrium_refl(), &by_hand));
-    let want = read_exr_planes(&by_hand).channels;
-    for f in 1..=3 {
-        let got = read_exr_planes(&d.join(format!("composite/out.{f:04}.exr")));
-        assert!(
-            got.channels == want,
-            "frame {f} differs from compose by hand"
-        );
-    }
+    assert_frames_are_atriums(d, "composite/out.####.exr", 1..=3);
     let chunk = json(&d.join("reports/frames.1-2.json"));
     assert_eq!(
         statuses(&chunk),
@@ -363,4 +351,350 @@ fn one_file_holds_every_planes_reflection_cropped_to_its_glass() {
         err.contains("plane 0 is missing") && err.contains("gap.exr"),
         "{err}"
     );
+}
+
+#[test]
+fn compose_creates_the_folders_of_its_outputs_and_report() {
+    // docs/farm.md's `-o comp/out.####.exr --report reports/…` in a shot folder that has
+    // neither folder yet: every frame used to fail ("the directory comp does not exist").
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    atrium_frames(d, &[1, 2]);
+    let mut c = compose_frames_to(d, "1-2", "comp/a/out.####.exr");
+    let out = ok(c.args(["--report", "reports/b/frames.1-2.json"]));
+    for f in [1, 2] {
+        assert!(d.join(format!("comp/a/out.{f:04}.exr")).is_file(), "{out}");
+    }
+    let report = json(&d.join("reports/b/frames.1-2.json"));
+    assert_eq!(
+        statuses(&report),
+        vec![(1, "composed".to_string()), (2, "composed".to_string())]
+    );
+    // One frame, into a new folder; no temporary file is left in it.
+    ok(&mut atrium_compose(
+        &atrium_refl(),
+        &d.join("single/x/out.png"),
+    ));
+    let names: Vec<_> = std::fs::read_dir(d.join("single/x"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, ["out.png"]);
+    // A run that fails makes no folder.
+    fails(
+        compose()
+            .current_dir(d)
+            .args(["--refl", "refl_0.0009.exr", "--trans", "trans.0009.exr"])
+            .args(["--mask", "mask.0001.png", "-o", "never/out.exr"]),
+    );
+    assert!(!d.join("never").exists());
+    // A folder that cannot be made is named.
+    std::fs::write(d.join("file"), "").unwrap();
+    fails_naming(
+        &mut atrium_compose(&atrium_refl(), &d.join("file/sub/out.exr")),
+        &["file/sub"],
+    );
+}
+
+/// The indented command of docs/farm.md that starts with `start`, its continuation lines
+/// joined (backslashes dropped).
+fn docs_command(start: &str) -> String {
+    let doc = std::fs::read_to_string(repo_path("docs/farm.md")).unwrap();
+    let mut lines = doc
+        .lines()
+        .skip_while(|l| !l.trim_start().starts_with(start));
+    let mut command = String::new();
+    for line in lines.by_ref() {
+        let line = line.trim();
+        match line.strip_suffix('\\') {
+            Some(part) => command.push_str(part),
+            None => {
+                command.push_str(line);
+                break;
+            }
+        }
+    }
+    assert!(!command.is_empty(), "docs/farm.md has no `{start}` command");
+    command
+}
+
+/// Replaces the value after `key` (up to the next space) in a command of docs/farm.md with
+/// `value`, quoted: the values a test cannot take as written (240 frames in /shots/atrium).
+fn set_docs_value(command: &mut String, key: &str, value: &str) {
+    let at = command
+        .find(key)
+        .unwrap_or_else(|| panic!("no {key}: {command}"))
+        + key.len();
+    let end = command[at..].find(' ').map_or(command.len(), |e| at + e);
+    command.replace_range(at..end, &format!("'{value}'"));
+}
+
+#[test]
+fn the_docs_standalone_compose_runs_as_written() {
+    // docs/farm.md's `compose …` as written, in a shot folder holding the atrium's passes as
+    // frames 101-108 and its planes.json: comp/ and reports/ do not exist yet.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    atrium_frames(d, &(101..=108).collect::<Vec<_>>());
+    std::fs::copy(
+        repo_path("fixtures/atrium/virtual/planes.json"),
+        d.join("planes.json"),
+    )
+    .unwrap();
+    let command = docs_command("compose --refl");
+    let args: Vec<&str> = command.split_whitespace().skip(1).collect();
+    ok(compose().current_dir(d).args(&args));
+    let report = json(&d.join("reports/frames.101-108.json"));
+    let composed: Vec<(u64, String)> = (101..=108).map(|f| (f, "composed".into())).collect();
+    assert_eq!(statuses(&report), composed);
+    // A farm's retry: every frame is complete and kept.
+    ok(compose().current_dir(d).args(&args));
+    let report = json(&d.join("reports/frames.101-108.json"));
+    assert!(
+        statuses(&report).iter().all(|(_, s)| s == "skipped"),
+        "{report}"
+    );
+}
+
+#[test]
+fn the_docs_blender_shot_renders_then_composites_each_once() {
+    // docs/farm.md's `openjd run …/glassdb-blender.yaml` as written, but for two frames in
+    // chunks of one, a work folder of its own and a small, quick render.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blend = crate::blender::default_scene(d, "defaults");
+    std::fs::rename(&blend, d.join("scene.blend")).unwrap();
+    let mut command = docs_command("openjd run integrations/farm/openjd/glassdb-blender.yaml");
+    // The parameters a test cannot take as written (1-240 frames in /shots/atrium).
+    set_docs_value(&mut command, "Frames=", "1-2");
+    set_docs_value(&mut command, "ChunkSize=", "1");
+    set_docs_value(&mut command, "WorkDir=", &d.display().to_string());
+    // A small, quick render: flags added to RenderArgs="…".
+    let at = command.find("RenderArgs=\"").expect("RenderArgs") + "RenderArgs=\"".len();
+    let close = at + command[at..].find('"').unwrap();
+    command.insert_str(close, " --samples 4 --resolution 64x36 --threads 2");
+    let openjd = oracle_python().with_file_name("openjd");
+    let script = format!(
+        "{} -p Glassdb='{}'",
+        command.replacen("openjd", &openjd.display().to_string(), 1),
+        env!("CARGO_BIN_EXE_glassdb")
+    );
+    let (out, stdout, stderr) = run(std::process::Command::new("bash")
+        .args(["-c", &script])
+        .current_dir(crate::util::repo_root()));
+    let log = format!("{script}\n{stdout}\n{stderr}");
+    assert!(out.status.success(), "{log}");
+    assert!(
+        log.contains("Chunks run: 4"),
+        "2 render + 2 composite chunks: {log}"
+    );
+    // Render tasks stop at the passes; each frame is composited once, by its composite task.
+    assert_eq!(log.matches("ready in").count(), 2, "{log}");
+    assert_eq!(log.matches("composited 1 frame(s)").count(), 2, "{log}");
+    let composites: Vec<PathBuf> = std::fs::read_dir(d.join("glassdb"))
+        .unwrap()
+        .flat_map(|chunk| std::fs::read_dir(chunk.unwrap().path()).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("composite.")
+        })
+        .collect();
+    assert_eq!(composites.len(), 2, "{composites:?}");
+}
+
+/// A one-node Slurm cluster on this machine, in `dir` (`scripts/slurm_local_cluster.sh`: its
+/// own munged, slurmctld and slurmd, as root); its daemons are stopped when it is dropped, a
+/// failed assertion included.
+struct LocalSlurm {
+    dir: PathBuf,
+}
+
+impl LocalSlurm {
+    /// Starts the cluster; a machine without Slurm, or a test run that is not root, fails here
+    /// with the script's message (install slurm-wlm and munge; run as root, as CI does).
+    fn start(dir: PathBuf) -> LocalSlurm {
+        std::fs::create_dir_all(&dir).unwrap();
+        // Made before the start, so that a half-started cluster is stopped too.
+        let cluster = LocalSlurm { dir };
+        let (out, stdout, stderr) = run(&mut cluster.script("start"));
+        assert!(
+            out.status.success(),
+            "the localhost Slurm cluster did not start (`bash scripts/test-all` installs \
+             slurm-wlm and munge, and CI runs it as root):\n{stdout}{stderr}"
+        );
+        cluster
+    }
+
+    fn script(&self, action: &str) -> std::process::Command {
+        let mut c = std::process::Command::new("bash");
+        c.arg(repo_path("scripts/slurm_local_cluster.sh"))
+            .arg(action)
+            .arg(&self.dir);
+        c
+    }
+
+    /// `program` run against this cluster (`SLURM_CONF`), with the Slurm tools and the built
+    /// `glassdb` on `PATH`, as a user who installed both would have them.
+    fn command(&self, program: &str) -> std::process::Command {
+        let bin = Path::new(env!("CARGO_BIN_EXE_glassdb")).parent().unwrap();
+        let path = std::env::var("PATH").unwrap_or_default();
+        let mut c = std::process::Command::new(program);
+        c.env("SLURM_CONF", self.dir.join("slurm.conf"))
+            .env("PATH", format!("{}:/usr/sbin:/sbin:{path}", bin.display()));
+        c
+    }
+
+    /// stdout of `program args…` against this cluster (a failure is part of the text).
+    fn query(&self, program: &str, args: &[&str]) -> String {
+        let (out, stdout, stderr) = run(self.command(program).args(args));
+        format!(
+            "$ {program} {}\n{stdout}{stderr}{}",
+            args.join(" "),
+            out.status
+        )
+    }
+
+    /// What to read when a job went wrong: the queue, the jobs, each task's output in
+    /// `work_dir` and the daemons' logs.
+    fn diagnosis(&self, jobs: &str, work_dir: &Path) -> String {
+        let mut text = self.query("squeue", &["-a"]);
+        text += &self.query("scontrol", &["-o", "show", "job", jobs]);
+        for entry in std::fs::read_dir(work_dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("slurm-")
+            {
+                let output = std::fs::read_to_string(&path).unwrap_or_default();
+                text += &format!("--- {}\n{output}", path.display());
+            }
+        }
+        text + &run(&mut self.script("logs")).1
+    }
+}
+
+impl Drop for LocalSlurm {
+    fn drop(&mut self) {
+        let (out, _, stderr) = run(&mut self.script("stop"));
+        if !out.status.success() {
+            eprintln!(
+                "stopping the Slurm cluster in {}: {stderr}",
+                self.dir.display()
+            );
+        }
+    }
+}
+
+/// (array task, state, start, end) of each task of a job array, by task.
+fn array_tasks(cluster: &LocalSlurm, job: &str) -> Vec<(u32, String, String, String)> {
+    let text = cluster.query("scontrol", &["-o", "show", "job", job]);
+    let mut tasks: Vec<_> = text
+        .lines()
+        .filter(|l| l.contains("ArrayTaskId="))
+        .map(|line| {
+            let field = |key: &str| {
+                line.split(' ')
+                    .find_map(|f| f.strip_prefix(key))
+                    .unwrap_or_else(|| panic!("no {key} in {line}"))
+                    .to_string()
+            };
+            let task = field("ArrayTaskId=").parse().unwrap();
+            (
+                task,
+                field("JobState="),
+                field("StartTime="),
+                field("EndTime="),
+            )
+        })
+        .collect();
+    tasks.sort();
+    tasks
+}
+
+#[test]
+fn the_docs_slurm_submission_runs_on_a_localhost_cluster() {
+    // docs/farm.md's `… integrations/farm/slurm/submit.sh --partition=render` as written, on a
+    // one-node cluster of this machine, but for frames 1-3 in chunks of 2 (the last chunk is
+    // one frame) in a shot folder of its own; its `render_passes.sh` copies the atrium's
+    // fixture passes per frame, standing in for a renderer.
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("shot");
+    std::fs::create_dir(&shot).unwrap();
+    let a = repo_path("fixtures/atrium");
+    crate::util::write_executable(
+        &shot,
+        "render_passes.sh",
+        &format!(
+            "#!/bin/sh\nset -e\nfor f in $(seq \"$1\" \"$2\"); do n=$(printf %04d $f)\n\
+             for p in refl_0 refl_1 refl_2 trans; do cp {a}/$p.exr $p.$n.exr; done\n\
+             cp {a}/mask.png mask.$n.png\ndone\n",
+            a = a.display()
+        ),
+    );
+    std::fs::copy(a.join("virtual/planes.json"), shot.join("planes.json")).unwrap();
+    let mut command = docs_command("FRAME_FIRST=");
+    set_docs_value(&mut command, "FRAME_LAST=", "3");
+    set_docs_value(&mut command, "CHUNK_SIZE=", "2");
+    set_docs_value(&mut command, "WORK_DIR=", &shot.display().to_string());
+
+    let cluster = LocalSlurm::start(dir.path().join("cluster"));
+    let submitted = std::time::Instant::now();
+    let mut submit = cluster.command("bash");
+    let stdout = ok(submit
+        .args(["-c", &command])
+        .current_dir(crate::util::repo_root()));
+    // submit.sh prints `render JOB composite JOB`.
+    let ids: Vec<&str> = stdout.split_whitespace().collect();
+    let [_, render, _, composite] = ids[..] else {
+        panic!("submit.sh printed {stdout:?}, not `render JOB composite JOB`");
+    };
+    let jobs = format!("{render},{composite}");
+    // Both arrays leave the queue within 3 minutes (about 12 s on an idle 2-core machine).
+    let limit = std::time::Duration::from_secs(180);
+    loop {
+        let queue = cluster.query("squeue", &["-h", "-j", &jobs]);
+        if queue.lines().count() == 2 && queue.ends_with("exit status: 0") {
+            break; // the command line and its status: no job left
+        }
+        assert!(
+            submitted.elapsed() < limit,
+            "the Slurm jobs {jobs} are still queued after {limit:?}:\n{}",
+            cluster.diagnosis(&jobs, &shot)
+        );
+        std::thread::sleep(std::time::Duration::from_millis(300));
+    }
+    eprintln!(
+        "Slurm: both arrays out of the queue {:.1} s after submission",
+        submitted.elapsed().as_secs_f64()
+    );
+
+    // Two tasks each, all completed; composite task K started when render task K had ended
+    // (aftercorr; the times are whole seconds).
+    let (renders, composites) = (
+        array_tasks(&cluster, render),
+        array_tasks(&cluster, composite),
+    );
+    let diagnosis = || cluster.diagnosis(&jobs, &shot);
+    assert_eq!(renders.len(), 2, "{renders:?}\n{}", diagnosis());
+    assert_eq!(composites.len(), 2, "{composites:?}\n{}", diagnosis());
+    for (r, c) in renders.iter().zip(&composites) {
+        assert!(
+            r.0 == c.0 && r.1 == "COMPLETED" && c.1 == "COMPLETED" && c.2 >= r.3,
+            "render task {r:?}, composite task {c:?}\n{}",
+            diagnosis()
+        );
+    }
+    // Every frame is what compose makes of the same passes by hand; each chunk's report says
+    // its frames were composed.
+    assert_frames_are_atriums(&shot, "comp/out.####.exr", 1..=3);
+    for (chunk, frames) in [("1-2", vec![1, 2]), ("3-3", vec![3])] {
+        let report = json(&shot.join(format!("reports/frames.{chunk}.json")));
+        let composed: Vec<(u64, String)> = frames.iter().map(|&f| (f, "composed".into())).collect();
+        assert_eq!(statuses(&report), composed, "{report}");
+    }
 }

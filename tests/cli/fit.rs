@@ -14,7 +14,7 @@ use crate::util::{
 
 #[path = "../../crates/fit/tests/common/inputs.rs"]
 mod inputs;
-use inputs::{gaussian, r_plus_t_above_one_csv};
+use inputs::{gaussian, r_plus_t_above_one_csv, r_plus_t_csv};
 
 const CLEAR: &str = "data/angles/clear_6mm_fresnel.csv";
 const BRONZE: &str = "data/angles/bronze_coated_window4.csv";
@@ -261,8 +261,17 @@ fn narrow_range_matches_the_50_digit_fit_and_eval_warns_beyond_it() {
         stderr.contains("extrapolated"),
         "fit should warn that 30–90° is extrapolated:\n{stderr}"
     );
+    // degree 6 extrapolated from 0–30° passes r = 1 before 90°: refused unless forced (the
+    // comparison with the 50-digit fit is over the data, where it holds)
+    fails_naming(
+        &mut fit(&csv, &["--degree", "6"]),
+        &["r > 1", "beyond the measured angles"],
+    );
     for degree in ["2", "4", "6"] {
-        let out = json(&ok(&mut fit(&csv, &["--degree", degree, "--json"])));
+        let out = json(&ok(&mut fit(
+            &csv,
+            &["--degree", degree, "--json", "--force"],
+        )));
         let curve = &out["glasses"][0]["reflectance"];
         let reference = fit_oracle("fit", &csv, "R", degree);
         let angles: Vec<f64> = (0..=30).map(f64::from).collect();
@@ -308,7 +317,7 @@ fn coated_glass_with_ct_above_one_passes_strict() {
 }
 
 #[test]
-fn outlier_in_noisy_data_is_reported() {
+fn outlier_in_noisy_data_is_refused_then_reported_when_forced() {
     let dir = tempfile::tempdir().unwrap();
     let noise = gaussian(7, 91);
     let rows: String = (0..=90)
@@ -325,11 +334,21 @@ fn outlier_in_noisy_data_is_reported() {
         "noisy.csv",
         format!("angle_deg,R\n{rows}").as_bytes(),
     );
-    let (res, stdout, stderr) = run(glassdb().arg("fit").arg(&csv));
+    // R falls by more than 0.02 after 55°: the reading is named with its line (header on line
+    // 1, 0° on line 2), and nothing is written
+    let out = dir.path().join("noisy.json");
+    let e = fails(glassdb().arg("fit").arg(&csv).arg("-o").arg(&out));
+    assert_names(&e, &["noisy.csv", "at 55° (line 57)", "--force"]);
+    assert!(!out.exists());
+    let (res, stdout, stderr) = run(glassdb().arg("fit").arg(&csv).arg("--force"));
     assert!(res.status.success(), "{stderr}");
     assert!(stdout.contains("suspect point at 55°"), "{stdout}");
     assert!(stderr.contains("suspect point at 55°"), "{stderr}");
-    let out = json(&ok(glassdb().arg("fit").arg(&csv).arg("--json")));
+    assert!(stderr.contains("written with --force"), "{stderr}");
+    let out = json(&ok(glassdb()
+        .arg("fit")
+        .arg(&csv)
+        .args(["--json", "--force"])));
     let r = &out["glasses"][0]["reflectance"];
     assert_eq!(f(&r["max_error_angle_deg"]), 55.0);
     assert_eq!(f(&r["suspect_points"][0]["angle_deg"]), 55.0);
@@ -404,21 +423,7 @@ fn strict_mode_fails_on_a_physical_violation() {
     let dir = tempfile::tempdir().unwrap();
     // R + T = 1.001: within the fit file's tolerance (0.002 per curve), so a warning, and an
     // error only with --strict.
-    let rows: String = (0..=9)
-        .map(|i| {
-            format!(
-                "{},{},{}\n",
-                i * 10,
-                0.1 + 0.001 * i as f64,
-                0.901 - 0.001 * i as f64
-            )
-        })
-        .collect();
-    let p = write_file(
-        dir.path(),
-        "small.csv",
-        format!("angle_deg,R,T\n{rows}").as_bytes(),
-    );
+    let p = write_file(dir.path(), "small.csv", r_plus_t_csv(0.901).as_bytes());
     let (res, _, stderr) = run(glassdb().arg("fit").arg(&p));
     assert!(res.status.success(), "{stderr}");
     assert!(stderr.contains("r + t > 1"), "{stderr}");
@@ -555,4 +560,254 @@ fn bundled_angle_tables_regenerate_byte_for_byte() {
             "data/angles/{name} differs from what python_oracle/make_angle_tables.py computes"
         );
     }
+}
+
+// ---- issue 31: first contact, and fits that were wrong with exit 0 ----
+
+#[test]
+fn docs_first_example_fits_the_flagship_table_without_a_warning() {
+    let doc = std::fs::read_to_string(repo_path("docs/fit.md")).unwrap();
+    let block = doc
+        .split("```sh\n")
+        .nth(1)
+        .expect("docs/fit.md has an sh block");
+    let first = block.lines().next().unwrap();
+    let command = first.split(" # ").next().unwrap();
+    let args: Vec<&str> = command.split_whitespace().collect();
+    assert_eq!(&args[..3], ["glassdb", "fit", CLEAR], "{first}");
+    let (res, stdout, stderr) = run(glassdb().args(&args[1..]).current_dir(repo_path("")));
+    assert!(res.status.success(), "{stderr}");
+    assert_eq!(stderr, "", "the first example warns");
+    assert_names(
+        &stdout,
+        &["glass clear_6mm_fresnel", "C_r(θ) =", "C_t(θ) ="],
+    );
+    assert!(!stdout.contains("warning"), "{stdout}");
+}
+
+/// The hand-written angle table of issue 31 (10° steps, a comment on line 1, the header on
+/// line 2, 0° on line 3, 50° on line 8), with the row of `angle` replaced by `row` if given.
+fn hand_table(dir: &Path, name: &str, replace: Option<(u32, &str)>) -> std::path::PathBuf {
+    const ROWS: [(u32, &str); 10] = [
+        (0, "0.080,0.820"),
+        (10, "0.080,0.820"),
+        (20, "0.080,0.819"),
+        (30, "0.082,0.815"),
+        (40, "0.088,0.810"),
+        (50, "0.100,0.800"),
+        (60, "0.130,0.750"),
+        (70, "0.220,0.640"),
+        (80, "0.450,0.400"),
+        (90, "1.000,0.000"),
+    ];
+    let mut text = String::from("# measured by hand, 10° steps\nangle_deg,R,T\n");
+    for (angle, values) in ROWS {
+        let values = match replace {
+            Some((a, row)) if a == angle => row,
+            _ => values,
+        };
+        text.push_str(&format!("{angle},{values}\n"));
+    }
+    write_file(dir, name, text.as_bytes())
+}
+
+#[test]
+fn the_clean_hand_written_table_fits_and_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = hand_table(dir.path(), "hand.csv", None);
+    let out = dir.path().join("hand.json");
+    ok(fit(&table, &["-o"]).arg(&out));
+    assert!(out.exists());
+}
+
+#[test]
+fn a_dropped_digit_is_refused_naming_its_angle_and_line() {
+    // Issue 31's case: T = 0.08 instead of 0.80 at 50°. The fit used to collapse to
+    // C_t = cos θ (t(60°) = 0.41 where the table says 0.75), warn once, write and exit 0.
+    let dir = tempfile::tempdir().unwrap();
+    let table = hand_table(dir.path(), "hand.csv", Some((50, "0.100,0.08")));
+    let out = dir.path().join("hand.json");
+    let e = fails(fit(&table, &["-o"]).arg(&out));
+    assert_names(
+        &e,
+        &[
+            "hand.csv",
+            "T = 0.08 at 50° (line 8)",
+            "ten times too small",
+            "hint:",
+            "--force",
+        ],
+    );
+    assert!(!out.exists(), "a refused fit is not written");
+    // --force writes it, the findings kept as warnings in the file
+    let (res, _, stderr) = run(fit(&table, &["--force", "-o"]).arg(&out));
+    assert!(res.status.success(), "{stderr}");
+    let written = std::fs::read_to_string(&out).unwrap();
+    assert!(written.contains("written with --force"), "{written}");
+    assert!(stderr.contains("T = 0.08 at 50° (line 8)"), "{stderr}");
+    // a digit dropped in R
+    let table = hand_table(dir.path(), "hand_r.csv", Some((50, "0.010,0.800")));
+    fails_naming(&mut fit(&table, &[]), &["R = 0.01 at 50° (line 8)"]);
+}
+
+#[test]
+fn a_shifted_decimal_point_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    // 0.80 written 8.0: a single value above 1 among fractions is a typo, not a percent table
+    let table = hand_table(dir.path(), "up.csv", Some((50, "0.100,8.0")));
+    let e = fails(&mut fit(&table, &[]));
+    assert_names(
+        &e,
+        &["up.csv", "line 8, column 3 (T): 8", "shifted decimal point"],
+    );
+    assert!(!e.contains("if the table is in percent"), "{e}");
+    // 0.80 written 0.080
+    let table = hand_table(dir.path(), "down.csv", Some((50, "0.100,0.080")));
+    fails_naming(
+        &mut fit(&table, &[]),
+        &["T = 0.08 at 50° (line 8)", "ten times too small"],
+    );
+    // R 0.080 written 0.80: still a fraction, but ten times its neighbours
+    let table = hand_table(dir.path(), "r10.csv", Some((10, "0.80,0.820")));
+    fails_naming(
+        &mut fit(&table, &[]),
+        &["R = 0.8 at 10° (line 4)", "ten times too large"],
+    );
+}
+
+#[test]
+fn r_and_t_swapped_on_a_row_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = hand_table(dir.path(), "swap.csv", Some((50, "0.800,0.100")));
+    fails_naming(
+        &mut fit(&table, &[]),
+        &[
+            "R = 0.8 at 50° (line 8)",
+            "T = 0.1 at 50° (line 8)",
+            "R and T swapped on this row",
+        ],
+    );
+    // the whole columns swapped: a reversed curve, not a list of typos
+    let text = std::fs::read_to_string(hand_table(dir.path(), "h.csv", None))
+        .unwrap()
+        .replace("angle_deg,R,T", "angle_deg,T,R");
+    let table = write_file(dir.path(), "columns.csv", text.as_bytes());
+    fails_naming(
+        &mut fit(&table, &[]),
+        &["columns.csv", "with the angle at most readings", "swapped"],
+    );
+}
+
+#[test]
+fn a_percent_value_in_a_fraction_column_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = hand_table(dir.path(), "pct.csv", Some((50, "0.100,80")));
+    let e = fails(&mut fit(&table, &[]));
+    assert_names(
+        &e,
+        &["pct.csv", "line 8, column 3 (T): 80", "a percent value"],
+    );
+    assert!(!e.contains("if the table is in percent"), "{e}");
+    // --percent, as the old hint said, would read every other value a hundred times too small
+    fails_naming(
+        &mut fit(&table, &["--percent"]),
+        &["pct.csv", "looks like fractions", "drop --percent"],
+    );
+    // a whole column in percent next to one in fractions
+    let text: String = std::fs::read_to_string(hand_table(dir.path(), "h.csv", None))
+        .unwrap()
+        .lines()
+        .map(|l| match l.split(',').collect::<Vec<_>>()[..] {
+            [a, r, t] if a.parse::<u32>().is_ok() => {
+                format!("{a},{r},{}\n", t.parse::<f64>().unwrap() * 100.0)
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    let table = write_file(dir.path(), "mixed.csv", text.as_bytes());
+    fails_naming(
+        &mut fit(&table, &[]),
+        &["column T is in percent but column R is in fractions"],
+    );
+}
+
+#[test]
+fn a_fit_far_from_its_data_or_unphysical_beyond_it_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f.json");
+    // degree 1 cannot follow clear glass: 0.45 off at 90°, line 95
+    let e = fails(
+        fit(
+            &repo_path(CLEAR),
+            &["--degree", "1", "--basis", "full", "-o"],
+        )
+        .arg(&out),
+    );
+    assert_names(
+        &e,
+        &[
+            "reflectance",
+            "at 90° (line 95)",
+            "10 × the tolerance 0.002",
+            "--force",
+        ],
+    );
+    assert!(!out.exists());
+    ok(fit(
+        &repo_path(CLEAR),
+        &["--degree", "1", "--basis", "full", "--force", "-o"],
+    )
+    .arg(&out));
+    assert!(out.exists());
+    // measured to 80° only, the fitted r passes 1 before 90°: refused, the fix named
+    let text: String = std::fs::read_to_string(repo_path(BRONZE))
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with("90,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let table = write_file(dir.path(), "to80.csv", text.as_bytes());
+    fails_naming(
+        &mut fit(&table, &[]),
+        &["r > 1", "beyond the measured angles", "add a 90° row"],
+    );
+}
+
+#[test]
+fn other_files_are_named_not_read_as_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    for (file, kind) in [
+        ("fixtures/atrium/refl_0.exr", "an OpenEXR image"),
+        ("fixtures/atrium/mask.png", "a PNG image"),
+    ] {
+        let e = fails(glassdb().arg("fit").arg(repo_path(file)));
+        assert_names(&e, &[file, &format!("is {kind}, not an angle table")]);
+        assert!(!e.contains("unknown column"), "{e}");
+        assert!(
+            e.len() < 400 && !e.contains('\u{fffd}'),
+            "binary bytes echoed: {e}"
+        );
+        let e = fails(glassdb().arg("eval").arg(repo_path(file)));
+        assert_names(&e, &[&format!("is {kind}, not a fit file")]);
+    }
+    // each command's file given to the other one points at it
+    let fits = dir.path().join("fits.json");
+    ok(fit(&repo_path(BRONZE), &["-o"]).arg(&fits));
+    let e = fails(glassdb().arg("fit").arg(&fits));
+    assert_names(
+        &e,
+        &[
+            "is a glassdb fit file, not an angle table",
+            &format!("glassdb eval {}", fits.display()),
+        ],
+    );
+    let e = fails(glassdb().arg("eval").arg(repo_path(BRONZE)));
+    assert_names(
+        &e,
+        &[
+            "is an angle table (CSV), not a fit file",
+            "glassdb fit",
+            "-o fits.json",
+        ],
+    );
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::util::{
-    assert_images_match, glassdb, make_ref, ok, read_exr_planes, read_png_planes, repo_path,
+    assert_images_match, glassdb, make_ref, names, ok, read_exr_planes, read_png_planes, repo_path,
     repo_root,
 };
 
@@ -80,16 +80,8 @@ fn atrium_virtual_scenes_regenerate_from_the_scene() {
     let dir = tempfile::tempdir().unwrap();
     let fresh = dir.path().join("virtual");
     mirror_atrium(&fresh);
-    let mut names: Vec<String> = std::fs::read_dir(&committed)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    let mut fresh_names: Vec<String> = std::fs::read_dir(&fresh)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    fresh_names.sort();
+    let fresh_names = names(&fresh);
+    let names = names(&committed);
     assert_eq!(
         fresh_names, names,
         "mirror writes other files than are committed"

@@ -364,3 +364,38 @@ fn a_refl_file_of_many_parts_composes_and_one_of_too_many_is_refused() {
     assert!(said.len() < 1000, "{said}");
     assert!(!dir.path().join("no.exr").exists());
 }
+
+/// Every kind of input's size limit, in the order of the table in docs/reliability.md: each
+/// declared by the library that reads that kind of file (the JSON limit by glassdb-io, the
+/// format's).
+fn input_limits() -> [glassdb_io::InputLimit; 10] {
+    [
+        glassdb_registry::CATALOG_FILE,
+        glassdb_io::limits::JSON,
+        glassdb_scene::CAMERA_FILE,
+        glassdb_fit::ANGLE_TABLE_FILE,
+        glassdb_spectral::SPECTRAL_FILE,
+        glassdb_scene::OBJ_FILE,
+        glassdb_scene::MTL_FILE,
+        glassdb_image::IMAGE_FILE,
+        glassdb_colour::display::CUBE_FILE,
+        glassdb_mask::MANIFEST_FILE,
+    ]
+}
+
+#[test]
+fn the_documented_table_lists_every_limit_in_order() {
+    let doc = std::fs::read_to_string(repo_path("docs/reliability.md")).unwrap();
+    let table = doc
+        .split("| kind | limit | read by |")
+        .nth(1)
+        .expect("docs/reliability.md has the limits table");
+    let documented: Vec<&str> = table
+        .lines()
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .filter_map(|l| l.split('|').nth(2).map(str::trim))
+        .collect();
+    let limits: Vec<String> = input_limits().iter().map(|l| l.size_text()).collect();
+    assert_eq!(documented, limits);
+}

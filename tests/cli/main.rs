@@ -7,6 +7,7 @@ mod cameras;
 mod colour;
 mod compose;
 mod farm;
+mod first_contact;
 mod fit;
 mod fixtures;
 mod limits;

@@ -549,6 +549,66 @@ fn blender_3_and_5_renders_composite_with_the_same_command_line() {
 }
 
 #[test]
+fn a_composite_is_composited_again() {
+    // A composite is a transmission pass like any other: its glassdb/* attributes (the run that
+    // wrote it) are replaced by this run's, in a single-part file (its attributes carried) and a
+    // multi-part one (every part carried). Both once failed at the write: "duplicate attribute
+    // name: `glassdb/version`".
+    let dir = tempfile::tempdir().unwrap();
+    let (reg, values) = registry(dir.path());
+    let (r0, t0) = values[&1];
+    let t08 = repo_path("fixtures/exr_windows/t08.exr");
+    let mask = dir.path().join("m.png");
+    rect_mask_png(&mask, 501, 401, [10, 20, 120, 90], 1);
+    let once = dir.path().join("once.exr");
+    ok(compose_cmd(&[&t08], &t08, &mask, &reg)
+        .args(["--data-type", "float", "-o"])
+        .arg(&once));
+    let reg2 = dir.path().join("second.json");
+    std::fs::copy(&reg, &reg2).unwrap();
+    let twice = dir.path().join("twice.exr");
+    ok(compose_cmd(&[&t08], &once, &mask, &reg2)
+        .args(["--data-type", "float", "-o"])
+        .arg(&twice));
+    let (_, _, input) = read_parts(&t08);
+    let (_, shared, output) = read_parts(&twice);
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let v = at(&input[0], name, 50, 50).unwrap();
+        let want = v * r0[c] + v * (r0[c] + t0[c]) * t0[c];
+        let got = at(&output[0], name, 50, 50).unwrap();
+        assert!(close(got, want), "{name}: got {got}, want {want}");
+    }
+    // The attributes are this run's: every copy of them (multi-part files hold them in each
+    // part) names the second registry, and the file reads back.
+    let provenance_is = |shared: &HashMap<String, String>, parts: &[Part], registry: &Path| {
+        let values: Vec<&String> = std::iter::once(shared)
+            .chain(parts.iter().map(|p| &p.other))
+            .filter_map(|m| m.get("glassdb/registry"))
+            .collect();
+        assert!(!values.is_empty(), "glassdb/registry is written");
+        for v in values {
+            assert_eq!(v, &registry.display().to_string());
+        }
+    };
+    provenance_is(&shared, &output, &reg2);
+
+    let render = "fixtures/blender/b50/multilayer.exr";
+    let (file, once) = blender_composite(dir.path(), render, &[]);
+    let twice = dir.path().join("twice_b50.exr");
+    ok(compose_cmd(&[&file], &once, &file, &reg2)
+        .args(["--mask-channels", "id=IndexMA,cos=facing"])
+        .args(["--data-type", "float", "-o"])
+        .arg(&twice));
+    let (_, shared, output) = read_parts(&twice);
+    assert_eq!(
+        output.len(),
+        read_parts(&file).2.len(),
+        "every part is kept"
+    );
+    provenance_is(&shared, &output, &reg2);
+}
+
+#[test]
 fn keep_channels_none_and_an_output_layer() {
     let dir = tempfile::tempdir().unwrap();
     let render = "fixtures/blender/b34/multilayer.exr";
@@ -715,9 +775,12 @@ fn png_alpha_is_straight_and_exr_alpha_premultiplied() {
 }
 
 #[test]
-fn half_output_counts_values_beyond_half_range() {
+fn half_output_clamps_values_beyond_half_range_and_reads_back() {
+    // Finite values beyond ±65504 are stored as the largest half, said with the first pixel,
+    // so that the output composites again (an infinity was written, and it came back as
+    // non-finite transmission samples).
     let dir = tempfile::tempdir().unwrap();
-    let (reg, _) = registry(dir.path());
+    let (reg, values) = registry(dir.path());
     let frame = PixelWindow::at_origin(3, 1);
     let trans = dir.path().join("t.exr");
     write_windowed_exr(
@@ -728,14 +791,34 @@ fn half_output_counts_values_beyond_half_range() {
     );
     let mask = dir.path().join("m.png");
     rect_mask_png(&mask, 3, 1, [2, 0, 2, 0], 1);
+    let half = dir.path().join("half.exr");
     let (_, _, stderr) = run(compose_cmd(&[&trans], &trans, &mask, &reg)
         .args(["--data-type", "half", "-o"])
-        .arg(dir.path().join("o.exr")));
+        .arg(&half));
     assert!(
-        stderr.contains("warning: 2 output samples exceed the half-float range"),
+        stderr.contains("warning: 2 output samples exceed the half-float range")
+            && stderr.contains("clamped to ±65504")
+            && stderr.contains("the first at pixel (0, 0), channel \"R\": 100000"),
         "{stderr}"
     );
     assert!(stderr.contains("--data-type float"), "{stderr}");
+    let (_, _, parts) = read_parts(&half);
+    assert_eq!(parts[0].channels["R"][..2], [65504.0, 1.0]);
+    assert_eq!(parts[0].channels["B"][..2], [-65504.0, 1.0]);
+
+    // Read back as the transmission pass, and as a reflection pass, by compose.
+    let again = dir.path().join("again.exr");
+    let (out, _, stderr) = run(compose_cmd(&[&half], &half, &mask, &reg)
+        .args(["--data-type", "float", "-o"])
+        .arg(&again));
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("NaN or infinite"), "{stderr}");
+    let (_, _, parts) = read_parts(&again);
+    let (r0, t0) = values[&1];
+    assert_eq!(parts[0].channels["R"][..2], [65504.0, 1.0]);
+    // Glass: the first composite's gain, applied again (both passes are the first output).
+    let gain = r0[1] + t0[1];
+    assert!(close(parts[0].channels["G"][2], gain * gain));
 }
 
 #[test]

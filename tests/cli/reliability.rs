@@ -10,7 +10,7 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::util::{
-    assert_names, compose, fails, glassdb, ok, registry_build, repo_path, write_file,
+    assert_names, compose, fails, glassdb, names, ok, registry_build, repo_path, write_file,
 };
 
 /// Runs `cmd` (no standard input) and returns its output, failing the test if it runs longer
@@ -52,16 +52,6 @@ fn refused_within(cmd: &mut Command, limit: Duration, parts: &[&str]) -> String 
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_names(&stderr, parts);
     stderr
-}
-
-/// The names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// Asserts that no `.glassdb-tmp-*` file is left in `dir`.
@@ -460,9 +450,10 @@ fn oversized_inputs_are_refused_from_their_size() {
 /// Writes the inputs of a compose that takes a while to encode: `w`×`h` float passes of
 /// render-like noise (uncompressed, quick to write) and an 8-bit mask, half glass.
 fn slow_compose_inputs(dir: &Path, w: u32, h: u32) {
-    use glassdb_compose::io::{OutputOptions, PassSource, parse_exr_compression, write_output};
-    use glassdb_compose::pixels::{LinearImage, PngBits};
+    use crate::util::write_pass;
+    use glassdb_encode::{OutputOptions, parse_exr_compression};
     use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
+    use glassdb_pass::{LinearImage, PassSource, PngBits};
     let n = (w * h) as usize;
     let noise = |i: u64| {
         let mut x = i.wrapping_mul(0x9e37_79b9_7f4a_7c15);
@@ -488,8 +479,8 @@ fn slow_compose_inputs(dir: &Path, w: u32, h: u32) {
     let src = PassSource::Png {
         bits: PngBits::Eight,
     };
-    write_output(&dir.join("trans.exr"), pass(1), &src, &opts).unwrap();
-    write_output(&dir.join("refl.exr"), pass(1 << 40), &src, &opts).unwrap();
+    write_pass(&dir.join("trans.exr"), pass(1), &src, &opts).unwrap();
+    write_pass(&dir.join("refl.exr"), pass(1 << 40), &src, &opts).unwrap();
     let mask = MaskImage {
         width: w,
         height: h,
@@ -505,13 +496,8 @@ fn slow_compose_inputs(dir: &Path, w: u32, h: u32) {
 fn start_compose(dir: &Path, out: &Path) -> Child {
     compose()
         .current_dir(dir)
+        .args(crate::util::EXAMPLE_INPUTS)
         .args([
-            "--refl",
-            "refl.exr",
-            "--trans",
-            "trans.exr",
-            "--mask",
-            "mask.png",
             "--data-type",
             "float",
             "--compression",
@@ -532,16 +518,29 @@ fn start_compose(dir: &Path, out: &Path) -> Child {
 /// exists. Returns the exit code, or `None` when compose finished before the signal could be
 /// sent (the test then tries again with a larger image).
 fn stop_while_writing(dir: &Path, out: &Path, signal: &str) -> Option<i32> {
-    let mut child = start_compose(dir, out);
+    let writing = || {
+        names(dir)
+            .iter()
+            .any(|n| n.starts_with(glassdb_io::TEMP_PREFIX))
+    };
+    let stopped = signal_when(start_compose(dir, out), writing, signal);
+    if stopped.is_none() {
+        let _ = std::fs::remove_file(out);
+    }
+    stopped.map(|(code, _)| code).unwrap_or(None)
+}
+
+/// Sends `signal` to `child` once `ready` says so, and waits for it. Returns its exit code and
+/// stderr, or `None` when it finished (successfully) before the signal could be sent.
+fn signal_when(
+    mut child: Child,
+    ready: impl Fn() -> bool,
+    signal: &str,
+) -> Option<(Option<i32>, String)> {
     let start = Instant::now();
     let mut sent = false;
     loop {
         if let Some(status) = child.try_wait().unwrap() {
-            if !sent {
-                assert!(status.success(), "compose failed: {status}");
-                let _ = std::fs::remove_file(out);
-                return None;
-            }
             let mut stderr = String::new();
             use std::io::Read;
             child
@@ -551,12 +550,13 @@ fn stop_while_writing(dir: &Path, out: &Path, signal: &str) -> Option<i32> {
                 .read_to_string(&mut stderr)
                 .unwrap();
             assert!(!stderr.contains("panicked"), "{stderr}");
-            return status.code();
+            if !sent {
+                assert!(status.success(), "compose failed: {stderr}");
+                return None;
+            }
+            return Some((status.code(), stderr));
         }
-        let writing = names(dir)
-            .iter()
-            .any(|n| n.starts_with(glassdb_io::TEMP_PREFIX));
-        if writing && !sent {
+        if !sent && ready() {
             let status = Command::new("kill")
                 .arg(format!("-{signal}"))
                 .arg(child.id().to_string())
@@ -611,6 +611,93 @@ fn a_stopped_compose_leaves_no_temporary_file_and_no_output() {
     }
 }
 
+/// Runs a sequence of `frames` frames of the slow inputs in `dir` (hard links `trans.0001.exr`,
+/// …) with `--report`, and sends `signal` once the first frame's output has landed. Returns the
+/// exit code and stderr, or `None` when the sequence finished before the signal was sent.
+fn stop_a_sequence(dir: &Path, frames: u32, signal: &str) -> Option<(Option<i32>, String)> {
+    for f in 1..=frames {
+        for (name, ext) in [("trans", "exr"), ("refl", "exr"), ("mask", "png")] {
+            let link = dir.join(format!("{name}.{f:04}.{ext}"));
+            if !link.exists() {
+                std::fs::hard_link(dir.join(format!("{name}.{ext}")), link).unwrap();
+            }
+        }
+    }
+    let child = compose()
+        .current_dir(dir)
+        .args(["--refl", "refl.####.exr", "--trans", "trans.####.exr"])
+        .args(["--mask", "mask.####.png", "--data-type", "float"])
+        .args([
+            "--zip-level",
+            "9",
+            "-o",
+            "out.####.exr",
+            "--report",
+            "r.json",
+        ])
+        .arg("--frames")
+        .arg(format!("1-{frames}"))
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn compose");
+    let landed = || names(dir).iter().any(|n| n.starts_with("out."));
+    signal_when(child, landed, signal)
+}
+
+#[test]
+fn a_stopped_sequence_writes_its_report() {
+    // The report says what a stopped run did: the frames finished (their outputs complete on
+    // disk), the ones in flight (interrupted: no output), the ones never started, the signal;
+    // and compose exits with 128 + the signal's number. (It was not written at all.)
+    for (signal, code) in [("TERM", 143), ("INT", 130)] {
+        if signal == "INT" && sigint_ignored() {
+            eprintln!("SIGINT is ignored by this test process and so by compose: not sent");
+            continue;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        slow_compose_inputs(d, 256, 256);
+        let mut frames = 16;
+        let (got, stderr) = loop {
+            if let Some(stopped) = stop_a_sequence(d, frames, signal) {
+                break stopped;
+            }
+            assert!(frames < 1024, "compose always finished before SIG{signal}");
+            for n in names(d).iter().filter(|n| n.starts_with("out.")) {
+                std::fs::remove_file(d.join(n)).unwrap();
+            }
+            frames *= 4;
+        };
+        assert_eq!(got, Some(code), "exit code after SIG{signal}: {stderr}");
+        assert!(stderr.contains("wrote r.json"), "{stderr}");
+        assert_no_temporaries(d);
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("r.json")).unwrap()).unwrap();
+        assert_eq!(report["stopped_by"], format!("SIG{signal}"));
+        let entries = report["frames"].as_array().unwrap();
+        let numbers: Vec<u64> = entries
+            .iter()
+            .map(|e| e["frame"].as_u64().unwrap())
+            .collect();
+        assert_eq!(numbers, (1..=u64::from(frames)).collect::<Vec<_>>());
+        let mut interrupted = Vec::new();
+        for e in entries {
+            let out = d.join(e["output"].as_str().unwrap());
+            match e["status"].as_str().unwrap() {
+                "composed" => assert!(out.exists() && e["seconds"]["encode"].is_number(), "{e}"),
+                "interrupted" => interrupted.push(e["frame"].clone()),
+                "not-started" => assert!(!out.exists(), "{e}"),
+                other => panic!("frame status {other} in a stopped run: {e}"),
+            }
+        }
+        assert!(report["composed"].as_u64().unwrap() >= 1, "{report}");
+        assert_eq!(report["interrupted"], serde_json::Value::from(interrupted));
+        assert!(report["interrupted"].as_array().unwrap().len() <= 2);
+    }
+}
+
 /// Error lines quote what they read bounded: a 200 kB CSV field (`glassdb fit`), a 400 kB
 /// catalog line (`glassdb registry build`) and a 200 kB spectral unit are cut with an
 /// ellipsis and their length (glassdb_io::quoted).
@@ -659,4 +746,64 @@ fn errors_quote_huge_input_values_bounded() {
     );
     let said = fails(glassdb().arg("spectral").arg(&spectral));
     assert!(said.len() < 1000, "{} bytes: {:.300}", said.len(), said);
+}
+
+/// Camera and planes files quote what they read bounded too: serde_json's own message
+/// (`invalid type: string "…"` quotes the value whole), a planes file's `format`, a camera's
+/// frame keys given twice (`"1"` and `"000…01"`).
+#[test]
+fn camera_and_planes_errors_quote_huge_values_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let huge = "x".repeat(100_000);
+    let camera = std::fs::read_to_string(repo_path("fixtures/scene/camera.json")).unwrap();
+    let cameras = [
+        serde_json::json!({"origin": huge, "target": [0, 0, 0], "fov_x_deg": 50, "width": 8, "height": 8})
+            .to_string(),
+        serde_json::json!({"frames": {"1": huge}}).to_string(),
+        format!(r#"{{"frames": {{"1": {camera}, "{}1": {camera}}}}}"#, "0".repeat(100_000)),
+    ];
+    for (k, text) in cameras.iter().enumerate() {
+        let cam = write_file(d, &format!("camera{k}.json"), text.as_bytes());
+        let said = fails(
+            glassdb()
+                .arg("mask")
+                .arg(repo_path("fixtures/scene/room.obj"))
+                .arg("--camera")
+                .arg(&cam)
+                .args(["--glass", "Clear_6mm=1", "-o"])
+                .arg(d.join("m.png")),
+        );
+        assert!(said.len() < 1000, "{} bytes: {:.300}", said.len(), said);
+        assert!(said.contains("bytes)"), "{said}");
+    }
+    let planes = [
+        serde_json::json!({"format": "glassdb-planes/1", "planes": [huge]}),
+        {
+            let atrium = repo_path("fixtures/atrium/virtual/planes.json");
+            let mut planes: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(atrium).unwrap()).unwrap();
+            planes["format"] = huge.clone().into();
+            planes
+        },
+    ];
+    for (k, json) in planes.iter().enumerate() {
+        let file = write_file(d, &format!("planes{k}.json"), json.to_string().as_bytes());
+        let a = |f: &str| repo_path(&format!("fixtures/atrium/{f}"));
+        let said = fails(
+            compose()
+                .args(["--refl".as_ref(), a("refl_0.exr").as_os_str()])
+                .args(["--trans".as_ref(), a("trans.exr").as_os_str()])
+                .args(["--mask".as_ref(), a("mask.png").as_os_str()])
+                .arg("--planes")
+                .arg(&file)
+                .arg("-o")
+                .arg(d.join("o.png")),
+        );
+        assert!(said.len() < 1000, "{} bytes: {:.300}", said.len(), said);
+        assert!(
+            said.contains("planes file") && said.contains("bytes)"),
+            "{said}"
+        );
+    }
 }

@@ -315,3 +315,70 @@ pub fn read_png_planes(path: &Path) -> Planes {
         channels,
     }
 }
+
+/// Writes `image` to `path` as glassdb writes an output of the whole frame (format from the
+/// extension), the defaults taken from `src`.
+pub fn write_pass(
+    path: &Path,
+    image: glassdb_pass::LinearImage,
+    src: &glassdb_pass::PassSource,
+    opts: &glassdb_encode::OutputOptions,
+) -> Result<glassdb_encode::WrittenOutput, glassdb_encode::EncodeError> {
+    let frame = glassdb_pass::CarriedFrame::whole(image.width, image.height);
+    glassdb_encode::write_output(path, image, frame, src, opts)
+}
+
+/// The bundled example's inputs as `compose` takes them, relative to [`example_copy`]'s folder.
+pub const EXAMPLE_INPUTS: [&str; 6] = [
+    "--refl",
+    "refl.exr",
+    "--trans",
+    "trans.exr",
+    "--mask",
+    "mask.png",
+];
+
+/// A temporary folder holding a copy of `fixtures/example`'s passes and mask.
+pub fn example_copy() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    for f in ["refl.exr", "trans.exr", "mask.png"] {
+        std::fs::copy(repo_path("fixtures/example").join(f), dir.path().join(f)).unwrap();
+    }
+    dir
+}
+
+/// `compose` of the atrium's transmission pass and mask (with its planes.json) with the
+/// reflection passes `refl`, into `out`.
+pub fn atrium_compose(refl: &[PathBuf], out: &Path) -> Command {
+    let a = repo_path("fixtures/atrium");
+    let mut c = compose();
+    for r in refl {
+        c.arg("--refl").arg(r);
+    }
+    c.arg("--trans")
+        .arg(a.join("trans.exr"))
+        .arg("--mask")
+        .arg(a.join("mask.png"))
+        .arg("--planes")
+        .arg(a.join("virtual/planes.json"))
+        .arg("-o")
+        .arg(out);
+    c
+}
+
+/// The atrium's three reflection passes.
+pub fn atrium_refl() -> Vec<PathBuf> {
+    (0..3)
+        .map(|k| repo_path(&format!("fixtures/atrium/refl_{k}.exr")))
+        .collect()
+}
+
+/// The names in `dir`, sorted.
+pub fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}

@@ -2,12 +2,12 @@
 //! layout `ociobakelut --format resolve_cube --shapersize` writes), checked pixel by pixel
 //! against OpenColorIO applying the same file (python_oracle/cube_oracle.py).
 
-use glassdb_compose::io::{ExrDataType, OutputOptions, PassSource, write_output};
-use glassdb_compose::pixels::LinearImage;
-use glassdb_compose::view::CubeLut;
+use glassdb_colour::CubeLut;
+use glassdb_encode::{ExrDataType, OutputOptions};
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
+use glassdb_pass::{LinearImage, PassSource};
 
-use crate::util::{compose, fails_naming, ok, read_png_planes, run_oracle};
+use crate::util::{compose, fails_naming, ok, read_png_planes, run_oracle, write_pass};
 
 const W: u32 = 16;
 const H: u32 = 8;
@@ -92,8 +92,8 @@ fn cube_view_matches_opencolorio() {
     };
     let trans = d.join("t.exr");
     let refl = d.join("r.exr");
-    write_output(&trans, image(&px), &src, &float_out).unwrap();
-    write_output(&refl, image(&vec![[0.0; 3]; px.len()]), &src, &float_out).unwrap();
+    write_pass(&trans, image(&px), &src, &float_out).unwrap();
+    write_pass(&refl, image(&vec![[0.0; 3]; px.len()]), &src, &float_out).unwrap();
     // No glass anywhere: the composite is the transmission pass.
     let mask = d.join("m.png");
     let n = (W * H) as usize;

@@ -132,12 +132,16 @@ fn canvas(url: &str, swaps: &[String], out: &Path) -> (Vec<[f64; 3]>, serde_json
     let refs: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
     let report: serde_json::Value =
         serde_json::from_str(run_oracle("viewer_driver.py", &refs).trim()).unwrap();
-    let bytes = std::fs::read(out).unwrap();
-    let pixels = bytes
+    (rgba_pixels(out), report)
+}
+
+/// The RGB of the RGBA bytes the driver wrote, per pixel.
+fn rgba_pixels(path: &Path) -> Vec<[f64; 3]> {
+    std::fs::read(path)
+        .unwrap()
         .chunks_exact(4)
         .map(|p| [0, 1, 2].map(|c| f64::from(p[c])))
-        .collect();
-    (pixels, report)
+        .collect()
 }
 
 /// The atrium exported with `extra` arguments into `dir/export`, opened from `file://`: its
@@ -244,11 +248,32 @@ fn exchange(url: &str, request: &[u8]) -> (u16, String) {
         .nth(1)
         .and_then(|c| c.parse().ok())
         .unwrap_or_else(|| panic!("no status in {text:?}"));
-    let body = text
-        .split_once("\r\n\r\n")
-        .map_or("", |(_, b)| b)
-        .to_string();
-    (code, body)
+    let (head, body) = text.split_once("\r\n\r\n").unwrap_or((&text, ""));
+    let chunked = head
+        .lines()
+        .any(|l| l.eq_ignore_ascii_case("transfer-encoding: chunked"));
+    (
+        code,
+        if chunked {
+            dechunk(body)
+        } else {
+            body.to_string()
+        },
+    )
+}
+
+/// An HTTP/1.1 chunked body, joined (tiny_http chunks large replies).
+fn dechunk(mut body: &str) -> String {
+    let mut out = String::new();
+    while let Some((size, rest)) = body.split_once("\r\n") {
+        let n = usize::from_str_radix(size.trim(), 16).unwrap_or(0);
+        if n == 0 || rest.len() < n {
+            break;
+        }
+        out.push_str(&rest[..n]);
+        body = rest[n..].strip_prefix("\r\n").unwrap_or(&rest[n..]);
+    }
+    out
 }
 
 /// One raw HTTP/1.1 request; the status code.
@@ -280,31 +305,14 @@ fn page_token(url: &str) -> String {
     rest[..rest.find('"').unwrap()].to_string()
 }
 
-/// A POST as the viewer's own page sends it: its `Origin` and session token.
+/// A POST as the viewer's own page sends it: its `Origin` and session token; the status.
 fn post(url: &str, path: &str, body: &[u8]) -> u16 {
-    let origin = format!("http://{}", host_of(url));
-    let token = page_token(url);
-    post_with(
-        url,
-        path,
-        body,
-        &[("Origin", &origin), ("X-Glassdb-Session", &token)],
-    )
+    post_reply(url, path, body).0
 }
 
-/// A POST of `body` with the `Host` of `url` and the extra `headers`.
+/// A POST of `body` with the `Host` of `url` and the extra `headers`; the status.
 fn post_with(url: &str, path: &str, body: &[u8], headers: &[(&str, &str)]) -> u16 {
-    let mut req = format!(
-        "POST {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\nContent-Length: {}\r\n",
-        host_of(url),
-        body.len()
-    );
-    for (name, value) in headers {
-        req += &format!("{name}: {value}\r\n");
-    }
-    let mut req = format!("{req}\r\n").into_bytes();
-    req.extend_from_slice(body);
-    status(url, &req)
+    post_with_reply(url, path, body, headers).0
 }
 
 #[test]
@@ -893,4 +901,464 @@ fn candidates_built_from_a_catalog_give_composes_pixels() {
     );
     let db = psnr(&got, &want);
     assert!(db >= 50.0, "page from the catalog vs compose: {db:.1} dB");
+}
+
+/// The driver's `layout` report of `url` (the window `window`, default 1400×1000) after the JS
+/// snippets `run`.
+fn layout(url: &str, run: &[&str], window: Option<&str>) -> serde_json::Value {
+    let mut args: Vec<&std::ffi::OsStr> = vec!["layout".as_ref(), url.as_ref()];
+    for js in run {
+        args.push("--run".as_ref());
+        args.push(js.as_ref());
+    }
+    if let Some(w) = window {
+        args.push("--window".as_ref());
+        args.push(w.as_ref());
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(run_oracle("viewer_driver.py", &args).trim()).unwrap();
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    assert!(report.get("error").is_none(), "{report}");
+    report
+}
+
+fn num(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+/// Issue 31: the frame fits the window (it was shown 1:1, a 320×240 frame in a 1400-px window)
+/// and zooms.
+#[test]
+fn the_frame_fits_the_window_and_zooms() {
+    let served = serve(&[]);
+    for window in [None, Some("800x600")] {
+        let r = layout(&served.url, &[], window);
+        let (stage, canvas) = (&r["stage"], &r["canvas"]);
+        let (sw, sh) = (num(&stage["width"]), num(&stage["height"]));
+        let (cw, ch) = (num(&canvas["width"]), num(&canvas["height"]));
+        assert!(
+            cw >= sw - 2.0 || ch >= sh - 2.0,
+            "{window:?}: the frame does not fill the stage: {r}"
+        );
+        assert!(cw <= sw + 0.5 && ch <= sh + 0.5, "{window:?}: {r}");
+        assert!((cw / ch - 320.0 / 240.0).abs() < 0.01, "{window:?}: {r}");
+        assert_eq!(r["zoom"]["fit"], true, "{r}");
+    }
+    let big = layout(&served.url, &[], None);
+    assert!(num(&big["canvas"]["width"]) > 640.0, "{big}");
+    // Zoomed by the hook and by the URL: screen pixels per frame pixel.
+    let r = layout(&served.url, &["window.glassdb.setZoom(2)"], None);
+    assert_eq!(num(&r["canvas"]["width"]), 640.0, "{r}");
+    assert_eq!(r["zoom"]["fit"], false, "{r}");
+    let r = layout(&format!("{}?zoom=1", served.url), &[], None);
+    assert_eq!(
+        (num(&r["canvas"]["width"]), num(&r["canvas"]["height"])),
+        (320.0, 240.0),
+        "{r}"
+    );
+}
+
+/// Issue 31: product names are readable, wrapped in their list and shown whole as tooltips
+/// (they were cut at the list's edge), in a wide and a narrow window.
+#[test]
+fn product_names_are_readable_not_cut() {
+    let served = serve(&[]);
+    let products = glassdb_registry_names();
+    for window in [None, Some("1000x700")] {
+        let r = layout(&served.url, &[], window);
+        let names = r["names"].as_array().unwrap();
+        assert!(names.len() >= products.len() + 2, "{r}");
+        for n in names {
+            assert_eq!(n["cut"], false, "{window:?}: cut: {n}");
+            assert_eq!(n["tooltip"], true, "{window:?}: no tooltip: {n}");
+        }
+    }
+}
+
+/// The product names of the bundled registry's default table.
+fn glassdb_registry_names() -> Vec<String> {
+    let reg: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(repo_path("data/registry.json")).unwrap())
+            .unwrap();
+    reg["tables"][0]["glasses"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| g["name"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// Issue 31: the A/B split line is visible on screen where the page switches from A to B, and
+/// follows the split; it is an element over the canvas, so the canvas's pixels (compared with
+/// compose's in the swap test) are untouched.
+#[test]
+fn the_split_line_is_visible_where_a_turns_to_b() {
+    let served = serve(&[]);
+    let r = layout(
+        &format!("{}?glassB=5:Stopray&ab=split&split=0.3", served.url),
+        &[],
+        None,
+    );
+    let canvas = &r["canvas"];
+    let line = &r["split_line"];
+    assert_eq!(
+        line["element"], "split-line",
+        "nothing drawn at the split: {r}"
+    );
+    assert_eq!(line["visible"], true, "{r}");
+    let want_x = num(&canvas["left"]) + 0.3 * num(&canvas["width"]);
+    let b = &line["box"];
+    let centre = num(&b["left"]) + num(&b["width"]) / 2.0;
+    assert!(
+        (centre - want_x).abs() <= 1.5,
+        "line at {centre}, split at {want_x}: {r}"
+    );
+    assert!(num(&b["height"]) >= num(&canvas["height"]) - 0.5, "{r}");
+    // It follows the split, and is gone when one set is shown.
+    let r = layout(
+        &served.url,
+        &["window.glassdb.setAB('split', 0.7)"],
+        Some("1000x700"),
+    );
+    let want_x = num(&r["canvas"]["left"]) + 0.7 * num(&r["canvas"]["width"]);
+    assert_eq!(r["split_line"]["element"], "split-line", "{r}");
+    assert!((num(&r["split_line"]["x"]) - want_x).abs() < 0.01);
+    let r = layout(&format!("{}?ab=B", served.url), &[], None);
+    assert!(r["split_line"].is_null(), "{r}");
+    assert_eq!(num(&r["split_box"]["width"]), 0.0, "hidden: {r}");
+}
+
+/// The size a `wrote … (N files, X MB)` line says, in MB.
+fn said_megabytes(out: &str) -> f64 {
+    let mb = out
+        .split_once(" files, ")
+        .and_then(|(_, rest)| rest.split_once(" MB)"))
+        .unwrap_or_else(|| panic!("no size in {out:?}"))
+        .0;
+    mb.parse().unwrap()
+}
+
+/// The bytes of every file in `dir`.
+fn folder_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().metadata().unwrap().len())
+        .sum()
+}
+
+/// Issue 31: the export stores its data compactly (it was 9.7 MB for the atrium: `f32` tables
+/// and mask, base64) and says its size. Its pixels are checked in the swap test (from
+/// `file://`, against compose).
+#[test]
+fn the_export_is_compact_and_says_its_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let export = dir.path().join("export");
+    let mut cmd = glassdb();
+    cmd.arg("view");
+    atrium_inputs(&mut cmd).arg("--export").arg(&export);
+    let out = ok(&mut cmd);
+    let bytes = folder_bytes(&export);
+    let said = said_megabytes(&out);
+    assert!(
+        (said - bytes as f64 / 1e6).abs() < 0.006,
+        "said {said} MB, wrote {bytes} bytes: {out}"
+    );
+    assert!(out.contains("(6 files,"), "{out}");
+    assert!(bytes < 4_000_000, "{bytes} bytes");
+    let frame = std::fs::metadata(export.join("frame-0000.js"))
+        .unwrap()
+        .len();
+    assert!(frame < 1_000_000, "frame-0000.js: {frame} bytes");
+}
+
+/// Issue 31: `glassdb view DIR` opens a `glassdb blender render` folder: its frames, passes,
+/// masks and sides from its run record; the second frame on the page is compose's of the same
+/// files and sides.
+#[test]
+fn a_blender_run_folder_opens_directly() {
+    let run = &crate::blender::rendered().runs[0];
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("glassdb-blender.json")).unwrap())
+            .unwrap();
+    let frames = record["frames"].as_array().unwrap();
+    assert!(frames.len() >= 2, "{record}");
+    let f = &frames[1];
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("frame2.png");
+    let mut cmd = glassdb();
+    cmd.arg("compose")
+        .arg("--trans")
+        .arg(run.join(f["trans"].as_str().unwrap()))
+        .arg("--mask")
+        .arg(run.join(f["mask"].as_str().unwrap()));
+    for (k, refl) in f["refl"].as_array().unwrap().iter().enumerate() {
+        cmd.arg("--refl").arg(run.join(refl.as_str().unwrap()));
+        cmd.arg("--side")
+            .arg(format!("{k}={}", f["sides"][k].as_str().unwrap()));
+    }
+    ok(cmd.args(["--dither", "none", "-o"]).arg(&out));
+    let want = png_pixels(&out);
+
+    let mut cmd = glassdb();
+    cmd.arg("view").arg(run);
+    let served = spawn_viewer(&mut cmd);
+    let (got, report) = canvas(
+        &format!("{}?frame=1", served.url),
+        &[],
+        &dir.path().join("f2.rgba"),
+    );
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    let db = psnr(&got, &want);
+    assert!(db >= 50.0, "frame 2 of the run vs compose: {db:.1} dB");
+    let (code, scene) = get_as(&served.url, "/api/scene", host_of(&served.url));
+    assert_eq!(code, 200);
+    let scene: serde_json::Value = serde_json::from_str(&scene).unwrap();
+    let labels: Vec<String> = frames.iter().map(|f| f["frame"].to_string()).collect();
+    assert_eq!(scene["frames"], serde_json::json!(labels), "{scene}");
+
+    // A folder without a run record, and passes given as well: refused, naming them.
+    fails_naming(
+        glassdb().arg("view").arg(dir.path()),
+        &[
+            "glassdb-blender.json",
+            "not a `glassdb blender render` output folder",
+        ],
+    );
+    fails_naming(
+        glassdb()
+            .arg("view")
+            .arg(run)
+            .arg("--trans")
+            .arg(run.join("trans.0001.exr")),
+        &["cannot be used with"],
+    );
+}
+
+/// The catalog unit the page's builder makes in the tests: Solarban R67 (coating on #2), 12.7
+/// mm argon, clear 6 mm; the bundled catalog has it as id 12.
+const UNIT_PANES: &str = "6|12.7:argon|2";
+const CATALOG_UNIT: &str = "Solarban R67 #2 | 12.7 argon | clear 6";
+
+/// Issue 26: a unit built on the page through its controls (outer pane, gap width and gas,
+/// inner pane) reaches the screen as compose draws that unit (the bundled catalog's id 12,
+/// put in glass 5's place in a registry written by the test); the picker shows a unit's
+/// build-up and Tv/Rv; a gap width left empty is a clear message on the page.
+#[test]
+fn a_unit_built_on_the_page_gives_composes_pixels_of_that_unit() {
+    let dir = tempfile::tempdir().unwrap();
+    let registry = swapped_registry(
+        &repo_path("data/registry.json"),
+        dir.path(),
+        SWAP_ID,
+        CATALOG_UNIT,
+    );
+    let want = compose_png(dir.path(), Some(&registry), "unit.png");
+    let served = serve(&[]);
+    let out = dir.path().join("unit.rgba");
+    let said = run_oracle(
+        "viewer_driver.py",
+        &[
+            "unit".as_ref(),
+            served.url.as_ref(),
+            "--glass".as_ref(),
+            "5".as_ref(),
+            "--panes".as_ref(),
+            UNIT_PANES.as_ref(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ],
+    );
+    let report: serde_json::Value = serde_json::from_str(said.trim()).unwrap();
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    assert_eq!(report["status_class"], "", "{report}");
+    let name = report["products"]["A"]["5"].as_str().unwrap();
+    assert!(
+        name.contains("Solarban R67") && name.contains("12.7 mm argon"),
+        "{report}"
+    );
+    assert_eq!(report["drawn"], 1, "{report}");
+    let got = rgba_pixels(&out);
+    let db = psnr(&got, &want);
+    assert!(db >= 50.0, "unit built on the page vs compose: {db:.1} dB");
+
+    // The width box left empty: the server's reason on the page, nothing drawn.
+    let said = run_oracle(
+        "viewer_driver.py",
+        &[
+            "unit".as_ref(),
+            served.url.as_ref(),
+            "--glass".as_ref(),
+            "5".as_ref(),
+            "--panes".as_ref(),
+            "6|nan:argon|2".as_ref(),
+        ],
+    );
+    let report: serde_json::Value = serde_json::from_str(said.trim()).unwrap();
+    assert_eq!(report["status_class"], "error", "{report}");
+    let status = report["status"].as_str().unwrap();
+    assert!(
+        status.contains("element 2") && status.contains("finite number"),
+        "{report}"
+    );
+    assert_eq!(report["drawn"], 0, "{report}");
+
+    // Choices the controls cannot make, through the page's hook: each said, none drawn.
+    let r = layout(
+        &served.url,
+        &[
+            "return window.glassdb.buildUnit([{glass: 2}, {gap_mm: 12, gas: 'argon'}, {gap_mm: 12, gas: 'argon'}, {glass: 2}])",
+            "return window.glassdb.buildUnit([{glass: 99}, {gap_mm: 12}, {glass: 2}])",
+            "return window.glassdb.buildUnit([{glass: 2}, {gap_mm: -4}, {glass: 2}])",
+        ],
+        None,
+    );
+    let thrown: Vec<&str> = r["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["thrown"].as_str().unwrap_or_else(|| panic!("built: {r}")))
+        .collect();
+    assert!(thrown[0].contains("two gaps in a row"), "{thrown:?}");
+    assert!(thrown[1].contains("no glass with id 99"), "{thrown:?}");
+    assert!(thrown[2].contains("-4"), "{thrown:?}");
+    let said = r["unit_status"].as_str().unwrap();
+    assert!(
+        said.starts_with("cannot build the unit") && said.contains("-4"),
+        "{said}"
+    );
+    // The picker shows the catalog units' build-up: panes, gaps, coated surfaces, Tv/Rv.
+    let unit = r["products_text"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|t| t.as_str())
+        .find(|t| t.starts_with(CATALOG_UNIT))
+        .unwrap_or_else(|| panic!("{r}"))
+        .to_string();
+    for part in ["coating on #2", "12.7 mm argon", "Tv ", "Rv out ", "Rv in "] {
+        assert!(unit.contains(part), "{part:?} not in {unit:?}");
+    }
+}
+
+/// A POST as the viewer's page sends it, its status and body.
+fn post_reply(url: &str, path: &str, body: &[u8]) -> (u16, String) {
+    let origin = format!("http://{}", host_of(url));
+    let token = page_token(url);
+    post_with_reply(
+        url,
+        path,
+        body,
+        &[("Origin", &origin), ("X-Glassdb-Session", &token)],
+    )
+}
+
+/// A POST of `body` with the `Host` of `url` and the extra `headers`: status and body.
+fn post_with_reply(url: &str, path: &str, body: &[u8], headers: &[(&str, &str)]) -> (u16, String) {
+    let mut req = format!(
+        "POST {path} HTTP/1.1\r\nHost: {}\r\nConnection: close\r\nContent-Length: {}\r\n",
+        host_of(url),
+        body.len()
+    );
+    for (name, value) in headers {
+        req += &format!("{name}: {value}\r\n");
+    }
+    let mut req = format!("{req}\r\n").into_bytes();
+    req.extend_from_slice(body);
+    exchange(url, &req)
+}
+
+/// Issue 26 at the HTTP level: `POST /api/unit` builds a unit, answers bad choices with 400 or
+/// 422 naming what is wrong, and, like the export, is refused from another site's page or
+/// without the page's token; an export carries the units the page built.
+#[test]
+fn unit_requests_are_checked_and_only_the_page_may_send_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let export = dir.path().join("from-page");
+    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    let u = &served.url;
+    let good = br#"{"elements": [{"glass": 6}, {"gap_mm": 12.7, "gas": "argon"}, {"glass": 2}]}"#;
+    let (code, body) = post_reply(u, "/api/unit", good);
+    assert_eq!(code, 200, "{body:.300}");
+    let built: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(built["format"], "glassdb-viewer-page/2");
+    assert_eq!(
+        built["product"]["unit"]["elements"][1]["gas"], "argon",
+        "{body:.600}"
+    );
+    let name = built["product"]["name"].as_str().unwrap().to_string();
+    for (request, code, says) in [
+        (
+            &br#"{"elements": [{"glass": 2}, {"gap_mm": 9}, {"gap_mm": 9}, {"glass": 2}]}"#[..],
+            422,
+            "two gaps in a row",
+        ),
+        (
+            br#"{"elements": [{"glass": 77}, {"gap_mm": 9}, {"glass": 2}]}"#,
+            422,
+            "no glass with id 77",
+        ),
+        (
+            br#"{"elements": [{"glass": 2}, {"gap_mm": null}, {"glass": 2}]}"#,
+            400,
+            "finite number",
+        ),
+        (
+            br#"{"elements": [{"glass": 2}, {"gap_mm": 9, "gas": "neon"}, {"glass": 2}]}"#,
+            400,
+            "unknown gas",
+        ),
+        (b"not json", 400, "must be JSON"),
+        (br#"{"elements": 5}"#, 400, "\\\"elements\\\""),
+    ] {
+        let (got, body) = post_reply(u, "/api/unit", request);
+        assert_eq!(got, code, "{}: {body}", String::from_utf8_lossy(request));
+        assert!(body.contains(says), "{says:?} not in {body}");
+        assert!(body.len() < 2000, "{body}");
+    }
+    // Another site's page, a request without the page's token or with another: refused.
+    let origin = format!("http://{}", host_of(u));
+    let token = page_token(u);
+    let wrong = "0".repeat(token.len());
+    for headers in [
+        vec![
+            ("Origin", "http://rebound.example"),
+            ("X-Glassdb-Session", token.as_str()),
+        ],
+        vec![("Origin", origin.as_str())],
+        vec![
+            ("Origin", origin.as_str()),
+            ("X-Glassdb-Session", wrong.as_str()),
+        ],
+        vec![("X-Glassdb-Session", token.as_str())],
+    ] {
+        let (code, body) = post_with_reply(u, "/api/unit", good, &headers);
+        assert_eq!(code, 403, "{headers:?}: {body}");
+    }
+    assert_eq!(get(u, "/api/unit"), 404);
+    // An export with the unit on glass 5: the page's data holds it and starts with it.
+    let request = serde_json::json!({
+        "glass": format!("5:{name}"),
+        "ev": 0,
+        "units": [serde_json::from_slice::<serde_json::Value>(good).unwrap()],
+    });
+    let (code, body) = post_reply(u, "/api/export", request.to_string().as_bytes());
+    assert_eq!(code, 200, "{body}");
+    let reply: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(
+        reply["bytes"].as_u64(),
+        Some(folder_bytes(&export)),
+        "{reply}"
+    );
+    assert_eq!(reply["files"], 6, "{reply}");
+    let data = std::fs::read_to_string(export.join("data.js")).unwrap();
+    assert!(
+        data.contains(&format!("5:{name}")),
+        "the export starts elsewhere"
+    );
+    let (_, report) = canvas(
+        &format!("file://{}", export.join("index.html").display()),
+        &[],
+        &dir.path().join("export.rgba"),
+    );
+    assert_eq!(report["products"]["A"]["5"], name.as_str(), "{report}");
 }

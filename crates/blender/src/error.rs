@@ -8,94 +8,170 @@ pub enum BlenderError {
     /// The Blender program could not be started (not installed, not on PATH, not executable).
     #[error("cannot run Blender at {path}")]
     NotFound {
+        /// The program.
         path: PathBuf,
+        /// Why it could not be started.
         source: std::io::Error,
     },
     /// The Python interpreter given for the `bpy` module cannot import it.
     #[error("{python} cannot import the bpy module (Blender as a Python module): {said}")]
-    NoBpyModule { python: PathBuf, said: String },
+    NoBpyModule {
+        /// The interpreter.
+        python: PathBuf,
+        /// What it printed.
+        said: String,
+    },
     /// `blender --version` did not say which Blender it is.
     #[error("{path} did not print a Blender version when asked for it (it printed {printed:?})")]
-    VersionUnreadable { path: PathBuf, printed: String },
+    VersionUnreadable {
+        /// The program.
+        path: PathBuf,
+        /// What it printed.
+        printed: String,
+    },
     /// `blender --version` (or the `bpy` probe) did not finish in time and was stopped.
     #[error("{path} did not answer within {seconds} s when asked for its Blender version")]
-    VersionTimedOut { path: PathBuf, seconds: u64 },
+    VersionTimedOut {
+        /// The program.
+        path: PathBuf,
+        /// The time it had.
+        seconds: u64,
+    },
     /// A Blender older than the oldest one supported.
     #[error(
         "{path} is Blender {found}; glassdb blender needs Blender {}.{} or newer",
         minimum.0, minimum.1
     )]
     TooOld {
+        /// The program.
         path: PathBuf,
+        /// Its version.
         found: String,
+        /// The oldest version supported (major, minor).
         minimum: (u32, u32),
     },
     /// The scene file is missing, not a regular file, or not a .blend file.
     #[error("{path} is not a Blender file: {reason}")]
-    NotBlendFile { path: PathBuf, reason: String },
+    NotBlendFile {
+        /// The file.
+        path: PathBuf,
+        /// What it is instead.
+        reason: String,
+    },
     /// The Blender-side script stopped on a problem of the scene (no camera, a material
     /// missing, an object that moves).
     #[error("Blender ({step}) on {blend}: {message} (log: {log})")]
     Scene {
+        /// The step (`export`, `render`).
         step: &'static str,
+        /// The scene.
         blend: PathBuf,
+        /// What the script said.
         message: String,
+        /// Blender's log.
         log: PathBuf,
     },
     /// Blender exited with an error or was killed (a crash).
     #[error("Blender ({step}) failed on {blend}: {status}; the end of its log {log}:\n{tail}")]
     Failed {
+        /// The step (`export`, `render`).
         step: &'static str,
+        /// The scene.
         blend: PathBuf,
+        /// How it ended.
         status: String,
+        /// Blender's log.
         log: PathBuf,
+        /// The end of the log.
         tail: String,
+    },
+    /// Blender exited without an error but did not write what the step asked of it (a stand-in
+    /// or a broken install that ignores the script).
+    #[error(
+        "{blender} exited without an error but wrote no scene export: {missing} missing in {dir} (its log: {log})"
+    )]
+    NothingWritten {
+        /// The Blender program run, with its version (`Blender 3.4.1 (/usr/bin/blender)`).
+        blender: String,
+        /// The files missing, comma-separated.
+        missing: String,
+        /// Where they should be.
+        dir: PathBuf,
+        /// Blender's log.
+        log: PathBuf,
     },
     /// Blender ran longer than allowed and was stopped.
     #[error(
         "Blender ({step}) on {blend} took longer than {seconds} s and was stopped (log: {log})"
     )]
     TimedOut {
+        /// The step (`export`, `render`).
         step: &'static str,
+        /// The scene.
         blend: PathBuf,
+        /// The time it had.
         seconds: u64,
+        /// Blender's log.
         log: PathBuf,
     },
     /// A file or directory of the run could not be created, read or written.
     #[error("cannot {action} {path}")]
     Io {
+        /// What was being done.
         action: &'static str,
+        /// The file or folder.
         path: PathBuf,
+        /// Why it failed.
         source: std::io::Error,
     },
     /// What Blender wrote is not what was asked (a missing pass, a crop of another size).
     #[error("{path}: {message}")]
-    BadRender { path: PathBuf, message: String },
+    BadRender {
+        /// The file Blender wrote (or should have).
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// A run record (`glassdb-blender.json`) that cannot be used.
     #[error("{path} is not a glassdb blender run record: {message}")]
-    BadRecord { path: PathBuf, message: String },
+    BadRecord {
+        /// The run record.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// A glass id that the registry does not have.
     #[error("glass id {id} (material {material}) is not in {registry}")]
     UnknownGlass {
+        /// The id.
         id: u16,
+        /// The Blender material mapped to it.
         material: String,
+        /// The registry's name.
         registry: String,
     },
     /// A frame list or option that cannot be used.
     #[error("{0}")]
     BadOption(String),
+    /// The scene's planes or masks failed.
     #[error(transparent)]
     Scene3d(#[from] glassdb_scene::SceneError),
+    /// A mask could not be written or read.
     #[error(transparent)]
     Mask(#[from] glassdb_mask::MaskError),
+    /// A frame could not be composited.
     #[error(transparent)]
     Compose(#[from] glassdb_compose::ComposeError),
+    /// A pass could not be read or written.
     #[error(transparent)]
     Image(#[from] glassdb_image::ImageError),
+    /// An output could not be written.
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),
+    /// An input could not be read.
     #[error(transparent)]
     Input(#[from] glassdb_io::InputError),
+    /// A registry could not be read.
     #[error(transparent)]
     Registry(#[from] glassdb_registry::RegistryError),
 }
@@ -108,6 +184,35 @@ impl BlenderError {
             action,
             path,
             source,
+        }
+    }
+}
+
+impl BlenderError {
+    /// The class of this error: a wrapped error's own class; a Blender missing, too old or
+    /// writing nothing is unsupported, one that does not finish in time a limit, a file of the run that cannot
+    /// be made or moved (or Blender failing) I/O; anything else is a scene, a render or an
+    /// option to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        use glassdb_io::ErrorKind;
+        match self {
+            BlenderError::Scene3d(e) => e.kind(),
+            BlenderError::Mask(e) => e.kind(),
+            BlenderError::Compose(e) => e.kind(),
+            BlenderError::Image(e) => e.kind(),
+            BlenderError::Output(e) => e.kind(),
+            BlenderError::Input(e) => e.kind(),
+            BlenderError::Registry(e) => e.kind(),
+            BlenderError::NotFound { .. }
+            | BlenderError::NoBpyModule { .. }
+            | BlenderError::VersionUnreadable { .. }
+            | BlenderError::TooOld { .. }
+            | BlenderError::NothingWritten { .. } => ErrorKind::Unsupported,
+            BlenderError::VersionTimedOut { .. } | BlenderError::TimedOut { .. } => {
+                ErrorKind::Limits
+            }
+            BlenderError::Io { .. } | BlenderError::Failed { .. } => ErrorKind::Io,
+            _ => ErrorKind::Invalid,
         }
     }
 }

@@ -22,27 +22,33 @@ pub struct ScriptJob {
     pub resolution: Option<String>,
     /// Cycles samples per pixel, or the scene's.
     pub samples: Option<u32>,
+    /// Cycles' seed.
     pub seed: u32,
     /// Render threads, or Blender's choice.
     pub threads: Option<u32>,
     /// Camera rays see the glass too (the Cycles reference render), instead of through it.
     pub reference: bool,
+    /// The glass as thin panes.
     pub glass: Vec<ThinPane>,
+    /// The frames to render.
     pub frames: Vec<ScriptFrame>,
 }
 
 /// One frame of a [`ScriptJob`].
 #[derive(Debug, Clone, Serialize)]
 pub struct ScriptFrame {
+    /// The frame number.
     pub frame: u32,
     /// The transmission pass (or the reference) to write.
     pub trans: PathBuf,
+    /// The reflection passes to render, one per plane with glass.
     pub planes: Vec<ScriptPlane>,
 }
 
 /// One reflection pass of a [`ScriptFrame`].
 #[derive(Debug, Clone, Serialize)]
 pub struct ScriptPlane {
+    /// The plane's index.
     pub index: usize,
     /// `[a, b, c, d]` of a·x + b·y + c·z + d = 0 in Blender's world, with the camera on the
     /// positive side.
@@ -53,6 +59,7 @@ pub struct ScriptPlane {
     /// up, chosen so that Blender's truncation gives exactly the plane's pixel rectangle
     /// (`glassdb_mask::PlaneBounds::blender_border`).
     pub border: [f64; 4],
+    /// The pass to write.
     pub output: PathBuf,
 }
 
@@ -60,16 +67,61 @@ pub struct ScriptPlane {
 /// other fields, such as the Blender version, are not read).
 #[derive(Debug, Clone, Deserialize)]
 pub struct ExportInfo {
+    /// The frames exported.
     pub frames: Vec<u32>,
+    /// The scene's materials.
     pub materials: Vec<String>,
+    /// The frames whose geometry differs from the first frame's (by frame number): each has
+    /// its own OBJ (`scene.NNNN.obj`), planes (`planes.NNNN/`) and mask.
+    #[serde(default)]
+    pub moving: std::collections::BTreeMap<u32, MovingFrame>,
+    /// The scene denoises (Cycles' denoiser on), which the passes turn off.
+    #[serde(default)]
+    pub denoising: bool,
+    /// The scene has motion blur on, which the passes turn off.
+    #[serde(default)]
+    pub motion_blur: bool,
+}
+
+/// A frame whose objects are not where they are in the first frame.
+#[derive(Debug, Clone, Deserialize)]
+pub struct MovingFrame {
+    /// The objects whose geometry differs from the first frame's.
+    pub objects: Vec<String>,
+}
+
+impl ExportInfo {
+    /// The scene's render settings that the passes do not take, said as the run record and
+    /// the command say them.
+    pub fn overrides(&self) -> Vec<String> {
+        let mut said = Vec::new();
+        if self.denoising {
+            said.push(
+                "denoising off (the scene denoises; the passes keep Cycles' own noise, and \
+                 Blender builds without OpenImageDenoise could not render them)"
+                    .to_string(),
+            );
+        }
+        if self.motion_blur {
+            said.push(
+                "motion blur off (the scene blurs motion; the masks are of each frame's instant)"
+                    .to_string(),
+            );
+        }
+        said
+    }
 }
 
 /// A plane's pixels in one frame: columns `x..x+width`, rows `y..y+height` (row 0 at the top).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct PixelBounds {
+    /// First column.
     pub x: u32,
+    /// First row.
     pub y: u32,
+    /// Columns.
     pub width: u32,
+    /// Rows.
     pub height: u32,
 }
 
@@ -90,14 +142,19 @@ impl From<PixelWindow> for PixelBounds {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameRecord {
+    /// The frame number.
     pub frame: u32,
+    /// The transmission pass, relative to the output folder.
     pub trans: String,
+    /// The mask, relative to the output folder.
     pub mask: String,
+    /// The reflection passes, plane k at k.
     pub refl: Vec<String>,
     /// Which face of each plane the camera sees.
     pub sides: Vec<Side>,
     /// Each plane's glass pixels (`None`: none in this frame; its pass is one black pixel).
     pub bounds: Vec<Option<PixelBounds>>,
+    /// The composite, relative to the output folder.
     pub composite: String,
 }
 
@@ -105,14 +162,25 @@ pub struct FrameRecord {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunRecord {
+    /// [`RECORD_FORMAT`].
     pub format: String,
+    /// The scene rendered.
     pub blend: String,
+    /// The Blender version that rendered it.
     pub blender: String,
     /// The `--glass PATTERN=ID` mappings.
     pub glass: Vec<String>,
+    /// Cycles samples per pixel, or the scene's.
     pub samples: Option<u32>,
+    /// The frames' width in pixels.
     pub width: u32,
+    /// The frames' height in pixels.
     pub height: u32,
+    /// The scene's render settings the passes overrode (denoising, motion blur), in words;
+    /// Cycles never denoises the passes.
+    #[serde(default)]
+    pub overrides: Vec<String>,
+    /// Every frame rendered.
     pub frames: Vec<FrameRecord>,
 }
 

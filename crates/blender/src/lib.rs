@@ -5,8 +5,12 @@
 //! pixel rectangle; Blender renders the transmission pass and one cropped reflection pass per
 //! plane ([`job`]); glassdb places the crops and composites every frame ([`pipeline`]).
 
+#![warn(missing_docs)]
+
 pub mod error;
+pub mod geometry;
 pub mod job;
+mod passes;
 pub mod pipeline;
 pub mod program;
 pub mod thin_pane;

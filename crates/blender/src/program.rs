@@ -68,6 +68,7 @@ pub enum Launcher {
 pub struct Blender {
     /// The Blender executable, or the Python interpreter that has `bpy`.
     pub path: PathBuf,
+    /// How it is run.
     pub launcher: Launcher,
     /// As Blender prints it (`3.4.1`).
     pub version: String,
@@ -78,11 +79,15 @@ pub struct Blender {
 pub struct BlenderRun<'a> {
     /// What the run does, for messages (`export`, `render`).
     pub step: &'static str,
+    /// The scene.
     pub blend: &'a Path,
+    /// The Blender-side script.
     pub script: &'a Path,
+    /// The script's arguments.
     pub args: Vec<String>,
     /// Blender's stdout and stderr are appended here.
     pub log: &'a Path,
+    /// The longest it may take.
     pub timeout: Duration,
 }
 

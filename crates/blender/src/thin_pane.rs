@@ -12,12 +12,16 @@ pub const STOPS: usize = 32;
 pub struct ThinPane {
     /// The Blender material.
     pub material: String,
+    /// Its registry id.
     pub id: u16,
     /// cos θ of each stop, ascending from 0 to 1 (quadratic spacing: dense near grazing, where
     /// the curves bend most).
     pub cos: Vec<f64>,
+    /// Front reflectance per channel at each stop.
     pub r_front: Vec<[f64; 3]>,
+    /// Back reflectance per channel at each stop.
     pub r_back: Vec<[f64; 3]>,
+    /// Transmittance per channel at each stop.
     pub t: Vec<[f64; 3]>,
 }
 

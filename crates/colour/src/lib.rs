@@ -1,10 +1,17 @@
 //! glassdb-colour: linear RGB working spaces: their primaries and whites, the XYZ→RGB matrices colour-science
 //! holds for them, how files name them (OpenEXR `chromaticities`, the Color Interop Forum ids
-//! Blender 5 writes as `colorInteropID`), and RGB→RGB conversion between them.
+//! Blender 5 writes as `colorInteropID`), and RGB→RGB conversion between them; and
+//! [`display`]: the display views (the sRGB transfer, `.cube` LUTs) that turn scene-linear RGB
+//! into a PNG's display-encoded values.
+
+#![warn(missing_docs)]
+
+pub mod display;
 
 use std::fmt;
 use std::str::FromStr;
 
+pub use display::{CubeError, CubeLut, DisplayView};
 pub use nalgebra::Matrix3;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};

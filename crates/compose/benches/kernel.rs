@@ -4,10 +4,10 @@
 //! `cargo bench -p glassdb-compose --bench kernel -- --warm-up-time 1 --measurement-time 3`
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use glassdb_compose::Side;
 use glassdb_compose::kernel::{KernelInput, compose_in_place};
 use glassdb_compose::lut::GlassLut;
 use glassdb_mask::{CosTheta, MaskImage};
+use glassdb_side::Side;
 use rayon::prelude::*;
 
 const W: usize = 3840;

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 mod bench_passes;
 
-use glassdb_compose::io::{ExrDataType, parse_exr_compression};
+use glassdb_encode::{ExrDataType, parse_exr_compression};
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

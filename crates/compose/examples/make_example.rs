@@ -11,9 +11,9 @@
 
 use std::path::PathBuf;
 
-use glassdb_compose::io::{ExrDataType, OutputOptions, PassSource, write_output};
-use glassdb_compose::pixels::LinearImage;
+use glassdb_encode::{ExrDataType, OutputOptions, write_output};
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
+use glassdb_pass::{CarriedFrame, LinearImage, PassSource, PngBits};
 
 const W: u32 = 256;
 const H: u32 = 192;
@@ -117,10 +117,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..OutputOptions::default()
     };
     let src = PassSource::Png {
-        bits: glassdb_compose::pixels::PngBits::Eight,
+        bits: PngBits::Eight,
     };
-    write_output(&out.join("trans.exr"), trans, &src, &half)?;
-    write_output(&out.join("refl.exr"), refl, &src, &half)?;
+    let frame = || CarriedFrame::whole(W, H);
+    write_output(&out.join("trans.exr"), trans, frame(), &src, &half)?;
+    write_output(&out.join("refl.exr"), refl, frame(), &src, &half)?;
     write_mask(&out.join("mask.png"), &mask, MaskFormat::Png8)?;
     println!("wrote {}/{{trans.exr, refl.exr, mask.png}}", out.display());
     Ok(())

@@ -20,7 +20,8 @@ use crate::lut::GlassLut;
 /// Where a pass's colour space came from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum SpaceSource {
-    /// Declared on the command line (`--input-space`), over anything the files say.
+    /// Declared by the caller (the command line's `--input-space`), over anything the files
+    /// say.
     Declared,
     /// The part's `colorInteropID` (Blender 5 writes one per part).
     InteropId(String),
@@ -33,7 +34,7 @@ pub enum SpaceSource {
 impl fmt::Display for SpaceSource {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SpaceSource::Declared => f.write_str("--input-space"),
+            SpaceSource::Declared => f.write_str("declared"),
             SpaceSource::InteropId(id) => write!(f, "colorInteropID \"{id}\""),
             SpaceSource::Chromaticities => f.write_str("chromaticities"),
             SpaceSource::Untagged => f.write_str("no colour tag, taken as linear Rec.709"),
@@ -44,7 +45,9 @@ impl fmt::Display for SpaceSource {
 /// A pass's linear RGB space and how it was known.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PassSpace {
+    /// The linear RGB space.
     pub space: RgbSpace,
+    /// How it was known.
     pub source: SpaceSource,
 }
 
@@ -175,6 +178,7 @@ impl LazyLut {
 /// The table a frame is composited with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ChosenTable {
+    /// The registry table's colour basis.
     pub basis: ColourBasis,
     /// Whether the table is not in the passes' own space (a luminous grey table, or the paper
     /// method's RGB for untagged passes).

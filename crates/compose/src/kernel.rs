@@ -17,7 +17,7 @@ use std::ops::Range;
 
 use glassdb_image::PixelWindow;
 use glassdb_mask::{CosCode, CosTheta, MaskImage};
-use glassdb_registry::Side;
+use glassdb_side::Side;
 use rayon::prelude::*;
 
 use crate::lut::{GlassLut, GlassSideLut, RtTriple};
@@ -52,8 +52,11 @@ impl PlanePass<'_> {
 /// e.g. its pane's screen rectangle, or reach beyond it).
 #[derive(Clone, Copy)]
 pub struct PlacedRefl<'a> {
+    /// Its R, G, B planes.
     pub rgb: [&'a [f32]; 3],
+    /// The pixels it holds, relative to the frame's top-left pixel.
     pub window: PixelWindow,
+    /// The face of the glass its plane shows.
     pub side: Side,
 }
 
@@ -93,8 +96,11 @@ pub enum KernelShapeError {
         "kernel input sizes disagree: transmission pass channel {channel} has {samples} samples for {pixels} mask pixels"
     )]
     Transmission {
+        /// The channel (0 R, 1 G, 2 B).
         channel: usize,
+        /// Its samples.
         samples: usize,
+        /// The pixels it should hold.
         pixels: usize,
     },
     /// A plane of a reflection pass has the wrong number of samples.
@@ -102,14 +108,23 @@ pub enum KernelShapeError {
         "kernel input sizes disagree: reflection pass {pass} channel {channel} has {samples} samples for the {pixels} pixels of its window"
     )]
     Reflection {
+        /// The reflection pass.
         pass: usize,
+        /// The channel (0 R, 1 G, 2 B).
         channel: usize,
+        /// Its samples.
         samples: usize,
+        /// The pixels it should hold.
         pixels: usize,
     },
     /// The reflection passes and the sides of their planes are not one to one.
     #[error("kernel input sizes disagree: {passes} reflection passes but {sides} plane sides")]
-    SidesPerPass { passes: usize, sides: usize },
+    SidesPerPass {
+        /// Reflection passes.
+        passes: usize,
+        /// Plane sides.
+        sides: usize,
+    },
 }
 
 impl<'a> KernelInput<'a> {

@@ -10,7 +10,8 @@
 //! - normal incidence from `r0`, `t0` (`r0_back` for the back side) for binary masks.
 
 use glassdb_mask::CosCode;
-use glassdb_registry::{GlassRecord, RegistryTable, Side};
+use glassdb_registry::{GlassRecord, RegistryTable};
+use glassdb_side::Side;
 use rayon::prelude::*;
 
 /// Intervals of the fine table over cos θ ∈ [0, 1].
@@ -19,7 +20,9 @@ pub const FINE_STEPS: usize = 4096;
 /// r and t of the three channels at one cos θ.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RtTriple {
+    /// Reflectance per channel.
     pub r: [f32; 3],
+    /// Transmittance per channel.
     pub t: [f32; 3],
 }
 

@@ -56,7 +56,9 @@ pub const DEFAULT_MAX_MEMORY: u64 = 8 << 30;
 /// One share of a frame's memory, for messages: what it is and its bytes.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MemoryItem {
+    /// What it is.
     pub what: String,
+    /// Its bytes.
     pub bytes: u64,
 }
 
@@ -117,6 +119,7 @@ pub struct Reservation<'a> {
 }
 
 impl MemoryBudget {
+    /// A budget of `limit` bytes, none held.
     pub fn new(limit: u64) -> MemoryBudget {
         MemoryBudget {
             limit,

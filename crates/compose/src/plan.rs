@@ -10,59 +10,171 @@ use std::path::Path;
 use glassdb_image::ImageWindows;
 use glassdb_mask::MaskHeader;
 
-use crate::colour::{self, PassSpace};
-use crate::io::{self, ExrDataType, OutputFormat, PassHeader, PassSource};
-use crate::memory::{MemoryEstimate, MemoryItem, file_label};
-use crate::pixels::PngBits;
-use crate::{ComposeError, ComposeJob, ComposeSettings, check_frames, in_frame};
+use glassdb_encode::{Encoding, ExrDataType};
+use glassdb_pass::{Carry, PassHeader, PassReadOptions, PassSource, PngBits};
 
-/// What the headers decided for one frame.
-pub(crate) struct FramePlan {
+use crate::colour::{self, ChosenTable, PassSpace, RegistryLuts};
+use crate::lut::GlassLut;
+use crate::memory::{MemoryBudget, MemoryEstimate, MemoryItem, Reservation, file_label};
+use crate::place::{check_frames, in_frame};
+use crate::{ComposeError, DecodeSettings, FrameFiles};
+
+/// What a frame is decoded for, as far as reading it must know: the channels of the
+/// transmission file an output carries over, and the encoding whose buffers the frame's memory
+/// estimate counts (`name` says what is encoded, in the estimate's shares).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DecodeTarget {
+    /// The transmission file's channels carried over.
+    pub carry: Carry,
+    /// The output's format and sample type or bit depth.
+    pub encoding: Encoding,
+    /// What is encoded, for the memory estimate's shares (an output's file name).
+    pub name: String,
+}
+
+impl DecodeTarget {
+    /// A frame decoded to be shown, not written (the viewer): nothing carried over, its memory
+    /// counted as the 8-bit (or the passes' 16-bit) PNG a display shows.
+    pub fn display() -> DecodeTarget {
+        DecodeTarget {
+            carry: Carry::NONE,
+            encoding: Encoding::Png { bits: None },
+            name: "the displayed image".into(),
+        }
+    }
+}
+
+/// How each input is read: the pass options with each pass's own layer, decided once.
+pub(crate) struct InputReads {
+    /// The transmission pass's.
+    pub(crate) trans: PassReadOptions,
+    /// Reflection pass k's at k.
+    pub(crate) refl: Vec<PassReadOptions>,
+}
+
+impl InputReads {
+    /// The read options of every pass of `files`: `settings.pass`, each with its own layer
+    /// where `settings.layers` names one.
+    fn of(files: &FrameFiles, settings: &DecodeSettings) -> InputReads {
+        let with_layer = |layer: Option<&Option<String>>| {
+            let mut opts = settings.pass.clone();
+            if let Some(Some(l)) = layer {
+                opts.layer = Some(l.clone());
+            }
+            opts
+        };
+        InputReads {
+            trans: with_layer(Some(&settings.layers.trans)),
+            refl: (0..files.refl.len())
+                .map(|k| with_layer(settings.layers.refl.get(k)))
+                .collect(),
+        }
+    }
+}
+
+/// What the headers decided for one frame: how it is read, its colour, where its inputs lie
+/// and the memory held for it.
+pub(crate) struct FramePlan<'a> {
+    /// How each pass is read.
+    pub(crate) reads: InputReads,
     /// The passes' one colour space.
     pub(crate) space: PassSpace,
+    /// The registry table chosen for that space.
+    pub(crate) table: ChosenTable,
+    /// The lookup table of that registry table.
+    pub(crate) lut: &'a GlassLut,
     /// The frame's display window (the transmission pass's), where a PNG mask is placed.
     pub(crate) display: glassdb_image::PixelWindow,
     /// Each reflection pass's windows in the frame as its file stores them (decoding may keep
     /// only the rows its plane's glass needs).
     pub(crate) refl_windows: Vec<ImageWindows>,
+    /// The frame's memory estimate.
     pub(crate) memory: MemoryEstimate,
+    /// The estimate held from the budget until the frame is dropped.
+    pub(crate) reservation: Reservation<'a>,
 }
 
-/// Reads every input's header and checks the frame from them (see the module docs).
-pub(crate) fn plan_frame(
-    job: &ComposeJob,
-    settings: &ComposeSettings,
-) -> Result<FramePlan, ComposeError> {
-    let trans = io::read_pass_header(
-        &job.trans,
-        &settings.pass_options(Some(&settings.layers.trans)),
-    )?;
-    let mask = glassdb_mask::read_mask_header(&job.mask, &settings.mask)?;
-    let refl = job
+/// The header phase: reads every input's header and checks the frame from them (see the
+/// module docs), chooses the registry table for the passes' space and holds the frame's
+/// memory from `budget` (refused over its limit).
+pub(crate) fn plan_frame<'a>(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    luts: &'a RegistryLuts,
+    budget: &'a MemoryBudget,
+    target: &DecodeTarget,
+) -> Result<FramePlan<'a>, ComposeError> {
+    if files.refl.is_empty() {
+        return Err(ComposeError::NoReflectionPass);
+    }
+    let reads = InputReads::of(files, settings);
+    let trans = glassdb_pass::read_pass_header(&files.trans, &reads.trans)?;
+    let mask = glassdb_mask::read_mask_header(&files.mask, &settings.mask)?;
+    let refl = files
         .refl
         .iter()
-        .enumerate()
-        .map(|(k, p)| io::read_refl_header(p, &settings.pass_options(settings.layers.refl.get(k))))
+        .zip(&reads.refl)
+        .map(|(p, opts)| glassdb_pass::read_refl_header(p, opts))
         .collect::<Result<Vec<_>, _>>()?;
 
     let display = trans.windows.display;
     let mask_windows = in_frame(mask.windows, !mask.has_coordinates, &display);
-    let mut others: Vec<(&Path, ImageWindows)> = vec![(job.mask.as_path(), mask_windows)];
-    others.extend(job.refl.iter().zip(&refl).map(|(path, p)| {
+    let mut others: Vec<(&Path, ImageWindows)> = vec![(files.mask.as_path(), mask_windows)];
+    others.extend(files.refl.iter().zip(&refl).map(|(path, p)| {
         (
             path.as_path(),
             in_frame(p.windows, !p.source.has_coordinates(), &display),
         )
     }));
-    check_frames(job, &trans.windows, &others)?;
+    check_frames(&files.trans, &trans.windows, &others)?;
     let refl_windows = others.iter().skip(1).map(|(_, w)| *w).collect();
 
+    let space = frame_space(files, settings, &trans, &refl)?;
+    if refl.len() > 1 && !mask.stores_planes {
+        return Err(ComposeError::MaskWithoutPlanes {
+            mask: files.mask.clone(),
+            passes: refl.len(),
+        });
+    }
+    let (table, lut) = luts.for_space(&space, &files.trans, &settings.registry_label)?;
+
+    let memory = estimate(files, target, &trans, &refl, &mask, &mask_windows);
+    if memory.total > budget.limit() {
+        return Err(ComposeError::MemoryLimit {
+            trans: files.trans.clone(),
+            estimate: memory.total,
+            limit: budget.limit(),
+            items: memory.items,
+            carried: memory.carried,
+        });
+    }
+    let reservation = budget.reserve(memory.total);
+    Ok(FramePlan {
+        reads,
+        space,
+        table,
+        lut,
+        display,
+        refl_windows,
+        memory,
+        reservation,
+    })
+}
+
+/// The passes' one colour space: each pass's from its header, or as declared; they must
+/// agree.
+fn frame_space(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    trans: &PassHeader,
+    refl: &[PassHeader],
+) -> Result<PassSpace, ComposeError> {
     let declared = settings.input_space;
-    let trans_space = colour::pass_space(&job.trans, &trans.colour, declared)?;
-    let refl_spaces = job
+    let trans_space = colour::pass_space(&files.trans, &trans.colour, declared)?;
+    let refl_spaces = files
         .refl
         .iter()
-        .zip(&refl)
+        .zip(refl)
         .map(|(path, pass)| {
             Ok((
                 path.clone(),
@@ -70,86 +182,27 @@ pub(crate) fn plan_frame(
             ))
         })
         .collect::<Result<Vec<_>, ComposeError>>()?;
-    let space = colour::frame_space((&job.trans, trans_space), &refl_spaces)?;
-
-    if refl.len() > 1 && !mask.stores_planes {
-        return Err(ComposeError::MaskWithoutPlanes {
-            mask: job.mask.clone(),
-            passes: refl.len(),
-        });
-    }
-
-    let memory = estimate(job, settings, &trans, &refl, &mask, &mask_windows)?;
-    Ok(FramePlan {
-        space,
-        display,
-        refl_windows,
-        memory,
-    })
+    colour::frame_space((&files.trans, trans_space), &refl_spaces)
 }
 
-/// The frame's memory from the headers (module docs of [`crate::memory`]).
+/// The frame's memory from the headers (module docs of [`crate::memory`]): the largest of its
+/// three stages, decoding, compositing and encoding, with the program's overhead.
 fn estimate(
-    job: &ComposeJob,
-    settings: &ComposeSettings,
+    files: &FrameFiles,
+    target: &DecodeTarget,
     trans: &PassHeader,
     refl: &[PassHeader],
     mask: &MaskHeader,
     mask_windows: &ImageWindows,
-) -> Result<MemoryEstimate, ComposeError> {
-    let format = io::output_format(&job.output)?;
+) -> MemoryEstimate {
     let pixels = trans.windows.data.pixel_count();
-    let carried = match (&trans.source, format) {
-        (PassSource::Exr { channel_names, .. }, OutputFormat::Exr)
-            if io::carries_whole_file(
-                &trans.parts,
-                channel_names,
-                (
-                    settings.output.keep_channels,
-                    settings.output.output_layer.is_some(),
-                ),
-            ) =>
-        {
-            trans
-                .parts
-                .iter()
-                .map(|p| p.stored_bytes())
-                .fold(0, u64::saturating_add)
-        }
-        _ => 0,
-    };
+    let carried = carried_bytes(trans, target);
     let placed_mask = if mask_windows.data == trans.windows.data {
         0
     } else {
         pixels.saturating_mul(mask.bytes_per_pixel)
     };
-    // Bytes per pixel of the composite (f32 R, G, B and maybe A) and of the carried channels.
-    let composite_bpp = trans.memory.kept / pixels.max(1);
-    let carried_bpp = carried / pixels.max(1);
-    let output = match format {
-        OutputFormat::Exr => {
-            // A half copy of one plane at a time; the compressor's window of blocks (raw, split
-            // and deflated: three copies of 16 rows of every channel, four blocks per thread).
-            let half = match io::output_data_type(&trans.source, &settings.output) {
-                ExrDataType::Half => pixels.saturating_mul(2),
-                ExrDataType::Float => 0,
-            };
-            let row_bytes = (trans.windows.data.width as u64)
-                .saturating_mul(composite_bpp.saturating_add(carried_bpp));
-            let rows = (16 * 4 * rayon::current_num_threads() as u64)
-                .min(trans.windows.data.height as u64);
-            half.saturating_add(row_bytes.saturating_mul(3 * rows))
-        }
-        OutputFormat::Png => {
-            // The encoded samples and the file (at most their size); 16-bit: a big-endian copy.
-            let channels = composite_bpp / 4;
-            match io::output_png_bits(&trans.source, &settings.output) {
-                PngBits::Eight => pixels.saturating_mul(channels).saturating_mul(2),
-                PngBits::Sixteen => pixels.saturating_mul(2 * channels).saturating_mul(3),
-            }
-        }
-    };
-
+    let output = encoding_bytes(trans, target, carried);
     let kept = std::iter::once(&trans.memory)
         .chain(refl.iter().map(|p| &p.memory))
         .chain(std::iter::once(&mask.memory))
@@ -161,14 +214,6 @@ fn estimate(
     let mut by_transient: Vec<usize> = (0..refl.len()).collect();
     by_transient.sort_by_key(|&k| std::cmp::Reverse(refl[k].memory.transient));
     by_transient.truncate(crate::memory::decoding_at_once());
-    let refl_share = |k: usize| {
-        let m = &refl[k].memory;
-        if by_transient.contains(&k) {
-            m.peak()
-        } else {
-            m.kept
-        }
-    };
     let transient = by_transient
         .iter()
         .map(|&k| refl[k].memory.transient)
@@ -184,37 +229,122 @@ fn estimate(
         .saturating_add(output);
     let largest_stage = decoding.max(compositing).max(encoding);
     let total = crate::memory::with_overhead(largest_stage);
-
-    let mut items = vec![MemoryItem {
-        what: file_label(&job.trans),
-        bytes: trans.memory.peak(),
-    }];
-    items.extend(job.refl.iter().enumerate().map(|(k, path)| MemoryItem {
-        what: file_label(path),
-        bytes: refl_share(k),
-    }));
-    items.push(MemoryItem {
-        what: format!("{} (the mask)", file_label(&job.mask)),
-        bytes: mask.memory.peak().saturating_add(placed_mask),
-    });
-    if carried > 0 {
-        items.push(MemoryItem {
-            what: format!("the channels of {} carried over", file_label(&job.trans)),
-            bytes: carried,
-        });
-    }
-    items.push(MemoryItem {
-        what: format!("encoding {}", file_label(&job.output)),
-        bytes: output,
-    });
-    items.push(MemoryItem {
-        what: "the program and what the allocator keeps".into(),
-        bytes: total - largest_stage,
-    });
-    items.sort_by(|a, b| b.bytes.cmp(&a.bytes).then_with(|| a.what.cmp(&b.what)));
-    Ok(MemoryEstimate {
-        total,
-        items,
+    let refl_share = |k: usize| {
+        let m = &refl[k].memory;
+        if by_transient.contains(&k) {
+            m.peak()
+        } else {
+            m.kept
+        }
+    };
+    let shares = Shares {
+        trans: trans.memory.peak(),
+        refl: (0..refl.len()).map(refl_share).collect(),
+        mask: mask.memory.peak().saturating_add(placed_mask),
         carried,
-    })
+        output,
+        overhead: total - largest_stage,
+    };
+    MemoryEstimate {
+        total,
+        items: shares.items(files, target),
+        carried,
+    }
+}
+
+/// Bytes of the transmission file's other channels carried over into an EXR output.
+fn carried_bytes(trans: &PassHeader, target: &DecodeTarget) -> u64 {
+    match (&trans.source, target.encoding) {
+        (PassSource::Exr { channel_names, .. }, Encoding::Exr { .. })
+            if glassdb_pass::carries_whole_file(&trans.parts, channel_names, target.carry) =>
+        {
+            trans
+                .parts
+                .iter()
+                .map(|p| p.stored_bytes())
+                .fold(0, u64::saturating_add)
+        }
+        _ => 0,
+    }
+}
+
+/// The encoder's own buffers for the output of `target`.
+fn encoding_bytes(trans: &PassHeader, target: &DecodeTarget, carried: u64) -> u64 {
+    let pixels = trans.windows.data.pixel_count();
+    // Bytes per pixel of the composite (f32 R, G, B and maybe A) and of the carried channels.
+    let composite_bpp = trans.memory.kept / pixels.max(1);
+    let carried_bpp = carried / pixels.max(1);
+    match target.encoding {
+        Encoding::Exr { data_type } => {
+            // A half copy of one plane at a time; the compressor's window of blocks (raw, split
+            // and deflated: three copies of 16 rows of every channel, four blocks per thread).
+            let half = match glassdb_encode::exr_data_type(&trans.source, data_type) {
+                ExrDataType::Half => pixels.saturating_mul(2),
+                ExrDataType::Float => 0,
+            };
+            let row_bytes = (trans.windows.data.width as u64)
+                .saturating_mul(composite_bpp.saturating_add(carried_bpp));
+            let rows = (16 * 4 * rayon::current_num_threads() as u64)
+                .min(trans.windows.data.height as u64);
+            half.saturating_add(row_bytes.saturating_mul(3 * rows))
+        }
+        Encoding::Png { bits } => {
+            // The encoded samples and the file (at most their size); 16-bit: a big-endian copy.
+            let channels = composite_bpp / 4;
+            match glassdb_encode::png_bits(&trans.source, bits) {
+                PngBits::Eight => pixels.saturating_mul(channels).saturating_mul(2),
+                PngBits::Sixteen => pixels.saturating_mul(2 * channels).saturating_mul(3),
+            }
+        }
+    }
+}
+
+/// The shares of a frame's estimate, in bytes, before they are named.
+struct Shares {
+    trans: u64,
+    refl: Vec<u64>,
+    mask: u64,
+    carried: u64,
+    output: u64,
+    overhead: u64,
+}
+
+impl Shares {
+    /// The shares named for messages, largest first.
+    fn items(self, files: &FrameFiles, target: &DecodeTarget) -> Vec<MemoryItem> {
+        let mut items = vec![MemoryItem {
+            what: file_label(&files.trans),
+            bytes: self.trans,
+        }];
+        items.extend(
+            files
+                .refl
+                .iter()
+                .zip(self.refl)
+                .map(|(path, bytes)| MemoryItem {
+                    what: file_label(path),
+                    bytes,
+                }),
+        );
+        items.push(MemoryItem {
+            what: format!("{} (the mask)", file_label(&files.mask)),
+            bytes: self.mask,
+        });
+        if self.carried > 0 {
+            items.push(MemoryItem {
+                what: format!("the channels of {} carried over", file_label(&files.trans)),
+                bytes: self.carried,
+            });
+        }
+        items.push(MemoryItem {
+            what: format!("encoding {}", target.name),
+            bytes: self.output,
+        });
+        items.push(MemoryItem {
+            what: "the program and what the allocator keeps".into(),
+            bytes: self.overhead,
+        });
+        items.sort_by(|a, b| b.bytes.cmp(&a.bytes).then_with(|| a.what.cmp(&b.what)));
+        items
+    }
 }

@@ -1,13 +1,15 @@
 //! Golden images small enough to compute by hand, and the r = 0, t = 1 identity.
 
-use std::collections::BTreeMap;
+use std::path::Path;
 
+use glassdb_encode::OutputOptions;
 use glassdb_mask::{CosTheta, MaskImage};
+use glassdb_pass::{CarriedFrame, LinearImage, PassReadOptions, PassSource};
 use proptest::prelude::*;
 
 use super::*;
 use crate::colour::RegistryLuts;
-use crate::kernel::{KernelShapeError, compose_in_place};
+use crate::kernel::{KernelInput, KernelShapeError, compose_in_place};
 use crate::lut::GlassLut;
 
 /// Glass 1: r = (0.1, 0.2, 0.3), t = (0.5, 0.6, 0.7) at every angle, back r = (0.4, 0.4, 0.4).
@@ -202,68 +204,23 @@ fn kernel_input_of_the_wrong_shape_is_refused_once() {
     assert_eq!(compose_in_place(ok.unwrap()).passthrough_pixels, 0);
 }
 
-#[test]
-fn planes_json_sides() {
-    let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("planes.json");
-    std::fs::write(&p, planes_json(&["front", "back"], &[0, 1])).unwrap();
-    let sides = sides_from_planes_json(&p, 2).unwrap();
-    assert_eq!(sides, BTreeMap::from([(0, Side::Front), (1, Side::Back)]));
-    // A planes file for another number of planes than the passes given is refused.
-    let err = sides_from_planes_json(&p, 3).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            ComposeError::PlaneCountMismatch {
-                planes: 2,
-                passes: 3,
-                ..
-            }
-        ),
-        "{err:?}"
-    );
-    assert!(
-        err.to_string()
-            .contains("2 glass plane(s) but 3 reflection pass(es)"),
-        "{err}"
-    );
-    std::fs::write(&p, r#"{"planes":[{"eye_side":"up"}]}"#).unwrap();
-    assert!(
-        sides_from_planes_json(&p, 1)
-            .unwrap_err()
-            .to_string()
-            .contains("planes.json")
-    );
-    // The scene crate's reader checks the side names, the format and the plane order.
-    for bad in [
-        planes_json(&["front", "up"], &[0, 1]),
-        planes_json(&["front", "back"], &[1, 0]),
-        planes_json(&["front"], &[0]).replace("glassdb-planes/1", "glassdb-planes/9"),
-    ] {
-        std::fs::write(&p, &bad).unwrap();
-        let err = sides_from_planes_json(&p, 2).unwrap_err();
-        assert!(
-            matches!(err, ComposeError::PlanesFile(_)) && err.to_string().contains("planes.json"),
-            "{err}"
-        );
-    }
-}
-
-/// A planes file as `glassdb mirror` writes it, with the given eye sides and plane indices.
-fn planes_json(sides: &[&str], indices: &[usize]) -> String {
-    let planes: Vec<String> = sides
-        .iter()
-        .zip(indices)
-        .map(|(side, index)| {
-            format!(
-                r#"{{"index":{index},"equation":[0.0,0.0,1.0,{index}.0],"area":1.0,"materials":["glass"],"triangles":2,"eye_side":"{side}","reflection_matrix":[[1.0,0.0,0.0,0.0],[0.0,1.0,0.0,0.0],[0.0,0.0,-1.0,0.0],[0.0,0.0,0.0,1.0]],"file":"virtual_plane_{index}.obj","triangles_written":0,"triangles_clipped":0}}"#
-            )
-        })
-        .collect();
-    format!(
-        r#"{{"format":"glassdb-planes/1","source":"scene.obj","eye":null,"tolerance":{{"angle_deg":0.5,"distance":0.001}},"planes":[{}]}}"#,
-        planes.join(",")
-    )
+/// Writes `planes` (R, G, B of `width × height` pixels) as a float EXR pass.
+fn write_float_pass(path: &Path, width: u32, height: u32, planes: [Vec<f32>; 3]) {
+    let img = LinearImage {
+        width,
+        height,
+        rgb: planes,
+        alpha: None,
+    };
+    let src = PassSource::Exr {
+        sample_type: glassdb_image::ExrSampleType::Float,
+        compression: glassdb_encode::DEFAULT_EXR_COMPRESSION,
+        layer: String::new(),
+        part: 0,
+        channel_names: vec!["R".into(), "G".into(), "B".into()],
+    };
+    let frame = CarriedFrame::whole(width, height);
+    glassdb_encode::write_output(path, img, frame, &src, &OutputOptions::default()).unwrap();
 }
 
 proptest! {
@@ -286,22 +243,18 @@ proptest! {
         let t_path = dir.path().join("t.exr");
         let r_path = dir.path().join("r.exr");
         let m_path = dir.path().join("m.png");
-        let write = |p: &Path, v: &[f32]| {
-            let img = pixels::LinearImage { width: 4, height: 3, rgb: planes(v), alpha: None };
-            let src = io::PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, compression: exr::compression::Compression::ZIP16, layer: String::new(), part: 0, channel_names: vec!["R".into(), "G".into(), "B".into()] };
-            io::write_output(p, img, &src, &OutputOptions::default()).unwrap();
-        };
+        let write = |p: &Path, v: &[f32]| write_float_pass(p, 4, 3, planes(v));
         write(&t_path, &trans);
         write(&r_path, &refl);
         glassdb_mask::write_mask(&m_path, &m, glassdb_mask::MaskFormat::Png8).unwrap();
-        let job = ComposeJob { refl: vec![r_path], trans: t_path, mask: m_path, output: dir.path().join("o.exr") };
+        let job = ComposeJob { inputs: FrameFiles { refl: vec![r_path], trans: t_path, mask: m_path }, output: dir.path().join("o.exr") };
         let luts = RegistryLuts::single(glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb), lut);
         compose_frame(&job, &ComposeSettings::default(), &luts).unwrap();
-        let out = io::read_pass(&job.output, &PassReadOptions::default()).unwrap();
+        let out = glassdb_pass::read_pass(&job.output, &PassReadOptions::default()).unwrap();
         let got: Vec<u32> = out.image.rgb.iter().flatten().map(|v| v.to_bits()).collect();
         let want: Vec<u32> = trans.iter().map(|v| v.to_bits()).collect();
         prop_assert_eq!(got, want);
-        let is_float = matches!(out.source, io::PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, .. });
+        let is_float = matches!(out.source, PassSource::Exr { sample_type: glassdb_image::ExrSampleType::Float, .. });
         prop_assert!(is_float);
     }
 }
@@ -338,20 +291,7 @@ fn a_frame_reports_its_stages_in_order() {
     let dir = tempfile::tempdir().unwrap();
     let write = |name: &str, v: f32| {
         let path = dir.path().join(name);
-        let img = pixels::LinearImage {
-            width: 2,
-            height: 1,
-            rgb: [vec![v; 2], vec![v; 2], vec![v; 2]],
-            alpha: None,
-        };
-        let src = io::PassSource::Exr {
-            sample_type: glassdb_image::ExrSampleType::Float,
-            compression: exr::compression::Compression::ZIP16,
-            layer: String::new(),
-            part: 0,
-            channel_names: vec!["R".into(), "G".into(), "B".into()],
-        };
-        io::write_output(&path, img, &src, &OutputOptions::default()).unwrap();
+        write_float_pass(&path, 2, 1, [vec![v; 2], vec![v; 2], vec![v; 2]]);
         path
     };
     let m = mask(
@@ -363,9 +303,11 @@ fn a_frame_reports_its_stages_in_order() {
     let m_path = dir.path().join("m.png");
     glassdb_mask::write_mask(&m_path, &m, glassdb_mask::MaskFormat::Png8).unwrap();
     let job = ComposeJob {
-        refl: vec![write("r.exr", 0.25)],
-        trans: write("t.exr", 0.5),
-        mask: m_path,
+        inputs: FrameFiles {
+            refl: vec![write("r.exr", 0.25)],
+            trans: write("t.exr", 0.5),
+            mask: m_path,
+        },
         output: dir.path().join("o.exr"),
     };
     let basis = glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb);
@@ -376,7 +318,10 @@ fn a_frame_reports_its_stages_in_order() {
     // a frame that fails before decoding reports no stage
     let log = glassdb_io::StageLog::default();
     let no_refl = ComposeJob {
-        refl: Vec::new(),
+        inputs: FrameFiles {
+            refl: Vec::new(),
+            ..job.inputs
+        },
         ..job
     };
     assert!(

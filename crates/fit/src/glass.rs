@@ -1,40 +1,28 @@
-//! Glass-level fitting (both curves of one glass), the physical checks, and the fit file
-//! (`{"glasses": [...]}`, `docs/fit-json.md`) that `glassdb eval` and later tools read.
-
-use std::path::Path;
+//! Glass-level fitting: both curves of one glass from its angle table, the screen for
+//! inconsistent readings before the fit, and the checks after it that refuse a fit far from
+//! its data or unphysical (`docs/fit.md`, "Refused fits").
 
 use serde::{Deserialize, Serialize};
 
 use crate::error::FitError;
 use crate::model::{AngleSamples, CurveFit, FitOptions, Quantity};
+use crate::physical::{REFUSE_TOLERANCE_FACTOR, physical_checks, refusing_checks};
 use crate::solve::fit_curve;
 use crate::table::GlassAngleTable;
-
-/// Step of the dense grid the physical checks run on (degrees, 0–90 inclusive).
-pub const CHECK_STEP_DEG: f64 = 0.25;
-/// Slack for the physical checks (absolute): a millionth, far below any measurement precision,
-/// so only real violations are reported.
-pub const CHECK_SLACK: f64 = 1e-6;
-
-/// The largest slack (absolute, on r or t) that validation ever allows a curve beyond the
-/// physical range 0 ≤ r, t ≤ 1, r + t ≤ 1: 0.01, one percentage point of reflectance or
-/// transmittance. Five times the default fit tolerance ([`crate::DEFAULT_TOL`]) and about the
-/// absolute uncertainty of a spectrophotometer's regular R and T, so a curve that misses the
-/// physical range by more is wrong, not noisy. A file never sets its own slack beyond this: fit
-/// files and registries record a tolerance per curve, and validation takes it only up to this
-/// cap (the registry refuses a larger recorded one; the registry builder refuses a larger fit
-/// tolerance).
-pub const MAX_CURVE_TOLERANCE: f64 = 0.01;
 
 /// The fitted curves of one glass. A glass measured for only one of R/T has only that key.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct GlassFit {
+    /// The glass's name (the table's `glass` column, or the file's stem).
     pub name: String,
+    /// r(θ), when the table has R values.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reflectance: Option<CurveFit>,
+    /// t(θ), when the table has T values.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transmittance: Option<CurveFit>,
-    /// Glass-level warnings: failed physical checks, repeated angles averaged.
+    /// Glass-level warnings: failed physical checks, repeated angles averaged, and what
+    /// `force` let through.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
 }
@@ -54,383 +42,251 @@ impl GlassFit {
     }
 }
 
-/// The whole output of `glassdb fit --json` / `-o`.
-#[derive(Serialize, Deserialize, Clone, Debug, PartialEq, Default)]
-pub struct FitFile {
-    pub glasses: Vec<GlassFit>,
-}
-
-impl FitFile {
-    /// Pretty JSON, newline-terminated.
-    pub fn to_json(&self) -> String {
-        let mut s = serde_json::to_string_pretty(self)
-            .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"));
-        s.push('\n');
-        s
-    }
-
-    /// The glass with this name (first match).
-    pub fn glass(&self, name: &str) -> Option<&GlassFit> {
-        self.glasses.iter().find(|g| g.name == name)
-    }
-}
-
-/// Reads and validates a fit file (see [`parse_fit_json`]).
-pub fn read_fit_file(path: &Path) -> Result<FitFile, FitError> {
-    let text =
-        glassdb_io::read_input(path, glassdb_io::limits::JSON).map_err(|source| FitError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    parse_fit_json(&text, path)
-}
-
-/// Parses a fit file and validates it ([`FitFile::validate`]). Another glassdb JSON file (a
-/// registry, a planes file) is named as such ([`FitError::OtherFile`]). `path` is used in
-/// messages only.
-pub fn parse_fit_json(bytes: &[u8], path: &Path) -> Result<FitFile, FitError> {
-    if let Some(kind) = OtherJson::identify(bytes) {
-        return Err(FitError::OtherFile {
-            path: path.to_path_buf(),
-            kind,
-        });
-    }
-    let file: FitFile = serde_json::from_slice(bytes).map_err(|e| FitError::FitFile {
-        path: path.to_path_buf(),
-        message: format!(
-            "not a glassdb fit file (line {}, column {}): {e}",
-            e.line(),
-            e.column()
-        ),
-    })?;
-    file.validate(path)?;
-    Ok(file)
-}
-
-/// Another glassdb JSON file handed to the fit file reader.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum OtherJson {
-    /// A glass registry (`{"schema": …, "tables" or "glasses": …}`).
-    Registry,
-    /// A planes file (`{"format": "glassdb-planes/…"}`).
-    Planes,
-}
-
-impl OtherJson {
-    /// The kind of glassdb JSON file `bytes` hold when it is not a fit file, from the top-level
-    /// keys only (none for anything else, including text that is not JSON).
-    pub fn identify(bytes: &[u8]) -> Option<OtherJson> {
-        #[derive(Deserialize)]
-        struct TopLevel {
-            #[serde(default)]
-            schema: Option<serde::de::IgnoredAny>,
-            #[serde(default)]
-            format: Option<String>,
-        }
-        let top: TopLevel = serde_json::from_slice(bytes).ok()?;
-        if top.schema.is_some() {
-            Some(OtherJson::Registry)
-        } else if top.format.is_some_and(|f| f.starts_with("glassdb-planes")) {
-            Some(OtherJson::Planes)
-        } else {
-            None
-        }
-    }
-}
-
-impl std::fmt::Display for OtherJson {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            OtherJson::Registry => "a glassdb glass registry",
-            OtherJson::Planes => "a glassdb planes file",
-        })
-    }
-}
-
-impl CurveFit {
-    /// The slack validation allows this curve beyond the physical range: its largest residual
-    /// on the data, at least [`crate::DEFAULT_TOL`] (the curve between and beyond the data
-    /// points) and at most [`MAX_CURVE_TOLERANCE`] (what the file records cannot widen it).
-    pub fn validation_tolerance(&self) -> f64 {
-        let residual = self.diagnostics.summary.max_abs_error;
-        let residual = if residual.is_finite() { residual } else { 0.0 };
-        residual.clamp(crate::DEFAULT_TOL, MAX_CURVE_TOLERANCE)
-    }
-
-    /// The angles (degrees) the curve was fitted over, where validation holds it to the
-    /// physical range: the measured range when the file records it, else 0–90°; a recorded
-    /// range reaching outside 0–90° or inverted counts as 0–90°, so that an edited file cannot
-    /// escape validation. Beyond it the curve is an extrapolation, which `glassdb eval`
-    /// warns about.
-    pub fn data_range(&self) -> (f64, f64) {
-        let d = &self.diagnostics;
-        let lo = d.angle_min_deg.filter(|a| a.is_finite()).unwrap_or(0.0);
-        let hi = d.angle_max_deg.filter(|a| a.is_finite()).unwrap_or(90.0);
-        if 0.0 <= lo && lo <= hi && hi <= 90.0 {
-            (lo, hi)
-        } else {
-            (0.0, 90.0)
-        }
-    }
-}
-
-impl FitFile {
-    /// Checks every glass, as the registry checks its curves (`docs/fit-json.md`, "Rules for
-    /// readers"): at least one curve per glass; each curve well formed
-    /// ([`crate::CosPolynomial::check_shape`]) with finite numbers; its normal value in [0, 1];
-    /// and on the dense grid ([`CHECK_STEP_DEG`]) over each curve's [`CurveFit::data_range`],
-    /// 0 ≤ r, t ≤ 1 and r + t ≤ 1, each within the curves'
-    /// [`CurveFit::validation_tolerance`]. `path` names the file in messages.
-    pub fn validate(&self, path: &Path) -> Result<(), FitError> {
-        for g in &self.glasses {
-            if g.reflectance.is_none() && g.transmittance.is_none() {
-                return Err(FitError::FitFile {
-                    path: path.to_path_buf(),
-                    message: format!(
-                        "glass `{}` has neither a reflectance nor a transmittance curve",
-                        g.name
-                    ),
-                });
-            }
-            for (q, c) in [
-                ("reflectance", &g.reflectance),
-                ("transmittance", &g.transmittance),
-            ] {
-                let Some(c) = c else { continue };
-                validate_curve(c, path, &g.name, q)?;
-            }
-            let tol = |c: &Option<CurveFit>| c.as_ref().map_or(0.0, CurveFit::validation_tolerance);
-            let (tol_r, tol_t) = (tol(&g.reflectance), tol(&g.transmittance));
-            let range = |c: &Option<CurveFit>| c.as_ref().map_or((0.0, 90.0), CurveFit::data_range);
-            let violations = violations(
-                g.reflectance.as_ref(),
-                g.transmittance.as_ref(),
-                Slack {
-                    r: tol_r,
-                    t: tol_t,
-                    sum: tol_r + tol_t,
-                    range_r: range(&g.reflectance),
-                    range_t: range(&g.transmittance),
-                },
-            );
-            if let Some((v, tolerance)) = violations.into_iter().next() {
-                return Err(FitError::Unphysical {
-                    path: path.to_path_buf(),
-                    glass: g.name.clone(),
-                    violation: v,
-                    tolerance,
-                });
-            }
-        }
-        Ok(())
-    }
-}
-
-/// One curve of a fit file: shape, finite numbers, normal value in [0, 1] (within its
-/// tolerance).
-fn validate_curve(
-    c: &CurveFit,
-    path: &Path,
-    glass: &str,
-    quantity: &'static str,
-) -> Result<(), FitError> {
-    let p = &c.polynomial;
-    p.check_shape().map_err(|source| FitError::CurveShape {
-        path: path.to_path_buf(),
-        glass: glass.to_string(),
-        quantity,
-        source,
-    })?;
-    let s = &c.diagnostics.summary;
-    let numbers = [s.rms_error, s.max_abs_error, s.max_error_angle_deg];
-    if !c.normal.is_finite()
-        || p.coefficients.iter().any(|v| !v.is_finite())
-        || numbers.iter().any(|v| !v.is_finite())
-    {
-        return Err(FitError::FitFile {
-            path: path.to_path_buf(),
-            message: format!(
-                "glass `{glass}`, {quantity}: non-finite normal value, coefficient or error"
-            ),
-        });
-    }
-    let tolerance = c.validation_tolerance();
-    if !(-tolerance..=1.0 + tolerance).contains(&c.normal) {
-        return Err(FitError::NormalOutOfRange {
-            path: path.to_path_buf(),
-            glass: glass.to_string(),
-            quantity,
-            normal: c.normal,
-            tolerance,
-        });
-    }
-    Ok(())
-}
-
-/// One failed physical check, with the worst angle on the dense grid.
+/// How to fit the two curves of a glass, and what to refuse.
 #[derive(Clone, Debug, PartialEq)]
-pub struct PhysicalViolation {
-    /// What failed, e.g. `r < 0`, `t > 1`, `r + t > 1`.
-    pub check: &'static str,
-    pub worst_angle_deg: f64,
-    /// The offending value at that angle (r, t or r + t).
-    pub worst_value: f64,
+pub struct GlassFitOptions {
+    /// The options of the reflectance curve (its `quantity` is set to reflectance).
+    pub reflectance: FitOptions,
+    /// The options of the transmittance curve (its `quantity` is set to transmittance).
+    pub transmittance: FitOptions,
+    /// Every failed physical check, however small (beyond [`crate::CHECK_SLACK`]), is an
+    /// error ([`FitError::Physical`]).
+    pub strict: bool,
+    /// Fit and return what would be refused (inconsistent readings, a fit far from its data
+    /// or unphysical), with each refusal as a warning instead.
+    pub force: bool,
 }
 
-impl std::fmt::Display for PhysicalViolation {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} on the fitted curve, worst at {}° ({:.6})",
-            self.check, self.worst_angle_deg, self.worst_value
-        )
+impl Default for GlassFitOptions {
+    /// The defaults of [`FitOptions::new`] for both curves, not strict, not forced.
+    fn default() -> Self {
+        GlassFitOptions {
+            reflectance: FitOptions::new(Quantity::Reflectance),
+            transmittance: FitOptions::new(Quantity::Transmittance),
+            strict: false,
+            force: false,
+        }
     }
 }
 
-/// Checks 0 ≤ r ≤ 1, 0 ≤ t ≤ 1 and r + t ≤ 1 (when both exist) on a dense 0–90° grid
-/// ([`CHECK_STEP_DEG`]), each with the slack [`CHECK_SLACK`]. C_t(θ) > 1 near normal incidence
-/// is not a violation (coated glass).
-pub fn physical_checks(r: Option<&CurveFit>, t: Option<&CurveFit>) -> Vec<PhysicalViolation> {
-    let slack = Slack {
-        r: CHECK_SLACK,
-        t: CHECK_SLACK,
-        sum: CHECK_SLACK,
-        range_r: (0.0, 90.0),
-        range_t: (0.0, 90.0),
-    };
-    violations(r, t, slack)
-        .into_iter()
-        .map(|(v, _)| v)
-        .collect()
-}
-
-/// How far each check may exceed the physical range before it is a violation, and the angles
-/// (degrees, inclusive) each curve is checked over (r + t where both ranges hold).
-#[derive(Clone, Copy)]
-struct Slack {
-    r: f64,
-    t: f64,
-    sum: f64,
-    range_r: (f64, f64),
-    range_t: (f64, f64),
-}
-
-/// The failed checks (see [`physical_checks`]) with the slack each exceeded, in the order
-/// first met on the grid. A value that is not finite is a violation whatever the slack.
-fn violations(
-    r: Option<&CurveFit>,
-    t: Option<&CurveFit>,
-    slack: Slack,
-) -> Vec<(PhysicalViolation, f64)> {
-    let steps = (90.0 / CHECK_STEP_DEG).round() as usize;
-    // (check, worst angle, worst value, amount, slack)
-    let mut worst: Vec<(&'static str, f64, f64, f64, f64)> = Vec::new();
-    let mut note = |check: &'static str, angle: f64, value: f64, amount: f64, slack: f64| {
-        let amount = if value.is_finite() {
-            amount
-        } else {
-            f64::INFINITY
-        };
-        if amount <= slack {
-            return;
-        }
-        match worst.iter_mut().find(|w| w.0 == check) {
-            Some(w) if amount > w.3 => *w = (check, angle, value, amount, slack),
-            Some(_) => {}
-            None => worst.push((check, angle, value, amount, slack)),
-        }
-    };
-    let within = |(lo, hi): (f64, f64), angle: f64| (lo..=hi).contains(&angle);
-    for i in 0..=steps {
-        let angle = i as f64 * CHECK_STEP_DEG;
-        let rv = r
-            .filter(|_| within(slack.range_r, angle))
-            .map(|c| c.eval_angle_deg(angle));
-        let tv = t
-            .filter(|_| within(slack.range_t, angle))
-            .map(|c| c.eval_angle_deg(angle));
-        if let Some(v) = rv {
-            note("r < 0", angle, v, -v, slack.r);
-            note("r > 1", angle, v, v - 1.0, slack.r);
-        }
-        if let Some(v) = tv {
-            note("t < 0", angle, v, -v, slack.t);
-            note("t > 1", angle, v, v - 1.0, slack.t);
-        }
-        if let (Some(a), Some(b)) = (rv, tv) {
-            note("r + t > 1", angle, a + b, a + b - 1.0, slack.sum);
-        }
+/// Fits both curves of a glass, in three phases:
+///
+/// 1. the screen ([`GlassAngleTable::screen`]): readings their neighbours contradict
+///    ([`FitError::InconsistentPoints`], [`FitError::ReversedCurve`]);
+/// 2. the fits ([`fit_curve`]);
+/// 3. the judgement: a curve that misses a reading by more than
+///    [`REFUSE_TOLERANCE_FACTOR`] × its tolerance ([`FitError::FarFromData`]), or fails
+///    [`refusing_checks`] over 0–90° ([`FitError::UnphysicalFit`]); with `strict`, any failed
+///    [`physical_checks`] ([`FitError::Physical`]).
+///
+/// Phases 1 and 3 refuse unless `force`, which turns their findings into warnings (strict
+/// checks stay errors). Smaller physical violations are warnings.
+pub fn fit_glass(table: &GlassAngleTable, opts: &GlassFitOptions) -> Result<GlassFit, FitError> {
+    let mut refusals = screen(table);
+    if !opts.force && !refusals.is_empty() {
+        return Err(refusals.swap_remove(0));
     }
-    worst
-        .into_iter()
-        .map(|(check, worst_angle_deg, worst_value, _, slack)| {
-            let v = PhysicalViolation {
-                check,
-                worst_angle_deg,
-                worst_value,
-            };
-            (v, slack)
-        })
-        .collect()
-}
-
-/// Fits both curves of a glass and runs the physical checks. With `strict`, a failed check is
-/// an error ([`FitError::Physical`]); otherwise it becomes a warning in the result.
-pub fn fit_glass(
-    table: &GlassAngleTable,
-    reflectance: &FitOptions,
-    transmittance: &FitOptions,
-    strict: bool,
-) -> Result<GlassFit, FitError> {
-    let r_opts = FitOptions {
-        quantity: Quantity::Reflectance,
-        ..reflectance.clone()
-    };
-    let t_opts = FitOptions {
-        quantity: Quantity::Transmittance,
-        ..transmittance.clone()
-    };
-    // Fits one curve of the table when it has one; an error names the glass and the quantity.
-    let fit = |samples: Option<&AngleSamples>, opts: &FitOptions, quantity: &'static str| {
-        samples
-            .map(|s| fit_curve(s, opts))
-            .transpose()
-            .map_err(|e| FitError::Curve {
-                glass: table.name.clone(),
-                quantity,
-                error: Box::new(e),
-            })
-    };
-    let r = fit(table.reflectance.as_ref(), &r_opts, "reflectance")?;
-    let t = fit(table.transmittance.as_ref(), &t_opts, "transmittance")?;
-    let mut warnings = Vec::new();
-    for rep in &table.repeated_angles {
-        let mut spreads = Vec::new();
-        if let Some(s) = rep.reflectance_spread {
-            spreads.push(format!("R spread {s:.5}"));
-        }
-        if let Some(s) = rep.transmittance_spread {
-            spreads.push(format!("T spread {s:.5}"));
-        }
-        warnings.push(format!(
-            "angle {}° given on {} rows: averaged ({})",
-            rep.angle_deg,
-            rep.rows,
-            spreads.join(", ")
-        ));
-    }
+    let (r, t) = fit_curves(table, opts)?;
     let violations = physical_checks(r.as_ref(), t.as_ref());
-    if strict && let Some(v) = violations.first() {
+    if opts.strict
+        && let Some(v) = violations.first()
+    {
         return Err(FitError::Physical {
+            path: table.path.clone(),
             glass: table.name.clone(),
-            message: format!("physical check failed: {v}"),
+            violation: v.clone(),
         });
     }
+    refusals.extend(judge(table, opts, r.as_ref(), t.as_ref()));
+    let forced = refuse_unless_forced(refusals, opts.force, table)?;
+
+    let mut warnings = repeated_angle_warnings(table);
     warnings.extend(violations.iter().map(|v| format!("physical check: {v}")));
+    warnings.extend(forced);
     Ok(GlassFit {
         name: table.name.clone(),
         reflectance: r,
         transmittance: t,
         warnings,
+    })
+}
+
+/// Phase 1: the screen's findings as refusals.
+fn screen(table: &GlassAngleTable) -> Vec<FitError> {
+    let screening = table.screen();
+    let mut refusals: Vec<FitError> = screening
+        .reversed
+        .iter()
+        .map(|&quantity| FitError::ReversedCurve {
+            path: table.path.clone(),
+            glass: table.name.clone(),
+            quantity,
+        })
+        .collect();
+    if !screening.points.is_empty() {
+        refusals.push(FitError::InconsistentPoints {
+            path: table.path.clone(),
+            glass: table.name.clone(),
+            points: screening.points,
+        });
+    }
+    refusals
+}
+
+/// Phase 2: the curves the table has, each with its options (quantity set); an error names the
+/// file, the glass and the curve.
+fn fit_curves(
+    table: &GlassAngleTable,
+    opts: &GlassFitOptions,
+) -> Result<(Option<CurveFit>, Option<CurveFit>), FitError> {
+    let fit = |samples: Option<&AngleSamples>, opts: &FitOptions, quantity: Quantity| {
+        let opts = FitOptions {
+            quantity,
+            ..opts.clone()
+        };
+        samples
+            .map(|s| fit_curve(s, &opts))
+            .transpose()
+            .map_err(|e| FitError::Curve {
+                path: table.path.clone(),
+                glass: table.name.clone(),
+                quantity: quantity.name(),
+                error: Box::new(e),
+            })
+    };
+    Ok((
+        fit(
+            table.reflectance.as_ref(),
+            &opts.reflectance,
+            Quantity::Reflectance,
+        )?,
+        fit(
+            table.transmittance.as_ref(),
+            &opts.transmittance,
+            Quantity::Transmittance,
+        )?,
+    ))
+}
+
+/// Phase 3: the fits far from their data ([`far_from_data`]) or failing [`refusing_checks`],
+/// as refusals.
+fn judge(
+    table: &GlassAngleTable,
+    opts: &GlassFitOptions,
+    r: Option<&CurveFit>,
+    t: Option<&CurveFit>,
+) -> Vec<FitError> {
+    let mut refusals: Vec<FitError> = [
+        (
+            r,
+            &table.reflectance,
+            &opts.reflectance,
+            Quantity::Reflectance,
+        ),
+        (
+            t,
+            &table.transmittance,
+            &opts.transmittance,
+            Quantity::Transmittance,
+        ),
+    ]
+    .into_iter()
+    .filter_map(|(curve, samples, o, quantity)| {
+        far_from_data(table, curve?, samples.as_ref()?, o.tol, quantity)
+    })
+    .collect();
+    // whether an angle lies within the measured range of a curve
+    let measured = |s: &Option<AngleSamples>, angle: f64| {
+        s.as_ref().is_some_and(|s| {
+            let lo = s.angle_deg.first().copied().unwrap_or(0.0);
+            let hi = s.angle_deg.last().copied().unwrap_or(90.0);
+            (lo..=hi).contains(&angle)
+        })
+    };
+    for (violation, tolerance) in refusing_checks(r, t) {
+        let (of_r, of_t) = violation.curves();
+        let angle = violation.worst_angle_deg;
+        let beyond_data = (of_r && !measured(&table.reflectance, angle))
+            || (of_t && !measured(&table.transmittance, angle));
+        refusals.push(FitError::UnphysicalFit {
+            path: table.path.clone(),
+            glass: table.name.clone(),
+            violation,
+            tolerance,
+            beyond_data,
+        });
+    }
+    refusals
+}
+
+/// Warnings for the angles given on several rows (averaged).
+fn repeated_angle_warnings(table: &GlassAngleTable) -> Vec<String> {
+    table
+        .repeated_angles
+        .iter()
+        .map(|rep| {
+            let mut spreads = Vec::new();
+            if let Some(s) = rep.reflectance_spread {
+                spreads.push(format!("R spread {s:.5}"));
+            }
+            if let Some(s) = rep.transmittance_spread {
+                spreads.push(format!("T spread {s:.5}"));
+            }
+            format!(
+                "angle {}° given on {} rows: averaged ({})",
+                rep.angle_deg,
+                rep.rows,
+                spreads.join(", ")
+            )
+        })
+        .collect()
+}
+
+/// The first of `refusals` as the error, or with `force` all of them as warnings (without
+/// the file and glass the warning's glass already names).
+fn refuse_unless_forced(
+    mut refusals: Vec<FitError>,
+    force: bool,
+    table: &GlassAngleTable,
+) -> Result<Vec<String>, FitError> {
+    if !force && !refusals.is_empty() {
+        return Err(refusals.swap_remove(0));
+    }
+    let prefix = format!("{}: glass `{}`", table.path.display(), table.name);
+    Ok(refusals
+        .iter()
+        .map(|e| {
+            let text = e.to_string();
+            let finding = text.strip_prefix(&prefix).map_or(text.as_str(), |rest| {
+                rest.trim_start_matches([':', ',', ' '])
+            });
+            format!("written with --force: {finding}")
+        })
+        .collect())
+}
+
+/// The reading a curve misses by most, as [`FitError::FarFromData`] when that is more than
+/// [`REFUSE_TOLERANCE_FACTOR`] × `tol`.
+fn far_from_data(
+    table: &GlassAngleTable,
+    curve: &CurveFit,
+    samples: &AngleSamples,
+    tol: f64,
+    quantity: Quantity,
+) -> Option<FitError> {
+    let (angle_deg, error) = samples
+        .angle_deg
+        .iter()
+        .zip(&samples.value)
+        .map(|(&a, &v)| (a, (curve.eval_angle_deg(a) - v).abs()))
+        .max_by(|x, y| x.1.total_cmp(&y.1))?;
+    (error > REFUSE_TOLERANCE_FACTOR * tol).then(|| FitError::FarFromData {
+        path: table.path.clone(),
+        glass: table.name.clone(),
+        quantity,
+        angle_deg,
+        lines: table.lines_of(angle_deg).to_vec(),
+        error,
+        tol,
     })
 }

@@ -61,8 +61,11 @@ impl std::str::FromStr for Basis {
 /// quantity at incidence angle θ to its normal-incidence value. `powers` ascend strictly.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct CosPolynomial {
+    /// Which powers the curve may use (paper: 1…n, full: 0…n).
     pub basis: Basis,
+    /// The powers p_k of cos θ, strictly ascending.
     pub powers: Vec<u32>,
+    /// The coefficients c_k, one per power.
     pub coefficients: Vec<f64>,
 }
 
@@ -102,14 +105,24 @@ pub const MAX_POWER: u32 = 64;
 /// Why a [`CosPolynomial`] as written (in a fit file or a registry) cannot be evaluated.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum PolynomialShape {
+    /// Neither powers nor coefficients.
     #[error("no terms")]
     NoTerms,
+    /// Not one coefficient per power.
     #[error("{powers} powers but {coefficients} coefficients")]
-    LengthMismatch { powers: usize, coefficients: usize },
+    LengthMismatch {
+        /// How many powers the curve lists.
+        powers: usize,
+        /// How many coefficients it lists.
+        coefficients: usize,
+    },
+    /// A power above [`MAX_POWER`].
     #[error("power {0} is beyond the supported {MAX_POWER}")]
     PowerTooHigh(u32),
+    /// Two consecutive powers that do not ascend.
     #[error("powers must ascend strictly, but {0} is followed by {1}")]
     NotAscending(u32, u32),
+    /// Power 0 in the paper basis.
     #[error("the paper basis has no constant term (power 0)")]
     ConstantInPaperBasis,
 }
@@ -166,6 +179,7 @@ pub fn cos_deg(angle_deg: f64) -> f64 {
 /// residual above 4, and above the tolerance): a probable outlier or typo in the table.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct SuspectPoint {
+    /// The point's angle of incidence (degrees).
     pub angle_deg: f64,
     /// fitted − measured, in the quantity's units (fraction).
     pub residual: f64,
@@ -207,6 +221,7 @@ impl FitSummary {
 /// JSON keys) and extra keys (all optional when reading).
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct FitDiagnostics {
+    /// The five numbers every consumer keeps.
     #[serde(flatten)]
     pub summary: FitSummary,
     /// Condition number of the same fit written in the power basis (cos^p θ columns): what a
@@ -216,9 +231,10 @@ pub struct FitDiagnostics {
     /// Distinct angles fitted (repeated angles averaged first).
     #[serde(default)]
     pub points: usize,
-    /// The measured range of angles; evaluating outside it is extrapolation.
+    /// The smallest measured angle; evaluating below it is extrapolation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angle_min_deg: Option<f64>,
+    /// The largest measured angle; evaluating above it is extrapolation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angle_max_deg: Option<f64>,
     /// True when `normal` is the table's 0° value; false when the table had no 0° row and
@@ -251,8 +267,10 @@ fn default_true() -> bool {
 pub struct CurveFit {
     /// The normal-incidence value r0 or t0 (fraction).
     pub normal: f64,
+    /// The ratio C(θ) to the normal value.
     #[serde(flatten)]
     pub polynomial: CosPolynomial,
+    /// How well it fits its data, and what was solved.
     #[serde(flatten)]
     pub diagnostics: FitDiagnostics,
 }
@@ -280,7 +298,9 @@ impl CurveFit {
 /// One measured curve: angles of incidence (degrees, 0–90) and the value at each (fraction).
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct AngleSamples {
+    /// Angles of incidence (degrees).
     pub angle_deg: Vec<f64>,
+    /// The value at each angle (fraction).
     pub value: Vec<f64>,
 }
 
@@ -288,11 +308,14 @@ pub struct AngleSamples {
 #[derive(Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum Quantity {
+    /// r(θ): the full basis by default.
     Reflectance,
+    /// t(θ): the better of the paper and full bases by default.
     Transmittance,
 }
 
 impl Quantity {
+    /// The lowercase name used in JSON and messages.
     pub fn name(self) -> &'static str {
         match self {
             Quantity::Reflectance => "reflectance",
@@ -318,6 +341,7 @@ pub struct FitOptions {
     /// `None`: full for reflectance; for transmittance the more accurate of paper and full on
     /// the data, preferring one whose t(θ) stays within 0–1 over 0–90°.
     pub basis: Option<Basis>,
+    /// Which curve this is (decides the default basis).
     pub quantity: Quantity,
 }
 

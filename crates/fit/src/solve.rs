@@ -17,12 +17,15 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::chebyshev::{ChebyshevBasis, to_power_basis};
 use crate::dd::Dd;
 use crate::error::FitError;
 use crate::model::{
     AngleSamples, Basis, CosPolynomial, CurveFit, FitDiagnostics, FitOptions, FitSummary, Quantity,
-    SuspectPoint, cos_deg,
+    SuspectPoint,
 };
+use crate::physical::{CHECK_SLACK, CHECK_STEP_DEG};
+use crate::prepared::{Prepared, prepare};
 
 /// Highest degree accepted (fixed or as --max-degree): at 20 the power basis on 0–90° already
 /// has a condition number near 1e15.
@@ -35,66 +38,6 @@ pub const SUSPECT_STUDENTIZED: f64 = 4.0;
 /// Automatic selection keeps the tolerance-meeting degree unless its leave-one-out RMS error
 /// exceeds this factor times the best leave-one-out error of the lower degrees (overfitting).
 pub const LOO_GUARD_FACTOR: f64 = 1.5;
-
-/// Validated samples, sorted by angle, repeated angles averaged.
-#[derive(Clone, Debug)]
-pub(crate) struct Prepared {
-    pub angle_deg: Vec<f64>,
-    pub cos: Vec<f64>,
-    pub value: Vec<f64>,
-    /// The 0° value when the samples include 0°.
-    pub measured_normal: Option<f64>,
-}
-
-pub(crate) fn prepare(samples: &AngleSamples) -> Result<Prepared, FitError> {
-    if samples.angle_deg.len() != samples.value.len() {
-        return Err(FitError::InvalidSamples(format!(
-            "{} angles but {} values",
-            samples.angle_deg.len(),
-            samples.value.len()
-        )));
-    }
-    if samples.angle_deg.is_empty() {
-        return Err(FitError::InvalidSamples("no samples".into()));
-    }
-    let mut pairs: Vec<(f64, f64)> = Vec::with_capacity(samples.value.len());
-    for (&a, &v) in samples.angle_deg.iter().zip(&samples.value) {
-        if !a.is_finite() || !(0.0..=90.0).contains(&a) {
-            return Err(FitError::InvalidSamples(format!(
-                "angle {a}° is not within 0–90°"
-            )));
-        }
-        if !v.is_finite() {
-            return Err(FitError::InvalidSamples(format!(
-                "value {v} at {a}° is not finite"
-            )));
-        }
-        pairs.push((a, v));
-    }
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut angle_deg = Vec::with_capacity(pairs.len());
-    let mut value = Vec::with_capacity(pairs.len());
-    let mut i = 0;
-    while i < pairs.len() {
-        let mut j = i + 1;
-        let mut sum = pairs[i].1;
-        while j < pairs.len() && pairs[j].0 == pairs[i].0 {
-            sum += pairs[j].1;
-            j += 1;
-        }
-        angle_deg.push(pairs[i].0);
-        value.push(sum / (j - i) as f64);
-        i = j;
-    }
-    let cos = angle_deg.iter().map(|&a| cos_deg(a)).collect();
-    let measured_normal = (angle_deg[0] == 0.0).then(|| value[0]);
-    Ok(Prepared {
-        angle_deg,
-        cos,
-        value,
-        measured_normal,
-    })
-}
 
 /// A fit at one basis and degree, before diagnostics are packaged.
 #[derive(Clone, Debug)]
@@ -112,104 +55,11 @@ pub(crate) struct Solved {
     pub suspects: Vec<SuspectPoint>,
 }
 
-/// Chebyshev T_0..T_{m-1} at u.
-fn chebyshev(u: f64, m: usize, out: &mut [f64]) {
-    for j in 0..m {
-        out[j] = match j {
-            0 => 1.0,
-            1 => u,
-            _ => 2.0 * u * out[j - 1] - out[j - 2],
-        };
-    }
-}
-
-/// Power-of-u coefficients of T_0..T_{m-1} (exact small integers).
-fn chebyshev_power_table(m: usize) -> Vec<Vec<f64>> {
-    let mut t: Vec<Vec<f64>> = Vec::with_capacity(m);
-    for j in 0..m {
-        let row = match j {
-            0 => vec![1.0],
-            1 => vec![0.0, 1.0],
-            _ => {
-                let mut row = vec![0.0; j + 1];
-                for (k, &c) in t[j - 1].iter().enumerate() {
-                    row[k + 1] += 2.0 * c;
-                }
-                for (k, &c) in t[j - 2].iter().enumerate() {
-                    row[k] -= c;
-                }
-                row
-            }
-        };
-        t.push(row);
-    }
-    t
-}
-
-/// The affine map x ↦ u = alpha·x + beta that sends [lo, hi] onto [-1, 1].
-#[derive(Clone, Copy, Debug)]
-struct Affine {
-    alpha: f64,
-    beta: f64,
-}
-
-impl Affine {
-    fn new(lo: f64, hi: f64) -> Affine {
-        if hi - lo > 1e-12 {
-            let alpha = 2.0 / (hi - lo);
-            Affine {
-                alpha,
-                beta: -(hi + lo) / (hi - lo),
-            }
-        } else {
-            Affine {
-                alpha: 0.0,
-                beta: 0.0,
-            }
-        }
-    }
-    fn u(self, x: f64) -> f64 {
-        self.alpha * x + self.beta
-    }
-}
-
 /// Number of coefficients of a basis at a degree.
 pub(crate) fn coefficient_count(basis: Basis, degree: u32) -> usize {
     match basis {
         Basis::Paper => degree as usize,
         Basis::Full => degree as usize + 1,
-    }
-}
-
-/// Converts Σ_j a_j φ_j(x) (φ_j = T_j(u(x)), or x·T_j(u(x)) for the paper basis) to power
-/// coefficients of x for the powers of `basis` at `degree`, in double-double.
-fn to_power_basis(a: &[Dd], map: Affine, basis: Basis) -> Vec<Dd> {
-    let m = a.len();
-    let table = chebyshev_power_table(m);
-    // coefficients in powers of u
-    let mut b = vec![Dd::ZERO; m];
-    for (j, row) in table.iter().enumerate() {
-        for (k, &c) in row.iter().enumerate() {
-            b[k] = b[k] + a[j] * Dd::from_f64(c);
-        }
-    }
-    // substitute u = alpha x + beta by Horner over polynomials: q ← q·(alpha x + beta) + b_k
-    let (alpha, beta) = (Dd::from_f64(map.alpha), Dd::from_f64(map.beta));
-    let mut q: Vec<Dd> = vec![Dd::ZERO; m];
-    for k in (0..m).rev() {
-        let mut next = vec![Dd::ZERO; m];
-        for (i, &qi) in q.iter().enumerate() {
-            if i + 1 < m {
-                next[i + 1] = next[i + 1] + qi * alpha;
-            }
-            next[i] = next[i] + qi * beta;
-        }
-        next[0] = next[0] + b[k];
-        q = next;
-    }
-    match basis {
-        Basis::Full => q,
-        Basis::Paper => q, // the factor x shifts every power up by one: powers 1..=n
     }
 }
 
@@ -293,60 +143,6 @@ impl NormalConstraint {
             NormalConstraint::Measured(v0) => Some(v0),
             _ => None,
         }
-    }
-}
-
-/// The Chebyshev-type basis of one fit: `T_j(u(x))` (full) or `x·T_j(u(x))` (paper), j < m.
-struct ChebyshevBasis {
-    basis: Basis,
-    map: Affine,
-    m: usize,
-}
-
-impl ChebyshevBasis {
-    /// The basis on the cos θ range of the fitted rows (and cos 0° = 1 when constrained).
-    fn on_rows(p: &Prepared, rows: &[usize], basis: Basis, m: usize, constrained: bool) -> Self {
-        let with_one = |bound: f64| if constrained { 1.0 } else { bound };
-        let lo = rows
-            .iter()
-            .map(|&i| p.cos[i])
-            .fold(f64::INFINITY, f64::min)
-            .min(with_one(f64::INFINITY));
-        let hi = rows
-            .iter()
-            .map(|&i| p.cos[i])
-            .fold(f64::NEG_INFINITY, f64::max)
-            .max(with_one(f64::NEG_INFINITY));
-        ChebyshevBasis {
-            basis,
-            map: Affine::new(lo, hi),
-            m,
-        }
-    }
-
-    /// The m basis functions at x, into `out` (`tj` is scratch of length m).
-    fn at(&self, x: f64, tj: &mut [f64], out: &mut [f64]) {
-        chebyshev(self.map.u(x), self.m, tj);
-        for j in 0..self.m {
-            out[j] = if self.basis == Basis::Paper {
-                x * tj[j]
-            } else {
-                tj[j]
-            };
-        }
-    }
-
-    /// The design matrix over the given rows.
-    fn design(&self, p: &Prepared, rows: &[usize]) -> DMatrix<f64> {
-        let mut a = DMatrix::<f64>::zeros(rows.len(), self.m);
-        let (mut tj, mut rowbuf) = (vec![0.0; self.m], vec![0.0; self.m]);
-        for (r, &i) in rows.iter().enumerate() {
-            self.at(p.cos[i], &mut tj, &mut rowbuf);
-            for j in 0..self.m {
-                a[(r, j)] = rowbuf[j];
-            }
-        }
-        a
     }
 }
 
@@ -692,15 +488,23 @@ fn select_degree(
 /// degree and basis selection.
 pub fn fit_curve(samples: &AngleSamples, opts: &FitOptions) -> Result<CurveFit, FitError> {
     // the inputs are validated finite numbers, so the linear algebra cannot meet NaN; a panic
-    // inside it would still be a bug, reported as an error rather than a crash
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        fit_curve_inner(samples, opts)
-    }))
-    .unwrap_or_else(|_| {
-        Err(FitError::Singular {
-            degree: opts.degree.unwrap_or(opts.max_degree),
-            points: samples.angle_deg.len(),
-        })
+    // inside it would still be a bug, reported as an internal error rather than a crash (and
+    // not as a property of the data, such as a singular system)
+    internal_errors(samples.angle_deg.len(), || fit_curve_inner(samples, opts))
+}
+
+/// Runs `fit`, turning a panic into [`FitError::Internal`] with the panic's message.
+fn internal_errors<T>(
+    points: usize,
+    fit: impl FnOnce() -> Result<T, FitError>,
+) -> Result<T, FitError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(fit)).unwrap_or_else(|payload| {
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic without a message".to_string());
+        Err(FitError::Internal { points, message })
     })
 }
 
@@ -766,10 +570,10 @@ fn in_unit_range(s: &Solved) -> bool {
         powers: s.basis.powers(s.degree),
         coefficients: s.coefficients.clone(),
     };
-    let steps = (90.0 / crate::glass::CHECK_STEP_DEG).round() as usize;
+    let steps = (90.0 / CHECK_STEP_DEG).round() as usize;
     (0..=steps).all(|i| {
-        let v = s.normal * poly.eval_angle_deg(i as f64 * crate::glass::CHECK_STEP_DEG);
-        (-crate::glass::CHECK_SLACK..=1.0 + crate::glass::CHECK_SLACK).contains(&v)
+        let v = s.normal * poly.eval_angle_deg(i as f64 * CHECK_STEP_DEG);
+        (-CHECK_SLACK..=1.0 + CHECK_SLACK).contains(&v)
     })
 }
 
@@ -838,4 +642,28 @@ fn package(p: &Prepared, s: Solved, how: &'static str, opts: &FitOptions) -> Cur
 
 fn finite_or(v: f64, fallback: f64) -> f64 {
     if v.is_finite() { v } else { fallback }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_in_the_fitter_is_an_internal_error_not_a_property_of_the_data() {
+        let e = internal_errors::<()>(7, || panic!("index out of bounds")).unwrap_err();
+        assert!(
+            matches!(&e, FitError::Internal { points: 7, message } if message == "index out of bounds"),
+            "{e:?}"
+        );
+        assert!(
+            e.to_string().starts_with("internal error in the fitter"),
+            "{e}"
+        );
+        let formatted = internal_errors::<()>(1, || panic!("{} coefficients", 3)).unwrap_err();
+        assert!(
+            formatted.to_string().ends_with("3 coefficients"),
+            "{formatted}"
+        );
+        assert_eq!(internal_errors(1, || Ok(5)).unwrap(), 5);
+    }
 }

@@ -7,21 +7,39 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::FitError;
+use crate::error::{CellRef, FitError};
 use crate::model::AngleSamples;
+use crate::screen::{Screening, screen_curves};
+use crate::sniff::{ExpectedFile, FileContent};
 
-/// Largest angle table read (bytes): far above any real table, small enough to never exhaust memory.
-pub const MAX_TABLE_BYTES: u64 = glassdb_io::limits::ANGLE_TABLE.bytes;
+/// The largest angle table read (CSV): far above any real table, small enough to never exhaust
+/// memory.
+pub const ANGLE_TABLE_FILE: glassdb_io::InputLimit =
+    glassdb_io::InputLimit::mib(64, "an angle table");
+
+/// Largest angle table read (bytes).
+pub const MAX_TABLE_BYTES: u64 = ANGLE_TABLE_FILE.bytes;
 
 /// An angle that appeared on more than one row of a glass: the values were averaged.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RepeatedAngle {
+    /// The repeated angle (degrees).
     pub angle_deg: f64,
     /// How many rows gave this angle.
     pub rows: usize,
-    /// Largest minus smallest value among those rows, per quantity (None: not measured).
+    /// Largest minus smallest R among those rows (None: R not measured there).
     pub reflectance_spread: Option<f64>,
+    /// Largest minus smallest T among those rows (None: T not measured there).
     pub transmittance_spread: Option<f64>,
+}
+
+/// Where one angle of a glass was read: the file's line numbers of its rows (1-based).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AngleRows {
+    /// The angle of incidence (degrees).
+    pub angle_deg: f64,
+    /// The lines of the rows that give this angle, ascending (several when it is repeated).
+    pub lines: Vec<u64>,
 }
 
 /// The measured curves of one glass, sorted by angle, repeated angles averaged.
@@ -29,10 +47,36 @@ pub struct RepeatedAngle {
 pub struct GlassAngleTable {
     /// The `glass` column's value, or the file stem when there is no `glass` column.
     pub name: String,
+    /// The file the table was read from (for messages).
+    pub path: PathBuf,
+    /// The reflectance curve, if the table has R values for this glass.
     pub reflectance: Option<AngleSamples>,
+    /// The transmittance curve, if the table has T values for this glass.
     pub transmittance: Option<AngleSamples>,
     /// Angles given on several rows (averaged), ascending.
     pub repeated_angles: Vec<RepeatedAngle>,
+    /// The rows of each distinct angle, ascending by angle.
+    pub rows: Vec<AngleRows>,
+}
+
+impl GlassAngleTable {
+    /// The readings of this table that their neighbours contradict ([`screen_curves`]), each
+    /// with its file lines.
+    pub fn screen(&self) -> Screening {
+        let mut screening = screen_curves(self.reflectance.as_ref(), self.transmittance.as_ref());
+        for p in &mut screening.points {
+            p.lines = self.lines_of(p.angle_deg).to_vec();
+        }
+        screening
+    }
+
+    /// The file lines that give `angle_deg` (empty when the table has no such angle).
+    pub fn lines_of(&self, angle_deg: f64) -> &[u64] {
+        self.rows
+            .iter()
+            .find(|r| r.angle_deg == angle_deg)
+            .map_or(&[], |r| r.lines.as_slice())
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -53,22 +97,34 @@ fn classify(header: &str) -> Option<Field> {
     }
 }
 
+/// One data row as read: the cells already numbers, not yet checked against the unit.
 struct Row {
     glass: String,
     angle_deg: f64,
-    r: Option<f64>,
-    t: Option<f64>,
+    line: u64,
+    r: Option<Cell>,
+    t: Option<Cell>,
+}
+
+/// An R or T cell: its value as written and where it stands.
+#[derive(Clone, Copy)]
+struct Cell {
+    value: f64,
+    line: u64,
+    /// 0-based column index.
+    column: usize,
 }
 
 /// Reads an angle table. With `percent`, R and T are in percent (0–100) and converted to
-/// fractions; without it a value above 1 is an error that suggests `--percent`.
+/// fractions; without it a table whose values are mostly above 1 is an error that suggests
+/// `--percent`, and a few values above 1 among fractions are named as typos.
 /// Every error names the file, and the line and column of the offending cell.
 pub fn read_angle_table(path: &Path, percent: bool) -> Result<Vec<GlassAngleTable>, FitError> {
     let io_err = |source| FitError::Io {
         path: path.to_path_buf(),
         source,
     };
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::ANGLE_TABLE).map_err(io_err)?;
+    let bytes = glassdb_io::read_input(path, ANGLE_TABLE_FILE).map_err(io_err)?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -77,14 +133,35 @@ pub fn read_angle_table(path: &Path, percent: bool) -> Result<Vec<GlassAngleTabl
 }
 
 /// Parses angle-table bytes (see [`read_angle_table`]); `path` is used in messages only and
-/// `default_name` names the glass when there is no `glass` column.
+/// `default_name` names the glass when there is no `glass` column. Binary data and JSON (a fit
+/// file, a registry) are named as what they are ([`FitError::OtherFile`]).
 pub fn parse_angle_table(
     bytes: &[u8],
     path: &Path,
     default_name: &str,
     percent: bool,
 ) -> Result<Vec<GlassAngleTable>, FitError> {
-    let p = || path.to_path_buf();
+    if let Some(kind) = FileContent::not_an_angle_table(bytes) {
+        return Err(FitError::OtherFile {
+            path: path.to_path_buf(),
+            kind,
+            expected: ExpectedFile::AngleTable,
+        });
+    }
+    let (names, rows) = read_rows(bytes, path, default_name, percent)?;
+    check_units(&rows, &names, path, percent)?;
+    let divisor = if percent { 100.0 } else { 1.0 };
+    group(rows, path, divisor)
+}
+
+/// The header's names and the data rows, every cell a finite number, every angle within 0–90°,
+/// no value negative (or above 100 with `percent`).
+fn read_rows(
+    bytes: &[u8],
+    path: &Path,
+    default_name: &str,
+    percent: bool,
+) -> Result<(Vec<String>, Vec<Row>), FitError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
@@ -92,8 +169,47 @@ pub fn parse_angle_table(
         .comment(Some(b'#'))
         .flexible(false)
         .from_reader(bytes);
+    let headers = rdr
+        .byte_headers()
+        .map_err(|e| csv_error(path.to_path_buf(), e))?
+        .clone();
+    let (names, columns) = read_header(&headers, path)?;
+    let reader = RowReader {
+        path,
+        names: &names,
+        columns,
+        default_name,
+        percent,
+    };
+    let mut rows = Vec::new();
+    let mut record = csv::ByteRecord::new();
+    while rdr
+        .read_byte_record(&mut record)
+        .map_err(|e| csv_error(path.to_path_buf(), e))?
+    {
+        rows.push(reader.row(&record)?);
+    }
+    if rows.is_empty() {
+        return Err(FitError::NoRows {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok((names, rows))
+}
 
-    let headers = rdr.byte_headers().map_err(|e| csv_error(p(), e))?.clone();
+/// Where the table's columns stand (0-based).
+#[derive(Clone, Copy)]
+struct Columns {
+    angle: usize,
+    r: Option<usize>,
+    t: Option<usize>,
+    glass: Option<usize>,
+}
+
+/// The header's names and where the columns stand: every name known and given once, an angle
+/// column and an R and/or a T column.
+fn read_header(headers: &csv::ByteRecord, path: &Path) -> Result<(Vec<String>, Columns), FitError> {
+    let p = || path.to_path_buf();
     if headers.is_empty() || (headers.len() == 1 && headers[0].iter().all(u8::is_ascii_whitespace))
     {
         return Err(FitError::EmptyFile { path: p() });
@@ -125,7 +241,7 @@ pub fn parse_angle_table(
         names.push(name);
     }
     let found = names.join(", ");
-    let Some(angle_col) = cols[Field::Angle as usize] else {
+    let Some(angle) = cols[Field::Angle as usize] else {
         return Err(FitError::MissingColumn {
             path: p(),
             line: header_line,
@@ -133,12 +249,13 @@ pub fn parse_angle_table(
             found,
         });
     };
-    let (r_col, t_col, glass_col) = (
-        cols[Field::R as usize],
-        cols[Field::T as usize],
-        cols[Field::Glass as usize],
-    );
-    if r_col.is_none() && t_col.is_none() {
+    let columns = Columns {
+        angle,
+        r: cols[Field::R as usize],
+        t: cols[Field::T as usize],
+        glass: cols[Field::Glass as usize],
+    };
+    if columns.r.is_none() && columns.t.is_none() {
         return Err(FitError::MissingColumn {
             path: p(),
             line: header_line,
@@ -146,135 +263,213 @@ pub fn parse_angle_table(
             found,
         });
     }
+    Ok((names, columns))
+}
 
-    let mut rows = Vec::new();
-    let mut record = csv::ByteRecord::new();
-    loop {
-        match rdr.read_byte_record(&mut record) {
-            Ok(true) => {}
-            Ok(false) => break,
-            Err(e) => return Err(csv_error(p(), e)),
-        }
+/// Reads the data rows of one table: what an error names (file, header names) and how the
+/// cells are read.
+struct RowReader<'a> {
+    path: &'a Path,
+    names: &'a [String],
+    columns: Columns,
+    default_name: &'a str,
+    percent: bool,
+}
+
+impl RowReader<'_> {
+    /// One data row: the angle within 0–90°, R and T (when given) not negative (nor above 100
+    /// with `percent`), the glass named.
+    fn row(&self, record: &csv::ByteRecord) -> Result<Row, FitError> {
         let line = record.position().map(|pos| pos.line()).unwrap_or(0);
-        let cell = |col: usize| -> Result<&str, FitError> {
-            let raw = record.get(col).unwrap_or(b"");
-            std::str::from_utf8(raw)
-                .map(str::trim)
-                .map_err(|_| FitError::NotANumber {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header: names.get(col).cloned().unwrap_or_default(),
-                    value: String::from_utf8_lossy(raw).into_owned(),
-                })
-        };
-        let number = |col: usize, text: &str| -> Result<f64, FitError> {
-            let header = names.get(col).cloned().unwrap_or_default();
-            let v: f64 = text.parse().map_err(|_| FitError::NotANumber {
-                path: p(),
-                line,
-                column: col + 1,
-                header: header.clone(),
-                value: text.to_string(),
-            })?;
-            if !v.is_finite() {
-                return Err(FitError::NotFinite {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header,
-                    value: text.to_string(),
-                });
-            }
-            Ok(v)
-        };
-        let angle_text = cell(angle_col)?;
+        let col = self.columns.angle;
+        let angle_text = self.cell(record, line, col)?;
         if angle_text.is_empty() {
             return Err(FitError::EmptyCell {
-                path: p(),
+                path: self.path.to_path_buf(),
                 line,
-                column: angle_col + 1,
-                header: names[angle_col].clone(),
+                column: col + 1,
+                header: self.names[col].clone(),
             });
         }
-        let angle_deg = number(angle_col, angle_text)?;
+        let angle_deg = self.number(line, col, angle_text)?;
         if !(0.0..=90.0).contains(&angle_deg) {
             return Err(FitError::AngleOutOfRange {
-                path: p(),
+                path: self.path.to_path_buf(),
                 line,
-                column: angle_col + 1,
-                header: names[angle_col].clone(),
+                column: col + 1,
+                header: self.names[col].clone(),
                 value: angle_deg,
             });
         }
-        let fraction = |col: Option<usize>| -> Result<Option<f64>, FitError> {
-            let Some(col) = col else { return Ok(None) };
-            let text = cell(col)?;
-            if text.is_empty() {
-                return Ok(None);
-            }
-            let v = number(col, text)?;
-            let header = names[col].clone();
-            if percent {
-                if !(0.0..=100.0).contains(&v) {
-                    return Err(FitError::ValueOutOfRange {
-                        path: p(),
-                        line,
-                        column: col + 1,
-                        header,
-                        value: v,
-                        range: "0–100 (percent)",
-                    });
-                }
-                Ok(Some(v / 100.0))
-            } else if v > 1.0 {
-                Err(FitError::AboveOneInFractions {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header,
-                    value: v,
-                })
-            } else if v < 0.0 {
-                Err(FitError::ValueOutOfRange {
-                    path: p(),
-                    line,
-                    column: col + 1,
-                    header,
-                    value: v,
-                    range: "0–1",
-                })
-            } else {
-                Ok(Some(v))
-            }
-        };
-        let r = fraction(r_col)?;
-        let t = fraction(t_col)?;
-        let glass = match glass_col {
+        let r = self.value(record, line, self.columns.r)?;
+        let t = self.value(record, line, self.columns.t)?;
+        let glass = match self.columns.glass {
             Some(col) => {
-                let name = cell(col)?;
+                let name = self.cell(record, line, col)?;
                 if name.is_empty() {
                     return Err(FitError::EmptyGlassName {
-                        path: p(),
+                        path: self.path.to_path_buf(),
                         line,
                         column: col + 1,
                     });
                 }
                 name.to_string()
             }
-            None => default_name.to_string(),
+            None => self.default_name.to_string(),
         };
-        rows.push(Row {
+        Ok(Row {
             glass,
             angle_deg,
+            line,
             r,
             t,
+        })
+    }
+
+    /// The text of a cell, trimmed; not UTF-8 is not a number.
+    fn cell<'r>(
+        &self,
+        record: &'r csv::ByteRecord,
+        line: u64,
+        col: usize,
+    ) -> Result<&'r str, FitError> {
+        let raw = record.get(col).unwrap_or(b"");
+        std::str::from_utf8(raw)
+            .map(str::trim)
+            .map_err(|_| FitError::NotANumber {
+                path: self.path.to_path_buf(),
+                line,
+                column: col + 1,
+                header: self.names.get(col).cloned().unwrap_or_default(),
+                value: String::from_utf8_lossy(raw).into_owned(),
+            })
+    }
+
+    /// A cell's text as a finite number.
+    fn number(&self, line: u64, col: usize, text: &str) -> Result<f64, FitError> {
+        let header = self.names.get(col).cloned().unwrap_or_default();
+        let v: f64 = text.parse().map_err(|_| FitError::NotANumber {
+            path: self.path.to_path_buf(),
+            line,
+            column: col + 1,
+            header: header.clone(),
+            value: text.to_string(),
+        })?;
+        if !v.is_finite() {
+            return Err(FitError::NotFinite {
+                path: self.path.to_path_buf(),
+                line,
+                column: col + 1,
+                header,
+                value: text.to_string(),
+            });
+        }
+        Ok(v)
+    }
+
+    /// An R or T cell of column `col` (none when the column or the cell is empty), within its
+    /// range.
+    fn value(
+        &self,
+        record: &csv::ByteRecord,
+        line: u64,
+        col: Option<usize>,
+    ) -> Result<Option<Cell>, FitError> {
+        let Some(col) = col else { return Ok(None) };
+        let text = self.cell(record, line, col)?;
+        if text.is_empty() {
+            return Ok(None);
+        }
+        let v = self.number(line, col, text)?;
+        let (top, range) = if self.percent {
+            (100.0, "0–100 (percent)")
+        } else {
+            (f64::INFINITY, "0–1")
+        };
+        if v < 0.0 || v > top {
+            return Err(FitError::ValueOutOfRange {
+                path: self.path.to_path_buf(),
+                line,
+                column: col + 1,
+                header: self.names[col].clone(),
+                value: v,
+                range,
+            });
+        }
+        Ok(Some(Cell {
+            value: v,
+            line,
+            column: col,
+        }))
+    }
+}
+
+/// The unit of the R and T cells, judged on the whole table: without `percent`, a table whose
+/// values are mostly above 1 is in percent ([`FitError::AboveOneInFractions`]), a column that
+/// is while another is not mixes units ([`FitError::MixedUnits`]), and a few values above 1
+/// among fractions are typos ([`FitError::ValuesAboveOne`]: a percent value or a shifted
+/// decimal point). With `percent`, a table whose non-zero values are mostly at most 1 is in
+/// fractions ([`FitError::FractionsReadAsPercent`]).
+fn check_units(rows: &[Row], names: &[String], path: &Path, percent: bool) -> Result<(), FitError> {
+    let cells = || rows.iter().flat_map(|r| [r.r, r.t]).flatten();
+    let above: Vec<Cell> = cells().filter(|c| c.value > 1.0).collect();
+    let total = cells().count();
+    let header = |c: &Cell| names.get(c.column).cloned().unwrap_or_default();
+    if percent {
+        // zeros (t at 90°, an opaque pane) say nothing about the unit
+        let nonzero = cells().filter(|c| c.value != 0.0).count();
+        let at_most_one = nonzero - above.len();
+        if 2 * at_most_one > nonzero {
+            return Err(FitError::FractionsReadAsPercent {
+                path: path.to_path_buf(),
+                at_most_one,
+                nonzero,
+            });
+        }
+        return Ok(());
+    }
+    let Some(first) = above.first() else {
+        return Ok(());
+    };
+    if 2 * above.len() > total {
+        return Err(FitError::AboveOneInFractions {
+            path: path.to_path_buf(),
+            line: first.line,
+            column: first.column + 1,
+            header: header(first),
+            value: first.value,
         });
     }
-    if rows.is_empty() {
-        return Err(FitError::NoRows { path: p() });
+    // per column: is it mostly above 1 (in percent) while another column is not?
+    let mut columns: Vec<usize> = cells().map(|c| c.column).collect();
+    columns.sort_unstable();
+    columns.dedup();
+    let mostly_above = |col: usize| {
+        let n = cells().filter(|c| c.column == col).count();
+        2 * above.iter().filter(|c| c.column == col).count() > n
+    };
+    if let (Some(&pc), Some(&fc)) = (
+        columns.iter().find(|&&c| mostly_above(c)),
+        columns.iter().find(|&&c| !mostly_above(c)),
+    ) {
+        return Err(FitError::MixedUnits {
+            path: path.to_path_buf(),
+            percent_column: names.get(pc).cloned().unwrap_or_default(),
+            fraction_column: names.get(fc).cloned().unwrap_or_default(),
+        });
     }
-    group(rows, path)
+    Err(FitError::ValuesAboveOne {
+        path: path.to_path_buf(),
+        cells: above
+            .iter()
+            .map(|c| CellRef {
+                line: c.line,
+                column: c.column + 1,
+                header: header(c),
+                value: c.value,
+            })
+            .collect(),
+    })
 }
 
 fn csv_error(path: PathBuf, e: csv::Error) -> FitError {
@@ -296,8 +491,9 @@ fn csv_error(path: PathBuf, e: csv::Error) -> FitError {
     }
 }
 
-/// Groups rows by glass (first-appearance order), sorts by angle, averages repeated angles.
-fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> {
+/// Groups rows by glass (first-appearance order), sorts by angle, averages repeated angles;
+/// R and T values are divided by `divisor` (100 for percent).
+fn group(rows: Vec<Row>, path: &Path, divisor: f64) -> Result<Vec<GlassAngleTable>, FitError> {
     let mut order: Vec<String> = Vec::new();
     let mut by_glass: std::collections::HashMap<String, Vec<Row>> =
         std::collections::HashMap::new();
@@ -310,10 +506,15 @@ fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> 
     let mut out = Vec::with_capacity(order.len());
     for name in order {
         let mut rows = by_glass.remove(&name).unwrap_or_default();
-        rows.sort_by(|a, b| a.angle_deg.total_cmp(&b.angle_deg));
+        rows.sort_by(|a, b| {
+            a.angle_deg
+                .total_cmp(&b.angle_deg)
+                .then(a.line.cmp(&b.line))
+        });
         let mut r = AngleSamples::default();
         let mut t = AngleSamples::default();
         let mut repeated = Vec::new();
+        let mut angle_rows = Vec::new();
         let mut i = 0;
         while i < rows.len() {
             let mut j = i + 1;
@@ -322,8 +523,16 @@ fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> 
             }
             let group = &rows[i..j];
             let angle = rows[i].angle_deg;
-            let rs: Vec<f64> = group.iter().filter_map(|row| row.r).collect();
-            let ts: Vec<f64> = group.iter().filter_map(|row| row.t).collect();
+            let rs: Vec<f64> = group
+                .iter()
+                .filter_map(|row| row.r)
+                .map(|c| c.value / divisor)
+                .collect();
+            let ts: Vec<f64> = group
+                .iter()
+                .filter_map(|row| row.t)
+                .map(|c| c.value / divisor)
+                .collect();
             if !rs.is_empty() {
                 r.angle_deg.push(angle);
                 r.value.push(mean(&rs));
@@ -340,6 +549,10 @@ fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> 
                     transmittance_spread: spread(&ts),
                 });
             }
+            angle_rows.push(AngleRows {
+                angle_deg: angle,
+                lines: group.iter().map(|row| row.line).collect(),
+            });
             i = j;
         }
         if r.angle_deg.is_empty() && t.angle_deg.is_empty() {
@@ -350,9 +563,11 @@ fn group(rows: Vec<Row>, path: &Path) -> Result<Vec<GlassAngleTable>, FitError> 
         }
         out.push(GlassAngleTable {
             name,
+            path: path.to_path_buf(),
             reflectance: (!r.angle_deg.is_empty()).then_some(r),
             transmittance: (!t.angle_deg.is_empty()).then_some(t),
             repeated_angles: repeated,
+            rows: angle_rows,
         });
     }
     Ok(out)

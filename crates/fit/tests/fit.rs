@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use glassdb_fit::{
     AngleSamples, Basis, CosPolynomial, CurveFit, FitError, FitFile, FitOptions, GlassFit,
-    Quantity, cos_deg, fit_curve, fit_glass, parse_angle_table, parse_fit_json, physical_checks,
-    read_angle_table,
+    GlassFitOptions, Quantity, cos_deg, fit_curve, fit_glass, parse_angle_table, parse_fit_json,
+    physical_checks, read_angle_table,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
@@ -32,6 +32,16 @@ fn opts(q: Quantity, basis: Option<Basis>, degree: Option<u32>) -> FitOptions {
         basis,
         degree,
         ..FitOptions::new(q)
+    }
+}
+
+/// Both curves' options, strict or not, forced or not.
+fn both(r: &FitOptions, t: &FitOptions, strict: bool, force: bool) -> GlassFitOptions {
+    GlassFitOptions {
+        reflectance: r.clone(),
+        transmittance: t.clone(),
+        strict,
+        force,
     }
 }
 
@@ -248,7 +258,8 @@ fn coated_bronze_curve_with_ct_above_one_is_accepted() {
     assert!((t.value[1] / t.value[0] - tau10).abs() < 1e-9);
     let r_opts = FitOptions::new(Quantity::Reflectance);
     let t_opts = FitOptions::new(Quantity::Transmittance);
-    let glass = fit_glass(table, &r_opts, &t_opts, true).expect("strict mode accepts C_t > 1");
+    let glass = fit_glass(table, &both(&r_opts, &t_opts, true, false))
+        .expect("strict mode accepts C_t > 1");
     assert!(glass.warnings.is_empty(), "{:?}", glass.warnings);
     assert!(
         glass
@@ -271,18 +282,36 @@ fn coated_bronze_curve_with_ct_above_one_is_accepted() {
         t.polynomial.eval_angle_deg(10.0)
     };
     // degree 8 follows the rise above 1 and is accepted, even in strict mode
-    let glass = fit_glass(table, &r_opts, &full(8), true).expect("strict mode accepts C_t > 1");
+    let glass = fit_glass(table, &both(&r_opts, &full(8), true, false))
+        .expect("strict mode accepts C_t > 1");
     let ct10 = ct_at_10(&glass);
     assert!(ct10 > 1.003 && ct10 < tau10, "degree 8: C_t(10°) = {ct10}");
     // degree 9 interpolates the 10 points (C_t(10°) = the WINDOW-4 value) but swings below 0
-    // between 80° and 90°: that, not C_t > 1, is what the physical check reports
+    // between 80° and 90°: that, not C_t > 1, is what the physical check reports, and it is
+    // beyond the curve's tolerance, so the fit is refused unless forced
     let t9 = full(9);
-    let glass = fit_glass(table, &r_opts, &t9, false).unwrap();
+    let e = fit_glass(table, &both(&r_opts, &t9, false, false)).unwrap_err();
+    assert!(
+        matches!(&e, FitError::UnphysicalFit { violation, .. } if violation.check == "t < 0"),
+        "{e}"
+    );
+    let glass = fit_glass(table, &both(&r_opts, &t9, false, true)).unwrap();
     let ct10 = ct_at_10(&glass);
     assert!((ct10 - tau10).abs() < 1e-9, "degree 9: C_t(10°) = {ct10}");
-    assert_eq!(glass.warnings.len(), 1, "{:?}", glass.warnings);
-    assert!(glass.warnings[0].contains("t < 0"), "{:?}", glass.warnings);
-    assert!(fit_glass(table, &r_opts, &t9, true).is_err());
+    assert!(
+        glass.warnings[0].starts_with("physical check: t < 0"),
+        "{:?}",
+        glass.warnings
+    );
+    assert!(
+        glass
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("written with --force: t < 0")),
+        "{:?}",
+        glass.warnings
+    );
+    assert!(fit_glass(table, &both(&r_opts, &t9, true, false)).is_err());
 }
 
 // ---- hard case 6: noise and one outlier ----
@@ -528,13 +557,13 @@ fn strict_mode_turns_a_violation_into_an_error() {
     let tables = parse(&r_plus_t_above_one_csv(), false).unwrap();
     let r = FitOptions::new(Quantity::Reflectance);
     let t = FitOptions::new(Quantity::Transmittance);
-    let lax = fit_glass(&tables[0], &r, &t, false).unwrap();
+    let lax = fit_glass(&tables[0], &both(&r, &t, false, true)).unwrap();
     assert!(
         lax.warnings.iter().any(|w| w.contains("r + t > 1")),
         "{:?}",
         lax.warnings
     );
-    let e = fit_glass(&tables[0], &r, &t, true).unwrap_err();
+    let e = fit_glass(&tables[0], &both(&r, &t, true, false)).unwrap_err();
     assert!(e.to_string().contains("r + t > 1"), "{e}");
 }
 
@@ -543,13 +572,7 @@ fn strict_mode_turns_a_violation_into_an_error() {
 #[test]
 fn fit_file_has_the_documented_keys_and_round_trips() {
     let tables = read_angle_table(&data("data/angles/clear_6mm_fresnel.csv"), false).unwrap();
-    let g = fit_glass(
-        &tables[0],
-        &FitOptions::new(Quantity::Reflectance),
-        &FitOptions::new(Quantity::Transmittance),
-        false,
-    )
-    .unwrap();
+    let g = fit_glass(&tables[0], &GlassFitOptions::default()).unwrap();
     let file = FitFile { glasses: vec![g] };
     let json = file.to_json();
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();

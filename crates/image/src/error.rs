@@ -1,27 +1,16 @@
 //! The one error type of glassdb-image. Each variant belongs to one [`ImageErrorKind`], the
 //! class a user can act on; the decoder's or encoder's own error is kept as the `source`.
 
-/// What a user can do about an [`ImageError`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum ImageErrorKind {
-    /// The bytes are not a well-formed image (corrupt, truncated): replace the file.
-    Invalid,
-    /// A well-formed image using a feature this crate does not read or write (deep data,
-    /// subsampled channels, another file format): convert the file.
-    Unsupported,
-    /// The image is larger than the configured pixel limit, or an EXR has more parts than
-    /// [`crate::MAX_EXR_PARTS`]: raise the limit or shrink the image.
-    Limits,
-    /// Reading or writing the underlying stream failed.
-    Io,
-    /// A decoder or encoder failed internally (a caught panic): a bug, not a property of the file.
-    Internal,
-}
+/// What a user can do about an [`ImageError`]: the class every glassdb error shares
+/// ([`glassdb_io::ErrorKind`]), under the name this crate has always given it.
+pub use glassdb_io::ErrorKind as ImageErrorKind;
 
 /// The codec a [`ImageError::CodecPanic`] came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Codec {
+    /// PNG (the `png` crate).
     Png,
+    /// OpenEXR (the `exr` crate).
     Exr,
 }
 
@@ -39,7 +28,10 @@ impl std::fmt::Display for Codec {
 pub enum ImageError {
     /// The bytes start with neither the PNG nor the OpenEXR magic number.
     #[error("neither PNG nor OpenEXR (it starts with bytes {start:02x?})")]
-    UnknownFormat { start: Vec<u8> },
+    UnknownFormat {
+        /// The file's first bytes.
+        start: Vec<u8>,
+    },
     /// The `exr` crate rejected the bytes; its error tells whether they are invalid,
     /// unsupported or unreadable.
     #[error("the OpenEXR data cannot be decoded")]
@@ -49,33 +41,54 @@ pub enum ImageError {
     PngDecode(#[source] png::DecodingError),
     /// The file's blocks are missing, overlapping or of the wrong size: truncated or corrupt.
     #[error("pixel data incomplete: {detail}")]
-    Incomplete { detail: String },
+    Incomplete {
+        /// What is missing or wrong.
+        detail: String,
+    },
     /// A feature this crate does not handle (deep data, subsampled channels, an empty image).
     #[error("unsupported: {feature}")]
-    Unsupported { feature: String },
+    Unsupported {
+        /// The feature.
+        feature: String,
+    },
     /// Larger than the allowed number of pixels (checked from the header, before allocating).
     #[error("{width}×{height} pixels exceeds the limit of {max_pixels} pixels")]
     TooLarge {
+        /// The image's width.
         width: u64,
+        /// The image's height.
         height: u64,
+        /// The pixel limit.
         max_pixels: u64,
     },
     /// An EXR of more parts than [`crate::MAX_EXR_PARTS`] (counted from its headers, before
     /// they are parsed).
     #[error("the OpenEXR file has more than {max} parts")]
-    TooManyParts { max: usize },
+    TooManyParts {
+        /// The most parts allowed.
+        max: usize,
+    },
     /// A codec panicked (a bug in it, reached by these bytes); the panic is caught, not renamed.
     #[error("the {codec} codec failed internally (it panicked: {message})")]
-    CodecPanic { codec: Codec, message: String },
+    CodecPanic {
+        /// The codec that panicked.
+        codec: Codec,
+        /// The panic's message.
+        message: String,
+    },
     /// Reading the file's header from its stream failed.
     #[error("cannot read the image header")]
     Read(#[source] std::io::Error),
     /// The sample buffer handed to an encoder does not match the image size.
     #[error("{samples} samples given for a {width}×{height} image of {channels} channel(s)")]
     SampleCount {
+        /// Samples given.
         samples: usize,
+        /// The image's width.
         width: u32,
+        /// The image's height.
         height: u32,
+        /// Channels per pixel.
         channels: usize,
     },
     /// The `png` crate could not encode the image.

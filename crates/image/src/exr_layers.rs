@@ -44,6 +44,7 @@ pub fn all_channel_names(parts: &[ExrPart]) -> Vec<String> {
 pub enum ChannelMatch {
     /// (part, channel index in the part).
     Found(usize, usize),
+    /// No channel fits the name.
     Missing,
     /// Several channels fit a shortened name; their full names.
     Ambiguous(Vec<String>),
@@ -264,12 +265,22 @@ pub fn plane_layers(parts: &[ExrPart]) -> Vec<(u32, String)> {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum LayerChoiceError {
     /// The file has no R, G, B channels at all; every channel it has.
-    NoRgb { available: Vec<String> },
+    NoRgb {
+        /// Every channel the file has.
+        available: Vec<String>,
+    },
     /// No layer has the name asked for; the layers there are.
-    NotFound { wanted: String, layers: Vec<String> },
+    NotFound {
+        /// The layer asked for.
+        wanted: String,
+        /// The RGB layers the file has.
+        layers: Vec<String>,
+    },
     /// Several layers fit (the name, or no name was given).
     Ambiguous {
+        /// The layer asked for (`None`: the default choice).
         wanted: Option<String>,
+        /// The RGB layers that fit it.
         layers: Vec<String>,
     },
 }

@@ -30,7 +30,9 @@ pub enum ExrStorage {
 /// samples kept exactly as another file stored them (half, float or uint).
 #[derive(Debug, Clone, PartialEq)]
 pub enum PlaneSamples {
+    /// Linear samples, written in the output's storage (half or float).
     Converted(Vec<f32>),
+    /// Samples copied exactly, in their own type (carried channels).
     Exact(FlatSamples),
 }
 
@@ -49,7 +51,9 @@ impl PlaneSamples {
 /// row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExrPlane {
+    /// The channel's full name (`layer.R`).
     pub name: String,
+    /// Its samples, one per pixel of the part's data window.
     pub samples: PlaneSamples,
     /// Quantise linearly in lossy compressions (alpha and other data); `false` leaves it to
     /// the `exr` crate's guess from the channel name.
@@ -75,6 +79,7 @@ pub struct ExrPartOut {
     /// The part's own attributes (its name, view, renderer attributes); the data window is
     /// set from `data_window`.
     pub attributes: LayerAttributes,
+    /// Its channels (any order: written sorted by name).
     pub planes: Vec<ExrPlane>,
 }
 
@@ -82,17 +87,21 @@ pub struct ExrPartOut {
 /// parts (several make a multi-part file, each of which needs a name).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExrImageOut {
+    /// The file's display window.
     pub display_window: PixelWindow,
     /// Attributes shared by the parts (chromaticities, pixel aspect, time code, custom ones);
     /// the display window is set from `display_window`.
     pub attributes: ImageAttributes,
+    /// Its parts, in order.
     pub parts: Vec<ExrPartOut>,
 }
 
 /// Encoding settings of [`write_exr_image`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExrWriteOptions {
+    /// How converted samples are stored.
     pub storage: ExrStorage,
+    /// The compression of every part.
     pub compression: Compression,
     /// zlib level (0–9) for ZIP/ZIPS, deflated in parallel by libdeflate (`exr_zip`); `None`
     /// leaves ZIP to the `exr` crate's own encoder (level 4).
@@ -100,10 +109,27 @@ pub struct ExrWriteOptions {
 }
 
 /// What [`write_exr_image`] did beyond writing the samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct ExrWriteReport {
-    /// Finite `f32` samples too large for half float, stored as ±Inf (half storage only).
+    /// Finite `f32` samples too large for half float, stored as ±65504, the largest finite half
+    /// (half storage only): an infinity would misstate a finite value and turn every later
+    /// filter, and glassdb's own next composite, into Inf or NaN.
     pub half_overflow: u64,
+    /// The first of them (in part, channel and scan-line order), with its value.
+    pub first_half_overflow: Option<ClampedSample>,
+}
+
+/// A sample clamped to the half-float range, where it lies and what it was.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClampedSample {
+    /// The channel's full name.
+    pub channel: String,
+    /// The pixel's column, in the image's pixel coordinates (the data window's origin added).
+    pub x: i64,
+    /// The pixel's row, likewise.
+    pub y: i64,
+    /// The value before it was clamped.
+    pub value: f32,
 }
 
 /// The largest finite half-float value.
@@ -170,10 +196,21 @@ pub fn write_exr_image<W: Write + Seek + Send>(
         let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
         for plane in part.planes {
             let samples = match plane.samples {
-                PlaneSamples::Converted(v) => match options.storage {
+                PlaneSamples::Converted(mut v) => match options.storage {
                     ExrStorage::Float => FlatSamples::F32(v),
                     ExrStorage::Half => {
-                        report.half_overflow += count_half_overflow(&v);
+                        let (count, first) = clamp_half_overflow(&mut v);
+                        report.half_overflow += count;
+                        if report.first_half_overflow.is_none()
+                            && let Some((i, value)) = first
+                        {
+                            report.first_half_overflow = Some(ClampedSample {
+                                channel: plane.name.clone(),
+                                x: i64::from(part.data_window.x) + (i % w.max(1)) as i64,
+                                y: i64::from(part.data_window.y) + (i / w.max(1)) as i64,
+                                value,
+                            });
+                        }
                         FlatSamples::F16(to_half(&v))
                     }
                 },
@@ -216,15 +253,28 @@ fn to_bounds(w: &PixelWindow) -> IntegerBounds {
     IntegerBounds::new(Vec2(w.x, w.y), Vec2(w.width, w.height))
 }
 
-/// Finite samples beyond the half-float range.
-fn count_half_overflow(v: &[f32]) -> u64 {
-    v.par_chunks(1 << 16)
-        .map(|c| {
-            c.iter()
-                .filter(|s| s.is_finite() && s.abs() > HALF_MAX)
-                .count() as u64
+/// Clamps the finite samples beyond the half-float range to ±[`HALF_MAX`] (NaN and ±Inf are
+/// left as they are); returns how many there were and the index and value of the first.
+fn clamp_half_overflow(v: &mut [f32]) -> (u64, Option<(usize, f32)>) {
+    const CHUNK: usize = 1 << 16;
+    v.par_chunks_mut(CHUNK)
+        .enumerate()
+        .map(|(k, c)| {
+            let mut count = 0u64;
+            let mut first = None;
+            for (i, s) in c.iter_mut().enumerate() {
+                if s.is_finite() && s.abs() > HALF_MAX {
+                    count += 1;
+                    first = first.or(Some((k * CHUNK + i, *s)));
+                    *s = s.clamp(-HALF_MAX, HALF_MAX);
+                }
+            }
+            (count, first)
         })
-        .sum()
+        .reduce(
+            || (0, None),
+            |(n, a), (m, b)| (n + m, if a.is_some() { a } else { b }),
+        )
 }
 
 /// `f32` to half in parallel chunks.
@@ -261,8 +311,15 @@ mod tests {
     use super::*;
 
     #[test]
-    fn half_overflow_counts_only_finite_samples_beyond_the_range() {
-        let v = [1.0, 65504.0, 65520.0, -1e6, f32::INFINITY, f32::NAN];
-        assert_eq!(count_half_overflow(&v), 2);
+    fn half_overflow_clamps_only_finite_samples_beyond_the_range() {
+        let mut v = vec![1.0, 65504.0, f32::INFINITY, f32::NAN];
+        v.extend(std::iter::repeat_n(0.5, 1 << 17));
+        v.extend([65520.0, -1e6]);
+        let (count, first) = clamp_half_overflow(&mut v);
+        assert_eq!(count, 2);
+        assert_eq!(first, Some(((1 << 17) + 4, 65520.0)));
+        let n = v.len();
+        assert_eq!(v[n - 2..], [HALF_MAX, -HALF_MAX]);
+        assert!(v[2] == f32::INFINITY && v[3].is_nan() && v[1] == 65504.0);
     }
 }

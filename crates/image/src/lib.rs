@@ -6,7 +6,11 @@
 //! Every call into a codec runs under a panic guard: a panic becomes
 //! [`ImageError::CodecPanic`] (class [`ImageErrorKind::Internal`]), never a claim about the file.
 
+#![warn(missing_docs)]
+
 mod error;
+mod exr_bands;
+mod exr_header;
 mod exr_layers;
 pub mod exr_read;
 mod exr_write;
@@ -25,19 +29,21 @@ pub use exr::meta::header::{
     ImageAttributes as ExrImageAttributes, LayerAttributes as ExrLayerAttributes,
 };
 pub use exr::prelude::FlatSamples;
+pub use exr_header::{
+    ExrChannelInfo, ExrColourTag, ExrHeaders, ExrPart, ExrSampleType, MAX_EXR_PARTS,
+    read_exr_header_info, read_exr_headers, read_exr_text_attributes,
+};
 pub use exr_layers::{
     ChannelMatch, LayerChoiceError, RgbLayer, all_channel_names, choose_rgb_layer, find_channel,
     plane_layers, rgb_layers,
 };
 pub use exr_read::{
-    ExactExr, ExactPart, ExrChannelInfo, ExrColourTag, ExrHeaders, ExrPart, ExrSampleType,
-    MAX_EXR_PARTS, check_exr_readable, read_exr_attributes, read_exr_channel_rows,
-    read_exr_channel_rows_from, read_exr_channels, read_exr_exact, read_exr_header_info,
-    read_exr_headers, read_exr_text_attributes,
+    ExactExr, ExactPart, check_exr_readable, read_exr_attributes, read_exr_channel_rows,
+    read_exr_channel_rows_from, read_exr_channels, read_exr_exact,
 };
 pub use exr_write::{
-    ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport, PlaneSamples,
-    encode_exr_f32, write_exr_image, write_exr_planes,
+    ClampedSample, ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport,
+    PlaneSamples, encode_exr_f32, write_exr_image, write_exr_planes,
 };
 pub use exr_zip::{DEFAULT_ZIP_LEVEL, zip_block_lines};
 pub use memory::ReadMemory;
@@ -45,13 +51,19 @@ pub use png_read::{PngHeader, PngPixels, PngSamples, decode_png, read_png_header
 pub use png_write::{PngColor, PngCompression, PngEncodeOptions, PngSampleSlice, encode_png};
 pub use window::{ImageWindows, PixelWindow, place_plane};
 
+/// The largest image file read: a pass or a mask, PNG or EXR (its pixel count is limited
+/// separately, from its header, before decoding).
+pub const IMAGE_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::gib(8, "an image");
+
 /// Default pixel limit: 2^27 (134 million pixels, e.g. 16384×8192).
 pub const DEFAULT_MAX_PIXELS: u64 = 1 << 27;
 
 /// The file formats this crate recognises by their first bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ImageFileKind {
+    /// PNG (its signature).
     Png,
+    /// OpenEXR (its magic number).
     Exr,
 }
 
@@ -70,7 +82,9 @@ pub fn sniff_image_kind(bytes: &[u8]) -> Option<ImageFileKind> {
 /// ([`read_image_header`]).
 #[derive(Debug, Clone)]
 pub enum ImageHeader {
+    /// A PNG's header chunks.
     Png(PngHeader),
+    /// An OpenEXR's headers.
     Exr(ExrHeaders),
 }
 
@@ -101,7 +115,9 @@ pub fn read_image_header<R: std::io::BufRead + std::io::Seek>(
 /// and its channels are decoded on request (only the part and channels a caller needs).
 #[derive(Debug)]
 pub enum ImageFile<'a> {
+    /// A PNG, decoded whole.
     Png(PngPixels),
+    /// An OpenEXR, its headers read and its channels decoded on request.
     Exr(ExrFile<'a>),
 }
 

@@ -7,7 +7,9 @@ use crate::PngHeader;
 /// decoding buffers), `kept` by what the read returns.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ReadMemory {
+    /// Bytes held only while reading (the file, the decoder's buffers).
     pub transient: u64,
+    /// Bytes kept after reading (the decoded planes).
     pub kept: u64,
 }
 

@@ -10,17 +10,22 @@ use crate::{Codec, ImageError};
 /// Decoded samples, interleaved, row-major, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PngSamples {
+    /// 8-bit samples.
     U8(Vec<u8>),
+    /// 16-bit samples.
     U16(Vec<u16>),
 }
 
 /// A decoded PNG.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PngPixels {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Samples per pixel after expansion: 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA.
     pub channels: usize,
+    /// The samples, interleaved.
     pub samples: PngSamples,
 }
 
@@ -47,7 +52,9 @@ impl PngPixels {
 /// the size, and the samples per pixel and bits per sample after expansion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PngHeader {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Samples per pixel after expansion: 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA.
     pub channels: usize,

@@ -6,8 +6,11 @@ use crate::ImageError;
 /// Colour layout of the samples handed to [`encode_png`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PngColor {
+    /// One grey channel.
     Grey,
+    /// Red, green, blue.
     Rgb,
+    /// Red, green, blue, alpha.
     Rgba,
 }
 
@@ -33,7 +36,9 @@ impl PngColor {
 /// Interleaved samples, row-major, row 0 at the top; the variant sets the bit depth.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum PngSampleSlice<'a> {
+    /// 8-bit samples.
     U8(&'a [u8]),
+    /// 16-bit samples.
     U16(&'a [u16]),
 }
 
@@ -50,14 +55,18 @@ impl PngSampleSlice<'_> {
 /// size.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PngCompression {
+    /// The fastest deflate (large frames).
     Fast,
+    /// The `png` crate's default.
     Balanced,
+    /// The smallest files (figures).
     High,
 }
 
 /// Encoder settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PngEncodeOptions {
+    /// How hard the deflate works.
     pub compression: PngCompression,
     /// Write an `sRGB` chunk (perceptual intent): the samples are sRGB-encoded light.
     pub srgb_chunk: bool,

@@ -5,9 +5,13 @@
 /// A rectangle of pixels in an image's coordinates: the top-left pixel and the size.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct PixelWindow {
+    /// Column of its top-left pixel.
     pub x: i32,
+    /// Row of its top-left pixel.
     pub y: i32,
+    /// Width in pixels.
     pub width: usize,
+    /// Height in pixels.
     pub height: usize,
 }
 
@@ -92,7 +96,9 @@ impl std::fmt::Display for PixelWindow {
 /// (the frame). For a PNG both are its size at (0, 0).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct ImageWindows {
+    /// The pixels stored.
     pub data: PixelWindow,
+    /// The frame they belong to.
     pub display: PixelWindow,
 }
 

@@ -29,7 +29,7 @@ impl ChildGroup {
             command.process_group(0);
         }
         let mut s = state();
-        if s.stopping {
+        if s.refuses() {
             return Err(registry::stopping_error());
         }
         let child = command.spawn()?;

@@ -12,10 +12,25 @@ pub const MAX_FRAMES: u64 = 1_000_000;
 pub enum FrameError {
     /// A frame list that does not parse or is out of range.
     #[error("frame list {spec:?}: {why} (e.g. 1-240 or 1,5,10-20)")]
-    List { spec: String, why: String },
+    List {
+        /// The list as given.
+        spec: String,
+        /// What is wrong with it.
+        why: String,
+    },
     /// A path without the `####` that the frame number replaces.
     #[error("{path} has no #### for the frame number")]
-    NoPattern { path: PathBuf },
+    NoPattern {
+        /// The path.
+        path: PathBuf,
+    },
+}
+
+impl FrameError {
+    /// The class of this error: always invalid input (a frame list or a path to fix).
+    pub fn kind(&self) -> crate::ErrorKind {
+        crate::ErrorKind::Invalid
+    }
 }
 
 /// Whether `pattern` contains a `#` run.

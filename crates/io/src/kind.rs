@@ -5,16 +5,24 @@ use std::fs::FileType;
 /// The kind of a file system entry.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FileKind {
+    /// A regular file.
     Regular,
+    /// A directory.
     Directory,
+    /// A character device (`/dev/zero`).
     CharDevice,
+    /// A block device.
     BlockDevice,
+    /// A FIFO (named pipe).
     Fifo,
+    /// A socket.
     Socket,
+    /// A symbolic link.
     Symlink,
     /// A link to an open file descriptor (`/dev/stdout`, `/dev/fd/N`, `/proc/self/fd/N`): it
     /// names whatever the descriptor is (a terminal, a pipe), not a file to replace.
     DescriptorLink,
+    /// Anything else.
     Other,
 }
 

@@ -47,6 +47,23 @@ pub fn bounded_message(message: &str) -> String {
         .join("\n")
 }
 
+/// A parser's error shown bounded ([`bounded_message`]): serde_json's `invalid type: string
+/// "…"` quotes the input whole. The error itself is kept, and so is its source.
+#[derive(Debug)]
+pub struct BoundedError<E>(pub E);
+
+impl<E: fmt::Display> fmt::Display for BoundedError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&bounded_message(&self.0.to_string()))
+    }
+}
+
+impl<E: std::error::Error> std::error::Error for BoundedError<E> {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
+}
+
 impl fmt::Display for Quoted<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let (head, cut) = match self.text.char_indices().nth(MAX_QUOTED_CHARS) {

@@ -11,6 +11,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fs::{File, Metadata, Permissions};
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::thread::ThreadId;
 
 use tempfile::TempPath;
 
@@ -69,6 +70,23 @@ pub(crate) struct State {
     inputs: BTreeMap<FileId, PathBuf>,
     /// The process groups of the programs started and not yet reaped (`crate::ChildGroup`).
     pub(crate) child_groups: BTreeSet<u32>,
+    /// What a stop still writes ([`on_stop`]), with the id of its registration.
+    on_stop: Option<(u64, StopHook)>,
+    /// The registrations made so far (ids of [`OnStop`]).
+    on_stop_count: u64,
+    /// The thread running the [`on_stop`] hook: the one that may still write while stopping.
+    stop_writer: Option<ThreadId>,
+}
+
+/// What a stop by a signal still writes, given the exit code (128 + the signal's number).
+type StopHook = Box<dyn FnOnce(i32) + Send>;
+
+impl State {
+    /// Whether this thread may no longer create, rename or start anything: a stop is under
+    /// way and this is not the thread writing the stop's last output.
+    pub(crate) fn refuses(&self) -> bool {
+        self.stopping && self.stop_writer != Some(std::thread::current().id())
+    }
 }
 
 static STATE: Mutex<State> = Mutex::new(State {
@@ -77,6 +95,9 @@ static STATE: Mutex<State> = Mutex::new(State {
     protect_inputs: false,
     inputs: BTreeMap::new(),
     child_groups: BTreeSet::new(),
+    on_stop: None,
+    on_stop_count: 0,
+    stop_writer: None,
 });
 
 /// The lock (a panic elsewhere does not make the records unusable).
@@ -86,10 +107,28 @@ pub(crate) fn state() -> MutexGuard<'static, State> {
 
 /// From now on, every file read through [`crate::read_input`] is an input that no output of
 /// this process may replace: [`crate::write_atomic`] and [`crate::refuse_input_as_output`]
-/// refuse an output that is (by device and inode) a file read before. The binaries call this
-/// first thing; a library never does, so that library users and tests are not affected.
+/// refuse an output that is (by device and inode) a file read or declared ([`declare_inputs`])
+/// before. This record is glassdb's one protection of inputs. The binaries call this first
+/// thing; a library never does, so that library users and tests are not affected (the record
+/// is process-wide, and a deleted file's inode is handed on).
 pub fn protect_inputs() {
     state().protect_inputs = true;
+}
+
+/// Declares `paths` as inputs of this process (when [`protect_inputs`] was called): files it
+/// will read, or names it reads from but that may not exist (a material library an OBJ names).
+/// No output may then replace or create one ([`crate::refuse_input_as_output`]). A library
+/// declares its inputs before its first output, so that a run refuses an output that is one of
+/// them before it does any work; reading a file through [`crate::read_input`] records it too.
+pub fn declare_inputs<'a>(paths: impl IntoIterator<Item = &'a Path>) {
+    let mut s = state();
+    if s.protect_inputs {
+        for path in paths {
+            if let Some(id) = FileId::of_path(path) {
+                s.inputs.entry(id).or_insert_with(|| path.to_path_buf());
+            }
+        }
+    }
 }
 
 /// Records a file read (when [`protect_inputs`] was called).
@@ -127,7 +166,7 @@ impl LiveTemp {
             .prefix(TEMP_PREFIX)
             .make_in(dir, |path| {
                 let mut s = state();
-                if s.stopping {
+                if s.refuses() {
                     return Err(stopping_error());
                 }
                 let mut options = std::fs::OpenOptions::new();
@@ -161,7 +200,7 @@ impl LiveTemp {
             return Err(std::io::Error::other("the temporary file is gone"));
         };
         let key = path.to_path_buf();
-        if s.stopping {
+        if s.refuses() {
             drop(path);
             s.temporaries.remove(&key);
             return Err(stopping_error());
@@ -185,20 +224,60 @@ impl Drop for LiveTemp {
 }
 
 /// Removes every temporary file this process is writing, kills the process groups of the
-/// programs it started ([`crate::ChildGroup`]) and exits with `code` (128 + the signal number,
-/// by convention: 130 for SIGINT, 143 for SIGTERM). The lock stays held, so no other thread
-/// creates a temporary file, renames one into place or starts a program after this point: the
-/// outputs that were finished before stay, the unfinished leave nothing behind.
+/// programs it started ([`crate::ChildGroup`]), runs the [`on_stop`] hook if one is registered,
+/// and exits with `code` (128 + the signal number, by convention: 130 for SIGINT, 143 for
+/// SIGTERM). From the stop on, no other thread creates a temporary file, renames one into
+/// place or starts a program: the outputs that were finished before stay, the unfinished leave
+/// nothing behind, and the hook's output (written by this thread) is the only one that lands.
 pub fn exit_removing_temporaries(code: i32) -> ! {
-    let mut s = state();
-    s.stopping = true;
-    for group in std::mem::take(&mut s.child_groups) {
-        crate::children::kill_group(group);
+    let hook = {
+        let mut s = state();
+        s.stopping = true;
+        for group in std::mem::take(&mut s.child_groups) {
+            crate::children::kill_group(group);
+        }
+        for path in std::mem::take(&mut s.temporaries) {
+            let _ = std::fs::remove_file(path);
+        }
+        s.stop_writer = Some(std::thread::current().id());
+        s.on_stop.take()
+    };
+    if let Some((_, hook)) = hook {
+        hook(code);
     }
-    for path in std::mem::take(&mut s.temporaries) {
-        let _ = std::fs::remove_file(path);
-    }
+    // Held to the end: nothing is created or renamed while the process exits.
+    let _s = state();
     std::process::exit(code)
+}
+
+/// Registers what a stop by a signal still writes before the process exits: compose's frames
+/// report, saying which frames were finished and which the stop interrupted. `hook` runs once,
+/// with the exit code, on the thread of [`exit_removing_temporaries`] after the unfinished
+/// outputs are removed; it may write outputs ([`crate::write_atomic`]), which no other thread
+/// can then. One hook at a time: a later registration replaces an earlier one. Dropping the
+/// returned [`OnStop`] unregisters it.
+#[must_use = "the hook is unregistered when the guard is dropped"]
+pub fn on_stop(hook: impl FnOnce(i32) + Send + 'static) -> OnStop {
+    let mut s = state();
+    s.on_stop_count += 1;
+    let id = s.on_stop_count;
+    s.on_stop = Some((id, Box::new(hook)));
+    OnStop { id }
+}
+
+/// The registration of an [`on_stop`] hook; dropping it unregisters the hook.
+#[derive(Debug)]
+pub struct OnStop {
+    id: u64,
+}
+
+impl Drop for OnStop {
+    fn drop(&mut self) {
+        let mut s = state();
+        if s.on_stop.as_ref().is_some_and(|(id, _)| *id == self.id) {
+            s.on_stop = None;
+        }
+    }
 }
 
 /// The folder `path` is in: its parent, or `.` for a bare file name.

@@ -24,4 +24,18 @@ fn after_protect_inputs_no_write_replaces_a_file_read() {
     }
     assert_eq!(std::fs::read(&a).unwrap(), b"input");
     write_bytes_atomic(&dir.path().join("other.txt"), b"output").unwrap();
+    // A declared input, which a library will read, and one it names that does not exist (a
+    // missing MTL): no output replaces or creates either.
+    let named = dir.path().join("named.json");
+    std::fs::write(&named, b"input").unwrap();
+    let missing = dir.path().join("missing.mtl");
+    glassdb_io::declare_inputs([named.as_path(), missing.as_path()]);
+    for out in [&named, &missing] {
+        let e = glassdb_io::refuse_input_as_output(out).unwrap_err();
+        assert!(matches!(e, OutputError::OutputIsInput { .. }), "{e:?}");
+        assert!(write_bytes_atomic(out, b"output").is_err());
+    }
+    assert_eq!(std::fs::read(&named).unwrap(), b"input");
+    assert!(!missing.exists());
+    glassdb_io::refuse_input_as_output(&dir.path().join("other.json")).unwrap();
 }

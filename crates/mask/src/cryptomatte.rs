@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 
 use glassdb_image::{ExrFile, ExrHeaders, ExrPart, ImageWindows, ReadMemory};
 
-use crate::read::{MaskHeader, PixelError, decode_channels, locate_channel, plan_channels};
+use crate::aov::{cos_from_aov, cos_from_geometry, planes_from_aov, planes_from_geometry};
+use crate::channels::{MaskHeader, PixelError, decode_channels, locate_channel, plan_channels};
 use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
 
 /// How an AOV relates to the glass it describes.
@@ -33,12 +34,18 @@ pub enum AovWeighting {
 #[derive(Debug, Clone, PartialEq)]
 pub enum CosSource {
     /// An AOV channel holding |N·I| (e.g. Blender: Geometry Normal · Incoming, absolute).
-    Aov { channel: String },
+    Aov {
+        /// The AOV's channel name.
+        channel: String,
+    },
     /// World-space Normal and Position passes (channel layers, e.g. `Normal`, `Position`, with
     /// `.X/.Y/.Z` or `.R/.G/.B`) and the camera position: cos θ = |N·(P − C)| / |P − C|.
     Geometry {
+        /// The Normal pass's layer name.
         normal: String,
+        /// The Position pass's layer name.
         position: String,
+        /// Where the camera is (the view rays' origin).
         camera_origin: [f64; 3],
     },
 }
@@ -52,9 +59,11 @@ pub struct CryptomatteOptions {
     pub layer: Option<String>,
     /// Which manifest names are glass, with their registration ids.
     pub glass: GlassNames,
+    /// Where cos θ comes from.
     pub cos: CosSource,
     /// Where each glass pixel's plane index comes from.
     pub planes: PlaneSource,
+    /// How the AOVs were written.
     pub weighting: AovWeighting,
 }
 
@@ -70,9 +79,13 @@ pub enum PlaneSource {
     /// (`planes.json`): the plane nearest the pixel's position among those whose normal is
     /// within `max_angle_deg` of the pixel's normal (either orientation).
     Geometry {
+        /// The Normal pass's layer name.
         normal: String,
+        /// The Position pass's layer name.
         position: String,
+        /// The planes' equations, in plane order.
         equations: Vec<[f64; 4]>,
+        /// The largest angle between a pixel's normal and its plane's, degrees.
         max_angle_deg: f64,
     },
 }
@@ -80,6 +93,7 @@ pub enum PlaneSource {
 /// One Cryptomatte layer found in a file's header.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CryptomatteLayer {
+    /// Its layer name.
     pub name: String,
     /// Name → hash, from the manifest.
     pub manifest: BTreeMap<String, u32>,
@@ -152,7 +166,7 @@ fn read_side_manifest(image: &Path, file: &str) -> Result<String, MaskError> {
         path: side.clone(),
         source,
     };
-    glassdb_io::read_input_string(&side, glassdb_io::limits::MANIFEST).map_err(read_err)
+    glassdb_io::read_input_string(&side, crate::MANIFEST_FILE).map_err(read_err)
 }
 
 /// `{"name": "hex"}` → name → hash.
@@ -570,135 +584,4 @@ pub fn float_encoded(hash: u32) -> u32 {
     } else {
         hash
     }
-}
-
-/// cos θ on glass pixels from an |N·I| AOV (divided by the glass coverage when the AOV is
-/// written by glass only).
-fn cos_from_aov(
-    aov: &[f32],
-    id: &[u16],
-    channel: &str,
-    divide: &impl Fn(f32, usize) -> f32,
-    pixel: &PixelError<'_>,
-) -> Result<Vec<f32>, MaskError> {
-    let mut cos = vec![0f32; id.len()];
-    for (i, c) in cos.iter_mut().enumerate() {
-        if id[i] == 0 {
-            continue;
-        }
-        let v = divide(aov[i], i);
-        if !(v.is_finite() && (-1e-3..=1.0 + 1e-2).contains(&v)) {
-            return Err(pixel.at(
-                i,
-                format!(
-                    "cos θ {v} from AOV {channel:?} is not in [0, 1] (is the AOV |N·I|, written as --mask-aovs says?)"
-                ),
-            ));
-        }
-        *c = v.clamp(0.0, 1.0);
-    }
-    Ok(cos)
-}
-
-/// cos θ on glass pixels from world-space Normal (planes 0–2) and Position (planes 3–5) passes
-/// and the camera position: |N·(P − C)| / (|N| |P − C|).
-fn cos_from_geometry(
-    passes: &[Vec<f32>],
-    id: &[u16],
-    camera_origin: [f64; 3],
-    pixel: &PixelError<'_>,
-) -> Result<Vec<f32>, MaskError> {
-    let mut cos = vec![0f32; id.len()];
-    for (i, c) in cos.iter_mut().enumerate() {
-        if id[i] == 0 {
-            continue;
-        }
-        let nrm: [f64; 3] = std::array::from_fn(|k| f64::from(passes[k][i]));
-        let v: [f64; 3] = std::array::from_fn(|k| f64::from(passes[3 + k][i]) - camera_origin[k]);
-        let (ln, lv) = (norm(nrm), norm(v));
-        if !(ln > 0.0 && lv > 0.0) {
-            return Err(pixel.at(
-                i,
-                "the Normal or Position pass is zero on a glass pixel".into(),
-            ));
-        }
-        let dot = nrm[0] * v[0] + nrm[1] * v[1] + nrm[2] * v[2];
-        *c = (dot.abs() / (ln * lv)).clamp(0.0, 1.0) as f32;
-    }
-    Ok(cos)
-}
-
-/// Plane indices on glass pixels from a plane AOV, rounded.
-fn planes_from_aov(
-    aov: &[f32],
-    id: &[u16],
-    name: &str,
-    divide: &impl Fn(f32, usize) -> f32,
-    pixel: &PixelError<'_>,
-) -> Result<Vec<u16>, MaskError> {
-    let mut plane = vec![0u16; id.len()];
-    for (i, p) in plane.iter_mut().enumerate() {
-        if id[i] == 0 {
-            continue;
-        }
-        let v = divide(aov[i], i);
-        let r = v.round();
-        if !(0.0..=65535.0).contains(&r) {
-            return Err(pixel.at(
-                i,
-                format!("plane {v} from AOV {name:?} is not an index in 0–65535"),
-            ));
-        }
-        *p = r as u16;
-    }
-    Ok(plane)
-}
-
-/// Plane indices on glass pixels from world-space Normal (planes 0–2) and Position (3–5)
-/// passes: among the planes whose normal lies within `max_angle_deg` of the pixel's normal
-/// (either orientation), the one nearest the pixel's position. At a pane's edge both passes
-/// average over what the pixel sees, so where no plane is that close in angle the best
-/// aligned one is taken.
-fn planes_from_geometry(
-    passes: &[Vec<f32>],
-    id: &[u16],
-    equations: &[[f64; 4]],
-    max_angle_deg: f64,
-    pixel: &PixelError<'_>,
-) -> Result<Vec<u16>, MaskError> {
-    let min_cos = max_angle_deg.to_radians().cos();
-    let mut plane = vec![0u16; id.len()];
-    for (i, p) in plane.iter_mut().enumerate() {
-        if id[i] == 0 {
-            continue;
-        }
-        let nrm: [f64; 3] = std::array::from_fn(|k| f64::from(passes[k][i]));
-        let pos: [f64; 3] = std::array::from_fn(|k| f64::from(passes[3 + k][i]));
-        let ln = norm(nrm);
-        if ln.is_nan() || ln <= 0.0 {
-            return Err(pixel.at(i, "the Normal pass is zero on a glass pixel".into()));
-        }
-        let scored: Vec<(usize, f64, f64)> = equations
-            .iter()
-            .enumerate()
-            .map(|(k, e)| {
-                let alignment = (e[0] * nrm[0] + e[1] * nrm[1] + e[2] * nrm[2]).abs() / ln;
-                let distance = (e[0] * pos[0] + e[1] * pos[1] + e[2] * pos[2] + e[3]).abs();
-                (k, alignment, distance)
-            })
-            .collect();
-        let nearest_aligned = scored
-            .iter()
-            .filter(|s| s.1 >= min_cos)
-            .min_by(|a, b| a.2.total_cmp(&b.2));
-        let best_aligned = scored.iter().max_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some(&(k, _, _)) = nearest_aligned.or(best_aligned) {
-            *p = k as u16;
-        }
-    }
-    Ok(plane)
-}
-
-fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }

@@ -8,7 +8,9 @@ use crate::MaskError;
 /// `PATTERN=ID`: names matching the glob pattern are glass with registration id ID.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct GlassMapping {
+    /// The glob pattern.
     pub pattern: String,
+    /// The registry id of what it matches.
     pub id: u16,
 }
 

@@ -12,6 +12,10 @@
 //! Id 0 means "no glass" everywhere. Decoding and encoding the files is glassdb-image's job;
 //! this crate maps the formats' layouts to and from [`MaskImage`].
 
+#![warn(missing_docs)]
+
+mod aov;
+mod channels;
 mod cos_code;
 mod cryptomatte;
 mod error;
@@ -23,6 +27,11 @@ use std::collections::BTreeMap;
 
 use rayon::prelude::*;
 
+/// The largest Cryptomatte manifest side file (JSON) read.
+pub const MANIFEST_FILE: glassdb_io::InputLimit =
+    glassdb_io::InputLimit::mib(64, "a Cryptomatte manifest");
+
+pub use channels::MaskHeader;
 pub use cos_code::CosCode;
 pub use cryptomatte::{
     AovWeighting, CosSource, CryptomatteLayer, CryptomatteOptions, PlaneSource, cryptomatte_layers,
@@ -33,8 +42,7 @@ pub use glass_names::{GlassMapping, GlassNames};
 pub use glassdb_image::DEFAULT_MAX_PIXELS;
 use glassdb_image::PixelWindow;
 pub use read::{
-    MaskHeader, read_mask, read_mask_bytes, read_mask_header, read_placed_mask,
-    read_placed_mask_bytes,
+    read_mask, read_mask_bytes, read_mask_header, read_placed_mask, read_placed_mask_bytes,
 };
 pub use write::{MaskFormat, write_mask, write_mask_bytes};
 
@@ -42,7 +50,9 @@ pub use write::{MaskFormat, write_mask, write_mask_bytes};
 /// entries.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MaskImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Glass registration id per pixel; 0 means "no glass".
     pub id: Vec<u16>,
@@ -58,8 +68,11 @@ pub struct MaskImage {
 /// stores a plane per pixel (a mask without planes has every glass pixel on plane 0).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlacedMask {
+    /// The mask's pixels.
     pub image: MaskImage,
+    /// Where they lie: the file's data and display windows.
     pub windows: glassdb_image::ImageWindows,
+    /// Whether the file stores a plane per pixel.
     pub stores_planes: bool,
     /// Whether the file states its pixels' coordinates (EXR); a PNG holds a whole frame at
     /// (0, 0), wherever the frame of the passes lies.
@@ -119,10 +132,15 @@ impl MaskImage {
 /// (`x_min..=x_max`, `y_min..=y_max`, row 0 at the top) and the glass pixels inside.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PlaneBounds {
+    /// Leftmost glass column.
     pub x_min: i32,
+    /// Topmost glass row.
     pub y_min: i32,
+    /// Rightmost glass column.
     pub x_max: i32,
+    /// Bottom glass row.
     pub y_max: i32,
+    /// Glass pixels of the plane.
     pub glass_pixels: u64,
 }
 

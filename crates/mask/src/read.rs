@@ -8,26 +8,14 @@ use std::io::{BufReader, Cursor};
 use std::path::Path;
 
 use glassdb_image::{
-    ChannelMatch, ExrFile, ExrPart, ImageHeader, ImageWindows, PngHeader, PngPixels, PngSamples,
-    ReadMemory,
+    ExrFile, ExrPart, ImageHeader, ImageWindows, PngHeader, PngPixels, PngSamples, ReadMemory,
 };
 
+use crate::channels::{
+    MaskHeader, PixelError, decode_channels, decode_err, locate_channel, plan_channels,
+};
 use crate::cryptomatte::{CryptomattePlan, decode_cryptomatte, plan_cryptomatte};
 use crate::{CosTheta, MaskError, MaskImage, MaskReadOptions, PlacedMask};
-
-/// What a mask file's header says, checked as the reader checks it before decoding any pixel:
-/// where its pixels lie, whether it stores planes, and what reading it costs in memory.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct MaskHeader {
-    pub windows: ImageWindows,
-    pub stores_planes: bool,
-    /// Whether the file states its pixels' coordinates (EXR); see [`PlacedMask`].
-    pub has_coordinates: bool,
-    /// Bytes per pixel of the decoded [`MaskImage`] (id, plane, cos θ, coverage).
-    pub bytes_per_pixel: u64,
-    /// Reading it: the file and the decoder's buffers while reading, the mask after.
-    pub memory: ReadMemory,
-}
 
 /// Reads a mask file's header only (a PNG's chunks up to its pixel data, an EXR's headers; no
 /// pixel is decompressed) and checks the layout `opts` asks for: a packed PNG is RGB, a binary
@@ -40,7 +28,7 @@ pub fn read_mask_header(path: &Path, opts: &MaskReadOptions) -> Result<MaskHeade
         source,
     };
     let (file, file_len) =
-        glassdb_io::open_input(path, glassdb_io::limits::IMAGE).map_err(read_err)?;
+        glassdb_io::open_input(path, glassdb_image::IMAGE_FILE).map_err(read_err)?;
     let header = glassdb_image::read_image_header(BufReader::new(file), opts.max_pixels)
         .map_err(|source| decode_err(path, source))?;
     Ok(MaskPlan::new(&header, path, opts)?.header(file_len))
@@ -55,7 +43,7 @@ pub fn read_mask(path: &Path, opts: &MaskReadOptions) -> Result<MaskImage, MaskE
 
 /// Reads a mask file with its windows and whether it stores planes.
 pub fn read_placed_mask(path: &Path, opts: &MaskReadOptions) -> Result<PlacedMask, MaskError> {
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|source| {
+    let bytes = glassdb_io::read_input(path, glassdb_image::IMAGE_FILE).map_err(|source| {
         MaskError::Read {
             path: path.to_path_buf(),
             source,
@@ -71,13 +59,6 @@ pub fn read_mask_bytes(
     opts: &MaskReadOptions,
 ) -> Result<MaskImage, MaskError> {
     read_placed_mask_bytes(bytes, path, opts).map(|m| m.image)
-}
-
-fn decode_err(path: &Path, source: glassdb_image::ImageError) -> MaskError {
-    MaskError::Decode {
-        path: path.to_path_buf(),
-        source,
-    }
 }
 
 /// Reads a mask from bytes in memory with its windows; `path` is only used in error messages.
@@ -237,51 +218,6 @@ fn plan_exr_channels(
     Ok(ExrChannelsPlan { wanted, windows })
 }
 
-/// Checks, from the headers, that channels `wanted` (part, channel) can be decoded (within
-/// `max_pixels`, not deep, not subsampled) and that their parts share one data window, which
-/// is returned with the display window.
-pub(crate) fn plan_channels(
-    parts: &[ExrPart],
-    wanted: &[(usize, usize)],
-    path: &Path,
-    max_pixels: u64,
-) -> Result<ImageWindows, MaskError> {
-    let mut windows: Option<ImageWindows> = None;
-    let mut part_ids: Vec<usize> = wanted.iter().map(|w| w.0).collect();
-    part_ids.sort_unstable();
-    part_ids.dedup();
-    for p in part_ids {
-        let channels: Vec<usize> = wanted.iter().filter(|w| w.0 == p).map(|w| w.1).collect();
-        let info = parts.get(p).ok_or_else(|| MaskError::Layout {
-            path: path.to_path_buf(),
-            detail: format!("no part {p}"),
-        })?;
-        glassdb_image::check_exr_readable(info, &channels, max_pixels)
-            .map_err(|source| decode_err(path, source))?;
-        match windows {
-            None => windows = Some(info.windows()),
-            Some(w) if w.data != info.data_window => {
-                return Err(different_windows(path, &w, info));
-            }
-            Some(_) => {}
-        }
-    }
-    windows.ok_or_else(|| MaskError::Layout {
-        path: path.to_path_buf(),
-        detail: "no mask channels".into(),
-    })
-}
-
-fn different_windows(path: &Path, w: &ImageWindows, info: &ExrPart) -> MaskError {
-    MaskError::Layout {
-        path: path.to_path_buf(),
-        detail: format!(
-            "the mask channels lie in parts with different data windows ({} and {})",
-            w.data, info.data_window
-        ),
-    }
-}
-
 /// The packed formats: R = plane, G = id, B = cos θ code (8- or 16-bit). Alpha is ignored.
 fn packed_from_png(png: &PngPixels, path: &Path) -> Result<MaskImage, MaskError> {
     if png.channels < 3 {
@@ -405,90 +341,6 @@ fn mask_from_exr(
         stores_planes,
         has_coordinates: true,
     })
-}
-
-/// Finds the (part, channel) named `name` (in `layer`, when given); a required channel that is
-/// missing is an error listing the channels the file has.
-pub(crate) fn locate_channel(
-    parts: &[ExrPart],
-    name: &str,
-    layer: Option<&str>,
-    required: bool,
-    path: &Path,
-) -> Result<Option<(usize, usize)>, MaskError> {
-    match glassdb_image::find_channel(parts, name, layer) {
-        ChannelMatch::Found(p, c) => Ok(Some((p, c))),
-        ChannelMatch::Ambiguous(candidates) => Err(MaskError::AmbiguousChannel {
-            path: path.to_path_buf(),
-            channel: name.to_string(),
-            candidates,
-        }),
-        ChannelMatch::Missing if required => Err(MaskError::MissingChannel {
-            path: path.to_path_buf(),
-            channel: match layer {
-                Some(l) => format!("{l}.{name}"),
-                None => name.to_string(),
-            },
-            available: glassdb_image::all_channel_names(parts),
-        }),
-        ChannelMatch::Missing => Ok(None),
-    }
-}
-
-/// Decodes channels `wanted` (part, channel) of the file, each part once with all its wanted
-/// channels, in the order asked; every part must have the same data window.
-pub(crate) fn decode_channels(
-    exr: &ExrFile<'_>,
-    wanted: &[(usize, usize)],
-    path: &Path,
-) -> Result<(ImageWindows, Vec<Vec<f32>>), MaskError> {
-    let mut out: Vec<Vec<f32>> = vec![Vec::new(); wanted.len()];
-    let mut windows: Option<ImageWindows> = None;
-    let mut parts: Vec<usize> = wanted.iter().map(|w| w.0).collect();
-    parts.sort_unstable();
-    parts.dedup();
-    for p in parts {
-        let slots: Vec<usize> = (0..wanted.len()).filter(|&k| wanted[k].0 == p).collect();
-        let channels: Vec<usize> = slots.iter().map(|&k| wanted[k].1).collect();
-        let (info, buffers) =
-            exr.read_channels(p, &channels)
-                .map_err(|source| MaskError::Decode {
-                    path: path.to_path_buf(),
-                    source,
-                })?;
-        match windows {
-            None => windows = Some(info.windows()),
-            Some(w) if w.data != info.data_window => {
-                return Err(different_windows(path, &w, &info));
-            }
-            Some(_) => {}
-        }
-        for (k, b) in slots.into_iter().zip(buffers) {
-            out[k] = b;
-        }
-    }
-    let windows = windows.ok_or_else(|| MaskError::Layout {
-        path: path.to_path_buf(),
-        detail: "no mask channels".into(),
-    })?;
-    Ok((windows, out))
-}
-
-/// Builds [`MaskError::BadPixel`] for a pixel index of a mask file.
-pub(crate) struct PixelError<'a> {
-    pub(crate) path: &'a Path,
-    pub(crate) width: usize,
-}
-
-impl PixelError<'_> {
-    pub(crate) fn at(&self, i: usize, detail: String) -> MaskError {
-        MaskError::BadPixel {
-            path: self.path.to_path_buf(),
-            x: (i % self.width) as u32,
-            y: (i / self.width) as u32,
-            detail,
-        }
-    }
 }
 
 /// Float samples that must be integers in 0–65535 (ids, planes).

@@ -9,6 +9,18 @@ fn opts() -> MaskReadOptions {
     MaskReadOptions::default()
 }
 
+/// The mask in `bytes`, read as file `name` with the default options.
+fn read(bytes: &[u8], name: &str) -> MaskImage {
+    read_mask_bytes(bytes, Path::new(name), &opts()).unwrap()
+}
+
+/// The message of reading `bytes` as file `name` with the default options, which must fail.
+fn read_error(bytes: &[u8], name: &str) -> String {
+    read_mask_bytes(bytes, Path::new(name), &opts())
+        .unwrap_err()
+        .to_string()
+}
+
 /// A 3×2 mask with hand-chosen values: ids 0, 7, 200 / 7, 0, 3; planes; cos codes.
 fn packed8() -> MaskImage {
     MaskImage {
@@ -69,7 +81,7 @@ fn packed_8bit_png_reads_green_as_id_blue_as_cos_red_as_plane() {
     // Pixel (1, 0): R = 4 (plane), G = 9 (id), B = 255 (cos 1).
     let data = [0, 0, 0, 4, 9, 255];
     let bytes = encode_png(2, 1, PngColor::Rgb, Depth::Eight, &data);
-    let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
+    let m = read(&bytes, "m.png");
     assert_eq!((m.width, m.height), (2, 1));
     assert_eq!(m.id, vec![0, 9]);
     assert_eq!(m.plane, vec![0, 4]);
@@ -86,7 +98,7 @@ fn packed_16bit_png_reads_big_endian_samples() {
     // One pixel: R = 1, G = 300, B = 32768 (cos = 32768/65535).
     let data = [0, 1, 0x01, 0x2c, 0x80, 0x00];
     let bytes = encode_png(1, 1, PngColor::Rgb, Depth::Sixteen, &data);
-    let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
+    let m = read(&bytes, "m.png");
     assert_eq!(m.id, vec![300]);
     assert_eq!(m.plane, vec![1]);
     assert_eq!(m.cos_theta, CosTheta::Quantized16(vec![32768]));
@@ -97,7 +109,7 @@ fn packed_16bit_png_reads_big_endian_samples() {
 fn rgba_png_alpha_is_ignored() {
     let data = [1, 2, 3, 0];
     let bytes = encode_png(1, 1, PngColor::Rgba, Depth::Eight, &data);
-    let m = read_mask_bytes(&bytes, Path::new("m.png"), &opts()).unwrap();
+    let m = read(&bytes, "m.png");
     assert_eq!((m.id[0], m.plane[0]), (2, 1));
 }
 
@@ -105,17 +117,14 @@ fn rgba_png_alpha_is_ignored() {
 fn png8_round_trip_is_exact() {
     let m = packed8();
     let bytes = write_mask_bytes(Path::new("x.png"), &m, MaskFormat::Png8).unwrap();
-    assert_eq!(
-        read_mask_bytes(&bytes, Path::new("x.png"), &opts()).unwrap(),
-        m
-    );
+    assert_eq!(read(&bytes, "x.png"), m);
 }
 
 #[test]
 fn png16_from_8bit_codes_is_exact_scaling_by_257() {
     let m = packed8();
     let bytes = write_mask_bytes(Path::new("x.png"), &m, MaskFormat::Png16).unwrap();
-    let back = read_mask_bytes(&bytes, Path::new("x.png"), &opts()).unwrap();
+    let back = read(&bytes, "x.png");
     assert_eq!(back.id, m.id);
     assert_eq!(
         back.cos_theta,
@@ -137,10 +146,7 @@ fn exr_round_trip_keeps_float_cos_plane_and_coverage() {
         coverage: Some(vec![0.0, 0.25, 1.0, 0.5]),
     };
     let bytes = write_mask_bytes(Path::new("x.exr"), &m, MaskFormat::Exr).unwrap();
-    assert_eq!(
-        read_mask_bytes(&bytes, Path::new("x.exr"), &opts()).unwrap(),
-        m
-    );
+    assert_eq!(read(&bytes, "x.exr"), m);
 }
 
 #[test]
@@ -163,9 +169,7 @@ fn exr_channel_names_are_selectable() {
     assert_eq!(m.plane, vec![0, 0]);
     assert_eq!(m.coverage, None);
 
-    let err = read_mask_bytes(&bytes, Path::new("aov.exr"), &opts())
-        .unwrap_err()
-        .to_string();
+    let err = read_error(&bytes, "aov.exr");
     assert!(
         err.contains("aov.exr") && err.contains("\"id\"") && err.contains("ViewLayer.IndexMA"),
         "{err}"
@@ -182,9 +186,7 @@ fn exr_fractional_id_names_the_pixel() {
             ("cos_theta", vec![0.5; 6]),
         ],
     );
-    let err = read_mask_bytes(&bytes, Path::new("bad.exr"), &opts())
-        .unwrap_err()
-        .to_string();
+    let err = read_error(&bytes, "bad.exr");
     assert!(
         err.contains("bad.exr") && err.contains("x 1, y 1") && err.contains("4.5"),
         "{err}"
@@ -198,16 +200,14 @@ fn exr_cos_outside_unit_interval_on_glass_is_an_error_but_ignored_off_glass() {
         1,
         vec![("id", vec![0.0, 1.0]), ("cos_theta", vec![7.0, 1.0000001])],
     );
-    let m = read_mask_bytes(&ok, Path::new("m.exr"), &opts()).unwrap();
+    let m = read(&ok, "m.exr");
     assert_eq!(m.cos_theta_at(1), 1.0);
     let bad = exr_bytes(
         2,
         1,
         vec![("id", vec![0.0, 1.0]), ("cos_theta", vec![0.0, f32::NAN])],
     );
-    let err = read_mask_bytes(&bad, Path::new("m.exr"), &opts())
-        .unwrap_err()
-        .to_string();
+    let err = read_error(&bad, "m.exr");
     assert!(err.contains("x 1, y 0") && err.contains("NaN"), "{err}");
 }
 
@@ -319,7 +319,7 @@ fn float_cos_rounds_to_nearest_code() {
         coverage: None,
     };
     let bytes = write_mask_bytes(Path::new("o.png"), &m, MaskFormat::Png8).unwrap();
-    let back = read_mask_bytes(&bytes, Path::new("o.png"), &opts()).unwrap();
+    let back = read(&bytes, "o.png");
     assert_eq!(back.cos_theta, CosTheta::Quantized8(vec![128, 0, 255]));
 }
 

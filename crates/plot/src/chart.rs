@@ -37,10 +37,15 @@ pub fn palette(i: usize) -> RGBColor {
 /// A polyline. Non-finite points break the line (they are never joined across).
 #[derive(Debug, Clone)]
 pub struct Line {
+    /// Its legend entry, if any.
     pub label: Option<String>,
+    /// Its colour.
     pub colour: RGBColor,
+    /// Drawn dashed.
     pub dashed: bool,
+    /// Stroke width in pixels.
     pub width: u32,
+    /// Its points, in data coordinates.
     pub points: Vec<(f64, f64)>,
 }
 
@@ -74,23 +79,33 @@ impl Line {
 /// Marker shapes for measured points and marked values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MarkerShape {
+    /// A filled circle.
     Circle,
+    /// A cross.
     Cross,
+    /// A filled triangle.
     Triangle,
+    /// A filled square.
     Square,
 }
 
 /// A set of markers (measured points, marked channel values).
 #[derive(Debug, Clone)]
 pub struct Markers {
+    /// Its legend entry, if any.
     pub label: Option<String>,
+    /// Its colour.
     pub colour: RGBColor,
+    /// Its shape.
     pub shape: MarkerShape,
+    /// Its size in pixels.
     pub size: u32,
+    /// Its points, in data coordinates.
     pub points: Vec<(f64, f64)>,
 }
 
 impl Markers {
+    /// Markers of `shape` at `points`, 4 pixels, with an optional legend entry.
     pub fn new(
         label: impl Into<Option<String>>,
         colour: RGBColor,
@@ -110,31 +125,47 @@ impl Markers {
 /// A shaded vertical band from `x0` to `x1` over the whole height of the panel.
 #[derive(Debug, Clone)]
 pub struct Shade {
+    /// Where it starts on the x axis.
     pub x0: f64,
+    /// Where it ends on the x axis.
     pub x1: f64,
+    /// Its legend entry, if any.
     pub label: Option<String>,
+    /// Its colour (drawn translucent).
     pub colour: RGBColor,
 }
 
 /// A text label at a data position.
 #[derive(Debug, Clone)]
 pub struct Annotation {
+    /// x of the text's left end, data coordinates.
     pub x: f64,
+    /// y of the text, data coordinates.
     pub y: f64,
+    /// The text.
     pub text: String,
+    /// Its colour.
     pub colour: RGBColor,
 }
 
 /// Where a panel's legend goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LegendCorner {
+    /// Top left.
     UpperLeft,
+    /// Top right.
     UpperRight,
+    /// Bottom left.
     LowerLeft,
+    /// Bottom right.
     LowerRight,
+    /// Middle of the right side.
     MiddleRight,
+    /// Middle of the left side.
     MiddleLeft,
+    /// Middle of the top.
     UpperMiddle,
+    /// Middle of the bottom.
     LowerMiddle,
     /// The position where the legend box covers the fewest drawn points.
     Auto,
@@ -144,15 +175,23 @@ pub enum LegendCorner {
 /// markers and text on top).
 #[derive(Debug, Clone)]
 pub struct Panel {
+    /// The panel's title, if any.
     pub title: Option<String>,
+    /// The x axis's label.
     pub x_label: String,
+    /// The y axis's label.
     pub y_label: String,
+    /// The x range shown.
     pub x_range: (f64, f64),
     /// `None`: fit the data (finite values inside the x range) with a small margin.
     pub y_range: Option<(f64, f64)>,
+    /// Its lines.
     pub lines: Vec<Line>,
+    /// Its markers.
     pub markers: Vec<Markers>,
+    /// Its shaded x ranges.
     pub shades: Vec<Shade>,
+    /// Its text annotations.
     pub annotations: Vec<Annotation>,
     /// Draw the line y = 0 when it is inside the range (residual panels).
     pub zero_line: bool,
@@ -402,7 +441,15 @@ fn check_range(what: &str, (a, b): (f64, f64)) -> Result<(), PlotError> {
     Ok(())
 }
 
-/// Draws a panel into `area`.
+/// The chart of a panel: f64 coordinates on both axes.
+type PanelChart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// Draws a panel into `area`: its axes and grid, then its shades, zero line, lines, markers
+/// and annotations, then the legend of what has a label.
 pub fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
@@ -438,6 +485,41 @@ pub fn draw_panel<DB: DrawingBackend>(
         .draw()
         .map_err(draw_err)?;
 
+    let mut any_label = draw_shades(&mut chart, panel, (x0, x1), (y0, y1))?;
+    if panel.zero_line && y0 < 0.0 && y1 > 0.0 {
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(x0, 0.0), (x1, 0.0)],
+                BLACK.mix(0.55).stroke_width(1),
+            )))
+            .map_err(draw_err)?;
+    }
+    any_label |= draw_lines(&mut chart, panel, (x0, x1), (y0, y1))?;
+    any_label |= draw_markers(&mut chart, panel, (x0, x1), (y0, y1))?;
+    for a in &panel.annotations {
+        if a.x.is_finite() && a.y.is_finite() && a.x >= x0 && a.x <= x1 && a.y >= y0 && a.y <= y1 {
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    a.text.clone(),
+                    (a.x, a.y),
+                    (FAMILY, 13).into_font().color(&a.colour),
+                )))
+                .map_err(draw_err)?;
+        }
+    }
+    if let (Some(corner), true) = (panel.legend, any_label) {
+        draw_legend(&mut chart, panel, corner, (x0, x1), (y0, y1))?;
+    }
+    Ok(())
+}
+
+/// The shaded x ranges (clipped to the panel); whether one has a label.
+fn draw_shades<'a, DB: DrawingBackend + 'a>(
+    chart: &mut PanelChart<'a, DB>,
+    panel: &Panel,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<bool, PlotError> {
     let mut any_label = false;
     for s in &panel.shades {
         let (sx0, sx1) = (s.x0.max(x0), s.x1.min(x1));
@@ -458,14 +540,17 @@ pub fn draw_panel<DB: DrawingBackend>(
             });
         }
     }
-    if panel.zero_line && y0 < 0.0 && y1 > 0.0 {
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                vec![(x0, 0.0), (x1, 0.0)],
-                BLACK.mix(0.55).stroke_width(1),
-            )))
-            .map_err(draw_err)?;
-    }
+    Ok(any_label)
+}
+
+/// The lines, each clipped into runs inside the panel; whether one has a label.
+fn draw_lines<'a, DB: DrawingBackend + 'a>(
+    chart: &mut PanelChart<'a, DB>,
+    panel: &Panel,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<bool, PlotError> {
+    let mut any_label = false;
     for line in &panel.lines {
         let style = line.colour.stroke_width(line.width);
         let mut labelled = false;
@@ -498,6 +583,17 @@ pub fn draw_panel<DB: DrawingBackend>(
             }
         }
     }
+    Ok(any_label)
+}
+
+/// The markers inside the panel; whether a series of them has a label.
+fn draw_markers<'a, DB: DrawingBackend + 'a>(
+    chart: &mut PanelChart<'a, DB>,
+    panel: &Panel,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<bool, PlotError> {
+    let mut any_label = false;
     for m in &panel.markers {
         let inside: Vec<(f64, f64)> = m
             .points
@@ -538,40 +634,38 @@ pub fn draw_panel<DB: DrawingBackend>(
             }),
         }
     }
-    for a in &panel.annotations {
-        if a.x.is_finite() && a.y.is_finite() && a.x >= x0 && a.x <= x1 && a.y >= y0 && a.y <= y1 {
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    a.text.clone(),
-                    (a.x, a.y),
-                    (FAMILY, 13).into_font().color(&a.colour),
-                )))
-                .map_err(draw_err)?;
+    Ok(any_label)
+}
+
+/// The legend in `corner` (chosen where the data leave room, for `Auto`).
+fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut PanelChart<'a, DB>,
+    panel: &Panel,
+    corner: LegendCorner,
+    x_range: (f64, f64),
+    y_range: (f64, f64),
+) -> Result<(), PlotError> {
+    let position = match corner {
+        LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
+        LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
+        LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
+        LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
+        LegendCorner::MiddleRight => SeriesLabelPosition::MiddleRight,
+        LegendCorner::MiddleLeft => SeriesLabelPosition::MiddleLeft,
+        LegendCorner::UpperMiddle => SeriesLabelPosition::UpperMiddle,
+        LegendCorner::LowerMiddle => SeriesLabelPosition::LowerMiddle,
+        LegendCorner::Auto => {
+            let (pw, ph) = chart.plotting_area().dim_in_pixel();
+            auto_legend_position(panel, x_range, y_range, (pw, ph))
         }
-    }
-    if let (Some(corner), true) = (panel.legend, any_label) {
-        let position = match corner {
-            LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
-            LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
-            LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
-            LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
-            LegendCorner::MiddleRight => SeriesLabelPosition::MiddleRight,
-            LegendCorner::MiddleLeft => SeriesLabelPosition::MiddleLeft,
-            LegendCorner::UpperMiddle => SeriesLabelPosition::UpperMiddle,
-            LegendCorner::LowerMiddle => SeriesLabelPosition::LowerMiddle,
-            LegendCorner::Auto => {
-                let (pw, ph) = chart.plotting_area().dim_in_pixel();
-                auto_legend_position(panel, (x0, x1), (y0, y1), (pw, ph))
-            }
-        };
-        chart
-            .configure_series_labels()
-            .position(position)
-            .label_font((FAMILY, 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.35))
-            .draw()
-            .map_err(draw_err)?;
-    }
+    };
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FAMILY, 13))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.35))
+        .draw()
+        .map_err(draw_err)?;
     Ok(())
 }

@@ -13,6 +13,7 @@ use crate::{Figure, ImageFormat, PlotError};
 /// One cell of a [`GridFigure`].
 #[derive(Debug, Clone)]
 pub struct Cell {
+    /// The main panel.
     pub main: Panel,
     /// A panel beneath the main one and the fraction of the cell height it takes.
     pub lower: Option<(Panel, f64)>,
@@ -21,9 +22,13 @@ pub struct Cell {
 /// Panels in a grid under a title.
 #[derive(Debug, Clone)]
 pub struct GridFigure {
+    /// The figure's title.
     pub title: String,
+    /// A line under it, if any.
     pub subtitle: Option<String>,
+    /// Its cells, row by row.
     pub cells: Vec<Cell>,
+    /// Cells per row.
     pub columns: usize,
     /// Size of one cell in pixels.
     pub cell_size: (u32, u32),

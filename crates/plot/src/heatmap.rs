@@ -18,9 +18,13 @@ pub const NO_VALUE_COLOUR: RGBColor = RGBColor(225, 225, 225);
 /// A row-major grid of optional values, row 0 at the top (image convention).
 #[derive(Debug, Clone)]
 pub struct HeatMapFigure {
+    /// The figure's title.
     pub title: String,
+    /// A line under it, if any.
     pub subtitle: Option<String>,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// `width * height` values; `None` where nothing is shown (drawn grey).
     pub values: Vec<Option<f64>>,
@@ -187,33 +191,41 @@ impl Figure for HeatMapFigure {
         }
         chart.draw_series(rects).map_err(draw_err)?;
 
-        // Colour bar.
-        let mut bar = ChartBuilder::on(&bar_area)
-            .margin_top(10)
-            .margin_bottom(50)
-            .margin_right(8)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..1.0, vmin..vmax)
-            .map_err(draw_err)?;
-        bar.configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_desc(self.value_label.as_str())
-            .label_style((FAMILY, 13))
-            .axis_desc_style((FAMILY, 14))
-            .y_label_formatter(&|v| format_tick(*v))
-            .draw()
-            .map_err(draw_err)?;
-        let steps = 128;
-        bar.draw_series((0..steps).map(|k| {
-            let a = vmin + (vmax - vmin) * k as f64 / steps as f64;
-            let b = vmin + (vmax - vmin) * (k + 1) as f64 / steps as f64;
-            Rectangle::new(
-                [(0.0, a), (1.0, b)],
-                viridis((k as f64 + 0.5) / steps as f64).filled(),
-            )
-        }))
-        .map_err(draw_err)?;
-        Ok(())
+        draw_colour_bar(&bar_area, &self.value_label, (vmin, vmax))
     }
+}
+
+/// The colour bar: the viridis scale from `vmin` to `vmax`, labelled `value_label`.
+fn draw_colour_bar<DB: DrawingBackend>(
+    bar_area: &DrawingArea<DB, Shift>,
+    value_label: &str,
+    (vmin, vmax): (f64, f64),
+) -> Result<(), PlotError> {
+    let mut bar = ChartBuilder::on(bar_area)
+        .margin_top(10)
+        .margin_bottom(50)
+        .margin_right(8)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.0, vmin..vmax)
+        .map_err(draw_err)?;
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc(value_label)
+        .label_style((FAMILY, 13))
+        .axis_desc_style((FAMILY, 14))
+        .y_label_formatter(&|v| format_tick(*v))
+        .draw()
+        .map_err(draw_err)?;
+    let steps = 128;
+    bar.draw_series((0..steps).map(|k| {
+        let a = vmin + (vmax - vmin) * k as f64 / steps as f64;
+        let b = vmin + (vmax - vmin) * (k + 1) as f64 / steps as f64;
+        Rectangle::new(
+            [(0.0, a), (1.0, b)],
+            viridis((k as f64 + 0.5) / steps as f64).filled(),
+        )
+    }))
+    .map_err(draw_err)?;
+    Ok(())
 }

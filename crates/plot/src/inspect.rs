@@ -10,7 +10,9 @@ use crate::PlotError;
 /// What a PNG holds, in numbers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PngSummary {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Number of distinct RGB colours.
     pub distinct_colours: usize,
@@ -23,7 +25,7 @@ pub struct PngSummary {
 /// Decodes the PNG at `path` (grey, RGB or RGBA; 16-bit samples as their high byte) and
 /// summarises it.
 pub fn summarize_png(path: &Path) -> Result<PngSummary, PlotError> {
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::IMAGE).map_err(|source| {
+    let bytes = glassdb_io::read_input(path, glassdb_image::IMAGE_FILE).map_err(|source| {
         PlotError::Read {
             path: path.into(),
             source,

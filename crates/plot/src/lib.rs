@@ -6,6 +6,8 @@
 //! Everything renders with plotters and the embedded DejaVu Sans font (no system font
 //! library); PNG or SVG by the output extension; files are written atomically.
 
+#![warn(missing_docs)]
+
 pub mod chart;
 pub mod colormap;
 mod error;

@@ -8,8 +8,8 @@ use glassdb_spectral::Integrator;
 use glassdb_stack::measured::model_angles_deg;
 use glassdb_stack::{Application, Combination, EvalOptions, Layer, Stack};
 
-use crate::build::{CatalogFiles, sha256_hex};
 use crate::catalog::LayerSpec;
+use crate::catalog_files::{CatalogFiles, sha256_hex};
 use crate::normal::NormalValues;
 use crate::{FileRef, RegistryError};
 
@@ -115,7 +115,7 @@ pub(crate) fn read_measured_table(
     let Some((rel, percent)) = &spec.angles else {
         return Ok(None);
     };
-    let (full, bytes) = files.read(rel, glass, glassdb_io::limits::ANGLE_TABLE)?;
+    let (full, bytes) = files.read(rel, glass, glassdb_fit::ANGLE_TABLE_FILE)?;
     let stem = full
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

@@ -9,12 +9,12 @@ use std::path::{Path, PathBuf};
 use glassdb_spectral::{IntegrationSettings, Integrator};
 use glassdb_stack::LayerModel;
 use rayon::prelude::*;
-use sha2::{Digest, Sha256};
 
 use crate::angle_model::{ModelTables, read_measured_table};
 use crate::catalog::{
     ElementSpec, GlassBuild, GlassSpec, LayerSpec, NormalSource, parse_catalog, resolve,
 };
+use crate::catalog_files::{CatalogFiles, sha256_hex};
 use crate::curves::{GlassCurves, fit_glass_curves};
 use crate::normal::{NormalValues, normal_values, read_layer};
 use crate::{
@@ -67,40 +67,9 @@ impl Default for BuildOptions {
     }
 }
 
-/// Reads the files a catalog names, relative to the catalog.
-pub(crate) struct CatalogFiles<'a> {
-    pub(crate) catalog_path: &'a Path,
-}
-
-impl CatalogFiles<'_> {
-    /// The full path and bytes of the file `rel` that `glass` names, of at most `limit`.
-    pub(crate) fn read(
-        &self,
-        rel: &str,
-        glass: &str,
-        limit: glassdb_io::InputLimit,
-    ) -> Result<(PathBuf, Vec<u8>), RegistryError> {
-        let path = resolve(self.catalog_path, rel);
-        match glassdb_io::read_input(&path, limit) {
-            Ok(bytes) => Ok((path, bytes)),
-            Err(source) => Err(RegistryError::InputFile {
-                glass: glass.to_string(),
-                path,
-                source,
-            }),
-        }
-    }
-}
-
-/// The hex SHA-256 of some bytes.
-pub(crate) fn sha256_hex(bytes: &[u8]) -> String {
-    let digest = Sha256::digest(bytes);
-    digest.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// The bytes of a catalog file, of at most [`glassdb_io::limits::CATALOG`].
+/// The bytes of a catalog file, of at most [`crate::CATALOG_FILE`].
 fn read_catalog(catalog_path: &Path) -> Result<Vec<u8>, RegistryError> {
-    glassdb_io::read_input(catalog_path, glassdb_io::limits::CATALOG).map_err(|source| {
+    glassdb_io::read_input(catalog_path, crate::CATALOG_FILE).map_err(|source| {
         RegistryError::Read {
             path: catalog_path.to_path_buf(),
             source,

@@ -15,16 +15,21 @@
 //!   system curves plus a [`UnitRecord`] (build-up, per-layer values, pane groups' depths and
 //!   reflectance shares); [`UnitBuilder`] builds one from a catalog's glasses on demand.
 
+#![warn(missing_docs)]
+
 mod angle_model;
 mod build;
 mod bundled;
 pub mod catalog;
+mod catalog_files;
 mod curves;
 mod error;
 mod lights;
 mod normal;
 mod record;
+mod registry;
 mod unit;
+mod unit_builder;
 mod unit_record;
 mod validate;
 
@@ -32,19 +37,25 @@ mod validate;
 /// glasses and its units use).
 pub use glassdb_stack::physics;
 
+/// The largest catalog (`catalog.toml`) read.
+pub const CATALOG_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::mib(16, "a catalog");
+
 pub use build::{Application, BuildOptions, MaskIds, build_registry, catalog_inputs};
 pub use bundled::{DEFAULT_REGISTRY_JSON, DEFAULT_REGISTRY_NAME, default_registry};
 pub use error::RegistryError;
 /// The cap on every curve's recorded validation tolerance (shared with fit files).
 pub use glassdb_fit::MAX_CURVE_TOLERANCE;
+/// The face of a pane a record's values are for (the `glassdb-side` crate's type).
+pub use glassdb_side::{Side, UnknownSide};
 pub use lights::{MAX_LIGHT_NAME, NamedLight, RegistryLight, check_light_name};
 pub use record::{
-    AngleCurve, AngleModelRecord, CHANNELS, ColourBasis, FileRef, GlassRecord, LuminousRecord,
-    ProductRecord, Provenance, Registry, RegistryTable, SCHEMA_VERSION,
-    SCHEMA_VERSION_BEFORE_LIGHTS, SCHEMA_VERSION_BEFORE_UNITS, SCHEMA_VERSION_ONE_TABLE, Side,
-    UnknownSide,
+    AngleCurve, AngleModelRecord, FileRef, GlassRecord, LuminousRecord, ProductRecord, Provenance,
 };
-pub use unit::{ChosenElement, UnitBuilder, UnitChoice};
+pub use registry::{
+    CHANNELS, ColourBasis, Registry, RegistryTable, SCHEMA_VERSION, SCHEMA_VERSION_BEFORE_LIGHTS,
+    SCHEMA_VERSION_BEFORE_UNITS, SCHEMA_VERSION_ONE_TABLE,
+};
+pub use unit_builder::{ChosenElement, UnitBuilder, UnitChoice};
 pub use unit_record::{
     Absorptance, GapRecord, PaneGroupRecord, SystemValues, UnitElement, UnitLayerRecord, UnitRecord,
 };

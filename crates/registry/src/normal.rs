@@ -5,8 +5,8 @@
 use glassdb_spectral::Integrator;
 use glassdb_stack::{Layer, LayerData, LayerOptions, StackError};
 
-use crate::build::{CatalogFiles, sha256_hex};
 use crate::catalog::{LayerSpec, NormalSource};
+use crate::catalog_files::{CatalogFiles, sha256_hex};
 use crate::{FileRef, LuminousRecord, ProductRecord, RegistryError};
 
 /// Per-channel normal-incidence values.
@@ -65,7 +65,7 @@ pub(crate) fn read_layer(
             unreachable!("layers given by an angle table are read by the unit builder")
         }
     };
-    let (full, bytes) = files.read(path, glass, glassdb_io::limits::SPECTRAL)?;
+    let (full, bytes) = files.read(path, glass, glassdb_spectral::SPECTRAL_FILE)?;
     let read_opts = glassdb_spectral::ReadOptions { percent };
     let data =
         glassdb_spectral::read_spectral_bytes(&bytes, &full.display().to_string(), &read_opts)

@@ -1,8 +1,6 @@
 //! Units in the registry: a catalog entry with `layers` built by the stack engine into a glass
 //! record per table (system curves, as for any glass, plus the [`UnitRecord`]: build-up,
-//! per-layer values, per-pane-group reflectance curves and depths); and [`UnitBuilder`], the
-//! entry point a front-end calls to build a unit from a catalog's glasses on demand (the
-//! viewer's "build a unit on the page").
+//! per-layer values, per-pane-group reflectance curves and depths).
 
 use std::path::{Path, PathBuf};
 
@@ -10,23 +8,19 @@ use glassdb_fit::{AngleSamples, Quantity};
 use glassdb_spectral::{Integrator, WindowMethod, WindowWeights};
 use glassdb_stack::measured::{MeasuredRatio, RatioFit, cos_deg, model_angles_deg};
 use glassdb_stack::{
-    Combination, Element, EvalOptions, Gap, Gas, Layer, LayerData, Optics, Stack, StackError,
+    Combination, Element, EvalOptions, Evaluation, Gap, Layer, LayerData, Optics, Stack, StackError,
 };
 
 use crate::angle_model::{ModelTables, integration_error, read_measured_table};
-use crate::build::{
-    BuildOptions, CatalogFiles, build_glass, glass_record, integrators_of, load_catalog, oriented,
-};
-use crate::catalog::{ElementSpec, GlassBuild, GlassSpec, LayerSpec, NormalSource};
+use crate::build::{BuildOptions, build_glass, glass_record, oriented};
+use crate::catalog::{ElementSpec, GlassSpec, LayerSpec, NormalSource};
+use crate::catalog_files::CatalogFiles;
 use crate::curves::{fit_glass_curves, fit_share_curves};
 use crate::normal::{CatalogLayer, normal_values, read_layer};
 use crate::unit_record::{
     Absorptance, GapRecord, PaneGroupRecord, SystemValues, UnitElement, UnitLayerRecord, UnitRecord,
 };
-use crate::{
-    AngleModelRecord, GlassRecord, LuminousRecord, Provenance, Registry, RegistryError,
-    RegistryTable,
-};
+use crate::{AngleModelRecord, GlassRecord, LuminousRecord, Provenance, RegistryError};
 
 /// Wavelengths (nm) of a grey layer (one given by its angle table alone): 300–2500 nm in 10 nm
 /// steps, the same value at each.
@@ -180,42 +174,10 @@ pub(crate) fn build_unit(
     integrators: &[Integrator],
     opts: &BuildOptions,
 ) -> Result<Vec<GlassRecord>, RegistryError> {
-    let glass = format!("{} (\"{}\")", spec.id, spec.name);
-    let catalog = files.catalog_path.to_path_buf();
-    let mut layers: Vec<(usize, &LayerSpec, UnitLayer)> = Vec::new();
-    let mut stack_elements = Vec::with_capacity(elements.len());
-    for (i, e) in elements.iter().enumerate() {
-        match e {
-            ElementSpec::Layer(l) => {
-                let label = element_label(&glass, i + 1, l.line);
-                let unit_layer = read_unit_layer(l, &spec.name, files, &label, opts)?;
-                stack_elements.push(Element::Layer(Box::new(unit_layer.read.layer.clone())));
-                layers.push((i, l, unit_layer));
-            }
-            ElementSpec::Gap {
-                thickness_mm, gas, ..
-            } => stack_elements.push(Element::Gap(Gap {
-                thickness_mm: *thickness_mm,
-                gas: *gas,
-            })),
-        }
-    }
-    let unit_err = |e: StackError| {
-        let line = e
-            .position()
-            .and_then(|p| elements.get(p - 1))
-            .map_or(spec.line, ElementSpec::line);
-        RegistryError::Unit {
-            path: catalog.clone(),
-            line,
-            glass: glass.clone(),
-            source: Box::new(e),
-        }
-    };
-    let stack = Stack::new(stack_elements).map_err(unit_err)?;
-    if layers.len() == 1 {
-        let (_, l, unit_layer) = &layers[0];
-        return one_layer_unit(spec, l, unit_layer, &stack, files, integrators, opts);
+    let unit = UnitBuild::read(spec, elements, files, opts)?;
+    if unit.layers.len() == 1 {
+        let (_, l, unit_layer) = &unit.layers[0];
+        return one_layer_unit(spec, l, unit_layer, &unit.stack, files, integrators, opts);
     }
     let angles = model_angles_deg();
     let eval_opts = EvalOptions {
@@ -223,56 +185,123 @@ pub(crate) fn build_unit(
         combination: Combination::PerWavelength,
     };
     let evaluate = |angles: &[f64], integrators: &[Integrator], window: bool| {
-        stack
+        unit.stack
             .evaluate(angles, integrators, window, eval_opts)
             .map_err(|e| match e {
-                StackError::Integration { .. } => integration_error(e, &glass),
-                other => unit_err(other),
+                StackError::Integration { .. } => integration_error(e, &unit.glass),
+                other => unit.error(other),
             })
     };
     // the colours at every angle; WINDOW's values (recorded at normal incidence) at 0° only
     let eval = evaluate(&angles, integrators, false)?;
     let at_normal = evaluate(&[0.0], &[], true)?;
-    let luminous = match stack.spectra_at(0.0).map_err(unit_err)? {
-        Some(s) => {
-            let lum = |v: &[f64], what: &str| {
-                glassdb_spectral::luminous_iso9050(&s.wavelength_nm, v).map_err(|source| {
-                    RegistryError::Integration {
-                        glass: glass.clone(),
-                        what: format!("luminous {what}"),
-                        source: Box::new(source),
-                    }
-                })
-            };
-            Some(LuminousRecord {
-                transmittance: lum(&s.optics.t, "transmittance")?,
-                reflectance: lum(&s.optics.rf, "reflectance")?,
-                reflectance_back: lum(&s.optics.rb, "back reflectance")?,
-            })
+    let luminous = unit.luminous()?;
+    integrators
+        .iter()
+        .enumerate()
+        .map(|(k, integrator)| unit.record(k, integrator, &eval, &at_normal, luminous, opts))
+        .collect()
+}
+
+/// A unit of several layers being built: its glass, its layers as read (with their position
+/// among the elements) and its validated stack.
+struct UnitBuild<'a> {
+    spec: &'a GlassSpec,
+    elements: &'a [ElementSpec],
+    /// The glass's label in messages.
+    glass: String,
+    catalog: PathBuf,
+    layers: Vec<(usize, &'a LayerSpec, UnitLayer)>,
+    stack: Stack,
+}
+
+impl<'a> UnitBuild<'a> {
+    /// Reads the unit's layers and builds its stack.
+    fn read(
+        spec: &'a GlassSpec,
+        elements: &'a [ElementSpec],
+        files: &CatalogFiles<'_>,
+        opts: &BuildOptions,
+    ) -> Result<Self, RegistryError> {
+        let glass = format!("{} (\"{}\")", spec.id, spec.name);
+        let mut layers: Vec<(usize, &LayerSpec, UnitLayer)> = Vec::new();
+        let mut stack_elements = Vec::with_capacity(elements.len());
+        for (i, e) in elements.iter().enumerate() {
+            match e {
+                ElementSpec::Layer(l) => {
+                    let label = element_label(&glass, i + 1, l.line);
+                    let unit_layer = read_unit_layer(l, &spec.name, files, &label, opts)?;
+                    stack_elements.push(Element::Layer(Box::new(unit_layer.read.layer.clone())));
+                    layers.push((i, l, unit_layer));
+                }
+                ElementSpec::Gap {
+                    thickness_mm, gas, ..
+                } => stack_elements.push(Element::Gap(Gap {
+                    thickness_mm: *thickness_mm,
+                    gas: *gas,
+                })),
+            }
         }
-        None => None,
-    };
-    let system = |o: Option<&Vec<Optics<f64>>>| {
-        o.map(|v| SystemValues {
-            transmittance: v[0].t,
-            reflectance: v[0].rf,
-            reflectance_back: v[0].rb,
+        let catalog = files.catalog_path.to_path_buf();
+        let stack = Stack::new(stack_elements)
+            .map_err(|e| unit_error(e, spec, elements, &catalog, &glass))?;
+        Ok(UnitBuild {
+            spec,
+            elements,
+            glass,
+            catalog,
+            layers,
+            stack,
         })
-    };
-    let mut records = Vec::with_capacity(integrators.len());
-    for (k, integrator) in integrators.iter().enumerate() {
+    }
+
+    /// A stack error as the registry's, on the catalog line of the element it names.
+    fn error(&self, e: StackError) -> RegistryError {
+        unit_error(e, self.spec, self.elements, &self.catalog, &self.glass)
+    }
+
+    /// The unit's luminous values (ISO 9050) at normal incidence, when its layers have spectra.
+    fn luminous(&self) -> Result<Option<LuminousRecord>, RegistryError> {
+        let Some(s) = self.stack.spectra_at(0.0).map_err(|e| self.error(e))? else {
+            return Ok(None);
+        };
+        let lum = |v: &[f64], what: &str| {
+            glassdb_spectral::luminous_iso9050(&s.wavelength_nm, v).map_err(|source| {
+                RegistryError::Integration {
+                    glass: self.glass.clone(),
+                    what: format!("luminous {what}"),
+                    source: Box::new(source),
+                }
+            })
+        };
+        Ok(Some(LuminousRecord {
+            transmittance: lum(&s.optics.t, "transmittance")?,
+            reflectance: lum(&s.optics.rf, "reflectance")?,
+            reflectance_back: lum(&s.optics.rb, "back reflectance")?,
+        }))
+    }
+
+    /// The unit's record in the basis of `integrator`, the `k`-th of `eval`'s.
+    fn record(
+        &self,
+        k: usize,
+        integrator: &Integrator,
+        eval: &Evaluation,
+        at_normal: &Evaluation,
+        luminous: Option<LuminousRecord>,
+        opts: &BuildOptions,
+    ) -> Result<GlassRecord, RegistryError> {
         let per_angle = &eval.colour[k];
         let row = |f: &dyn Fn(&Optics<[f64; 3]>) -> [f64; 3]| -> Vec<[f64; 3]> {
             per_angle.iter().map(f).collect()
         };
-        let clamp = |v: [f64; 3]| v.map(|x| x.clamp(0.0, 1.0));
         let normal = crate::normal::NormalValues {
-            r0: clamp(per_angle[0].rf),
-            t0: clamp(per_angle[0].t),
-            r0_back: clamp(per_angle[0].rb),
+            r0: clamp_unit(per_angle[0].rf),
+            t0: clamp_unit(per_angle[0].t),
+            r0_back: clamp_unit(per_angle[0].rb),
         };
         let mut tables = ModelTables {
-            angles: angles.clone(),
+            angles: eval.angles_deg.clone(),
             rf: row(&|o| o.rf),
             t: row(&|o| o.t),
             rb: row(&|o| o.rb),
@@ -280,8 +309,58 @@ pub(crate) fn build_unit(
         tables.rf[0] = normal.r0;
         tables.t[0] = normal.t0;
         tables.rb[0] = normal.r0_back;
-        let curves = fit_glass_curves(&normal, &tables, None, opts, &glass)?;
-        let n_groups = stack.groups().len();
+        let curves = fit_glass_curves(&normal, &tables, None, opts, &self.glass)?;
+        let groups = self.group_records(per_angle, &tables, opts)?;
+        let unit_elements = self.element_records(integrator, at_normal)?;
+        let angle_model = AngleModelRecord {
+            kind: "unit".into(),
+            applied: opts.application.name().to_string(),
+            ior: None,
+            measured_max_angle_deg: None,
+            continued_by: None,
+            chosen_by: format!(
+                "{} layers combined {}",
+                self.layers.len(),
+                eval.combination.name()
+            ),
+        };
+        let mut record = glass_record(
+            self.spec,
+            &normal,
+            curves,
+            luminous,
+            angle_model,
+            Provenance::default(),
+        );
+        let system = |o: Option<&Vec<Optics<f64>>>| {
+            o.map(|v| SystemValues {
+                transmittance: v[0].t,
+                reflectance: v[0].rf,
+                reflectance_back: v[0].rb,
+            })
+        };
+        record.unit = Some(UnitRecord {
+            elements: unit_elements,
+            groups,
+            thickness_mm: self.stack.thickness_mm(),
+            combined: eval.combination.name().to_string(),
+            photopic: system(at_normal.photopic.as_ref()),
+            solar: system(at_normal.solar.as_ref()),
+        });
+        Ok(record)
+    }
+
+    /// Each pane group's share of the reflectance, front and back, with its fitted curves.
+    fn group_records(
+        &self,
+        per_angle: &[Optics<[f64; 3]>],
+        tables: &ModelTables,
+        opts: &BuildOptions,
+    ) -> Result<Vec<PaneGroupRecord>, RegistryError> {
+        let n_groups = self.stack.groups().len();
+        let row = |f: &dyn Fn(&Optics<[f64; 3]>) -> [f64; 3]| -> Vec<[f64; 3]> {
+            per_angle.iter().map(f).collect()
+        };
         let shares_front = stored_shares(
             (0..n_groups).map(|g| row(&|o| o.share_front[g])).collect(),
             &tables.rf,
@@ -291,7 +370,7 @@ pub(crate) fn build_unit(
             &tables.rb,
         );
         let mut groups = Vec::with_capacity(n_groups);
-        for (g, group) in stack.groups().iter().enumerate() {
+        for (g, group) in self.stack.groups().iter().enumerate() {
             let share = |front: bool| -> Result<([f64; 3], [crate::AngleCurve; 3]), RegistryError> {
                 let table = if front {
                     shares_front[g].clone()
@@ -311,7 +390,7 @@ pub(crate) fn build_unit(
                     if front { "front" } else { "back" }
                 );
                 let curves =
-                    fit_share_curves(table[0], &tables, &table, quantity, opts, &glass, &name)?;
+                    fit_share_curves(table[0], tables, &table, quantity, opts, &self.glass, &name)?;
                 Ok((table[0], curves))
             };
             let (r0, c_r) = share(true)?;
@@ -327,9 +406,19 @@ pub(crate) fn build_unit(
                 c_r_back,
             });
         }
-        let mut unit_elements = Vec::with_capacity(elements.len());
-        let mut next_layer = layers.iter().enumerate().peekable();
-        for (i, e) in elements.iter().enumerate() {
+        Ok(groups)
+    }
+
+    /// The build-up as recorded: gaps, and each layer's record in `integrator`'s basis with
+    /// its solar absorptance in the unit.
+    fn element_records(
+        &self,
+        integrator: &Integrator,
+        at_normal: &Evaluation,
+    ) -> Result<Vec<UnitElement>, RegistryError> {
+        let mut unit_elements = Vec::with_capacity(self.elements.len());
+        let mut next_layer = self.layers.iter().enumerate().peekable();
+        for (i, e) in self.elements.iter().enumerate() {
             match e {
                 ElementSpec::Gap {
                     thickness_mm, gas, ..
@@ -339,7 +428,7 @@ pub(crate) fn build_unit(
                 })),
                 ElementSpec::Layer(_) => {
                     let (index, (_, l, unit_layer)) = next_layer.next().expect("one per layer");
-                    debug_assert_eq!(layers[index].0, i);
+                    debug_assert_eq!(self.layers[index].0, i);
                     let absorptance = at_normal.solar.as_ref().map(|s| Absorptance {
                         front: s[0].absorptance_front[index],
                         back: s[0].absorptance_back[index],
@@ -347,45 +436,42 @@ pub(crate) fn build_unit(
                     unit_elements.push(UnitElement::Layer(Box::new(layer_record(
                         l,
                         unit_layer,
-                        stack.layers().nth(index).expect("layer").thickness_mm,
+                        self.stack.layers().nth(index).expect("layer").thickness_mm,
                         integrator,
                         absorptance,
-                        &glass,
+                        &self.glass,
                     )?)));
                 }
             }
         }
-        let angle_model = AngleModelRecord {
-            kind: "unit".into(),
-            applied: opts.application.name().to_string(),
-            ior: None,
-            measured_max_angle_deg: None,
-            continued_by: None,
-            chosen_by: format!(
-                "{} layers combined {}",
-                layers.len(),
-                eval.combination.name()
-            ),
-        };
-        let mut record = glass_record(
-            spec,
-            &normal,
-            curves,
-            luminous,
-            angle_model,
-            Provenance::default(),
-        );
-        record.unit = Some(UnitRecord {
-            elements: unit_elements,
-            groups,
-            thickness_mm: stack.thickness_mm(),
-            combined: eval.combination.name().to_string(),
-            photopic: system(at_normal.photopic.as_ref()),
-            solar: system(at_normal.solar.as_ref()),
-        });
-        records.push(record);
+        Ok(unit_elements)
     }
-    Ok(records)
+}
+
+/// A stack error as the registry's, on the catalog line of the element it names (the unit's
+/// line when it names none).
+fn unit_error(
+    e: StackError,
+    spec: &GlassSpec,
+    elements: &[ElementSpec],
+    catalog: &Path,
+    glass: &str,
+) -> RegistryError {
+    let line = e
+        .position()
+        .and_then(|p| elements.get(p - 1))
+        .map_or(spec.line, ElementSpec::line);
+    RegistryError::Unit {
+        path: catalog.to_path_buf(),
+        line,
+        glass: glass.to_string(),
+        source: Box::new(e),
+    }
+}
+
+/// Each channel clamped to 0–1.
+fn clamp_unit(v: [f64; 3]) -> [f64; 3] {
+    v.map(|x| x.clamp(0.0, 1.0))
 }
 
 /// One layer's record in its unit (in `integrator`'s basis, as it faces in the unit).
@@ -479,141 +565,6 @@ fn one_layer_unit(
     Ok(records)
 }
 
-/// One element of a unit chosen from a catalog's glasses.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ChosenElement {
-    /// A single glass of the catalog, by id, turned round or not.
-    Glass {
-        /// Its catalog id.
-        id: u16,
-        /// Turned round (coating on the other surface).
-        flip: bool,
-    },
-    /// A gap.
-    Gap {
-        /// Thickness (mm).
-        thickness_mm: f64,
-        /// Its gas.
-        gas: Gas,
-    },
-}
-
-/// A unit chosen on a front-end (the viewer's picker): its id and name and its elements,
-/// outside first.
-#[derive(Debug, Clone, PartialEq)]
-pub struct UnitChoice {
-    /// The id the unit gets.
-    pub id: u16,
-    /// Its name.
-    pub name: String,
-    /// Layers (the catalog's single glasses) and gaps, outside first.
-    pub elements: Vec<ChosenElement>,
-}
-
-/// A catalog loaded once, building units from its single glasses on demand: the entry point
-/// a front-end calls (`glassdb view` builds a unit on the page with it). Each build reads the
-/// chosen glasses' files, runs the stack engine and fits the curves of every table.
-#[derive(Debug)]
-pub struct UnitBuilder {
-    catalog_path: PathBuf,
-    specs: Vec<GlassSpec>,
-    /// The tables a build makes, empty.
-    tables: Vec<RegistryTable>,
-    integrators: Vec<Integrator>,
-    opts: BuildOptions,
-}
-
-impl UnitBuilder {
-    /// Loads the catalog and prepares the integrators of `opts.tables`.
-    pub fn new(catalog_path: &Path, opts: BuildOptions) -> Result<UnitBuilder, RegistryError> {
-        let (tables, integrators) = integrators_of(&opts)?;
-        let (specs, _) = load_catalog(catalog_path)?;
-        Ok(UnitBuilder {
-            catalog_path: catalog_path.to_path_buf(),
-            specs,
-            tables,
-            integrators,
-            opts,
-        })
-    }
-
-    /// The catalog's single glasses (the layers a unit can be built from): id and name.
-    pub fn glasses(&self) -> Vec<(u16, &str)> {
-        self.specs
-            .iter()
-            .filter(|s| matches!(s.build, GlassBuild::Single(_)))
-            .map(|s| (s.id, s.name.as_str()))
-            .collect()
-    }
-
-    /// Builds the chosen unit: a validated registry of one glass in each table of the options.
-    pub fn build(&self, choice: &UnitChoice) -> Result<Registry, RegistryError> {
-        let bad = |message: String| RegistryError::CatalogEntry {
-            path: self.catalog_path.clone(),
-            glass: format!("\"{}\" (id {})", choice.name, choice.id),
-            message,
-        };
-        if choice.id == 0 {
-            return Err(bad("id 0 is \"no glass\" in every mask".into()));
-        }
-        let mut elements = Vec::with_capacity(choice.elements.len());
-        for (i, e) in choice.elements.iter().enumerate() {
-            elements.push(match e {
-                ChosenElement::Gap { thickness_mm, gas } => ElementSpec::Gap {
-                    thickness_mm: *thickness_mm,
-                    gas: *gas,
-                    line: 0,
-                },
-                ChosenElement::Glass { id, flip } => {
-                    let spec = self.specs.iter().find(|s| s.id == *id).ok_or_else(|| {
-                        bad(format!("element {}: the catalog has no glass with id {id}", i + 1))
-                    })?;
-                    let GlassBuild::Single(layer) = &spec.build else {
-                        return Err(bad(format!(
-                            "element {}: glass {id} (\"{}\") is a unit itself; a layer is a single glass",
-                            i + 1,
-                            spec.name
-                        )));
-                    };
-                    let mut layer = layer.clone();
-                    layer.flip = *flip;
-                    layer.line = spec.line;
-                    ElementSpec::Layer(layer)
-                }
-            });
-        }
-        let spec = GlassSpec {
-            id: choice.id,
-            name: choice.name.clone(),
-            line: 0,
-            build: GlassBuild::Unit(elements.clone()),
-        };
-        let files = CatalogFiles {
-            catalog_path: &self.catalog_path,
-        };
-        let records = build_unit(&spec, &elements, &files, &self.integrators, &self.opts).map_err(
-            |e| match e {
-                RegistryError::Unit { glass, source, .. } => RegistryError::UnitChoice {
-                    path: self.catalog_path.clone(),
-                    glass,
-                    source,
-                },
-                other => other,
-            },
-        )?;
-        let tables = self
-            .tables
-            .iter()
-            .zip(records)
-            .map(|(table, g)| RegistryTable {
-                glasses: vec![g],
-                ..table.clone()
-            })
-            .collect();
-        Registry::new(tables)
-    }
-}
-
 /// The pane groups' reflectance shares as the registry stores them (`[group][angle]`, per
 /// channel). A channel can integrate negative: an out-of-gamut colour, e.g. a blue coating's
 /// back reflectance in sRGB's red under the narrow-band LED-RGB1. In a channel where some
@@ -648,75 +599,4 @@ fn stored_shares(mut shares: Vec<Vec<[f64; 3]>>, unit: &[[f64; 3]]) -> Vec<Vec<[
         }
     }
     shares
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn bundled() -> UnitBuilder {
-        let catalog = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/catalog.toml");
-        UnitBuilder::new(&catalog, BuildOptions::default()).unwrap()
-    }
-
-    fn gap() -> ChosenElement {
-        ChosenElement::Gap {
-            thickness_mm: 12.7,
-            gas: Gas::Argon,
-        }
-    }
-
-    fn glass(id: u16) -> ChosenElement {
-        ChosenElement::Glass { id, flip: false }
-    }
-
-    #[test]
-    fn the_viewer_builds_a_unit_from_the_catalogs_glasses() {
-        let b = bundled();
-        assert!(b.glasses().iter().any(|&(id, _)| id == 6));
-        assert!(
-            b.glasses().iter().all(|&(id, _)| id != 11),
-            "units are not layers"
-        );
-        let choice = UnitChoice {
-            id: 300,
-            name: "R67 | argon | clear 6".into(),
-            elements: vec![glass(6), gap(), glass(2)],
-        };
-        let reg = b.build(&choice).unwrap();
-        let g = reg.default_table().glass(300).unwrap();
-        let unit = g.unit.as_ref().unwrap();
-        assert_eq!(unit.groups.len(), 2);
-        assert_eq!(unit.elements.len(), 3);
-        // the same unit in the bundled catalog (id 12) has the same optics
-        let bundled = crate::default_registry().unwrap();
-        let twelve = bundled.default_table().glass(12).unwrap();
-        assert_eq!(
-            (g.r0, g.t0, g.r0_back),
-            (twelve.r0, twelve.t0, twelve.r0_back)
-        );
-    }
-
-    #[test]
-    fn bad_choices_say_what_is_wrong() {
-        let b = bundled();
-        let build = |elements: Vec<ChosenElement>| {
-            let choice = UnitChoice {
-                id: 300,
-                name: "bad".into(),
-                elements,
-            };
-            glassdb_io::ErrorChain(&b.build(&choice).unwrap_err()).to_string()
-        };
-        let e = build(vec![glass(99)]);
-        assert!(e.contains("no glass with id 99"), "{e}");
-        let e = build(vec![glass(11)]);
-        assert!(e.contains("is a unit itself"), "{e}");
-        let e = build(vec![glass(2), gap(), gap(), glass(2)]);
-        assert!(e.contains("two gaps in a row") && !e.contains(":0:"), "{e}");
-        let e = build(vec![glass(2), gap()]);
-        assert!(e.contains("gap at the inner end"), "{e}");
-        let e = build(vec![glass(20), gap(), glass(2)]);
-        assert!(e.contains("is opaque but layer 3"), "{e}");
-    }
 }

@@ -5,7 +5,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::record::{AngleCurve, LuminousRecord, Provenance, Side};
+use crate::record::{AngleCurve, LuminousRecord, Provenance};
+use glassdb_side::Side;
 
 /// A unit's build-up and per-group reflectances.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -6,8 +6,10 @@ use std::collections::BTreeMap;
 use glassdb_fit::MAX_CURVE_TOLERANCE;
 
 use crate::RegistryError;
-use crate::record::{AngleCurve, CHANNELS, GlassRecord, Registry, RegistryTable, Side};
+use crate::record::{AngleCurve, GlassRecord};
+use crate::registry::{CHANNELS, Registry, RegistryTable};
 use crate::unit_record::{UnitElement, UnitRecord};
+use glassdb_side::Side;
 
 /// Angle step of the validation grid (degrees): 0, 0.25, …, 90.
 const VALIDATION_STEP_DEG: f64 = 0.25;

@@ -8,13 +8,17 @@ pub enum ReportError {
     /// An input file (the catalog) could not be read.
     #[error("cannot read {path}")]
     Read {
+        /// The catalog.
         path: PathBuf,
+        /// Why it could not be read.
         source: glassdb_io::InputError,
     },
     /// The figures directory could not be created.
     #[error("cannot create the figures directory {path}")]
     CreateDir {
+        /// The folder.
         path: PathBuf,
+        /// Why it could not be made.
         source: std::io::Error,
     },
     /// Writing the page or a figure failed (nothing was written).
@@ -38,4 +42,22 @@ pub enum ReportError {
     /// An error from the mask crate (a glass mapping).
     #[error(transparent)]
     Mask(#[from] glassdb_mask::MaskError),
+}
+
+impl ReportError {
+    /// The class of this error: a wrapped error's own class; a folder that cannot be made is
+    /// I/O.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        match self {
+            ReportError::Read { source, .. } => source.kind(),
+            ReportError::CreateDir { .. } => glassdb_io::ErrorKind::Io,
+            ReportError::Output(e) => e.kind(),
+            ReportError::Plot(e) => e.kind(),
+            ReportError::Fit(e) => e.kind(),
+            ReportError::Spectral(e) => e.kind(),
+            ReportError::Registry(e) => e.kind(),
+            ReportError::Scene(e) => e.kind(),
+            ReportError::Mask(e) => e.kind(),
+        }
+    }
 }

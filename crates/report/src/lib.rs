@@ -7,6 +7,8 @@
 //! Each section of the page is one module; every input file is named by the caller
 //! ([`ReportOptions`]).
 
+#![warn(missing_docs)]
+
 mod cos_storage;
 mod degree_basis;
 mod error;
@@ -48,23 +50,29 @@ pub struct ReportOptions {
 /// A spectrum file and the name its figures go by (`spectral_<name>_<method>.png`).
 #[derive(Debug, Clone)]
 pub struct SpectrumFigure {
+    /// The spectral file.
     pub spectrum: PathBuf,
+    /// The name its figures go by.
     pub name: String,
 }
 
 /// The scene used to compare the paper's Gouraud-interpolated cos θ with the exact one.
 #[derive(Debug, Clone)]
 pub struct GouraudScene {
+    /// The OBJ scene.
     pub obj: PathBuf,
+    /// Its camera.
     pub camera: PathBuf,
     /// `PATTERN=ID` as `glassdb mask --glass`.
     pub glass: Vec<String>,
+    /// The catalog of its glasses.
     pub catalog: PathBuf,
 }
 
 /// The generated page and its figures, which [`Report::write`] writes together.
 #[derive(Debug)]
 pub struct Report {
+    /// The page's Markdown.
     pub markdown: String,
     /// Where the figures go (written by [`Report::write`]).
     pub figures: Vec<PathBuf>,

@@ -114,13 +114,12 @@ pub(crate) fn section_spectral(md: &mut String, catalog: &Path) -> Result<(), Re
 
 /// Reads every spectral glass of the catalog and integrates its τ and front ρ by each method.
 fn spectral_rows(catalog: &Path) -> Result<Vec<SpectralRow>, ReportError> {
-    let text =
-        glassdb_io::read_input_string(catalog, glassdb_io::limits::CATALOG).map_err(|source| {
-            ReportError::Read {
-                path: catalog.into(),
-                source,
-            }
-        })?;
+    let text = glassdb_io::read_input_string(catalog, glassdb_registry::CATALOG_FILE).map_err(
+        |source| ReportError::Read {
+            path: catalog.into(),
+            source,
+        },
+    )?;
     let specs = parse_catalog(&text, catalog)?;
     let (cmfs, srgb_settings) = spectral_methods();
     let mut rows = Vec::new();

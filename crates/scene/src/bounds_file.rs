@@ -16,6 +16,7 @@ pub const PLANE_BOUNDS_FORMAT: &str = "glassdb-plane-bounds/1";
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlaneBoundsFile {
+    /// [`PLANE_BOUNDS_FORMAT`].
     pub format: String,
     /// The animation frame, or `null` for a single mask.
     pub frame: Option<u32>,
@@ -23,6 +24,7 @@ pub struct PlaneBoundsFile {
     pub mask: String,
     /// The frame's size in pixels (the display window).
     pub width: u32,
+    /// Mask height in pixels.
     pub height: u32,
     /// Planes with glass in view, by increasing index; a plane not listed needs no reflection
     /// pass in this frame.
@@ -51,9 +53,13 @@ pub struct PlaneBoundsEntry {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BlenderBorder {
+    /// Left edge, fraction of the frame's width.
     pub min_x: f64,
+    /// Right edge, fraction of the frame's width.
     pub max_x: f64,
+    /// Bottom edge, fraction of the frame's height (y up).
     pub min_y: f64,
+    /// Top edge, fraction of the frame's height (y up).
     pub max_y: f64,
 }
 
@@ -109,8 +115,8 @@ impl PlaneBoundsFile {
         };
         if file.format != PLANE_BOUNDS_FORMAT {
             return Err(bad(format!(
-                "format {:?} is not {PLANE_BOUNDS_FORMAT:?}",
-                file.format
+                "format {} is not {PLANE_BOUNDS_FORMAT:?}",
+                glassdb_io::quoted(&file.format)
             )));
         }
         for p in &file.planes {

@@ -20,7 +20,9 @@ pub enum PlaneSource {
     Detect(PlaneTolerance),
     /// Use these planes (from a `planes.json`); every glass face must lie on one.
     Given {
+        /// The planes, by index.
         planes: Vec<Plane>,
+        /// How far a glass face may lie from its plane.
         tolerance: PlaneTolerance,
     },
 }
@@ -28,6 +30,7 @@ pub enum PlaneSource {
 /// The labelled scene plus what the user should know about it.
 #[derive(Debug, Clone)]
 pub struct MaskScene {
+    /// The triangles, labelled, as the rasteriser draws them.
     pub raster: RasterScene,
     /// The planes, by index.
     pub planes: Vec<Plane>,
@@ -83,7 +86,34 @@ pub fn build_mask_scene(
         m.and_then(|i| table.get(i).copied().flatten())
             .map(|k| mappings[k].id)
     };
-    let is_glass = |m: Option<usize>| id_of(m).is_some();
+    let (planes, assignment) = glass_planes(scene, source, &matcher, |m| id_of(m).is_some())?;
+    let unmatched_patterns = unmatched_patterns(scene, mappings, &table);
+    let (mut raster, glass_tris) = scene_geometry(scene, &assignment, id_of);
+    let pane_of = if panes {
+        find_panes(&mut raster, &glass_tris, &planes)
+    } else {
+        vec![0u32; glass_tris.len()]
+    };
+    label_glass(&mut raster, &glass_tris, &pane_of, &planes);
+    Ok(MaskScene {
+        raster,
+        planes,
+        unmatched_patterns,
+        glass_triangles: glass_tris.len(),
+    })
+}
+
+/// Each mesh's triangles' plane (`None`: not glass), mesh by mesh.
+type PlaneAssignment = Vec<Vec<Option<usize>>>;
+
+/// The glass planes (detected, or given with every glass face assigned to one) and each mesh's
+/// triangles' plane (`None`: not glass).
+fn glass_planes(
+    scene: &Scene,
+    source: &PlaneSource,
+    matcher: &MaterialMatcher,
+    is_glass: impl Fn(Option<usize>) -> bool,
+) -> Result<(Vec<Plane>, PlaneAssignment), SceneError> {
     let (planes, assignment) = match source {
         PlaneSource::Detect(tol) => {
             let (gp, a) = detect_planes(scene, is_glass, *tol, &matcher.describe())?;
@@ -102,6 +132,15 @@ pub fn build_mask_scene(
             ),
         });
     }
+    Ok((planes, assignment))
+}
+
+/// The mappings (`PATTERN=ID`) whose pattern matched no material with faces.
+fn unmatched_patterns(
+    scene: &Scene,
+    mappings: &[GlassMapping],
+    table: &[Option<usize>],
+) -> Vec<String> {
     let used: Vec<bool> = (0..mappings.len())
         .map(|k| {
             scene
@@ -110,13 +149,21 @@ pub fn build_mask_scene(
                 .any(|m| !m.triangles.is_empty() && m.material.and_then(|i| table[i]) == Some(k))
         })
         .collect();
-    let unmatched_patterns = mappings
+    mappings
         .iter()
         .zip(&used)
         .filter(|(_, u)| !**u)
         .map(|(m, _)| format!("{}={}", m.pattern, m.id))
-        .collect();
+        .collect()
+}
 
+/// Every mesh's positions and triangles in one list, every triangle opaque, and the glass
+/// triangles: (global triangle, id, plane).
+fn scene_geometry(
+    scene: &Scene,
+    assignment: &[Vec<Option<usize>>],
+    id_of: impl Fn(Option<usize>) -> Option<u16>,
+) -> (RasterScene, Vec<(u32, u16, u16)>) {
     let total = scene.triangle_count();
     let mut raster = RasterScene {
         positions: Vec::with_capacity(scene.meshes.iter().map(|m| m.positions.len()).sum()),
@@ -125,9 +172,8 @@ pub fn build_mask_scene(
         glass: Vec::new(),
         panes: Vec::new(),
     };
-    // (global triangle, id, plane) of every glass triangle.
     let mut glass_tris: Vec<(u32, u16, u16)> = Vec::new();
-    for (mesh, row) in scene.meshes.iter().zip(&assignment) {
+    for (mesh, row) in scene.meshes.iter().zip(assignment) {
         let base = raster.positions.len() as u32;
         raster.positions.extend_from_slice(&mesh.positions);
         let id = id_of(mesh.material);
@@ -141,73 +187,89 @@ pub fn build_mask_scene(
             }
         }
     }
+    (raster, glass_tris)
+}
 
-    // Panes: glass triangles of one plane connected through shared corner positions.
-    let mut pane_of = vec![0u32; glass_tris.len()];
-    if panes {
-        let mut dsu = Dsu((0..glass_tris.len() as u32).collect());
-        let mut first: HashMap<(u16, [u64; 3]), u32> = HashMap::new();
-        for (k, &(g, _, plane)) in glass_tris.iter().enumerate() {
-            for &v in &raster.triangles[g as usize] {
-                let p = raster.positions[v as usize];
-                let key = (plane, [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()]);
-                match first.get(&key) {
-                    Some(&o) => dsu.union(o, k as u32),
-                    None => {
-                        first.insert(key, k as u32);
-                    }
+/// Panes: glass triangles of one plane connected through shared corner positions, each with
+/// its rectangle in its plane. Returns each glass triangle's pane.
+fn find_panes(
+    raster: &mut RasterScene,
+    glass_tris: &[(u32, u16, u16)],
+    planes: &[Plane],
+) -> Vec<u32> {
+    let mut dsu = Dsu((0..glass_tris.len() as u32).collect());
+    let mut first: HashMap<(u16, [u64; 3]), u32> = HashMap::new();
+    for (k, &(g, _, plane)) in glass_tris.iter().enumerate() {
+        for &v in &raster.triangles[g as usize] {
+            let p = raster.positions[v as usize];
+            let key = (plane, [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()]);
+            match first.get(&key) {
+                Some(&o) => dsu.union(o, k as u32),
+                None => {
+                    first.insert(key, k as u32);
                 }
             }
         }
-        let mut root_to_pane: HashMap<u32, u32> = HashMap::new();
-        let mut bounds: Vec<[f64; 4]> = Vec::new();
-        for k in 0..glass_tris.len() {
-            let root = dsu.find(k as u32);
-            let (g, _, plane) = glass_tris[k];
-            let pane = *root_to_pane.entry(root).or_insert_with(|| {
-                bounds.push([
-                    f64::INFINITY,
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                    f64::NEG_INFINITY,
-                ]);
-                raster.panes.push(PaneRect {
-                    origin: [0.0; 3],
-                    u: [0.0; 3],
-                    v: [0.0; 3],
-                    u_min: 0.0,
-                    v_min: 0.0,
-                    u_len: 0.0,
-                    v_len: 0.0,
-                });
-                let pl = planes[plane as usize];
-                let (u, v) = plane_axes(pl.normal);
-                let last = raster.panes.len() - 1;
-                raster.panes[last].origin = math::scale(pl.normal, -pl.d);
-                raster.panes[last].u = u;
-                raster.panes[last].v = v;
-                last as u32
-            });
-            pane_of[k] = pane;
-            let r = raster.panes[pane as usize];
-            let b = &mut bounds[pane as usize];
-            for &vi in &raster.triangles[g as usize] {
-                let rel = math::sub(raster.positions[vi as usize], r.origin);
-                let (su, sv) = (math::dot(rel, r.u), math::dot(rel, r.v));
-                b[0] = b[0].min(su);
-                b[1] = b[1].min(sv);
-                b[2] = b[2].max(su);
-                b[3] = b[3].max(sv);
-            }
-        }
-        for (r, b) in raster.panes.iter_mut().zip(&bounds) {
-            r.u_min = b[0];
-            r.v_min = b[1];
-            r.u_len = (b[2] - b[0]).max(1e-300);
-            r.v_len = (b[3] - b[1]).max(1e-300);
+    }
+    let mut pane_of = vec![0u32; glass_tris.len()];
+    let mut root_to_pane: HashMap<u32, u32> = HashMap::new();
+    let mut bounds: Vec<[f64; 4]> = Vec::new();
+    for k in 0..glass_tris.len() {
+        let root = dsu.find(k as u32);
+        let (g, _, plane) = glass_tris[k];
+        let pane = *root_to_pane.entry(root).or_insert_with(|| {
+            bounds.push([
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ]);
+            raster.panes.push(pane_in_plane(&planes[plane as usize]));
+            (raster.panes.len() - 1) as u32
+        });
+        pane_of[k] = pane;
+        let r = raster.panes[pane as usize];
+        let b = &mut bounds[pane as usize];
+        for &vi in &raster.triangles[g as usize] {
+            let rel = math::sub(raster.positions[vi as usize], r.origin);
+            let (su, sv) = (math::dot(rel, r.u), math::dot(rel, r.v));
+            b[0] = b[0].min(su);
+            b[1] = b[1].min(sv);
+            b[2] = b[2].max(su);
+            b[3] = b[3].max(sv);
         }
     }
+    for (r, b) in raster.panes.iter_mut().zip(&bounds) {
+        r.u_min = b[0];
+        r.v_min = b[1];
+        r.u_len = (b[2] - b[0]).max(1e-300);
+        r.v_len = (b[3] - b[1]).max(1e-300);
+    }
+    pane_of
+}
 
+/// A pane of `plane` before its extent is known: the plane's point nearest the origin and two
+/// in-plane axes.
+fn pane_in_plane(plane: &Plane) -> PaneRect {
+    let (u, v) = plane_axes(plane.normal);
+    PaneRect {
+        origin: math::scale(plane.normal, -plane.d),
+        u,
+        v,
+        u_min: 0.0,
+        v_min: 0.0,
+        u_len: 0.0,
+        v_len: 0.0,
+    }
+}
+
+/// Gives every glass triangle the label of its (id, plane, pane).
+fn label_glass(
+    raster: &mut RasterScene,
+    glass_tris: &[(u32, u16, u16)],
+    pane_of: &[u32],
+    planes: &[Plane],
+) {
     let mut label_of: HashMap<(u16, u16, u32), u32> = HashMap::new();
     for (k, &(g, id, plane)) in glass_tris.iter().enumerate() {
         let pane = pane_of[k];
@@ -224,12 +286,6 @@ pub fn build_mask_scene(
         });
         raster.labels[g as usize] = label;
     }
-    Ok(MaskScene {
-        raster,
-        planes,
-        unmatched_patterns,
-        glass_triangles: glass_tris.len(),
-    })
 }
 
 /// How cos θ is stored in the mask.

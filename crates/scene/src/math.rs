@@ -4,26 +4,31 @@
 /// A point or direction in scene units.
 pub type Vec3 = [f64; 3];
 
+/// a + b.
 #[inline]
 pub fn add(a: Vec3, b: Vec3) -> Vec3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
+/// a − b.
 #[inline]
 pub fn sub(a: Vec3, b: Vec3) -> Vec3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+/// a · s.
 #[inline]
 pub fn scale(a: Vec3, s: f64) -> Vec3 {
     [a[0] * s, a[1] * s, a[2] * s]
 }
 
+/// The dot product a · b.
 #[inline]
 pub fn dot(a: Vec3, b: Vec3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// The cross product a × b.
 #[inline]
 pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
     [
@@ -33,6 +38,7 @@ pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
     ]
 }
 
+/// The Euclidean length |a|.
 #[inline]
 pub fn norm(a: Vec3) -> f64 {
     dot(a, a).sqrt()
@@ -65,6 +71,7 @@ pub fn triangle_normal_area2(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     cross(sub(b, a), sub(c, a))
 }
 
+/// Whether every component is finite.
 pub fn is_finite(a: Vec3) -> bool {
     a.iter().all(|x| x.is_finite())
 }

@@ -9,7 +9,9 @@ use crate::obj::Scene;
 /// A plane `n·X + d = 0` with unit normal `n`; its front is the side `n` points to.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plane {
+    /// Unit normal, pointing to the front.
     pub normal: Vec3,
+    /// Offset: n·X + d = 0 on the plane.
     pub d: f64,
 }
 
@@ -121,6 +123,7 @@ impl PlaneTolerance {
         }
     }
 
+    /// Refuses a tolerance that is negative, not finite, or an angle of 90° or more.
     pub fn validate(&self) -> Result<(), SceneError> {
         if !(self.angle_deg.is_finite() && self.angle_deg >= 0.0 && self.angle_deg < 90.0) {
             return Err(SceneError::BadOption {
@@ -168,6 +171,7 @@ pub struct MaterialMatcher {
 }
 
 impl MaterialMatcher {
+    /// A matcher of `patterns` (glob syntax); a malformed pattern is an error naming it.
     pub fn new<S: AsRef<str>>(patterns: &[S]) -> Result<MaterialMatcher, SceneError> {
         let patterns = patterns
             .iter()

@@ -1,7 +1,7 @@
 //! `glassdb mirror` as a library call: find the glass planes, write one virtual scene per
 //! plane and `planes.json`.
 
-use glassdb_registry::Side;
+use glassdb_side::Side;
 use std::path::{Component, Path, PathBuf};
 
 use crate::error::SceneError;
@@ -14,6 +14,7 @@ use crate::planes_file::{PLANES_FORMAT, PlaneEntry, PlanesFile, ToleranceJson};
 /// What to mirror and where to put it.
 #[derive(Debug, Clone)]
 pub struct MirrorRequest<'a> {
+    /// The scene.
     pub scene: &'a Scene,
     /// Glob patterns of the glass materials (may be empty with an explicit plane).
     pub glass_patterns: Vec<String>,
@@ -21,15 +22,20 @@ pub struct MirrorRequest<'a> {
     pub explicit_plane: Option<[f64; 4]>,
     /// The eye: selects the kept half-space of each plane. Without it, the front side.
     pub eye: Option<Vec3>,
+    /// How faces are grouped into planes.
     pub tolerance: PlaneTolerance,
+    /// Where the virtual scenes and `planes.json` go.
     pub out_dir: &'a Path,
 }
 
 /// What was written.
 #[derive(Debug, Clone)]
 pub struct MirrorReport {
+    /// The `planes.json` written.
     pub planes_path: PathBuf,
+    /// What it holds.
     pub planes: PlanesFile,
+    /// Each virtual scene's counts.
     pub stats: Vec<MirrorStats>,
 }
 
@@ -132,7 +138,7 @@ fn write_virtual_scenes_staged(req: &MirrorRequest<'_>) -> Result<MirrorReport, 
         },
         planes: entries,
     };
-    let planes_path = write_planes_file(&mut staged, &file, scene, req.out_dir)?;
+    let planes_path = write_planes_file(&mut staged, &file, req.out_dir)?;
     staged.commit()?;
     Ok(MirrorReport {
         planes_path,
@@ -263,8 +269,7 @@ fn write_plane_scene(
 ) -> Result<String, SceneError> {
     let name = virtual_scene_name(gp.index);
     let path = out_dir.join(&name);
-    let inputs = scene.input_files();
-    glassdb_io::refuse_input_as_output(&path, inputs.iter().map(PathBuf::as_path))?;
+    glassdb_io::refuse_input_as_output(&path)?;
     let header = vec![
         format!(
             "virtual scene of {} (glassdb mirror)",
@@ -286,12 +291,10 @@ fn write_plane_scene(
 fn write_planes_file(
     staged: &mut glassdb_io::StagedOutput,
     file: &PlanesFile,
-    scene: &Scene,
     out_dir: &Path,
 ) -> Result<PathBuf, SceneError> {
     let planes_path = out_dir.join("planes.json");
-    let inputs = scene.input_files();
-    glassdb_io::refuse_input_as_output(&planes_path, inputs.iter().map(PathBuf::as_path))?;
+    glassdb_io::refuse_input_as_output(&planes_path)?;
     let json = serde_json::to_string_pretty(file).map_err(|source| SceneError::EncodeJson {
         path: planes_path.clone(),
         source,

@@ -10,25 +10,40 @@ use std::path::PathBuf;
 pub enum SceneWarning {
     /// An `mtllib` names a file that does not exist; the `usemtl` names are still used.
     MissingMaterialLibrary {
+        /// The OBJ.
         obj: PathBuf,
+        /// The `mtllib` line.
         line: usize,
+        /// The library's path.
         library: PathBuf,
     },
     /// A `usemtl` name that no (present) material library defines.
     UndefinedMaterial {
+        /// The OBJ.
         obj: PathBuf,
+        /// The first `usemtl` line naming it.
         line: usize,
+        /// The material.
         name: String,
     },
     /// A polygon that could not be ear-clipped in its plane and was fan-triangulated instead.
     PolygonFanned {
+        /// The OBJ.
         obj: PathBuf,
+        /// The face's line.
         line: usize,
+        /// Its corners.
         vertices: usize,
+        /// Why it could not be ear-clipped.
         reason: FanReason,
     },
     /// More fanned polygons than are listed one by one.
-    MorePolygonsFanned { obj: PathBuf, count: usize },
+    MorePolygonsFanned {
+        /// The OBJ.
+        obj: PathBuf,
+        /// How many more.
+        count: usize,
+    },
 }
 
 /// Why a polygon was fan-triangulated rather than ear-clipped.
@@ -36,17 +51,28 @@ pub enum SceneWarning {
 pub enum FanReason {
     /// A vertex lies `deviation` (scene units) from the polygon's plane, more than the
     /// planarity tolerance allows for a polygon of `size` (its bounding-box diagonal).
-    NonPlanar { deviation: f64, size: f64 },
+    NonPlanar {
+        /// The farthest corner's distance from the polygon's plane.
+        deviation: f64,
+        /// The polygon's size (its bounding-box diagonal).
+        size: f64,
+    },
     /// The outline encloses no net area although its vertices are not on one line: it
     /// crosses itself with opposite windings (a bow tie).
     ZeroArea,
     /// Two edges of the outline cross; the edges are given by their first corners, 1-based
     /// positions in the face as written (edge k runs from corner k to the next corner).
-    SelfIntersecting { edges: [usize; 2] },
+    SelfIntersecting {
+        /// The two edges that cross (indices of their first corners).
+        edges: [usize; 2],
+    },
     /// The outline overlaps or touches itself so that no ear could be cut.
     NoEar,
     /// Too many vertices to ear-clip (quadratic cost); `max` is the limit.
-    TooManyVertices { max: usize },
+    TooManyVertices {
+        /// The most corners clipped.
+        max: usize,
+    },
 }
 
 impl fmt::Display for FanReason {

@@ -268,12 +268,11 @@ impl Spd {
 /// Reads a light's SPD from a CSV file: a header `wavelength_nm,power`, then one sample per
 /// line (`#` starts a comment line; blank lines are skipped). Errors name the file and line.
 pub fn read_spd_file(path: &Path) -> Result<Spd, SpectralError> {
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::SPECTRAL).map_err(|source| {
-        SpectralError::Io {
+    let bytes =
+        glassdb_io::read_input(path, crate::SPECTRAL_FILE).map_err(|source| SpectralError::Io {
             path: path.to_path_buf(),
             source,
-        }
-    })?;
+        })?;
     read_spd_bytes(&bytes, &path.display().to_string())
 }
 

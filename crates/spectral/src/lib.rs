@@ -22,6 +22,8 @@
 //! agree with it to 1e-9 relative; the differences where colour is wrong are in
 //! `docs/spectral.md`.
 
+#![warn(missing_docs)]
+
 #[macro_use]
 mod names;
 mod balance;
@@ -29,10 +31,12 @@ mod error;
 mod illuminant;
 mod integrate;
 mod interp;
+mod open;
 mod read;
 mod read_csv;
 mod read_igsdb;
 mod sniff;
+mod spline;
 mod tables;
 mod window;
 
@@ -51,8 +55,6 @@ pub use integrate::{
     RgbCmf, luminous, luminous_iso9050, rgb_matrix,
 };
 pub use interp::resample;
-pub use read::{
-    ProductInfo, ReadOptions, SpectralData, SpectralFormat, detect_format, microns_to_nm,
-    read_spectral_bytes, read_spectral_file,
-};
+pub use open::{SPECTRAL_FILE, detect_format, read_spectral_bytes, read_spectral_file};
+pub use read::{ProductInfo, ReadOptions, SpectralData, SpectralFormat, microns_to_nm};
 pub use window::{WindowMethod, WindowWeights, window_average};

@@ -1,19 +1,16 @@
-//! Readers for spectral glazing data: our CSV and instrument exports (`read_csv`), LBNL
-//! Optics/IGDB text files (here) and IGSDB JSON of both schema generations (`read_igsdb`).
+//! What every reader of spectral glazing data shares (the data, its product information, the
+//! values collected before the common checks), and the LBNL Optics/IGDB text reader; our CSV
+//! and instrument exports are read by `read_csv`, IGSDB JSON of both schema generations by
+//! `read_igsdb`, and `open` chooses among them.
 //!
 //! Every reader returns wavelengths in nm, strictly increasing, and values as fractions in
 //! `[0, 1]`; anything else is an error naming the source and line (and column for CSV and the
 //! whitespace-separated Optics rows). Data glassdb does not read (shading products, BSDF XML,
 //! diffuse data, binary files) is refused by name ([`crate::UnsupportedKind`]).
 
-use std::path::Path;
-
 use serde::{Deserialize, Serialize};
 
 use crate::error::{SpectralError, UnsupportedKind};
-use crate::read_csv::{looks_like_csv, read_csv};
-use crate::read_igsdb::read_igsdb_json;
-use crate::sniff::{unsupported_kind, utf16_to_utf8};
 
 /// Which reader produced a [`SpectralData`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -32,12 +29,15 @@ pub enum SpectralFormat {
 /// Product metadata found in the file (all optional: our CSV carries none).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ProductInfo {
+    /// The product's name.
     pub name: Option<String>,
+    /// Its maker.
     pub manufacturer: Option<String>,
     /// Optics `{ Type: … }` or IGSDB `subtype` (falling back to `type` in the older schema), as written.
     pub product_type: Option<String>,
     /// `Front`, `Back`, `Neither`, `Both`, as written.
     pub coated_side: Option<String>,
+    /// Its thickness.
     pub thickness_mm: Option<f64>,
     /// Incidence angles (degrees) other than 0° for which the file also holds spectra (IGSDB v2
     /// angle blocks), in file order. Only the 0° spectrum is read; empty for other formats.
@@ -47,6 +47,7 @@ pub struct ProductInfo {
     /// interlayer), each as "name (subtype, thickness mm)"; empty for other formats.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub composition: Vec<String>,
+    /// The reader that read it.
     pub format: SpectralFormat,
 }
 
@@ -71,8 +72,9 @@ impl ProductInfo {
 /// length and holds fractions in `[0, 1]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SpectralData {
-    /// The file name (or the name given to [`read_spectral_bytes`]), for messages.
+    /// The file name (or the name given to [`crate::read_spectral_bytes`]), for messages.
     pub source: String,
+    /// Wavelengths, nm, strictly increasing.
     pub wavelength_nm: Vec<f64>,
     /// Spectral transmittance τ(λ).
     pub transmittance: Option<Vec<f64>>,
@@ -80,6 +82,7 @@ pub struct SpectralData {
     pub reflectance_front: Option<Vec<f64>>,
     /// Spectral reflectance of the back side (CSV `Rb`).
     pub reflectance_back: Option<Vec<f64>>,
+    /// The product, as far as the file says.
     pub product: ProductInfo,
 }
 
@@ -91,91 +94,6 @@ pub struct ReadOptions {
     /// error (the file looks like fractions). CSV columns whose header says percent (`%T`,
     /// `T (%)`) are percent without it.
     pub percent: bool,
-}
-
-/// Reads a spectral file; the format comes from the extension, then from the content.
-pub fn read_spectral_file(path: &Path, opts: &ReadOptions) -> Result<SpectralData, SpectralError> {
-    let bytes = glassdb_io::read_input(path, glassdb_io::limits::SPECTRAL).map_err(|source| {
-        SpectralError::Io {
-            path: path.to_path_buf(),
-            source,
-        }
-    })?;
-    read_spectral_bytes(&bytes, &path.display().to_string(), opts)
-}
-
-/// Reads spectral data from memory. `source_name` is used for messages and, by its extension
-/// (`.csv`, `.json`, anything else), to choose the format; when the extension says nothing
-/// the content decides (`{"` starts JSON, a wavelength header starts CSV, else Optics).
-///
-/// UTF-16 text with a byte-order mark is read as text. Binary data and markup (BSDF XML, HTML)
-/// are refused as [`SpectralError::Unsupported`] whatever the extension says.
-pub fn read_spectral_bytes(
-    bytes: &[u8],
-    source_name: &str,
-    opts: &ReadOptions,
-) -> Result<SpectralData, SpectralError> {
-    let transcoded = utf16_to_utf8(bytes);
-    let bytes = transcoded.as_deref().unwrap_or(bytes);
-    if let Some(kind) = unsupported_kind(bytes) {
-        return Err(SpectralError::Unsupported {
-            source_name: source_name.to_owned(),
-            kind,
-        });
-    }
-    match detect_format(bytes, source_name) {
-        SpectralFormat::Csv => read_csv(bytes, source_name, opts),
-        SpectralFormat::Optics => read_optics(bytes, source_name),
-        SpectralFormat::IgsdbJson => read_igsdb_json(bytes, source_name),
-    }
-}
-
-/// Chooses the reader: by extension, then by the first non-blank bytes.
-pub fn detect_format(bytes: &[u8], source_name: &str) -> SpectralFormat {
-    let ext = Path::new(source_name)
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("csv" | "tsv") => return SpectralFormat::Csv,
-        Some("json") => return SpectralFormat::IgsdbJson,
-        Some(
-            "dat" | "lof" | "afg" | "oag" | "ipe" | "vta" | "gvb" | "hct" | "ppg" | "sgg" | "gdt",
-        ) => {
-            return SpectralFormat::Optics;
-        }
-        _ => {}
-    }
-    let text_start: Vec<u8> = bytes
-        .iter()
-        .copied()
-        .skip_while(|b| b.is_ascii_whitespace() || *b == 0xEF || *b == 0xBB || *b == 0xBF)
-        .take(4096)
-        .collect();
-    let after_first = || text_start[1..].iter().find(|b| !b.is_ascii_whitespace());
-    match text_start.first() {
-        Some(b'{') if matches!(after_first(), Some(b'"') | Some(b'}')) => {
-            return SpectralFormat::IgsdbJson;
-        }
-        Some(b'{') => return SpectralFormat::Optics,
-        // A list of products (the API's search results).
-        Some(b'[') if matches!(after_first(), Some(b'{')) => return SpectralFormat::IgsdbJson,
-        _ => {}
-    }
-    let lower: Vec<u8> = text_start.iter().map(|b| b.to_ascii_lowercase()).collect();
-    if lower.windows(11).any(|w| w == b"wavelength_") {
-        return SpectralFormat::Csv;
-    }
-    // A header with a wavelength column (`Wavelength (nm)`, `nm`, …), perhaps below a title.
-    // Whole lines only, so that a multi-byte UTF-8 character is never cut in two.
-    let complete_lines = match text_start.iter().rposition(|&b| b == b'\n') {
-        Some(end) => &text_start[..end],
-        None => &text_start[..],
-    };
-    if looks_like_csv(&decode_cp1252(complete_lines)) {
-        return SpectralFormat::Csv;
-    }
-    SpectralFormat::Optics
 }
 
 /// Where a value came from, for messages.
@@ -389,7 +307,7 @@ enum WavelengthUnit {
     Nanometers,
 }
 
-fn read_optics(bytes: &[u8], source: &str) -> Result<SpectralData, SpectralError> {
+pub(crate) fn read_optics(bytes: &[u8], source: &str) -> Result<SpectralData, SpectralError> {
     let mut product = ProductInfo::empty(SpectralFormat::Optics);
     let mut unit: Option<WavelengthUnit> = None;
     let mut raw_wl: Vec<f64> = Vec::new();

@@ -318,112 +318,9 @@ pub(crate) fn read_csv(
         .headers()
         .map_err(|e| csv_error(source, e, line_offset))?
         .clone();
-    let header_line = header + 1;
-    let mut wl_col: Option<(usize, WavelengthUnit)> = None;
-    let mut q_cols: [Option<(usize, bool)>; 3] = [None, None, None];
-    let mut unnamed: Vec<usize> = Vec::new();
-    for (i, name) in headers.iter().enumerate() {
-        let column = classify(name)
-            .map_err(|message| SpectralError::parse(source, header_line, Some(i + 1), message))?;
-        match column {
-            Column::Unnamed => unnamed.push(i),
-            Column::Wavelength(unit) => {
-                if wl_col.is_some() {
-                    return Err(SpectralError::parse(
-                        source,
-                        header_line,
-                        Some(i + 1),
-                        "more than one wavelength column (several samples side by side? glassdb reads one sample per file)",
-                    ));
-                }
-                wl_col = Some((i, unit));
-            }
-            Column::Quantity { slot, percent } => {
-                if q_cols[slot].is_some() {
-                    return Err(SpectralError::parse(
-                        source,
-                        header_line,
-                        Some(i + 1),
-                        format!(
-                            "column `{}` repeats {} (R and Rf are the same quantity)",
-                            name.trim(),
-                            QUANTITY_NAMES[slot]
-                        ),
-                    ));
-                }
-                q_cols[slot] = Some((i, percent));
-            }
-        }
-    }
-    let Some((wl_index, wl_unit)) = wl_col else {
-        return Err(SpectralError::parse(
-            source,
-            header_line,
-            None,
-            "no wavelength_nm or wavelength_um column",
-        ));
-    };
-    let mut raw_wl: Vec<f64> = Vec::new();
-    let mut collected = Collected {
-        source,
-        wavelength_nm: Vec::new(),
-        wavelength_places: Vec::new(),
-        quantities: q_cols.map(|c| c.map(|_| (Vec::new(), Vec::new()))),
-    };
-    let mut record = csv::StringRecord::new();
-    loop {
-        match reader.read_record(&mut record) {
-            Ok(false) => break,
-            Ok(true) => {}
-            Err(e) => return Err(csv_error(source, e, line_offset)),
-        }
-        let line = record.position().map_or(0, |p| p.line() as usize) + line_offset;
-        let field = |i: usize| record.get(i).unwrap_or("");
-        for &i in &unnamed {
-            if !field(i).is_empty() {
-                return Err(SpectralError::parse(
-                    source,
-                    line,
-                    Some(i + 1),
-                    format!("column {} has values but no header", i + 1),
-                ));
-            }
-        }
-        let place = Place {
-            line,
-            column: Some(wl_index + 1),
-        };
-        raw_wl.push(csv_number(field(wl_index), source, place, "wavelength")?);
-        collected.wavelength_places.push(place);
-        for (slot, col) in q_cols.iter().enumerate() {
-            let (Some((col, _)), Some((values, places))) =
-                (col, collected.quantities[slot].as_mut())
-            else {
-                continue;
-            };
-            let place = Place {
-                line,
-                column: Some(col + 1),
-            };
-            values.push(csv_number(
-                field(*col),
-                source,
-                place,
-                QUANTITY_NAMES[slot],
-            )?);
-            places.push(place);
-        }
-    }
-    // Instruments scan from long to short wavelengths: a strictly decreasing table is reversed.
-    if raw_wl.len() > 1 && raw_wl.windows(2).all(|w| w[1] < w[0]) {
-        raw_wl.reverse();
-        collected.wavelength_places.reverse();
-        for (values, places) in collected.quantities.iter_mut().flatten() {
-            values.reverse();
-            places.reverse();
-        }
-    }
-    let microns = match wl_unit {
+    let columns = Columns::of(&headers, source, header + 1)?;
+    let (raw_wl, mut collected) = columns.read_rows(&mut reader, source, line_offset)?;
+    let microns = match columns.wavelength.1 {
         WavelengthUnit::Nanometres => false,
         WavelengthUnit::Microns => true,
         WavelengthUnit::FromValues => !raw_wl.iter().all(|&w| w >= 100.0),
@@ -433,12 +330,156 @@ pub(crate) fn read_csv(
     } else {
         raw_wl
     };
-    let percent = q_cols.map(|c| opts.percent || c.is_some_and(|(_, p)| p));
+    let percent = columns
+        .quantities
+        .map(|c| opts.percent || c.is_some_and(|(_, p)| p));
     collected.finish(
         percent,
         opts.percent,
         ProductInfo::empty(SpectralFormat::Csv),
     )
+}
+
+/// What the header says of each column: the wavelength column and its unit, each quantity's
+/// column and whether it is in percent, and the columns without a name (which must stay
+/// empty).
+struct Columns {
+    wavelength: (usize, WavelengthUnit),
+    quantities: [Option<(usize, bool)>; 3],
+    unnamed: Vec<usize>,
+}
+
+impl Columns {
+    /// The columns of `headers` (on line `header_line` of `source`).
+    fn of(
+        headers: &csv::StringRecord,
+        source: &str,
+        header_line: usize,
+    ) -> Result<Columns, SpectralError> {
+        let mut wl_col: Option<(usize, WavelengthUnit)> = None;
+        let mut q_cols: [Option<(usize, bool)>; 3] = [None, None, None];
+        let mut unnamed: Vec<usize> = Vec::new();
+        for (i, name) in headers.iter().enumerate() {
+            let column = classify(name).map_err(|message| {
+                SpectralError::parse(source, header_line, Some(i + 1), message)
+            })?;
+            match column {
+                Column::Unnamed => unnamed.push(i),
+                Column::Wavelength(unit) => {
+                    if wl_col.is_some() {
+                        return Err(SpectralError::parse(
+                            source,
+                            header_line,
+                            Some(i + 1),
+                            "more than one wavelength column (several samples side by side? glassdb reads one sample per file)",
+                        ));
+                    }
+                    wl_col = Some((i, unit));
+                }
+                Column::Quantity { slot, percent } => {
+                    if q_cols[slot].is_some() {
+                        return Err(SpectralError::parse(
+                            source,
+                            header_line,
+                            Some(i + 1),
+                            format!(
+                                "column `{}` repeats {} (R and Rf are the same quantity)",
+                                name.trim(),
+                                QUANTITY_NAMES[slot]
+                            ),
+                        ));
+                    }
+                    q_cols[slot] = Some((i, percent));
+                }
+            }
+        }
+        let Some(wavelength) = wl_col else {
+            return Err(SpectralError::parse(
+                source,
+                header_line,
+                None,
+                "no wavelength_nm or wavelength_um column",
+            ));
+        };
+        Ok(Columns {
+            wavelength,
+            quantities: q_cols,
+            unnamed,
+        })
+    }
+
+    /// Reads every row: the raw wavelengths (in the file's unit) and the quantities with the
+    /// place of every value; a table from long to short wavelengths is reversed.
+    fn read_rows<'s, R: std::io::Read>(
+        &self,
+        reader: &mut csv::Reader<R>,
+        source: &'s str,
+        line_offset: usize,
+    ) -> Result<(Vec<f64>, Collected<'s>), SpectralError> {
+        let wl_index = self.wavelength.0;
+        let mut raw_wl: Vec<f64> = Vec::new();
+        let mut collected = Collected {
+            source,
+            wavelength_nm: Vec::new(),
+            wavelength_places: Vec::new(),
+            quantities: self.quantities.map(|c| c.map(|_| (Vec::new(), Vec::new()))),
+        };
+        let mut record = csv::StringRecord::new();
+        loop {
+            match reader.read_record(&mut record) {
+                Ok(false) => break,
+                Ok(true) => {}
+                Err(e) => return Err(csv_error(source, e, line_offset)),
+            }
+            let line = record.position().map_or(0, |p| p.line() as usize) + line_offset;
+            let field = |i: usize| record.get(i).unwrap_or("");
+            for &i in &self.unnamed {
+                if !field(i).is_empty() {
+                    return Err(SpectralError::parse(
+                        source,
+                        line,
+                        Some(i + 1),
+                        format!("column {} has values but no header", i + 1),
+                    ));
+                }
+            }
+            let place = Place {
+                line,
+                column: Some(wl_index + 1),
+            };
+            raw_wl.push(csv_number(field(wl_index), source, place, "wavelength")?);
+            collected.wavelength_places.push(place);
+            for (slot, col) in self.quantities.iter().enumerate() {
+                let (Some((col, _)), Some((values, places))) =
+                    (col, collected.quantities[slot].as_mut())
+                else {
+                    continue;
+                };
+                let place = Place {
+                    line,
+                    column: Some(col + 1),
+                };
+                values.push(csv_number(
+                    field(*col),
+                    source,
+                    place,
+                    QUANTITY_NAMES[slot],
+                )?);
+                places.push(place);
+            }
+        }
+        // Instruments scan from long to short wavelengths: a strictly decreasing table is
+        // reversed.
+        if raw_wl.len() > 1 && raw_wl.windows(2).all(|w| w[1] < w[0]) {
+            raw_wl.reverse();
+            collected.wavelength_places.reverse();
+            for (values, places) in collected.quantities.iter_mut().flatten() {
+                values.reverse();
+                places.reverse();
+            }
+        }
+        Ok((raw_wl, collected))
+    }
 }
 
 fn csv_error(source: &str, e: csv::Error, line_offset: usize) -> SpectralError {

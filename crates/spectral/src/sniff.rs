@@ -2,36 +2,9 @@
 //! (XML/HTML, BSDF XML), which no spectral reader reads and which otherwise get a misleading
 //! "expected 4 numbers" or "invalid JSON" message.
 
+use glassdb_io::sniff::SNIFF_BYTES;
+
 use crate::error::UnsupportedKind;
-
-/// How many leading bytes the sniffers look at.
-const SNIFF_BYTES: usize = 8192;
-
-/// Known binary signatures and what they usually are.
-const SIGNATURES: &[(&[u8], &str)] = &[
-    (b"\x89PNG\r\n\x1a\n", "a PNG image"),
-    (b"\xFF\xD8\xFF", "a JPEG image"),
-    (b"\x76\x2F\x31\x01", "an OpenEXR image"),
-    (b"%PDF-", "a PDF document"),
-    (
-        b"PK\x03\x04",
-        "a ZIP archive, e.g. an .xlsx workbook or a THERM .thmz",
-    ),
-    (
-        b"\xD0\xCF\x11\xE0\xA1\xB1\x1A\xE1",
-        "an OLE2 compound file, e.g. a legacy .xls workbook",
-    ),
-    (
-        b"\x00\x01\x00\x00Standard Jet DB",
-        "a Microsoft Access database, e.g. the IGDB's .mdb",
-    ),
-    (
-        b"\x00\x01\x00\x00Standard ACE DB",
-        "a Microsoft Access database (.accdb)",
-    ),
-    (b"SQLite format 3\x00", "an SQLite database"),
-    (b"\x1F\x8B", "gzip-compressed data"),
-];
 
 /// UTF-16 text with a byte-order mark (Excel's "Unicode Text" export, some instrument software),
 /// as UTF-8. `None` when there is no UTF-16 BOM. Unpaired surrogates become U+FFFD.
@@ -61,21 +34,9 @@ pub(crate) fn unsupported_kind(bytes: &[u8]) -> Option<UnsupportedKind> {
     binary_kind(bytes).or_else(|| markup_kind(bytes))
 }
 
+/// Binary data, named from its signature by the one list of them (`glassdb_io::sniff`).
 fn binary_kind(bytes: &[u8]) -> Option<UnsupportedKind> {
-    if let Some((_, what)) = SIGNATURES.iter().find(|(sig, _)| bytes.starts_with(sig)) {
-        return Some(UnsupportedKind::Binary { what: Some(what) });
-    }
-    let head = &bytes[..bytes.len().min(SNIFF_BYTES)];
-    // Text never holds NUL; control bytes other than whitespace (and the DOS end-of-file mark)
-    // are rare in text and common in binary data. Bytes ≥ 0x80 are text in Windows-1252.
-    let control = head
-        .iter()
-        .filter(|&&b| (b < 0x20 && !matches!(b, b'\t' | b'\n' | b'\r' | 0x0C | 0x1A)) || b == 0x7F)
-        .count();
-    if head.contains(&0) || control * 20 > head.len() {
-        return Some(UnsupportedKind::Binary { what: None });
-    }
-    None
+    glassdb_io::sniff::binary_kind(bytes).map(|b| UnsupportedKind::Binary { what: b.what })
 }
 
 fn markup_kind(bytes: &[u8]) -> Option<UnsupportedKind> {

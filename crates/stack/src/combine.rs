@@ -126,34 +126,52 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         out.t[i] = system.t;
         out.rf[i] = system.rf;
         out.rb[i] = system.rb;
-        absorptances(&rt, &mut abs, &mut scratch);
-        for (a, v) in out.absorptance_front.iter_mut().zip(&abs) {
-            a[i] = *v;
-        }
-        for (r, l) in reversed.iter_mut().zip(rt.iter().rev()) {
-            *r = l.reversed();
-        }
-        absorptances(&reversed, &mut abs, &mut scratch);
-        for (a, v) in out.absorptance_back.iter_mut().rev().zip(&abs) {
-            a[i] = *v;
-        }
+        from_both_sides(
+            &rt,
+            &mut reversed,
+            (&mut abs, &mut scratch),
+            absorptances,
+            (&mut out.absorptance_front, &mut out.absorptance_back),
+            i,
+        );
         for (g, range) in group_rt.iter_mut().zip(groups) {
             let members = &rt[range.clone()];
             *g = members[1..].iter().fold(members[0], |acc, &l| acc.then(l));
         }
-        reflectance_shares(&group_rt, &mut shares, &mut scratch);
-        for (s, v) in out.share_front.iter_mut().zip(&shares) {
-            s[i] = *v;
-        }
-        for (r, g) in groups_reversed.iter_mut().zip(group_rt.iter().rev()) {
-            *r = g.reversed();
-        }
-        reflectance_shares(&groups_reversed, &mut shares, &mut scratch);
-        for (s, v) in out.share_back.iter_mut().rev().zip(&shares) {
-            s[i] = *v;
-        }
+        from_both_sides(
+            &group_rt,
+            &mut groups_reversed,
+            (&mut shares, &mut scratch),
+            reflectance_shares,
+            (&mut out.share_front, &mut out.share_back),
+            i,
+        );
     }
     out
+}
+
+/// `per_item` (absorptances, reflectance shares) of `items` lit from the front, then from the
+/// back (`items` in reverse order, each turned round, in `reversed`), written at sample `i` of
+/// `front` and `back`, both indexed as `items` are.
+fn from_both_sides(
+    items: &[Rt],
+    reversed: &mut [Rt],
+    (values, scratch): (&mut [f64], &mut [f64]),
+    per_item: fn(&[Rt], &mut [f64], &mut [f64]),
+    (front, back): (&mut [Vec<f64>], &mut [Vec<f64>]),
+    i: usize,
+) {
+    per_item(items, values, scratch);
+    for (f, v) in front.iter_mut().zip(values.iter()) {
+        f[i] = *v;
+    }
+    for (r, l) in reversed.iter_mut().zip(items.iter().rev()) {
+        *r = l.reversed();
+    }
+    per_item(reversed, values, scratch);
+    for (b, v) in back.iter_mut().rev().zip(values.iter()) {
+        b[i] = *v;
+    }
 }
 
 /// `r_behind[k]`: the front reflectance of `items[k..]` combined (0 at `k = items.len()`),

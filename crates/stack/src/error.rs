@@ -145,3 +145,17 @@ impl StackError {
         }
     }
 }
+
+impl StackError {
+    /// The class of this error: a spectrum that cannot be integrated or checked, or a table
+    /// that cannot be fitted, keeps its own class; anything else is a build-up to fix.
+    pub fn kind(&self) -> glassdb_io::ErrorKind {
+        match self {
+            StackError::LayerSpectrum { source, .. } | StackError::Integration { source, .. } => {
+                source.kind()
+            }
+            StackError::Fit { source, .. } => source.kind(),
+            _ => glassdb_io::ErrorKind::Invalid,
+        }
+    }
+}

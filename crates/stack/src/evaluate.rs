@@ -170,6 +170,102 @@ fn window_weights(
     }
 }
 
+/// How one output of a per-band evaluation reduces a spectrum: an integrator, or a WINDOW
+/// method's weights on each layer's wavelengths (a method only when every layer covers it).
+enum BandReduction<'a> {
+    Colour(&'a Integrator),
+    Window(Vec<WindowWeights>),
+}
+
+impl BandReduction<'_> {
+    /// Layer `k`'s spectrum `v` on its wavelengths `wl`, reduced to this output's bands.
+    fn reduce(
+        &self,
+        k: usize,
+        wl: &[f64],
+        v: &[f64],
+    ) -> Result<Vec<f64>, glassdb_spectral::SpectralError> {
+        match self {
+            BandReduction::Colour(i) => i.channels(wl, v).map(|c| c.to_vec()),
+            BandReduction::Window(w) => w[k].average(v).map(|a| vec![a]),
+        }
+    }
+}
+
+/// A layer's quantity in messages: `what of layer L at deg°`.
+fn layer_label(l: &Layer, what: &str, deg: f64) -> String {
+    format!("{what} of layer {} at {deg}°", l.label)
+}
+
+/// An integration failure about `what`, as the stack's error.
+fn integration(what: String) -> impl FnOnce(glassdb_spectral::SpectralError) -> StackError {
+    move |source| StackError::Integration {
+        what,
+        source: Box::new(source),
+    }
+}
+
+/// The weights of WINDOW `method` on each layer's wavelengths; none when a layer has no
+/// spectrum or its spectrum does not cover the method's.
+fn layers_window_weights(
+    layers: &[&Layer],
+    method: WindowMethod,
+) -> Result<Option<Vec<WindowWeights>>, StackError> {
+    let mut per_layer = Vec::with_capacity(layers.len());
+    for l in layers {
+        let LayerData::Spectral { wavelength_nm, .. } = &l.data else {
+            return Ok(None);
+        };
+        let what = || format!("{} average of layer {}", method.name(), l.label);
+        match window_weights(method, wavelength_nm, what)? {
+            Some(w) => per_layer.push(w),
+            None => return Ok(None),
+        }
+    }
+    Ok(Some(per_layer))
+}
+
+/// Per layer and output, the normal values reduced to the output's bands and clamped to
+/// [0, 1] as a registry stores them (for models applied per channel; none otherwise).
+#[allow(clippy::type_complexity)]
+fn reduced_normals(
+    layers: &[&Layer],
+    outputs: &[BandReduction<'_>],
+    application: Application,
+) -> Result<Vec<Vec<Option<[Vec<f64>; 3]>>>, StackError> {
+    let mut normals = Vec::with_capacity(layers.len());
+    for (k, l) in layers.iter().enumerate() {
+        let mut per = Vec::with_capacity(outputs.len());
+        for r in outputs {
+            per.push(match (&l.data, application) {
+                (
+                    LayerData::Spectral {
+                        wavelength_nm,
+                        t,
+                        rf,
+                        rb,
+                    },
+                    Application::PerChannel,
+                ) => {
+                    let red = |v: &[f64], what: &str| {
+                        r.reduce(k, wavelength_nm, v)
+                            .map(|x| x.into_iter().map(|c| c.clamp(0.0, 1.0)).collect())
+                            .map_err(integration(layer_label(l, what, 0.0)))
+                    };
+                    Some([
+                        red(t, "transmittance")?,
+                        red(rf, "front reflectance")?,
+                        red(rb, "back reflectance")?,
+                    ])
+                }
+                _ => None,
+            });
+        }
+        normals.push(per);
+    }
+    Ok(normals)
+}
+
 /// The name of one spectrum of [`Optics`] at an angle, for messages.
 fn quantity_names(o: &Optics<Vec<f64>>) -> Vec<String> {
     let mut names = vec![
@@ -353,81 +449,16 @@ impl Stack {
     ) -> Result<Vec<Averaged>, StackError> {
         let groups = self.group_ranges();
         let layers: Vec<&Layer> = self.layers().collect();
-        let label =
-            |l: &Layer, what: &str, deg: f64| format!("{what} of layer {} at {deg}°", l.label);
-        let integration = |what: String| {
-            move |source| StackError::Integration {
-                what,
-                source: Box::new(source),
-            }
-        };
-        // How each output reduces a spectrum: an integrator, or a WINDOW method's weights on
-        // each layer's wavelengths (a method only when every layer covers it).
-        enum Reduce<'a> {
-            Colour(&'a Integrator),
-            Window(Vec<WindowWeights>),
-        }
-        let mut outputs: Vec<Reduce<'_>> = integrators.iter().map(Reduce::Colour).collect();
+        let mut outputs: Vec<BandReduction<'_>> =
+            integrators.iter().map(BandReduction::Colour).collect();
         let mut averaged = Vec::new();
         for &m in methods {
-            let mut per_layer = Vec::with_capacity(layers.len());
-            for l in &layers {
-                let LayerData::Spectral { wavelength_nm, .. } = &l.data else {
-                    break;
-                };
-                let what = || format!("{} average of layer {}", m.name(), l.label);
-                match window_weights(m, wavelength_nm, what)? {
-                    Some(w) => per_layer.push(w),
-                    None => break,
-                }
-            }
-            if per_layer.len() == layers.len() {
-                outputs.push(Reduce::Window(per_layer));
+            if let Some(per_layer) = layers_window_weights(&layers, m)? {
+                outputs.push(BandReduction::Window(per_layer));
                 averaged.push((m, Vec::with_capacity(eval.angles_deg.len())));
             }
         }
-        let reduce = |r: &Reduce<'_>,
-                      k: usize,
-                      wl: &[f64],
-                      v: &[f64]|
-         -> Result<Vec<f64>, glassdb_spectral::SpectralError> {
-            match r {
-                Reduce::Colour(i) => i.channels(wl, v).map(|c| c.to_vec()),
-                Reduce::Window(w) => w[k].average(v).map(|a| vec![a]),
-            }
-        };
-        // Per layer and output, the normal values reduced to the output's bands and clamped
-        // to [0, 1] as a registry stores them (for models applied per channel).
-        let mut normals: Vec<Vec<Option<[Vec<f64>; 3]>>> = Vec::new();
-        for (k, l) in layers.iter().enumerate() {
-            let mut per = Vec::new();
-            for r in &outputs {
-                per.push(match (&l.data, application) {
-                    (
-                        LayerData::Spectral {
-                            wavelength_nm,
-                            t,
-                            rf,
-                            rb,
-                        },
-                        Application::PerChannel,
-                    ) => {
-                        let red = |v: &[f64], what: &str| {
-                            reduce(r, k, wavelength_nm, v)
-                                .map(|x| x.into_iter().map(|c| c.clamp(0.0, 1.0)).collect())
-                                .map_err(integration(label(l, what, 0.0)))
-                        };
-                        Some([
-                            red(t, "transmittance")?,
-                            red(rf, "front reflectance")?,
-                            red(rb, "back reflectance")?,
-                        ])
-                    }
-                    _ => None,
-                });
-            }
-            normals.push(per);
-        }
+        let normals = reduced_normals(&layers, &outputs, application)?;
         let prepared: Vec<Vec<ModelSample>> = layers.iter().map(|l| l.prepare()).collect();
         for &deg in &eval.angles_deg.clone() {
             let c = cos_deg(deg);
@@ -449,8 +480,8 @@ impl Stack {
                     let v = match (&l.data, &own[k], &normals[k][o]) {
                         (LayerData::Spectral { wavelength_nm, .. }, Some(v), _) => {
                             let red = |x: &[f64], what: &str| {
-                                reduce(r, k, wavelength_nm, x)
-                                    .map_err(integration(label(l, what, deg)))
+                                r.reduce(k, wavelength_nm, x)
+                                    .map_err(integration(layer_label(l, what, deg)))
                             };
                             LayerValues {
                                 t: red(&v.t, "transmittance")?,

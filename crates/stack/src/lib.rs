@@ -18,6 +18,8 @@
 //! The crate knows nothing of catalogs, files or registries: the registry builds units from
 //! its catalog with it, and `glassdb stack` from the command line.
 
+#![warn(missing_docs)]
+
 mod combine;
 mod error;
 mod evaluate;

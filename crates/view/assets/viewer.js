@@ -26,6 +26,25 @@
     return out.buffer;
   }
 
+  // An export's data (crates/view/src/export.rs, packed_base64): RGBA texels of 2- or 4-byte
+  // elements, each the difference from the same channel of the texel before, their bytes
+  // gathered by position (byte 0 of every element, then byte 1, …), gzip, base64. Undone here,
+  // the browser's own DecompressionStream inflating it.
+  async function packedBytes(text, elementBytes) {
+    const stream = new Blob([base64Bytes(text)]).stream().pipeThrough(new DecompressionStream('gzip'));
+    const packed = new Uint8Array(await new Response(stream).arrayBuffer());
+    const n = packed.length / elementBytes;
+    const out = new Uint8Array(packed.length);
+    for (let b = 0; b < elementBytes; b++) {
+      const plane = packed.subarray(b * n, (b + 1) * n);
+      for (let i = 0; i < n; i++) out[i * elementBytes + b] = plane[i];
+    }
+    // Typed arrays wrap on store, as the differences did.
+    const values = elementBytes === 4 ? new Uint32Array(out.buffer) : new Uint16Array(out.buffer);
+    for (let i = 4; i < values.length; i++) values[i] += values[i - 4];
+    return out.buffer;
+  }
+
   function loadScript(src) {
     return new Promise((resolve, reject) => {
       const s = document.createElement('script');
@@ -46,21 +65,39 @@
     return kind === 'json' ? r.json() : r.arrayBuffer();
   }
 
+  // The page's data (crates/view/src/page.rs), from the server or from an export: read here
+  // only, so that every field the page uses comes through one place that knows its version.
+  const PAGE_FORMAT = 'glassdb-viewer-page/2';
+
+  function readScene(scene) {
+    if (!scene || scene.format !== PAGE_FORMAT) {
+      throw new Error('the page data is ' + (scene && scene.format) + ', not ' + PAGE_FORMAT
+        + ': serve or export it with the glassdb of this page');
+    }
+    return scene;
+  }
+
+  function readFrame(info, passes, mask) {
+    return { info: { ids: info.ids, trans: info.trans, plane_sides: info.plane_sides }, passes, mask };
+  }
+
+  // A unit the server built (POST api/unit): its product and its table.
+  function readBuiltUnit(built) {
+    if (!built || built.format !== PAGE_FORMAT) throw new Error('the unit data is not ' + PAGE_FORMAT);
+    return { product: built.product, lut: new Float32Array(base64Bytes(built.lut)), buildMs: built.build_ms };
+  }
+
   const source = EXPORT ? {
-    scene: async () => EXPORT.scene,
-    luts: async () => EXPORT.luts.map((text) => new Float32Array(base64Bytes(text))),
+    scene: async () => readScene(EXPORT.scene),
+    luts: async () => Promise.all(EXPORT.luts.map(async (text) => new Float32Array(await packedBytes(text, 4)))),
     view: async (i) => new Float32Array(base64Bytes(EXPORT.views[i])),
     frame: async (i) => {
       if (!EXPORT.frames[i]) await loadScript(window.GLASSDB_EXPORT_FRAME_FILES[i]);
       const f = EXPORT.frames[i];
-      return {
-        info: f.info,
-        passes: new Uint16Array(base64Bytes(f.passes)),
-        mask: new Float32Array(base64Bytes(f.mask)),
-      };
+      return readFrame(f.info, new Uint16Array(await packedBytes(f.passes, 2)), new Float32Array(await packedBytes(f.mask, 4)));
     },
   } : {
-    scene: () => fetchOk('api/scene', 'json'),
+    scene: async () => readScene(await fetchOk('api/scene', 'json')),
     // One request for every table, and a frame's parts one after the other: the page keeps to
     // one connection.
     luts: async (n) => {
@@ -73,7 +110,7 @@
       const info = await fetchOk('api/frame/' + i, 'json');
       const passes = await fetchOk('api/frame/' + i + '/passes');
       const mask = await fetchOk('api/frame/' + i + '/mask');
-      return { info, passes: new Uint16Array(passes), mask: new Float32Array(mask) };
+      return readFrame(info, new Uint16Array(passes), new Float32Array(mask));
     },
   };
 
@@ -330,6 +367,56 @@ void main() {
     const slotFloats = lutLayout.rows_per_slot * lutLayout.width * 4;
     canvas.width = W;
     canvas.height = H;
+
+    // ---- the frame on screen: fitted to the stage (the default), or zoomed ----
+    const params = new URLSearchParams(location.search);
+    const stage = $('stage');
+    const frameBox = $('frame-box');
+    const zoom = { fit: true, scale: 1 };
+    const fitScale = () => Math.max(1 / 64, Math.min(stage.clientWidth / W, stage.clientHeight / H));
+    // `anchor`: a point on screen [x, y] that stays over the same frame pixel (the wheel's).
+    function applyZoom(anchor) {
+      if (zoom.fit) zoom.scale = fitScale();
+      let at = null;
+      if (anchor) {
+        const r = frameBox.getBoundingClientRect();
+        at = [(anchor[0] - r.left) / r.width, (anchor[1] - r.top) / r.height];
+      }
+      frameBox.style.width = W * zoom.scale + 'px';
+      frameBox.style.height = H * zoom.scale + 'px';
+      if (at) {
+        const r = frameBox.getBoundingClientRect();
+        stage.scrollLeft += r.left + at[0] * r.width - anchor[0];
+        stage.scrollTop += r.top + at[1] * r.height - anchor[1];
+      }
+      $('zoom-label').textContent = (zoom.fit ? 'fit, ' : '') + Math.round(zoom.scale * 100) + ' %';
+    }
+    function setZoom(z, anchor) {
+      if (z === 'fit') {
+        zoom.fit = true;
+      } else {
+        const scale = Number(z);
+        if (!Number.isFinite(scale) || scale <= 0) throw new Error('zoom ' + z + ': give fit or a factor such as 2');
+        zoom.fit = false;
+        zoom.scale = Math.min(64, Math.max(1 / 16, scale));
+      }
+      applyZoom(anchor);
+    }
+    $('zoom-fit').onclick = () => setZoom('fit');
+    $('zoom-1').onclick = () => setZoom(1);
+    $('zoom-in').onclick = () => setZoom(zoom.scale * 1.25);
+    $('zoom-out').onclick = () => setZoom(zoom.scale / 1.25);
+    stage.addEventListener('wheel', (ev) => {
+      ev.preventDefault();
+      setZoom(zoom.scale * Math.pow(1.25, -Math.sign(ev.deltaY)), [ev.clientX, ev.clientY]);
+    }, { passive: false });
+    new ResizeObserver(() => { if (zoom.fit) applyZoom(); }).observe(stage);
+    try {
+      setZoom(params.get('zoom') || 'fit');
+    } catch (e) {
+      setZoom('fit');
+      status(e.message, true);
+    }
     const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false, alpha: false });
     if (!gl) throw new Error('this browser has no WebGL2');
     if (scene.planes > 64) throw new Error('the page handles at most 64 planes');
@@ -407,14 +494,12 @@ void main() {
     gl.uniform1i(u('uHeight'), H);
     gl.uniform1i(u('uMode'), { code8: 0, cos: 1, normal: 2 }[scene.mask_mode]);
     gl.uniform1i(u('uPlanes'), scene.planes);
-    gl.uniform1iv(u('uSide'), Int32Array.from({ length: 64 }, (_, k) => scene.plane_sides[k] === 'back' ? 1 : 0));
     gl.uniform1i(u('uConvert'), scene.display_matrix ? 1 : 0);
     gl.uniformMatrix3fv(u('uDisplay'), true, scene.display_matrix || [1, 0, 0, 0, 1, 0, 0, 0, 1]);
 
     // Every product's table, on the CPU (a swap then uploads one slot's rows and nothing else).
     const luts = await source.luts(products.length);
 
-    const params = new URLSearchParams(location.search);
     const state = {
       // Slot i is product i's id (scene.slots): each glass starts with its own product.
       sets: { A: slots.map((_, i) => i), B: null },
@@ -429,6 +514,9 @@ void main() {
       drawn: 0,
       lastSwapMs: null,
       lastFrameLoadMs: null,
+      lastUnit: null,
+      // The unit being put together on the page: panes {glass, flip} and gaps {gap_mm, gas}.
+      unit: [],
     };
     const applySpec = (set, spec) => {
       for (const [id, p] of parseChoices(products, slots, spec)) state.sets[set][slots.indexOf(id)] = p;
@@ -455,10 +543,33 @@ void main() {
       gl.uniform1f(u('uSplitX'), state.split * W);
       gl.viewport(0, 0, W, H);
       gl.drawArrays(gl.TRIANGLES, 0, 3);
+      placeSplitLine();
       state.drawn += 1;
       canvas.dataset.drawn = String(state.drawn);
       window.glassdbFrameDrawn = state.drawn;
     }
+
+    // The split line over the frame, where the shader switches from set A to set B.
+    const splitLine = $('split-line');
+    function placeSplitLine() {
+      splitLine.hidden = state.ab !== 'split';
+      splitLine.style.left = (100 * Math.min(1, Math.max(0, state.split))) + '%';
+    }
+    splitLine.addEventListener('pointerdown', (ev) => {
+      ev.preventDefault();
+      splitLine.setPointerCapture(ev.pointerId);
+      splitLine.dataset.dragging = '1';
+    });
+    splitLine.addEventListener('pointermove', (ev) => {
+      if (!splitLine.dataset.dragging) return;
+      const r = frameBox.getBoundingClientRect();
+      state.split = Math.min(1, Math.max(0, (ev.clientX - r.left) / r.width));
+      $('split').value = String(state.split);
+      draw();
+    });
+    const stopDrag = () => { delete splitLine.dataset.dragging; };
+    splitLine.addEventListener('pointerup', stopDrag);
+    splitLine.addEventListener('pointercancel', stopDrag);
 
     // Waits for the frame drawn (reading a pixel back finishes the drawing): only where a time
     // is taken, so that the exposure slider and the split drag do not stall on the GPU.
@@ -476,6 +587,8 @@ void main() {
         data.passes.subarray(W * H * 4));
       gl.bindTexture(gl.TEXTURE_2D, maskTex);
       gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.FLOAT, data.mask);
+      // The side of each plane the camera sees in this frame (it may change as the camera moves).
+      gl.uniform1iv(u('uSide'), Int32Array.from({ length: 64 }, (_, k) => data.info.plane_sides[k] === 'back' ? 1 : 0));
       state.frame = i;
       state.data = data;
       renderGlasses();
@@ -517,8 +630,20 @@ void main() {
     function productValues(p) {
       const f = (v) => v.toFixed(3);
       const l = p.luminous;
-      return (l ? 'τv ' + f(l.transmittance) + ' ρv ' + f(l.reflectance) : 'no luminous values') +
-        ' · t0 ' + p.t0.map(f).join('/') + ' · r0 ' + p.r0.map(f).join('/');
+      const luminous = !l ? 'no luminous values'
+        : p.unit ? 'Tv ' + f(l.transmittance) + ' Rv out ' + f(l.reflectance) + ' Rv in ' + f(l.reflectance_back)
+          : 'τv ' + f(l.transmittance) + ' ρv ' + f(l.reflectance);
+      return luminous + ' · t0 ' + p.t0.map(f).join('/') + ' · r0 ' + p.r0.map(f).join('/');
+    }
+
+    // A unit's build-up, outside first: panes (thickness, product, coated surfaces) and gaps.
+    function buildupText(unit) {
+      const mm = (v) => (Math.round(v * 10) / 10) + ' mm';
+      return unit.elements.map((e) => e.kind === 'gap' ? mm(e.thickness_mm) + ' ' + e.gas
+        : (e.thickness_mm ? mm(e.thickness_mm) + ' ' : '') + e.name
+          + (e.coated_surfaces.length ? ' (coating on #' + e.coated_surfaces.join(', #') + ')' : '')
+          + (e.flipped ? ' [flipped]' : '')).join(' | ')
+        + (unit.thickness_mm ? ' · ' + mm(unit.thickness_mm) + ' in all' : '');
     }
 
     function renderGlasses() {
@@ -535,6 +660,7 @@ void main() {
         const name = document.createElement('span');
         name.className = 'name';
         name.textContent = 'id ' + id + ': A ' + a.name + (a !== b ? ' | B ' + b.name : '');
+        li.title = name.textContent;
         li.append(name);
         const px = document.createElement('span');
         px.className = 'values';
@@ -555,7 +681,6 @@ void main() {
         const li = document.createElement('li');
         li.dataset.index = String(p.index);
         if (slot >= 0 && state.sets[state.edit][slot] === p.index) li.className = 'current';
-        li.title = 'registry id ' + p.id + ', angle model ' + p.angle_model;
         li.append(swatch(p.r0), swatch(p.t0));
         const name = document.createElement('span');
         name.className = 'name';
@@ -564,6 +689,15 @@ void main() {
         values.className = 'values';
         values.textContent = productValues(p);
         name.append(values);
+        let tip = p.name + '\n' + values.textContent;
+        if (p.unit) {
+          const buildup = document.createElement('div');
+          buildup.className = 'buildup';
+          buildup.textContent = buildupText(p.unit);
+          name.append(buildup);
+          tip += '\n' + buildup.textContent;
+        }
+        li.title = tip + '\n' + (p.request ? 'built on this page' : 'registry id ' + p.id) + ', angle model ' + p.angle_model;
         li.append(name);
         li.onclick = () => {
           if (state.selected === null) { status('click a glass first', true); return; }
@@ -591,7 +725,7 @@ void main() {
         return;
       }
       const plane = Math.round(m[1]);
-      const side = scene.plane_sides[plane] === 'back' ? 1 : 0;
+      const side = d.info.plane_sides[plane] === 'back' ? 1 : 0;
       const cos = scene.mask_mode === 'code8' ? m[2] / 255 : scene.mask_mode === 'cos' ? m[2] : 1;
       const set = state.ab === 'B' || (state.ab === 'split' && x >= state.split * W) ? 'B' : 'A';
       const lut = luts[state.sets[set][slot]];
@@ -698,12 +832,145 @@ void main() {
     const sessionFetch = (url, init) => fetch(url, { ...init, headers: { 'X-Glassdb-Session': session ? session.content : '' } });
     exportButton.onclick = async () => {
       try {
-        const r = await sessionFetch('api/export', { method: 'POST', body: JSON.stringify({ glass: choicesParam(state.edit), ev: state.ev }) });
+        // The units built on this page that the edited set uses travel with the request: the
+        // server builds them again for the export (it keeps none).
+        const used = new Set(slots.map((_, s) => state.sets[state.edit][s]));
+        const units = products.filter((p) => p.request && used.has(p.index)).map((p) => ({ elements: p.request }));
+        const r = await sessionFetch('api/export', { method: 'POST', body: JSON.stringify({ glass: choicesParam(state.edit), ev: state.ev, units }) });
         const body = await r.json();
         if (!r.ok) throw new Error(body.error);
-        status('exported to ' + body.path);
+        status('exported to ' + body.path + ' (' + body.files + ' files, ' + (body.bytes / 1e6).toFixed(2) + ' MB)');
       } catch (e) { status('export failed: ' + e.message, true); }
     };
+
+    // ---- a unit built on the page: the server runs the stack engine and sends its table ----
+
+    const unitStatus = (text, isError) => {
+      const s = $('unit-status');
+      s.textContent = text;
+      s.className = isError ? 'error' : '';
+    };
+    const layers = scene.unit_layers;
+    const canBuild = !EXPORT && layers.length > 0;
+    state.unit = layers.length ? [{ glass: layers[0].id, flip: false }, { gap_mm: 12.7, gas: 'argon' }, { glass: layers[0].id, flip: false }] : [];
+    function renderUnitBuilder() {
+      const ol = $('unit-elements');
+      ol.textContent = '';
+      const panes = state.unit.filter((e) => e.glass !== undefined).length;
+      let pane = 0;
+      state.unit.forEach((e, k) => {
+        const li = document.createElement('li');
+        if (e.glass !== undefined) {
+          pane += 1;
+          li.append(pane === 1 ? 'outer pane ' : pane === panes ? 'inner pane ' : 'pane ' + pane + ' ');
+          const sel = document.createElement('select');
+          sel.className = 'unit-glass';
+          for (const l of layers) {
+            const o = document.createElement('option');
+            o.value = String(l.id);
+            o.textContent = l.name;
+            sel.append(o);
+          }
+          sel.value = String(e.glass);
+          sel.title = 'the catalog glass of this pane';
+          sel.onchange = () => { e.glass = Number(sel.value); };
+          const flip = document.createElement('input');
+          flip.type = 'checkbox';
+          flip.className = 'unit-flip';
+          flip.checked = e.flip;
+          flip.onchange = () => { e.flip = flip.checked; };
+          const label = document.createElement('label');
+          label.title = 'turn the pane round: its coating on the other surface';
+          label.append(flip, ' flip');
+          li.append(sel, ' ', label);
+        } else {
+          li.append('gap ');
+          const width = document.createElement('input');
+          width.type = 'number';
+          width.className = 'unit-gap';
+          width.min = '0';
+          width.step = '0.1';
+          width.value = String(e.gap_mm);
+          // An empty or malformed box is NaN (sent as null, refused by the server, which says why).
+          width.oninput = width.onchange = () => { e.gap_mm = width.value.trim() === '' ? NaN : Number(width.value); };
+          const gas = document.createElement('select');
+          gas.className = 'unit-gas';
+          for (const g of scene.gases) {
+            const o = document.createElement('option');
+            o.value = g;
+            o.textContent = g;
+            gas.append(o);
+          }
+          if (e.gas === undefined) e.gas = 'air';
+          gas.value = e.gas;
+          gas.onchange = () => { e.gas = gas.value; };
+          li.append(width, ' mm ', gas);
+          if (panes > 2 && k === state.unit.length - 2) {
+            const remove = document.createElement('button');
+            remove.type = 'button';
+            remove.textContent = 'remove gap and pane';
+            remove.onclick = () => { state.unit.splice(k, 2); renderUnitBuilder(); };
+            li.append(' ', remove);
+          }
+        }
+        ol.append(li);
+      });
+      $('unit-add-pane').disabled = !canBuild;
+      $('unit-build').disabled = !canBuild;
+      if (!canBuild) {
+        unitStatus(EXPORT ? 'an exported page builds no units (it has no server); its units are those exported'
+          : 'start glassdb view with --catalog CATALOG to build units from its glasses');
+      }
+    }
+    $('unit-add-pane').onclick = () => {
+      state.unit.push({ gap_mm: 12.7, gas: 'argon' }, { glass: layers[0].id, flip: false });
+      renderUnitBuilder();
+    };
+    // Builds the unit on the builder (NaN widths travel as null and are refused by the server,
+    // which says why), puts it on the selected glass and draws: the milliseconds from the request
+    // to the frame on screen, and the server's share.
+    async function buildUnit() {
+      const t0 = performance.now();
+      if (state.selected === null) throw new Error('click a glass first');
+      const elements = state.unit.map((e) => ({ ...e }));
+      const key = JSON.stringify(elements);
+      let p = products.find((q) => q.request && JSON.stringify(q.request) === key);
+      let buildMs = 0;
+      if (!p) {
+        const r = await sessionFetch('api/unit', { method: 'POST', body: JSON.stringify({ elements }) });
+        let body;
+        try { body = await r.json(); } catch (e) { throw new Error(r.status + ' ' + r.statusText); }
+        if (!r.ok) throw new Error(body.error || r.status + ' ' + r.statusText);
+        const built = readBuiltUnit(body);
+        p = built.product;
+        p.index = products.length;
+        p.request = elements;
+        products.push(p);
+        luts.push(built.lut);
+        buildMs = built.buildMs;
+      }
+      choose(state.selected, p.index);
+      state.lastUnit = { ms: performance.now() - t0, buildMs, name: p.name };
+      return state.lastUnit;
+    }
+    // Builds and says the outcome under the builder (the button and the hook alike).
+    async function buildAndSay() {
+      unitStatus('building…');
+      try {
+        const u = await buildUnit();
+        unitStatus('id ' + state.selected + ' → ' + u.name + '\non screen in ' + u.ms.toFixed(0) + ' ms (server ' + u.buildMs.toFixed(0) + ' ms)');
+        return u;
+      } catch (e) {
+        unitStatus('cannot build the unit: ' + e.message, true);
+        throw e;
+      }
+    }
+    $('unit-build').onclick = async () => {
+      // What the controls show (a box cleared without an input event included).
+      for (const box of document.querySelectorAll('#unit-elements input.unit-gap')) box.onchange();
+      try { await buildAndSay(); } catch (e) { /* said under the builder */ }
+    };
+    renderUnitBuilder();
 
     // ---- automation hooks ----
     window.glassdb = {
@@ -712,6 +979,14 @@ void main() {
       setEv: (ev) => { state.ev = ev; draw(); },
       setView: async (name) => { await setView(scene.views.findIndex((v) => v.name === name)); draw(); },
       setAB: (mode, split) => { state.ab = mode; if (split !== undefined) state.split = split; draw(); },
+      // Where the split line stands (0–1 across the frame) while A | B is split, else null.
+      split: () => (state.ab === 'split' ? state.split : null),
+      setZoom: (z) => setZoom(z),
+      // The frame's scale on screen (screen pixels per frame pixel) and whether it fits the stage.
+      zoom: () => ({ fit: zoom.fit, scale: zoom.scale }),
+      // Puts `elements` on the unit builder and builds it (as its button does).
+      buildUnit: async (elements) => { state.unit = elements.map((e) => ({ ...e })); renderUnitBuilder(); return buildAndSay(); },
+      lastUnit: () => state.lastUnit,
       loadFrame,
       products: () => ({ A: Object.fromEntries(slots.map((id, s) => [id, products[state.sets.A[s]].name])),
         B: Object.fromEntries(slots.map((id, s) => [id, products[state.sets.B[s]].name])) }),

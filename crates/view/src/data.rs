@@ -11,9 +11,9 @@
 //!   holds the 256 8-bit entries, then the [`FINE_STEPS`] + 1 fine entries, then normal
 //!   incidence.
 
+use glassdb_colour::CubeLut;
 use glassdb_compose::DecodedFrame;
 use glassdb_compose::lut::{FINE_STEPS, GlassSideLut, RtTriple};
-use glassdb_compose::view::CubeLut;
 use glassdb_mask::{CosCode, CosTheta};
 
 /// Texels per row of the lookup-table texture (WebGL2 guarantees 2048).

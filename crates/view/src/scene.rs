@@ -2,39 +2,86 @@
 //! products (every record of the registry's table in the passes' space) and their lookup
 //! tables, and the choice of a product per glass id.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-use glassdb_colour::RgbSpace;
+use glassdb_colour::{CubeLut, RgbSpace};
 use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::lut::GlassLut;
 use glassdb_compose::memory::MemoryBudget;
-use glassdb_compose::view::CubeLut;
-use glassdb_compose::{ComposeJob, ComposeSettings, DecodedFrame, decode_frame, sequence};
-use glassdb_registry::{GlassRecord, Registry, Side};
-use serde_json::{Value, json};
+use glassdb_compose::{DecodeSettings, DecodeTarget, DecodedFrame, FrameFiles, decode_frame};
+use glassdb_registry::{GlassRecord, Registry};
+use glassdb_side::Side;
+use glassdb_stack::Gas;
 
 use crate::ViewError;
 use crate::data::{self, MaskMode};
+use crate::page::{LutLayout, PAGE_FORMAT, PageDisplayView, PageFrame, PageProduct, PageScene};
+use crate::units::{BuiltUnit, UnitWorkshop};
 
-/// The viewer's inputs: the compose job (paths may hold `####` when `frames` is given), how
-/// to read it, and the registry whose records are the candidate products.
+/// The viewer's inputs: the frames' files and sides, how to read them, and the registry whose
+/// records are the candidate products.
 pub struct ViewerInputs {
-    pub job: ComposeJob,
-    /// Frame numbers of a sequence; empty for a single frame.
-    pub frames: Vec<u32>,
-    pub settings: ComposeSettings,
+    /// The frames, in order (at least one).
+    pub frames: Vec<ViewerFrame>,
+    /// How the inputs are read and checked, as `compose` reads them.
+    pub settings: DecodeSettings,
+    /// The registry whose records are the candidate products.
     pub registry: Registry,
-    /// `.cube` views the page offers beside `standard`.
-    pub views: Vec<CubeLut>,
+    /// `.cube` display views the page offers beside `standard`.
+    pub display_views: Vec<CubeLut>,
+    /// The catalog whose single glasses the page builds units from (none: the page builds
+    /// no units).
+    pub unit_catalog: Option<PathBuf>,
+}
+
+/// One frame the viewer shows: its label on the page, its files and the side of each plane
+/// the camera sees in it (a camera that moves may see a plane from the other side later).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewerFrame {
+    /// The frame's number, or its transmission pass for a single frame.
+    pub label: String,
+    /// The passes and the mask.
+    pub files: FrameFiles,
+    /// Side of each plane that faces the camera; planes not listed show the front.
+    pub plane_sides: BTreeMap<usize, Side>,
+}
+
+impl ViewerFrame {
+    /// The frames of a sequence: `files` with their `#` runs expanded for each of `numbers`,
+    /// every frame with the same sides; no numbers: `files` as one frame.
+    pub fn sequence(
+        files: &FrameFiles,
+        numbers: &[u32],
+        plane_sides: &BTreeMap<usize, Side>,
+    ) -> Result<Vec<ViewerFrame>, ViewError> {
+        if numbers.is_empty() {
+            return Ok(vec![ViewerFrame {
+                label: files.trans.display().to_string(),
+                files: files.clone(),
+                plane_sides: plane_sides.clone(),
+            }]);
+        }
+        numbers
+            .iter()
+            .map(|&n| {
+                Ok(ViewerFrame {
+                    label: n.to_string(),
+                    files: files.for_frame(n)?,
+                    plane_sides: plane_sides.clone(),
+                })
+            })
+            .collect()
+    }
 }
 
 /// One decoded frame as the page uploads it.
 #[derive(Debug)]
 pub struct FrameData {
-    /// Glass pixels per id, the mask kind: the frame's JSON.
-    pub info: Value,
+    /// Glass pixels per id and the frame's transmission pass: the frame's JSON.
+    pub info: PageFrame,
     /// Half-float passes ([`data::pass_bytes`]).
     pub passes: Vec<u8>,
     /// The mask ([`data::mask_bytes`]).
@@ -44,7 +91,9 @@ pub struct FrameData {
 /// A product chosen for a glass id: (id, index of the product in [`Viewer::products`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GlassChoice {
+    /// The glass id.
     pub id: u16,
+    /// The product's index in [`Viewer::products`].
     pub product: usize,
 }
 
@@ -62,8 +111,10 @@ pub struct Viewer {
     product_luts: Arc<[u8]>,
     /// Each `.cube` view's tables as the page uploads them ([`data::view_bytes`]).
     view_tables: Vec<Arc<[u8]>>,
-    scene: Value,
+    scene: PageScene,
     mask_mode: MaskMode,
+    /// Where units asked for on the page are built.
+    units: Option<UnitWorkshop>,
     /// The last frame decoded.
     cache: Mutex<Option<(usize, Arc<FrameData>)>>,
 }
@@ -74,8 +125,15 @@ impl Viewer {
     pub fn open(inputs: ViewerInputs) -> Result<Viewer, ViewError> {
         let luts = RegistryLuts::new(&inputs.registry);
         let budget = MemoryBudget::new(inputs.settings.max_memory);
-        let first_job = job_of(&inputs, 0)?;
-        let first = decode_frame(&first_job, &inputs.settings, &luts, &budget, (false, false))?;
+        let first_frame = inputs.frames.first().ok_or(ViewError::NoFrames)?;
+        let first_files = &first_frame.files;
+        let first = decode_frame(
+            first_files,
+            &inputs.settings,
+            &luts,
+            &budget,
+            &DecodeTarget::display(),
+        )?;
         let (width, height, planes) = (
             first.trans.image.width,
             first.trans.image.height,
@@ -89,9 +147,19 @@ impl Viewer {
             .map(|t| t.glasses.clone())
             .unwrap_or_default();
         let slots = slot_map(&products);
+        let units = match &inputs.unit_catalog {
+            Some(catalog) => {
+                let table = inputs
+                    .registry
+                    .table(table.basis)
+                    .unwrap_or_else(|| inputs.registry.default_table());
+                Some(UnitWorkshop::new(catalog, table)?)
+            }
+            None => None,
+        };
         let product_luts = product_tables(&products, &slots, first.lut);
         // Kept for the page's first request.
-        let first_data = Arc::new(frame_data(&first, &first_job, &slots));
+        let first_data = Arc::new(frame_data(&first, first_frame, &slots));
         drop(first);
         let display_matrix = (space.space != RgbSpace::Srgb).then(|| {
             let m = glassdb_colour::rgb_to_rgb(space.space, RgbSpace::Srgb);
@@ -100,38 +168,42 @@ impl Viewer {
                 .map(|(r, c)| m[(r, c)])
                 .collect::<Vec<f64>>()
         });
-        let frames: Vec<String> = if inputs.frames.is_empty() {
-            vec![first_job.trans.display().to_string()]
-        } else {
-            inputs.frames.iter().map(u32::to_string).collect()
+        let frames: Vec<String> = inputs.frames.iter().map(|f| f.label.clone()).collect();
+        let scene = PageScene {
+            format: PAGE_FORMAT,
+            width,
+            height,
+            planes,
+            frames,
+            space: space.to_string(),
+            table: table.basis.to_string(),
+            approximate_table: table.approximate,
+            display_matrix,
+            registry: inputs.settings.registry_label.clone(),
+            mask_mode: mask_mode.name(),
+            trans: first_files.trans.display().to_string(),
+            lut: LutLayout::TEXTURE,
+            slots: products.iter().map(|g| g.id).collect(),
+            products: products
+                .iter()
+                .enumerate()
+                .map(|(i, g)| PageProduct::of(i, g))
+                .collect(),
+            views: inputs
+                .display_views
+                .iter()
+                .map(PageDisplayView::of)
+                .collect(),
+            unit_layers: units
+                .as_ref()
+                .map_or_else(Vec::new, |u| u.layers().to_vec()),
+            gases: Gas::ALL.iter().map(|g| g.name()).collect(),
+            export_available: false,
+            initial_glass: None,
+            initial_ev: None,
         };
-        let scene = json!({
-            "width": width,
-            "height": height,
-            "planes": planes,
-            "plane_sides": (0..planes).map(|k| side_name(inputs.settings.plane_sides.get(&k).copied().unwrap_or(Side::Front))).collect::<Vec<_>>(),
-            "frames": frames,
-            "space": space.to_string(),
-            "table": table.basis.to_string(),
-            "approximate_table": table.approximate,
-            "display_matrix": display_matrix,
-            "registry": inputs.settings.registry_label,
-            "mask_mode": mask_mode.name(),
-            "trans": first_job.trans.display().to_string(),
-            "lut": {
-                "width": data::LUT_WIDTH,
-                "rows_per_curve": data::LUT_ROWS_PER_CURVE,
-                "rows_per_slot": data::LUT_ROWS_PER_SLOT,
-                "fine_offset": data::LUT_FINE_OFFSET,
-                "fine_steps": glassdb_compose::lut::FINE_STEPS,
-                "normal_offset": data::LUT_NORMAL_OFFSET,
-            },
-            "slots": products.iter().map(|g| g.id).collect::<Vec<_>>(),
-            "products": products.iter().enumerate().map(|(i, g)| product_json(i, g)).collect::<Vec<_>>(),
-            "views": inputs.views.iter().map(view_json).collect::<Vec<_>>(),
-        });
         let view_tables = inputs
-            .views
+            .display_views
             .iter()
             .map(|v| data::view_bytes(v).into())
             .collect();
@@ -145,12 +217,13 @@ impl Viewer {
             view_tables,
             scene,
             mask_mode,
+            units,
             cache: Mutex::new(Some((0, first_data))),
         })
     }
 
-    /// The scene description the page starts from.
-    pub fn scene(&self) -> &Value {
+    /// The scene the page starts from (no export button, no initial choices).
+    pub fn scene(&self) -> &PageScene {
         &self.scene
     }
 
@@ -159,9 +232,14 @@ impl Viewer {
         &self.products
     }
 
+    /// Where the page's units are built, if it builds any.
+    pub fn units(&self) -> Option<&UnitWorkshop> {
+        self.units.as_ref()
+    }
+
     /// How many frames there are.
     pub fn frame_count(&self) -> usize {
-        self.inputs.frames.len().max(1)
+        self.inputs.frames.len()
     }
 
     /// Where product `index`'s lookup table lies in [`Viewer::all_product_luts`]: the table
@@ -203,24 +281,30 @@ impl Viewer {
         }
         // Free the old frame first: two frames need not fit in memory together.
         *cache = None;
-        let job = job_of(&self.inputs, index)?;
+        let Some(viewer_frame) = self.inputs.frames.get(index) else {
+            return Err(ViewError::NoSuchFrame {
+                index,
+                frames: self.inputs.frames.len(),
+            });
+        };
+        let files = &viewer_frame.files;
         let frame = decode_frame(
-            &job,
+            files,
             &self.inputs.settings,
             &self.luts,
             &self.budget,
-            (false, false),
+            &DecodeTarget::display(),
         )?;
         let mode = MaskMode::of(&frame.mask.cos_theta);
         if mode != self.mask_mode {
             return Err(ViewError::MaskKindChanges {
-                frame: self.inputs.frames.get(index).copied().unwrap_or(0),
-                mask: job.mask.clone(),
+                frame: viewer_frame.label.clone(),
+                mask: files.mask.clone(),
                 found: mode.name(),
                 first: self.mask_mode.name(),
             });
         }
-        let data = Arc::new(frame_data(&frame, &job, &self.slots));
+        let data = Arc::new(frame_data(&frame, viewer_frame, &self.slots));
         drop(frame);
         *cache = Some((index, data.clone()));
         Ok(data)
@@ -230,6 +314,21 @@ impl Viewer {
     /// id; or a part of its name matching one product only). Names may hold commas: a comma
     /// starts a new choice only when `ID:` follows it.
     pub fn parse_choices(&self, spec: &str) -> Result<Vec<GlassChoice>, ViewError> {
+        self.parse_choices_among(spec, &[])
+    }
+
+    /// [`Viewer::parse_choices`] among the products and `units` built on the page (numbered
+    /// after the products, in their order).
+    pub fn parse_choices_among(
+        &self,
+        spec: &str,
+        units: &[BuiltUnit],
+    ) -> Result<Vec<GlassChoice>, ViewError> {
+        let candidates: Vec<&GlassRecord> = self
+            .products
+            .iter()
+            .chain(units.iter().map(|u| &u.record))
+            .collect();
         split_choices(spec)
             .into_iter()
             .map(|part| {
@@ -249,7 +348,7 @@ impl Viewer {
                 }
                 Ok(GlassChoice {
                     id,
-                    product: self.find_product(name.trim())?,
+                    product: find_product_in(&candidates, name.trim())?,
                 })
             })
             .collect()
@@ -257,62 +356,77 @@ impl Viewer {
 
     /// The product a name means (see [`Viewer::parse_choices`]).
     pub fn find_product(&self, name: &str) -> Result<usize, ViewError> {
-        let lower = name.to_lowercase();
-        if let Some(i) = self
-            .products
-            .iter()
-            .position(|g| g.name.to_lowercase() == lower)
-        {
-            return Ok(i);
-        }
-        if let Ok(id) = name.parse::<u16>()
-            && let Some(i) = self.products.iter().position(|g| g.id == id)
-        {
-            return Ok(i);
-        }
-        let matches: Vec<usize> = (0..self.products.len())
-            .filter(|&i| self.products[i].name.to_lowercase().contains(&lower))
-            .collect();
-        match matches.as_slice() {
-            [i] => Ok(*i),
-            [] => Err(ViewError::UnknownProduct {
-                name: name.to_string(),
-                candidates: self
-                    .products
-                    .iter()
-                    .map(|g| format!("{} ({})", g.name, g.id))
-                    .collect::<Vec<_>>()
-                    .join("; "),
-            }),
-            many => Err(ViewError::AmbiguousProduct {
-                name: name.to_string(),
-                matches: many
-                    .iter()
-                    .map(|&i| self.products[i].name.clone())
-                    .collect::<Vec<_>>()
-                    .join("; "),
-            }),
-        }
+        find_product_in(&self.products.iter().collect::<Vec<_>>(), name)
     }
 
-    /// Glass choices as the page's `glass` parameter (product names).
-    pub fn choices_param(&self, choices: &[GlassChoice]) -> String {
+    /// Glass choices as the page's `glass` parameter (product names), among the products and
+    /// `units` (as [`Viewer::parse_choices_among`] numbers them).
+    pub fn choices_param(&self, choices: &[GlassChoice], units: &[BuiltUnit]) -> String {
+        let name = |i: usize| match self.products.get(i) {
+            Some(g) => &g.name,
+            None => &units[i - self.products.len()].record.name,
+        };
         choices
             .iter()
-            .map(|c| format!("{}:{}", c.id, self.products[c.product].name))
+            .map(|c| format!("{}:{}", c.id, name(c.product)))
             .collect::<Vec<_>>()
             .join(",")
+    }
+}
+
+/// The candidate a name means: its full name (any case), its registry id, or a part of its
+/// name that only it has.
+fn find_product_in(candidates: &[&GlassRecord], name: &str) -> Result<usize, ViewError> {
+    let lower = name.to_lowercase();
+    if let Some(i) = candidates
+        .iter()
+        .position(|g| g.name.to_lowercase() == lower)
+    {
+        return Ok(i);
+    }
+    if let Ok(id) = name.parse::<u16>()
+        && let Some(i) = candidates.iter().position(|g| g.id == id)
+    {
+        return Ok(i);
+    }
+    let matches: Vec<usize> = (0..candidates.len())
+        .filter(|&i| candidates[i].name.to_lowercase().contains(&lower))
+        .collect();
+    match matches.as_slice() {
+        [i] => Ok(*i),
+        [] => Err(ViewError::UnknownProduct {
+            name: name.to_string(),
+            candidates: candidates
+                .iter()
+                .map(|g| format!("{} ({})", g.name, g.id))
+                .collect::<Vec<_>>()
+                .join("; "),
+        }),
+        many => Err(ViewError::AmbiguousProduct {
+            name: name.to_string(),
+            matches: many
+                .iter()
+                .map(|&i| candidates[i].name.clone())
+                .collect::<Vec<_>>()
+                .join("; "),
+        }),
     }
 }
 
 /// A decoded frame as the page uploads it; `slots` gives each mask id's glass slot.
 fn frame_data(
     frame: &DecodedFrame<'_>,
-    job: &ComposeJob,
+    source: &ViewerFrame,
     slots: &HashMap<u16, usize>,
 ) -> FrameData {
     FrameData {
-        info: json!({ "ids": frame.id_counts, "trans": job.trans.display().to_string() }),
+        info: PageFrame {
+            ids: frame.id_counts.clone(),
+            trans: source.files.trans.display().to_string(),
+            plane_sides: (0..frame.refl.len())
+                .map(|k| source.plane_sides.get(&k).copied().unwrap_or(Side::Front))
+                .collect(),
+        },
         passes: data::pass_bytes(frame),
         mask: data::mask_bytes(frame, |id| slots.get(&id).copied()),
     }
@@ -374,61 +488,6 @@ fn split_choices(spec: &str) -> Vec<&str> {
     }
     parts.push(&spec[start..]);
     parts.into_iter().filter(|p| !p.trim().is_empty()).collect()
-}
-
-fn side_name(side: Side) -> &'static str {
-    match side {
-        Side::Front => "front",
-        Side::Back => "back",
-    }
-}
-
-/// A `.cube` view as the scene lists it: its name and its tables' sizes and domains.
-fn view_json(lut: &CubeLut) -> Value {
-    let name = lut.path.file_stem().map_or_else(
-        || lut.path.display().to_string(),
-        |s| s.to_string_lossy().into_owned(),
-    );
-    json!({
-        "name": name,
-        "title": lut.title,
-        "shaper": lut.shaper_table().map(|t| json!({
-            "len": t.size,
-            "rows": t.size.div_ceil(data::LUT_WIDTH),
-            "scale": t.scale,
-            "offset": t.offset,
-        })),
-        "cube": lut.cube_table().map(|t| json!({
-            "n": t.size,
-            "scale": t.scale,
-            "offset": t.offset,
-        })),
-    })
-}
-
-fn product_json(index: usize, g: &GlassRecord) -> Value {
-    json!({
-        "index": index,
-        "id": g.id,
-        "name": g.name,
-        "r0": g.r0,
-        "t0": g.t0,
-        "r0_back": g.r0_back,
-        "luminous": g.luminous.map(|l| json!({
-            "transmittance": l.transmittance,
-            "reflectance": l.reflectance,
-            "reflectance_back": l.reflectance_back,
-        })),
-        "angle_model": g.angle_model.kind,
-    })
-}
-
-/// The job of frame `index`: the pattern's paths with its number, or the job itself.
-fn job_of(inputs: &ViewerInputs, index: usize) -> Result<ComposeJob, ViewError> {
-    match inputs.frames.get(index) {
-        Some(&n) => Ok(sequence::frame_job(&inputs.job, n)?),
-        None => Ok(inputs.job.clone()),
-    }
 }
 
 #[cfg(test)]

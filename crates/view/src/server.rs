@@ -21,7 +21,8 @@
 //! | `GET /api/product/N/lut` | product N's lookup table |
 //! | `GET /api/view/N` | `.cube` view N's tables ([`crate::data::view_bytes`]) |
 //! | `GET /api/luts` | every product's table, one after the other (the page's one request) |
-//! | `POST /api/export` | `{"glass": "1:NAME,…", "ev": 0}`: writes the export folder given at start |
+//! | `POST /api/export` | `{"glass": "1:NAME,…", "ev": 0, "units": […]}`: writes the export folder given at start (with the units built on the page it names); answers its path, files and bytes |
+//! | `POST /api/unit` | `{"elements": [{"glass": 6}, {"gap_mm": 12.7, "gas": "argon"}, {"glass": 2}]}`: the unit built ([`crate::units`]) |
 
 use std::io::{Cursor, Read};
 use std::net::{IpAddr, SocketAddr, ToSocketAddrs};
@@ -32,7 +33,11 @@ use glassdb_io::{ErrorChain, quoted};
 use serde_json::{Value, json};
 use tiny_http::{Header, Method, Request, Response, Server, StatusCode};
 
+use base64::Engine;
+use base64::engine::general_purpose::STANDARD;
+
 use crate::export::ExportFolder;
+use crate::page::{PAGE_FORMAT, PageBuiltUnit, PageProduct};
 use crate::scene::FrameData;
 use crate::{ViewError, Viewer, assets, export};
 
@@ -149,6 +154,7 @@ impl ViewServer {
                     Method::Get | Method::Head => self.get(&path),
                     Method::Post => match read_body(&mut request) {
                         Ok(body) if path == "/api/export" => self.export(&body),
+                        Ok(body) if path == "/api/unit" => self.unit(&body),
                         Ok(_) => Reply::error(404, "no such resource"),
                         Err(reply) => reply,
                     },
@@ -172,7 +178,7 @@ impl ViewServer {
                 403,
                 &format!(
                     "this viewer answers requests for localhost, 127.0.0.1, [::1] or the \
-                     address it was started on (--bind), not for Host {}",
+                     address it was started on, not for Host {}",
                     quoted(host)
                 ),
             ));
@@ -189,7 +195,8 @@ impl ViewServer {
                 ),
             ));
         }
-        // The one request that changes something (other methods are answered 405).
+        // The requests that change something or cost the machine work (the export, a unit
+        // built); other methods are answered 405.
         if *request.method() == Method::Post {
             if origin.is_none() {
                 return Some(Reply::error(
@@ -225,8 +232,8 @@ impl ViewServer {
             ),
             "/api/scene" => {
                 let mut scene = v.scene().clone();
-                scene["export_available"] = json!(self.export.is_some());
-                Reply::json(&scene)
+                scene.export_available = self.export.is_some();
+                Reply::json(&json!(scene))
             }
             _ => {
                 let parts: Vec<&str> = path.trim_start_matches('/').split('/').collect();
@@ -262,10 +269,10 @@ impl ViewServer {
         };
         let data = match self.viewer.frame(i) {
             Ok(d) => d,
-            Err(e) => return Reply::error(500, &ErrorChain(&e).to_string()),
+            Err(e) => return Reply::error(e.http_status(), &ErrorChain(&e).to_string()),
         };
         match rest {
-            [] => Reply::json(&data.info),
+            [] => Reply::json(&json!(data.info)),
             ["passes"] => Reply::binary(Body::Frame(data, FramePart::Passes)),
             ["mask"] => Reply::binary(Body::Frame(data, FramePart::Mask)),
             _ => Reply::error(404, "no such resource"),
@@ -287,13 +294,69 @@ impl ViewServer {
         if !ev.is_finite() {
             return Reply::error(400, "ev must be a finite number");
         }
-        let choices = match self.viewer.parse_choices(glass) {
+        // The units built on the page that the choices use: built again here (the server
+        // keeps none).
+        let unit_requests = match request.get("units") {
+            None | Some(Value::Null) => &[][..],
+            Some(Value::Array(units)) => units.as_slice(),
+            Some(_) => return Reply::error(400, "units must be an array of unit requests"),
+        };
+        let mut units = Vec::with_capacity(unit_requests.len());
+        for u in unit_requests {
+            let Some(workshop) = self.viewer.units() else {
+                return Reply::error(
+                    409,
+                    "this viewer was started without a catalog to build units from",
+                );
+            };
+            match workshop.build(u) {
+                Ok(built) => units.push(built),
+                Err(e @ ViewError::UnitRequest { .. }) => {
+                    return Reply::error(400, &ErrorChain(&e).to_string());
+                }
+                Err(e) => return Reply::error(e.http_status(), &ErrorChain(&e).to_string()),
+            }
+        }
+        let choices = match self.viewer.parse_choices_among(glass, &units) {
             Ok(c) => c,
             Err(e) => return Reply::error(400, &ErrorChain(&e).to_string()),
         };
-        match export::write_export(&self.viewer, folder, &choices, ev) {
-            Ok(()) => Reply::json(&json!({ "path": folder.dir.display().to_string() })),
+        match export::write_export(&self.viewer, folder, &choices, ev, &units) {
+            Ok(summary) => Reply::json(&json!({
+                "path": folder.dir.display().to_string(),
+                "files": summary.files,
+                "bytes": summary.bytes,
+            })),
             Err(e) => Reply::error(500, &ErrorChain(&e).to_string()),
+        }
+    }
+}
+
+impl ViewServer {
+    /// `POST /api/unit`: builds the unit the page asks for (400 for a malformed request, 422
+    /// for one the stack engine refuses, 409 without a catalog to build from).
+    fn unit(&self, body: &[u8]) -> Reply {
+        let Some(units) = self.viewer.units() else {
+            return Reply::error(
+                409,
+                "this viewer was started without a catalog to build units from",
+            );
+        };
+        let Ok(request) = serde_json::from_slice::<Value>(body) else {
+            return Reply::error(400, "the unit request must be JSON");
+        };
+        let start = std::time::Instant::now();
+        match units.build(&request) {
+            Ok(built) => Reply::json(&json!(PageBuiltUnit {
+                format: PAGE_FORMAT,
+                product: PageProduct::of(0, &built.record),
+                lut: STANDARD.encode(&built.lut),
+                build_ms: start.elapsed().as_secs_f64() * 1e3,
+            })),
+            Err(e @ ViewError::UnitRequest { .. }) => {
+                Reply::error(400, &ErrorChain(&e).to_string())
+            }
+            Err(e) => Reply::error(e.http_status(), &ErrorChain(&e).to_string()),
         }
     }
 }

@@ -4,9 +4,14 @@
 # (--dependency=aftercorr). Prints both job ids. docs/farm.md.
 #
 #   FRAME_FIRST=1 FRAME_LAST=240 CHUNK_SIZE=8 WORK_DIR=/shots/atrium \
-#   RENDER_COMMAND='glassdb blender render scene.blend --frames $FRAMES' \
-#   COMPOSE_ARGS='--refl refl_0.####.exr --trans trans.####.exr --mask mask.####.exr' \
-#   OUTPUT=composite/out.####.exr GLASSDB=glassdb  integrations/farm/slurm/submit.sh [sbatch options…]
+#   RENDER_COMMAND='./render_passes.sh $FRAME_START $FRAME_END' \
+#   COMPOSE_ARGS='--refl refl_0.####.exr --trans trans.####.exr --mask mask.####.png --planes planes.json' \
+#   OUTPUT=comp/out.####.exr [GLASSDB=glassdb] integrations/farm/slurm/submit.sh [sbatch options…]
+#
+# RENDER_COMMAND runs in WORK_DIR with FRAMES=first-last, FRAME_START and FRAME_END set; the
+# composite runs `$GLASSDB compose $COMPOSE_ARGS -o $OUTPUT --frames $FRAMES --skip-existing
+# --report reports/frames.$FRAMES.json` there (tested: tests/cli/farm.rs runs docs/farm.md's
+# command on scripts/slurm_local_cluster.sh).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 : "${FRAME_FIRST:?}" "${FRAME_LAST:?}" "${CHUNK_SIZE:?}" "${WORK_DIR:?}" "${RENDER_COMMAND:?}" \

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use glassdb_compose::io::{ExrDataType, OutputOptions, PassSource, write_output};
-use glassdb_compose::pixels::{LinearImage, PngBits};
+use glassdb_encode::{ExrDataType, OutputOptions, write_output};
+use glassdb_pass::{CarriedFrame, LinearImage, PassSource, PngBits};
 
 /// A deterministic hash of `i` in [0, 1).
 fn noise(i: u64) -> f32 {
@@ -49,17 +49,10 @@ pub fn write_passes(
     let src = PassSource::Png {
         bits: PngBits::Eight,
     };
-    write_output(
-        &out.join("trans.exr"),
-        pass(1, [0.6, 0.5, 0.4]),
-        &src,
-        &opts,
-    )?;
-    write_output(
-        &out.join("refl.exr"),
-        pass(1 << 40, [0.9, 1.0, 1.2]),
-        &src,
-        &opts,
-    )?;
+    let frame = || CarriedFrame::whole(w as u32, h as u32);
+    let trans = pass(1, [0.6, 0.5, 0.4]);
+    write_output(&out.join("trans.exr"), trans, frame(), &src, &opts)?;
+    let refl = pass(1 << 40, [0.9, 1.0, 1.2]);
+    write_output(&out.join("refl.exr"), refl, frame(), &src, &opts)?;
     Ok(())
 }

@@ -18,18 +18,24 @@ pub fn gaussian(seed: u64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// An angle table (R and T at 0°, 10°, …, 90°) with R + T = 1.02 at every angle, so the fitted
-/// r + t exceeds 1.
-pub fn r_plus_t_above_one_csv() -> String {
+/// An angle table (R and T at 0°, 10°, …, 90°) with R = 0.1 + 0.001·i and
+/// T = `t_at_normal` − 0.001·i at 10·i degrees: R + T = 0.1 + `t_at_normal` at every angle.
+pub fn r_plus_t_csv(t_at_normal: f64) -> String {
     let rows: String = (0..=9)
         .map(|i| {
             format!(
                 "{},{},{}\n",
                 i * 10,
                 0.1 + 0.001 * i as f64,
-                0.92 - 0.001 * i as f64
+                t_at_normal - 0.001 * i as f64
             )
         })
         .collect();
     format!("angle_deg,R,T\n{rows}")
+}
+
+/// The table of [`r_plus_t_csv`] with R + T = 1.02 at every angle, so the fitted r + t
+/// exceeds 1.
+pub fn r_plus_t_above_one_csv() -> String {
+    r_plus_t_csv(0.92)
 }

@@ -30,6 +30,7 @@ pub struct FitPlotOptions {
     pub degree: Option<u32>,
     /// Tolerance and highest degree of the automatic choice.
     pub tol: f64,
+    /// Highest degree tried.
     pub max_degree: u32,
     /// Also fit and draw the paper basis (powers 1…n, no constant) beside the full basis.
     pub compare_paper: bool,

@@ -14,23 +14,31 @@ use crate::heatmap::HeatMapFigure;
 /// Which value of the glass the heat map shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MaskQuantity {
+    /// r(θ).
     Reflectance,
+    /// t(θ).
     Transmittance,
 }
 
 /// Which channel, or their Rec.709 luminance (0.2126 R + 0.7152 G + 0.0722 B).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MaskChannel {
+    /// Luminance of the three channels.
     Luminance,
+    /// The red channel.
     R,
+    /// The green channel.
     G,
+    /// The blue channel.
     B,
 }
 
 /// Options of the mask figure.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MaskPlotOptions {
+    /// r or t.
     pub quantity: MaskQuantity,
+    /// Which channel.
     pub channel: MaskChannel,
     /// Planes whose glass is seen from its back face (`--side k=back`).
     pub back_planes: Vec<u16>,

@@ -16,7 +16,9 @@ use crate::plots::fit::{REFLECTANCE_COLOUR, TRANSMITTANCE_COLOUR};
 /// Options of the spectral figure.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SpectralPlotOptions {
+    /// How values are integrated.
     pub settings: IntegrationSettings,
+    /// How the file is read.
     pub read: ReadOptions,
 }
 
@@ -144,6 +146,22 @@ pub fn spectral_figure_of(
     }
     main.y_range = Some((0.0, y_hi));
 
+    let lower = weights_panel(opts, &grid, &weights);
+    Ok(GridFigure {
+        title: format!("Spectra: {}", short_name(&data.source)),
+        subtitle: Some(summary.join("; ")),
+        cells: vec![Cell {
+            main,
+            lower: Some((lower, 0.4)),
+        }],
+        columns: 1,
+        cell_size: (900, 760),
+    })
+}
+
+/// The lower panel: the method's channel weights over wavelength, each divided by its peak.
+fn weights_panel(opts: &SpectralPlotOptions, grid: &[f64], weights: &[[f64; 3]]) -> Panel {
+    let luminous = matches!(opts.settings.method, Method::Luminous);
     let mut lower = Panel::new("wavelength λ (nm)", "channel weight (peak = 1)", VISIBLE_NM);
     lower.zero_line = true;
     lower.legend = Some(LegendCorner::Auto);
@@ -159,7 +177,7 @@ pub fn spectral_figure_of(
         }
         let pts: Vec<(f64, f64)> = grid
             .iter()
-            .zip(&weights)
+            .zip(weights)
             .map(|(&wl, w)| (wl, w[c] / peak))
             .collect();
         let colour = if luminous {
@@ -181,16 +199,7 @@ pub fn spectral_figure_of(
         }
         Method::Luminous => "D65 × V(λ), 380–780 nm at 10 nm".into(),
     });
-    Ok(GridFigure {
-        title: format!("Spectra: {}", short_name(&data.source)),
-        subtitle: Some(summary.join("; ")),
-        cells: vec![Cell {
-            main,
-            lower: Some((lower, 0.4)),
-        }],
-        columns: 1,
-        cell_size: (900, 760),
-    })
+    lower
 }
 
 fn short_name(source: &str) -> String {

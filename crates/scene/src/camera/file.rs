@@ -16,18 +16,31 @@ use crate::error::SceneError;
 
 /// Largest camera file read (a camera is a few hundred bytes; an animation file of ten
 /// thousand frames a few megabytes).
-pub const MAX_CAMERA_FILE_BYTES: u64 = glassdb_io::limits::CAMERA.bytes;
+pub const CAMERA_FILE: glassdb_io::InputLimit = glassdb_io::InputLimit::mib(16, "a camera file");
+
+/// Largest camera file read, in bytes ([`CAMERA_FILE`]).
+pub const MAX_CAMERA_FILE_BYTES: u64 = CAMERA_FILE.bytes;
 
 /// Where the camera of each frame comes from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum CameraSource {
     /// One camera, the same for every frame.
-    One { path: PathBuf, camera: Camera },
+    One {
+        /// The camera file.
+        path: PathBuf,
+        /// Its camera.
+        camera: Camera,
+    },
     /// One file per frame: `pattern` has a `#` run that the frame number replaces.
-    PerFrame { pattern: PathBuf },
+    PerFrame {
+        /// The file pattern.
+        pattern: PathBuf,
+    },
     /// One file with a `frames` object: each frame's camera JSON, validated when asked for.
     Animation {
+        /// The animation file.
         path: PathBuf,
+        /// Each frame's camera JSON.
         frames: BTreeMap<u32, Value>,
     },
 }
@@ -125,7 +138,7 @@ impl CameraSource {
                 let spec = CameraSpec::deserialize(value).map_err(|e| SceneError::BadCamera {
                     path: path.clone(),
                     frame: Some(f),
-                    message: e.to_string(),
+                    message: glassdb_io::bounded_message(&e.to_string()),
                 })?;
                 Camera::from_spec(&spec, path, Some(f))
             }
@@ -158,7 +171,7 @@ fn read_camera_text(path: &Path, frame: Option<u32>) -> Result<String, SceneErro
             source,
         },
     };
-    glassdb_io::read_input_string(path, glassdb_io::limits::CAMERA).map_err(read_err)
+    glassdb_io::read_input_string(path, CAMERA_FILE).map_err(read_err)
 }
 
 /// Parses a camera file: an object with a `frames` key is an animation, anything else one
@@ -173,8 +186,13 @@ fn parse_camera_json(
         frame,
         message,
     };
-    let json_err =
-        |e: serde_json::Error| bad(format!("line {}, column {}: {e}", e.line(), e.column()));
+    let json_err = |e: serde_json::Error| {
+        bad(glassdb_io::bounded_message(&format!(
+            "line {}, column {}: {e}",
+            e.line(),
+            e.column()
+        )))
+    };
     let value: Value = serde_json::from_str(text).map_err(json_err)?;
     let animated = matches!(&value, Value::Object(m) if m.contains_key("frames"));
     drop(value);
@@ -204,7 +222,9 @@ fn parse_camera_json(
             })?;
         if let Some(first) = keys.get(&number) {
             return Err(bad(format!(
-                "frame {number} is given twice in \"frames\" (keys {first:?} and {key:?})"
+                "frame {number} is given twice in \"frames\" (keys {} and {})",
+                glassdb_io::quoted(first),
+                glassdb_io::quoted(&key)
             )));
         }
         keys.insert(number, key);

@@ -15,7 +15,7 @@ mod tests;
 
 use std::path::Path;
 
-pub use file::{CameraSource, MAX_CAMERA_FILE_BYTES};
+pub use file::{CAMERA_FILE, CameraSource, MAX_CAMERA_FILE_BYTES};
 pub use spec::{CameraSpec, SensorFit};
 
 use crate::error::SceneError;
@@ -31,15 +31,20 @@ pub const MAX_PIXELS: u64 = 1 << 27;
 /// of pixel (0, 0). Symmetric about 0 without lens shift.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewPlane {
+    /// Left edge of the view plane at distance 1.
     pub x_min: f64,
+    /// Right edge.
     pub x_max: f64,
+    /// Bottom edge.
     pub y_min: f64,
+    /// Top edge.
     pub y_max: f64,
 }
 
 /// A validated camera: its orthonormal frame and its view plane.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
+    /// Where the camera is.
     pub origin: Vec3,
     /// Unit view direction (towards `target`; Blender's local −Z).
     pub forward: Vec3,
@@ -49,7 +54,9 @@ pub struct Camera {
     pub up: Vec3,
     /// The image rectangle at unit depth.
     pub view: ViewPlane,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// The view plane as centre and half-extent per axis, as computed from the lens (the
     /// projection uses these, so that an unshifted camera projects exactly as the symmetric

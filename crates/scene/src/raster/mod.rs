@@ -36,7 +36,10 @@ pub enum CosMode {
     Exact,
     /// The paper's way: cos θ at the nodes of an N×N mesh over each pane's bounding
     /// rectangle, linearly interpolated over the mesh triangles in screen space (Gouraud).
-    Gouraud { mesh: u32 },
+    Gouraud {
+        /// N, the cells per side of each pane.
+        mesh: u32,
+    },
 }
 
 /// What a glass label stands for.
@@ -61,10 +64,15 @@ pub struct PaneRect {
     pub origin: Vec3,
     /// Unit in-plane axes.
     pub u: Vec3,
+    /// The second in-plane axis.
     pub v: Vec3,
+    /// The pane's smallest u.
     pub u_min: f64,
+    /// The pane's smallest v.
     pub v_min: f64,
+    /// Its extent along u.
     pub u_len: f64,
+    /// Its extent along v.
     pub v_len: f64,
 }
 
@@ -72,16 +80,22 @@ pub struct PaneRect {
 /// (0: opaque, k ≥ 1: `glass[k − 1]`).
 #[derive(Debug, Clone, Default)]
 pub struct RasterScene {
+    /// Every vertex.
     pub positions: Vec<Vec3>,
+    /// Every triangle (indices into `positions`).
     pub triangles: Vec<[u32; 3]>,
+    /// Each triangle's label: 0 opaque, k the glass `glass[k - 1]`.
     pub labels: Vec<u32>,
+    /// The glass labels.
     pub glass: Vec<GlassLabel>,
+    /// The panes (Gouraud mode).
     pub panes: Vec<PaneRect>,
 }
 
 /// Options of one rasterisation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RasterOptions {
+    /// How cos θ is computed.
     pub cos: CosMode,
     /// K: coverage from K×K sub-pixel samples when K ≥ 2; 1 = pixel centres only.
     pub samples: u32,
@@ -90,9 +104,13 @@ pub struct RasterOptions {
 /// The mask in memory, row-major with row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RasterOutput {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// Glass id per pixel (0: none).
     pub id: Vec<u16>,
+    /// Plane per pixel.
     pub plane: Vec<u16>,
     /// cos θ in [0, 1]; 0 where there is no glass.
     pub cos_theta: Vec<f32>,

@@ -18,7 +18,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::SpectralError;
 use crate::illuminant::{CieIlluminant, Illuminant, WhiteBalance, xy_of};
-use crate::interp::{check_coverage, for_each_on_grid, spline_kernel, sprague_kernel, validate};
+use crate::interp::{check_coverage, for_each_on_grid, sprague_kernel, validate};
+use crate::spline::spline_kernel;
 use crate::tables::{Table, tables};
 use glassdb_colour::{RgbSpace, cat02, xyz_to_rgb};
 
@@ -77,8 +78,11 @@ pub enum Method {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum MethodKind {
+    /// [`Method::Colorimetric`].
     Colorimetric,
+    /// [`Method::Paper`].
     Paper,
+    /// [`Method::Luminous`].
     Luminous,
 }
 
@@ -126,6 +130,7 @@ impl fmt::Display for Method {
 #[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(into = "SettingsJson", try_from = "SettingsJson")]
 pub struct IntegrationSettings {
+    /// The method.
     pub method: Method,
     /// Hold the spectrum's end values constant where it does not cover the method's grid
     /// (colour-science's behaviour); without it partial coverage is an error.

@@ -1,62 +1,103 @@
-//! Animations: file patterns with a `#` run for the frame number (`r.####.exr` → `r.0007.exr`),
-//! frame lists (`1-240`, `1,5,10-20`) (both from `glassdb_io::frames`), and every frame composed with two frames in flight at
-//! a time (so one frame's decoding overlaps another's encoding) as long as their memory
-//! estimates fit the limit together; a frame with missing or bad inputs is reported and the
-//! others go on.
+//! Animations through the compositor (docs/farm.md): every frame of a pattern job
+//! (`r.####.exr` → `r.0007.exr`, frame lists such as `1-240`, both from `glassdb_io::frames`)
+//! composed with two frames in flight at a time (so one frame's decoding overlaps another's
+//! encoding) as long as their memory estimates fit the limit together; a frame with missing or
+//! bad inputs is reported and the others go on. With [`SequenceOptions::skip_existing`] a
+//! frame whose output is complete is left alone, so that a farm's retry only composites what
+//! is missing; [`report`] writes what became of every frame.
 
-use std::path::{Path, PathBuf};
+#![warn(missing_docs)]
+
+pub mod report;
+
+use std::path::Path;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-use crate::colour::RegistryLuts;
-use crate::memory::MemoryBudget;
-use crate::{ComposeError, ComposeJob, ComposeSettings, FrameReport, compose_frame_within};
+use glassdb_compose::colour::RegistryLuts;
+use glassdb_compose::memory::MemoryBudget;
+use glassdb_compose::{
+    ComposeError, ComposeJob, ComposeSettings, FrameReport, compose_frame_within,
+};
+use glassdb_io::ErrorKind;
 
-/// Whether `pattern` contains a `#` run (`glassdb_io::frames`, shared with `glassdb mask`).
-pub fn is_pattern(pattern: &Path) -> bool {
-    glassdb_io::is_frame_pattern(pattern)
+pub use report::{FramesReport, SequenceProgress};
+
+/// Why a frame of a sequence, or the sequence itself, failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SequenceError {
+    /// The frame could not be composited.
+    #[error(transparent)]
+    Compose(#[from] ComposeError),
+    /// A path's frame pattern could not be expanded.
+    #[error(transparent)]
+    Frame(#[from] glassdb_io::FrameError),
+    /// Several frames into one output file.
+    #[error(
+        "the output {path} has no #### for the frame number, so every frame would overwrite it"
+    )]
+    OutputWithoutFramePattern {
+        /// The output pattern.
+        path: std::path::PathBuf,
+    },
+    /// An existing output could not be read to see whether it is complete.
+    #[error("cannot read {path}")]
+    ReadOutput {
+        /// The output.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        cause: glassdb_io::InputError,
+    },
+    /// An existing output is not a complete image.
+    #[error("{path}")]
+    IncompleteOutput {
+        /// The output.
+        path: std::path::PathBuf,
+        /// What the decoder found.
+        #[source]
+        source: glassdb_image::ImageError,
+    },
+    /// The frames report could not be encoded as JSON.
+    #[error("cannot encode the frames report {path}")]
+    EncodeReport {
+        /// The report.
+        path: std::path::PathBuf,
+        /// serde's error.
+        #[source]
+        source: serde_json::Error,
+    },
+    /// The frames report could not be written.
+    #[error(transparent)]
+    Output(#[from] glassdb_io::OutputError),
 }
 
-/// Replaces the last run of `#` in `pattern` by `frame`, zero-padded to the run's length.
-pub fn expand(pattern: &Path, frame: u32) -> Result<PathBuf, ComposeError> {
-    glassdb_io::expand_frame_pattern(pattern, frame).map_err(ComposeError::from)
-}
-
-/// Parses a frame list: `N`, `A-B`, comma-separated, e.g. `1-240` or `1,5,10-20`.
-pub fn parse_frames(spec: &str) -> Result<Vec<u32>, ComposeError> {
-    glassdb_io::parse_frame_list(spec).map_err(ComposeError::from)
-}
-
-/// The job of frame `frame`: every path with a `#` run expanded (paths without one, such as a
-/// reflection pass reused for every frame, stay as they are).
-pub fn frame_job(pattern: &ComposeJob, frame: u32) -> Result<ComposeJob, ComposeError> {
-    let ex = |p: &Path| {
-        if is_pattern(p) {
-            expand(p, frame)
-        } else {
-            Ok(p.to_path_buf())
+impl SequenceError {
+    /// The class of this error: the wrapped error's, invalid for an output pattern that would
+    /// put every frame into one file.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            SequenceError::Compose(e) => e.kind(),
+            SequenceError::Frame(e) => e.kind(),
+            SequenceError::ReadOutput { cause, .. } => cause.kind(),
+            SequenceError::IncompleteOutput { source, .. } => source.kind(),
+            SequenceError::Output(e) => e.kind(),
+            SequenceError::OutputWithoutFramePattern { .. } => ErrorKind::Invalid,
+            SequenceError::EncodeReport { .. } => ErrorKind::Internal,
         }
-    };
-    Ok(ComposeJob {
-        refl: pattern
-            .refl
-            .iter()
-            .map(|p| ex(p))
-            .collect::<Result<_, _>>()?,
-        trans: ex(&pattern.trans)?,
-        mask: ex(&pattern.mask)?,
-        output: ex(&pattern.output)?,
-    })
+    }
 }
 
 /// The result of one frame.
 #[derive(Debug)]
 pub struct FrameOutcome {
+    /// The frame number.
     pub frame: u32,
     /// The frame's files (`None` when a pattern could not be expanded).
     pub job: Option<ComposeJob>,
-    pub result: Result<FrameDone, ComposeError>,
+    /// What became of it.
+    pub result: Result<FrameDone, SequenceError>,
     /// Wall-clock time of the frame, including the check of an existing output.
     pub wall: Duration,
 }
@@ -67,7 +108,9 @@ pub enum FrameDone {
     /// Composited and written; `replaced` says why an existing output was not kept (with
     /// [`SequenceOptions::skip_existing`]: it was incomplete).
     Composed {
+        /// What the composite did.
         report: Box<FrameReport>,
+        /// Why an existing output was replaced, when one was.
         replaced: Option<String>,
     },
     /// Left alone: its output exists and is complete ([`output_is_complete`]).
@@ -96,15 +139,15 @@ pub struct SequenceOptions {
 /// (every pixel of a PNG; every part, channel and chunk of an EXR), within `max_pixels` per
 /// part. The error says what is wrong (missing, truncated, corrupt). It does not compare the
 /// file with the frame's inputs: after changing an input, rerun without skipping.
-pub fn output_is_complete(path: &Path, max_pixels: u64) -> Result<(), ComposeError> {
+pub fn output_is_complete(path: &Path, max_pixels: u64) -> Result<(), SequenceError> {
     let bytes =
-        glassdb_io::read_previous_output(path, glassdb_io::limits::IMAGE).map_err(|cause| {
-            ComposeError::Read {
+        glassdb_io::read_previous_output(path, glassdb_image::IMAGE_FILE).map_err(|cause| {
+            SequenceError::ReadOutput {
                 path: path.to_path_buf(),
                 cause,
             }
         })?;
-    let decode = |source| ComposeError::Decode {
+    let decode = |source| SequenceError::IncompleteOutput {
         path: path.to_path_buf(),
         source,
     };
@@ -126,21 +169,23 @@ pub const FRAMES_IN_FLIGHT: usize = 2;
 /// completion order). Returns the outcomes in frame order. The frames in flight share
 /// `settings.max_memory`: a frame whose estimate does not fit beside the other's waits for it
 /// (so two large frames run one after the other), and a frame over the whole limit fails.
+/// `progress` (made for `pattern` and `frames`) follows the frames as they start and end.
 pub fn compose_sequence(
     pattern: &ComposeJob,
     frames: &[u32],
     settings: &ComposeSettings,
     luts: &RegistryLuts,
     options: SequenceOptions,
+    progress: &SequenceProgress,
     on_done: &(dyn Fn(&FrameOutcome) + Sync),
-) -> Result<Vec<FrameOutcome>, ComposeError> {
-    if !is_pattern(&pattern.output) && frames.len() > 1 {
-        return Err(ComposeError::OutputWithoutFramePattern {
+) -> Result<Vec<FrameOutcome>, SequenceError> {
+    if !glassdb_io::is_frame_pattern(&pattern.output) && frames.len() > 1 {
+        return Err(SequenceError::OutputWithoutFramePattern {
             path: pattern.output.clone(),
         });
     }
     let next = AtomicUsize::new(0);
-    let budget = MemoryBudget::new(settings.max_memory);
+    let budget = MemoryBudget::new(settings.decode.max_memory);
     let results: Mutex<Vec<FrameOutcome>> = Mutex::new(Vec::with_capacity(frames.len()));
     std::thread::scope(|scope| {
         for _ in 0..FRAMES_IN_FLIGHT.min(frames.len()) {
@@ -149,12 +194,14 @@ pub fn compose_sequence(
                     let k = next.fetch_add(1, Ordering::Relaxed);
                     let Some(&frame) = frames.get(k) else { break };
                     let start = Instant::now();
-                    let (job, result) = match frame_job(pattern, frame) {
+                    let job = pattern.for_frame(frame);
+                    progress.start(frame, job.as_ref().ok());
+                    let (job, result) = match job {
                         Ok(job) => {
                             let result = compose_or_skip(&job, settings, luts, &budget, options);
                             (Some(job), result)
                         }
-                        Err(e) => (None, Err(e)),
+                        Err(e) => (None, Err(e.into())),
                     };
                     let outcome = FrameOutcome {
                         frame,
@@ -162,6 +209,7 @@ pub fn compose_sequence(
                         result,
                         wall: start.elapsed(),
                     };
+                    progress.finish(&outcome);
                     on_done(&outcome);
                     if let Ok(mut r) = results.lock() {
                         r.push(outcome);
@@ -182,10 +230,10 @@ fn compose_or_skip(
     luts: &RegistryLuts,
     budget: &MemoryBudget,
     options: SequenceOptions,
-) -> Result<FrameDone, ComposeError> {
+) -> Result<FrameDone, SequenceError> {
     let mut replaced = None;
     if options.skip_existing && job.output.exists() {
-        match output_is_complete(&job.output, settings.pass.max_pixels) {
+        match output_is_complete(&job.output, settings.decode.pass.max_pixels) {
             Ok(()) => return Ok(FrameDone::Skipped),
             Err(e) => {
                 replaced = Some(format!(
@@ -200,31 +248,4 @@ fn compose_or_skip(
         report: Box::new(report),
         replaced,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn patterns_expand_with_padding() {
-        assert_eq!(
-            expand(Path::new("r.####.exr"), 7).unwrap(),
-            PathBuf::from("r.0007.exr")
-        );
-        assert_eq!(
-            expand(Path::new("d#/t.##.png"), 123).unwrap(),
-            PathBuf::from("d#/t.123.png")
-        );
-        assert!(expand(Path::new("r.exr"), 1).is_err());
-    }
-
-    #[test]
-    fn frame_lists() {
-        assert_eq!(parse_frames("1-3").unwrap(), vec![1, 2, 3]);
-        assert_eq!(parse_frames("5, 1-2,2").unwrap(), vec![1, 2, 5]);
-        assert!(parse_frames("3-1").is_err());
-        assert!(parse_frames("a").is_err());
-        assert!(parse_frames("0-4000000").is_err());
-    }
 }

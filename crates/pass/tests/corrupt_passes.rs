@@ -3,9 +3,8 @@
 
 use std::path::Path;
 
-use glassdb_compose::ComposeError;
-use glassdb_compose::io::{PassReadOptions, read_pass_bytes};
 use glassdb_image::ImageErrorKind;
+use glassdb_pass::{PassError, PassReadOptions, read_pass_bytes};
 
 fn sweep(fixture: &str) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -26,7 +25,7 @@ fn sweep(fixture: &str) {
             Err(e) => e,
         };
         assert!(
-            matches!(err, ComposeError::Decode { .. })
+            matches!(err, PassError::Decode { .. })
                 && matches!(
                     err.image_error_kind(),
                     Some(ImageErrorKind::Invalid | ImageErrorKind::Unsupported)

@@ -14,12 +14,14 @@
 
 use rayon::prelude::*;
 
-use crate::view::ViewTransform;
+use glassdb_colour::DisplayView;
 
 /// Linear-light RGB(A), planar, row-major, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// R, G, B planes, `width * height` samples each.
     pub rgb: [Vec<f32>; 3],
@@ -48,14 +50,7 @@ impl LinearImage {
     /// Straight alpha (PNG's convention) to premultiplied (EXR's and the compositor's):
     /// colour × alpha. Without alpha nothing changes.
     pub fn premultiply(&mut self) {
-        if let Some(alpha) = &self.alpha {
-            for plane in &mut self.rgb {
-                plane
-                    .par_iter_mut()
-                    .zip(alpha.par_iter())
-                    .for_each(|(c, &a)| *c *= a);
-            }
-        }
+        self.with_alpha(|c, a| *c *= a);
     }
 
     /// Premultiplied to straight alpha, for PNG output: colour ÷ alpha where alpha > 0;
@@ -63,16 +58,22 @@ impl LinearImage {
     /// `--unpremult` does (light with no coverage, e.g. a reflection on a transparent
     /// background, cannot be stored straight).
     pub fn unpremultiply(&mut self) {
+        self.with_alpha(|c, a| {
+            if a > 0.0 {
+                *c /= a;
+            }
+        });
+    }
+
+    /// `f(colour, alpha)` on every colour sample with its pixel's alpha, in parallel; nothing
+    /// without alpha.
+    fn with_alpha(&mut self, f: impl Fn(&mut f32, f32) + Sync + Send) {
         if let Some(alpha) = &self.alpha {
             for plane in &mut self.rgb {
                 plane
                     .par_iter_mut()
                     .zip(alpha.par_iter())
-                    .for_each(|(c, &a)| {
-                        if a > 0.0 {
-                            *c /= a;
-                        }
-                    });
+                    .for_each(|(c, &a)| f(c, a));
             }
         }
     }
@@ -92,18 +93,13 @@ impl LinearImage {
     /// with an 8×8 ordered (Bayer) pattern when `dither` is set. Values outside [0, 1] are
     /// clamped, NaN becomes 0.
     pub fn to_encoded(&self, bits: PngBits, dither: bool) -> EncodedImage {
-        self.to_encoded_view(bits, dither, &ViewTransform::Standard)
+        self.to_encoded_view(bits, dither, &DisplayView::Standard)
     }
 
-    /// Encodes into PNG samples through `view`: [`ViewTransform::Standard`] is the sRGB
+    /// Encodes into PNG samples through `view`: [`DisplayView::Standard`] is the sRGB
     /// transfer of [`LinearImage::to_encoded`]; a LUT's output is taken as display-encoded and
     /// only clamped to [0, 1] (NaN → 0) before the same quantisation (and dither).
-    pub fn to_encoded_view(
-        &self,
-        bits: PngBits,
-        dither: bool,
-        view: &ViewTransform,
-    ) -> EncodedImage {
+    pub fn to_encoded_view(&self, bits: PngBits, dither: bool, view: &DisplayView) -> EncodedImage {
         let w = self.width as usize;
         let channels = if self.alpha.is_some() { 4 } else { 3 };
         let n = self.pixel_count();
@@ -112,8 +108,8 @@ impl LinearImage {
             let i = y * w + x;
             let rgb = [linear(i, 0), linear(i, 1), linear(i, 2)];
             let [r, g, b] = match view {
-                ViewTransform::Standard => rgb.map(linear_to_srgb),
-                ViewTransform::Lut(lut) => lut.apply(rgb).map(sanitize),
+                DisplayView::Standard => rgb.map(linear_to_srgb),
+                DisplayView::Lut(lut) => lut.apply(rgb).map(sanitize),
             };
             let a = self
                 .alpha
@@ -166,7 +162,9 @@ impl LinearImage {
 /// Bit depth of PNG samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PngBits {
+    /// 8 bits per sample.
     Eight,
+    /// 16 bits per sample.
     Sixteen,
 }
 
@@ -184,17 +182,22 @@ pub enum InputTransfer {
 /// light: convert with [`EncodedImage::to_linear`] before any arithmetic.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EncodedImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA.
     pub channels: usize,
+    /// The samples, `width × height × channels` of them.
     pub samples: EncodedSamples,
 }
 
 /// Interleaved encoded samples.
 #[derive(Debug, Clone, PartialEq)]
 pub enum EncodedSamples {
+    /// 8-bit samples.
     U8(Vec<u8>),
+    /// 16-bit samples.
     U16(Vec<u16>),
 }
 

@@ -1,0 +1,295 @@
+//! Glassdb's own geometry of a `glassdb blender render` run, per frame: the planes, the masks,
+//! each plane's side and pixel rectangle, and the glass as thin panes for Blender. Frames whose
+//! objects are where the first frame has them share its scene; a frame whose objects moved
+//! (an animated object, a sliding door) has its own (`scene.NNNN.obj`, `planes.NNNN/`).
+
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+use glassdb_colour::RgbSpace;
+use glassdb_image::PixelWindow;
+use glassdb_mask::{GlassMapping, MaskFormat};
+use glassdb_registry::ColourBasis;
+use glassdb_scene::{
+    CameraSource, FrameMask, MaskJob, MaskPlanes, MirrorRequest, PlaneSource, PlaneTolerance,
+    label_scene, load_obj, mask_frames, write_virtual_scenes,
+};
+use glassdb_side::Side;
+
+use crate::BlenderError;
+use crate::job::{ExportInfo, FrameRecord, PixelBounds, ScriptFrame, ScriptPlane};
+use crate::pipeline::{RegistryChoice, Workspace, frame_name, moving_obj_name};
+use crate::thin_pane::ThinPane;
+
+/// The planes, masks and each plane's pixels of every frame, and what Blender renders next.
+pub struct Masks {
+    /// Glass planes found.
+    pub(crate) planes: usize,
+    /// Each glass material and its registry id.
+    pub(crate) glass_materials: Vec<(String, u16)>,
+    /// The glass as the thin-pane shader draws it.
+    pub(crate) panes: Vec<ThinPane>,
+    /// Each frame's files, sides and plane rectangles.
+    pub(crate) frames: Vec<FrameRecord>,
+    /// What Blender renders of each frame.
+    pub(crate) script_frames: Vec<ScriptFrame>,
+    /// Each frame's plane rectangles, where its crops go.
+    pub(crate) crops: Vec<Vec<Option<PixelWindow>>>,
+    /// The frames' size.
+    pub(crate) size: (u32, u32),
+}
+
+/// glassdb's own geometry, per frame: the planes (`glassdb mirror`'s detection, from the
+/// frame's eye; `planes.json` from the first frame, `planes.NNNN/planes.json` for a frame whose
+/// objects moved), the mask (`glassdb_scene::mask_frames`, float EXR), each plane's side and
+/// pixel rectangle, and the glass as thin panes for Blender. Frames whose geometry is the first
+/// frame's share its scene, planes and labelling.
+pub fn planes_and_masks(
+    work: &Workspace<'_>,
+    info: &ExportInfo,
+    registry: &RegistryChoice,
+) -> Result<Masks, BlenderError> {
+    let dir = &work.dir;
+    let cameras = CameraSource::open(&dir.join("camera.json"))?;
+    let Some(&first_frame) = info.frames.first() else {
+        return Err(BlenderError::BadRender {
+            path: dir.join("export.json"),
+            message:
+                "no frames to render (the scene's frame range, or the frames asked for, is empty)"
+                    .into(),
+        });
+    };
+    let glass_materials = glass_of_materials(&info.materials, &work.mappings)?;
+    let panes = thin_panes(&glass_materials, registry)?;
+    let mut frames = FramesOfMasks {
+        work,
+        planes: Vec::new(),
+        tolerance: 0.0,
+        first_frame,
+        size: None,
+        records: Vec::new(),
+        script_frames: Vec::new(),
+        crops: Vec::new(),
+        error: None,
+    };
+    let mut planes_found = 0;
+    for group in scene_groups(info, dir) {
+        let scene = load_obj(&group.obj)?;
+        let eye = cameras.camera(Some(group.frames[0]))?.origin;
+        let report = write_virtual_scenes(&MirrorRequest {
+            scene: &scene,
+            glass_patterns: work.mappings.iter().map(|m| m.pattern.clone()).collect(),
+            explicit_plane: None,
+            eye: Some(eye),
+            tolerance: PlaneTolerance::default_for(&scene),
+            out_dir: &group.planes_dir,
+        })?;
+        frames.planes = report.planes.planes();
+        frames.tolerance = report.planes.tolerance.distance;
+        planes_found = planes_found.max(frames.planes.len());
+        let source = PlaneSource::Given {
+            planes: frames.planes.clone(),
+            tolerance: report.planes.tolerance(),
+        };
+        let labelled = label_scene(&scene, &work.mappings, &MaskPlanes::Given(source), false)?;
+        drop(scene);
+        let job = MaskJob {
+            labelled: &labelled,
+            cameras: &cameras,
+            options: work.options,
+            format: MaskFormat::Exr,
+            output: dir.join("mask.####.exr"),
+            bounds: None,
+        };
+        mask_frames(
+            &job,
+            &group.frames,
+            &glassdb_io::NoProgress,
+            &mut |frame, mask| match mask
+                .map_err(BlenderError::from)
+                .and_then(|m| frames.add(frame, &m))
+            {
+                Ok(()) => ControlFlow::Continue(()),
+                Err(e) => {
+                    frames.error = Some(e);
+                    ControlFlow::Break(())
+                }
+            },
+        );
+        if let Some(e) = frames.error.take() {
+            return Err(e);
+        }
+    }
+    frames.sort();
+    Ok(Masks {
+        planes: planes_found,
+        glass_materials,
+        panes,
+        frames: frames.records,
+        script_frames: frames.script_frames,
+        crops: frames.crops,
+        size: frames.size.unwrap_or_default(),
+    })
+}
+
+/// Frames that share one exported scene: its OBJ and where its planes go.
+struct SceneGroup {
+    obj: PathBuf,
+    planes_dir: PathBuf,
+    frames: Vec<u32>,
+}
+
+/// The first frame's scene with every frame whose geometry is the same, then one group per
+/// frame whose objects moved.
+fn scene_groups(info: &ExportInfo, dir: &Path) -> Vec<SceneGroup> {
+    let still = SceneGroup {
+        obj: dir.join("scene.obj"),
+        planes_dir: dir.to_path_buf(),
+        frames: info
+            .frames
+            .iter()
+            .copied()
+            .filter(|f| !info.moving.contains_key(f))
+            .collect(),
+    };
+    let moving = info.moving.keys().map(|&f| SceneGroup {
+        obj: dir.join(moving_obj_name(f)),
+        planes_dir: dir.join(format!("planes.{f:04}")),
+        frames: vec![f],
+    });
+    std::iter::once(still)
+        .chain(moving)
+        .filter(|g| !g.frames.is_empty())
+        .collect()
+}
+
+/// The frames' records and render jobs, gathered mask by mask.
+struct FramesOfMasks<'w, 'a> {
+    work: &'w Workspace<'a>,
+    /// The planes of the frames being added.
+    planes: Vec<glassdb_scene::Plane>,
+    /// planes.json's distance tolerance.
+    tolerance: f64,
+    first_frame: u32,
+    /// The first frame's size, which every frame must have.
+    size: Option<(u32, u32)>,
+    records: Vec<FrameRecord>,
+    script_frames: Vec<ScriptFrame>,
+    crops: Vec<Vec<Option<PixelWindow>>>,
+    error: Option<BlenderError>,
+}
+
+impl FramesOfMasks<'_, '_> {
+    /// Puts the frames in frame order (they are added scene by scene).
+    fn sort(&mut self) {
+        let mut all: Vec<_> = std::mem::take(&mut self.records)
+            .into_iter()
+            .zip(std::mem::take(&mut self.script_frames))
+            .zip(std::mem::take(&mut self.crops))
+            .collect();
+        all.sort_by_key(|((r, _), _)| r.frame);
+        for ((r, s), c) in all {
+            self.records.push(r);
+            self.script_frames.push(s);
+            self.crops.push(c);
+        }
+    }
+
+    /// Adds frame `frame`, whose mask is `mask`: each plane's side (from the camera) and glass
+    /// rectangle, where Blender renders its crop.
+    fn add(&mut self, frame: u32, mask: &FrameMask) -> Result<(), BlenderError> {
+        let (width, height) = *self.size.get_or_insert((mask.width, mask.height));
+        if (mask.width, mask.height) != (width, height) {
+            return Err(BlenderError::BadRender {
+                path: self.work.dir.join("camera.json"),
+                message: format!(
+                    "frame {frame} is {}x{}, but frame {} is {width}x{height}; \
+                     every frame of a run must have one size",
+                    mask.width, mask.height, self.first_frame
+                ),
+            });
+        }
+        let rectangles: Vec<_> = (0..self.planes.len())
+            .map(|k| {
+                u16::try_from(k)
+                    .ok()
+                    .and_then(|k| mask.plane_bounds.get(&k))
+            })
+            .collect();
+        let refl: Vec<String> = (0..self.planes.len())
+            .map(|k| frame_name(&format!("refl_{k}"), frame))
+            .collect();
+        let mut sides = Vec::new();
+        let mut script_planes = Vec::new();
+        for (k, plane) in self.planes.iter().enumerate() {
+            let front = plane.signed_distance(mask.camera_origin) >= 0.0;
+            sides.push(if front { Side::Front } else { Side::Back });
+            let facing = if front { *plane } else { plane.flipped() };
+            if let Some(r) = rectangles[k] {
+                script_planes.push(ScriptPlane {
+                    index: k,
+                    equation: facing.equation(),
+                    tolerance: self.tolerance,
+                    border: r.blender_border(width, height),
+                    output: self.work.staging.join(&refl[k]),
+                });
+            }
+        }
+        self.script_frames.push(ScriptFrame {
+            frame,
+            trans: self.work.staging.join(frame_name("trans", frame)),
+            planes: script_planes,
+        });
+        let windows: Vec<Option<PixelWindow>> =
+            rectangles.iter().map(|r| r.map(|r| r.window())).collect();
+        self.records.push(FrameRecord {
+            frame,
+            trans: frame_name("trans", frame),
+            mask: frame_name("mask", frame),
+            refl,
+            sides,
+            bounds: windows.iter().map(|w| w.map(PixelBounds::from)).collect(),
+            composite: frame_name("composite", frame),
+        });
+        self.crops.push(windows);
+        Ok(())
+    }
+}
+
+/// Each glass material's registry record as the thin-pane shader's tables (the registry's
+/// linear Rec.709 table, else its default one).
+fn thin_panes(
+    glass_materials: &[(String, u16)],
+    registry: &RegistryChoice,
+) -> Result<Vec<ThinPane>, BlenderError> {
+    let table = registry
+        .registry
+        .table(ColourBasis::Space(RgbSpace::Srgb))
+        .unwrap_or_else(|| registry.registry.default_table());
+    glass_materials
+        .iter()
+        .map(|(material, id)| {
+            table
+                .glass(*id)
+                .map(|g| ThinPane::of(material, g))
+                .ok_or_else(|| BlenderError::UnknownGlass {
+                    id: *id,
+                    material: material.clone(),
+                    registry: registry.label.clone(),
+                })
+        })
+        .collect()
+}
+
+/// Each Blender material that a `--glass` pattern matches (first match wins), with its id.
+fn glass_of_materials(
+    materials: &[String],
+    mappings: &[GlassMapping],
+) -> Result<Vec<(String, u16)>, BlenderError> {
+    let patterns: Vec<&str> = mappings.iter().map(|m| m.pattern.as_str()).collect();
+    let matcher = glassdb_scene::MaterialMatcher::new(&patterns)?;
+    Ok(materials
+        .iter()
+        .filter_map(|m| matcher.first_match(m).map(|k| (m.clone(), mappings[k].id)))
+        .collect())
+}

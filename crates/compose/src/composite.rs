@@ -1,0 +1,99 @@
+//! The composite phase: a decoded frame's reflection passes placed with their planes' sides,
+//! the kernel ([`crate::kernel`]) run in place on the transmission pass, and what the report
+//! says of the frame.
+
+use std::collections::BTreeMap;
+
+use glassdb_image::ImageWindows;
+use glassdb_side::Side;
+
+use crate::colour::{ChosenTable, PassSpace};
+use crate::kernel::{self, KernelCounts, KernelInput, OutsidePass, PlacedRefl};
+use crate::memory::MemoryEstimate;
+use crate::{ComposeError, ComposeSettings, DecodedFrame, OutsidePolicy};
+
+/// The composite of a frame, ready to be written, and what the report says of it.
+pub(crate) struct Composited {
+    /// The transmission pass, composited in place, with what its output carries.
+    pub(crate) image: ToWrite,
+    pub(crate) facts: FrameFacts,
+}
+
+/// What is written: the composite in the transmission pass's frame, and the passes' space.
+pub(crate) struct ToWrite {
+    pub(crate) trans: glassdb_pass::Pass,
+    pub(crate) frame: glassdb_pass::CarriedFrame,
+    pub(crate) space: PassSpace,
+    pub(crate) table: ChosenTable,
+}
+
+/// The report's facts of a composited frame.
+pub(crate) struct FrameFacts {
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) windows: ImageWindows,
+    pub(crate) id_counts: BTreeMap<u16, u64>,
+    pub(crate) cos_range: Option<(f64, f64)>,
+    pub(crate) counts: KernelCounts,
+    pub(crate) outside_pixels: u64,
+    pub(crate) memory: MemoryEstimate,
+}
+
+/// The composite phase: every reflection pass placed in the frame with its plane's side, the
+/// kernel run in place on the transmission pass, and the decoded passes freed beside the
+/// encoder.
+pub(crate) fn composite(
+    mut frame: DecodedFrame<'_>,
+    settings: &ComposeSettings,
+) -> Result<Composited, ComposeError> {
+    let placed: Vec<PlacedRefl<'_>> = frame
+        .refl
+        .iter()
+        .zip(&frame.refl_windows)
+        .enumerate()
+        .map(|(k, (p, &window))| {
+            let [r, g, b] = &p.image.rgb;
+            PlacedRefl {
+                rgb: [r.as_slice(), g.as_slice(), b.as_slice()],
+                window,
+                side: settings.plane_sides.get(&k).copied().unwrap_or(Side::Front),
+            }
+        })
+        .collect();
+    let outside_mode = match settings.decode.outside {
+        OutsidePolicy::Transmission => OutsidePass::Transmission,
+        OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
+    };
+    let [r, g, b] = &mut frame.trans.image.rgb;
+    let input = KernelInput::placed([r, g, b], &placed, &frame.mask, frame.lut, outside_mode)?;
+    let counts = kernel::compose_in_place(input);
+    let cos_range = frame.mask.cos_theta_range();
+    drop(placed);
+    // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
+    // another thread does it while the encoder keeps both cores busy.
+    // Where no thread can be started, the closure, and so the passes, are dropped here.
+    let (refl, mask) = (frame.refl, frame.mask);
+    let _ = std::thread::Builder::new()
+        .name("glassdb-free".into())
+        .spawn(move || drop((refl, mask)));
+    let trans = frame.trans;
+    let facts = FrameFacts {
+        width: trans.image.width,
+        height: trans.image.height,
+        windows: trans.windows,
+        id_counts: frame.id_counts,
+        cos_range,
+        counts,
+        outside_pixels: frame.outside.values().map(|(n, _)| n).sum(),
+        memory: frame.memory,
+    };
+    Ok(Composited {
+        image: ToWrite {
+            trans,
+            frame: frame.frame,
+            space: frame.space,
+            table: frame.table,
+        },
+        facts,
+    })
+}

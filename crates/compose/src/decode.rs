@@ -1,0 +1,314 @@
+//! The decode phase: a frame's inputs decoded in parallel as its header phase
+//! ([`crate::plan`]) planned them, placed in the transmission pass's frame and checked, ready
+//! for the kernel (`composite`) or for the viewer's GPU textures. Nothing here knows of an
+//! output file: what the transmission file carries over is a [`Carry`].
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use glassdb_image::{ImageWindows, PixelWindow};
+use glassdb_mask::{MaskImage, PlacedMask};
+use glassdb_pass::{CarriedFrame, Carry, Pass, PassReadOptions};
+use rayon::prelude::*;
+
+use crate::colour::{ChosenTable, PassSpace};
+use crate::lut::GlassLut;
+use crate::memory::{self, MemoryEstimate};
+use crate::place::{absolute_from, check_frames, in_frame, relative_to};
+use crate::plan::{FramePlan, InputReads};
+use crate::{ComposeError, DecodeSettings, FrameFiles, OutsidePolicy, UnknownIds};
+
+/// One frame's inputs decoded, placed in the transmission pass's frame and checked, ready for
+/// the kernel (compose) or for the viewer's GPU textures.
+pub struct DecodedFrame<'a> {
+    /// The transmission pass: its image is the frame (its data window).
+    pub trans: Pass,
+    /// What an output would carry from the transmission pass's file.
+    pub frame: CarriedFrame,
+    /// The reflection passes, plane k at k.
+    pub refl: Vec<Pass>,
+    /// Each reflection pass's data window relative to the frame's top-left pixel.
+    pub refl_windows: Vec<PixelWindow>,
+    /// The mask, moved into the frame's data window.
+    pub mask: MaskImage,
+    /// The passes' colour space.
+    pub space: PassSpace,
+    /// The registry table chosen for that space.
+    pub table: ChosenTable,
+    /// The lookup table of that registry table.
+    pub lut: &'a GlassLut,
+    /// Glass pixels per id.
+    pub id_counts: BTreeMap<u16, u64>,
+    /// Per plane: glass pixels outside its reflection pass and their bounding box (frame-relative).
+    pub outside: BTreeMap<usize, (u64, PixelWindow)>,
+    /// The frame's memory estimate.
+    pub memory: MemoryEstimate,
+    /// The estimate held from the budget until this is dropped.
+    pub reservation: memory::Reservation<'a>,
+}
+
+/// The decoded inputs of one image, as read.
+struct DecodedInputs {
+    trans: Pass,
+    frame: CarriedFrame,
+    refl: Vec<Pass>,
+    mask: PlacedMask,
+}
+
+/// The decode phase of a frame its header phase planned: decodes the inputs, places them in
+/// the transmission pass's frame and checks ids, planes and glass outside cropped passes (as
+/// `settings` says). `carry` says what the transmission file carries over.
+pub(crate) fn decode_planned<'a>(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    plan: FramePlan<'a>,
+    carry: Carry,
+) -> Result<DecodedFrame<'a>, ComposeError> {
+    let FramePlan {
+        reads,
+        space,
+        table,
+        lut,
+        display,
+        refl_windows: stored_refl_windows,
+        memory,
+        reservation,
+    } = plan;
+    let inputs = decode_inputs(files, settings, &reads, &display, carry)?;
+    let placed = place_inputs(files, inputs)?;
+    let id_counts = placed.mask.id_pixel_counts();
+    check_inputs(
+        files,
+        settings,
+        lut,
+        placed.refl.len(),
+        &placed.mask,
+        &id_counts,
+    )?;
+    let outside = glass_outside_passes(&placed.mask, lut, &placed.refl_windows);
+    if let (OutsidePolicy::Error, Some((&plane, &(pixels, bounds)))) =
+        (settings.outside, outside.iter().next())
+    {
+        return Err(ComposeError::GlassOutsidePass {
+            plane,
+            pass: files.refl[plane].clone(),
+            pixels,
+            pass_window: stored_refl_windows
+                .get(plane)
+                .map_or(placed.stored_windows[plane], |w| w.data),
+            bounds: absolute_from(&bounds, &placed.trans.windows.data),
+        });
+    }
+    Ok(DecodedFrame {
+        trans: placed.trans,
+        frame: placed.frame,
+        refl: placed.refl,
+        refl_windows: placed.refl_windows,
+        mask: placed.mask,
+        space,
+        table,
+        lut,
+        id_counts,
+        outside,
+        memory,
+        reservation,
+    })
+}
+
+/// Reads the inputs of one image in parallel; the transmission file's attributes (and other
+/// channels, as `carry` says) come with it.
+fn decode_inputs(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    reads: &InputReads,
+    display: &PixelWindow,
+    carry: Carry,
+) -> Result<DecodedInputs, ComposeError> {
+    let read_trans = || -> Result<(Pass, CarriedFrame), ComposeError> {
+        Ok(glassdb_pass::read_transmission(
+            &files.trans,
+            &reads.trans,
+            carry,
+        )?)
+    };
+    let mask_then_refl = || -> Result<(PlacedMask, Vec<Pass>), ComposeError> {
+        let mask = glassdb_mask::read_placed_mask(&files.mask, &settings.mask)?;
+        let at = in_frame(mask.windows, !mask.has_coordinates, display).data;
+        let rows = mask
+            .image
+            .plane_bounds()
+            .into_iter()
+            .map(|(plane, b)| {
+                let y = i64::from(at.y);
+                (plane, (y + i64::from(b.y_min), y + i64::from(b.y_max)))
+            })
+            .collect();
+        let refl = read_reflections(files, &reads.refl, &rows)?;
+        Ok((mask, refl))
+    };
+    let (trans, mask_refl) = rayon::join(read_trans, mask_then_refl);
+    let (trans, frame) = trans?;
+    let (mask, refl) = mask_refl?;
+    Ok(DecodedInputs {
+        trans,
+        frame,
+        refl,
+        mask,
+    })
+}
+
+/// The reflection passes a few at a time (as many as there are threads): each holds its
+/// compressed blocks (read from its file by seeking) only while it is decoded, so that many
+/// planes do not hold every file at once (`memory` counts it so). Of each, only the rows of
+/// its plane's glass in the mask are decoded (`rows`, frame coordinates; a plane without glass
+/// decodes one block).
+fn read_reflections(
+    files: &FrameFiles,
+    reads: &[PassReadOptions],
+    rows: &BTreeMap<u16, (i64, i64)>,
+) -> Result<Vec<Pass>, ComposeError> {
+    let at_once = memory::decoding_at_once();
+    let mut passes = Vec::with_capacity(files.refl.len());
+    for (c, chunk) in files.refl.chunks(at_once).enumerate() {
+        let decoded = chunk
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let k = c * at_once + i;
+                let rows = u16::try_from(k)
+                    .ok()
+                    .and_then(|plane| rows.get(&plane))
+                    .copied()
+                    .unwrap_or((i64::MIN, i64::MIN));
+                glassdb_pass::read_pass_rows(p, &reads[k], rows)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        passes.extend(decoded);
+    }
+    Ok(passes)
+}
+
+/// The decoded inputs placed in the transmission pass's frame.
+struct PlacedInputs {
+    trans: Pass,
+    frame: CarriedFrame,
+    refl: Vec<Pass>,
+    /// Each reflection pass's data window relative to the frame.
+    refl_windows: Vec<PixelWindow>,
+    /// Each reflection pass's data window as decoded (absolute).
+    stored_windows: Vec<PixelWindow>,
+    /// The mask moved into the frame's data window.
+    mask: MaskImage,
+}
+
+/// Places what was decoded in the transmission pass's frame, checked again on what was
+/// decoded: the header phase checked the headers, and a file replaced between the two reads
+/// (a pass re-rendered while a farm composites) must not give a silently misplaced image.
+fn place_inputs(files: &FrameFiles, inputs: DecodedInputs) -> Result<PlacedInputs, ComposeError> {
+    let DecodedInputs {
+        trans,
+        frame,
+        refl,
+        mask,
+    } = inputs;
+    let data = trans.windows.data;
+    let display = trans.windows.display;
+    let mask_windows = in_frame(mask.windows, !mask.has_coordinates, &display);
+    let refl_windows: Vec<ImageWindows> = refl
+        .iter()
+        .map(|p| in_frame(p.windows, !p.source.has_coordinates(), &display))
+        .collect();
+    let mut others: Vec<(&Path, ImageWindows)> = vec![(files.mask.as_path(), mask_windows)];
+    others.extend(
+        files
+            .refl
+            .iter()
+            .map(PathBuf::as_path)
+            .zip(refl_windows.iter().copied()),
+    );
+    check_frames(&files.trans, &trans.windows, &others)?;
+    let PlacedMask { image: mask, .. } = mask;
+    let mask = if mask_windows.data == data {
+        mask
+    } else {
+        let placed = mask.placed(&mask_windows.data, &data);
+        drop(mask);
+        placed
+    };
+    Ok(PlacedInputs {
+        refl_windows: refl_windows
+            .iter()
+            .map(|w| relative_to(&w.data, &data))
+            .collect(),
+        stored_windows: refl_windows.iter().map(|w| w.data).collect(),
+        trans,
+        frame,
+        refl,
+        mask,
+    })
+}
+
+/// Checks ids and planes of the mask (placed in the frame) before compositing (that a mask
+/// without planes is not given several passes is checked from its header, `plan`).
+fn check_inputs(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    lut: &GlassLut,
+    refl_count: usize,
+    mask: &MaskImage,
+    id_counts: &BTreeMap<u16, u64>,
+) -> Result<(), ComposeError> {
+    let unknown: Vec<(u16, u64)> = id_counts
+        .iter()
+        .filter(|(id, _)| !lut.contains(**id))
+        .map(|(a, b)| (*a, *b))
+        .collect();
+    if !unknown.is_empty() && settings.unknown == UnknownIds::Error {
+        return Err(ComposeError::UnknownIds {
+            mask: files.mask.clone(),
+            registry: settings.registry_label.clone(),
+            none_known: unknown.len() == id_counts.len(),
+            ids: unknown,
+        });
+    }
+    if mask.max_plane() as usize >= refl_count {
+        let mut per_plane: BTreeMap<u16, u64> = BTreeMap::new();
+        for (&id, &p) in mask.id.iter().zip(&mask.plane) {
+            if id != 0 && p as usize >= refl_count {
+                *per_plane.entry(p).or_default() += 1;
+            }
+        }
+        if let Some((&plane, &pixels)) = per_plane.iter().next() {
+            return Err(ComposeError::PlaneWithoutPass {
+                mask: files.mask.clone(),
+                plane,
+                pixels,
+                passes: refl_count,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Glass pixels (with a table) outside their plane's reflection pass: per plane, the count and
+/// bounding box in frame-relative coordinates. `windows[k]` is pass k's window relative to the
+/// frame.
+fn glass_outside_passes(
+    mask: &MaskImage,
+    lut: &GlassLut,
+    windows: &[PixelWindow],
+) -> BTreeMap<usize, (u64, PixelWindow)> {
+    let frame = PixelWindow::at_origin(mask.width as usize, mask.height as usize);
+    if windows.iter().all(|w| w.contains_window(&frame)) {
+        return BTreeMap::new();
+    }
+    mask.plane_bounds_of(|x, y, id, plane| {
+        lut.contains(id)
+            && windows
+                .get(usize::from(plane))
+                .is_some_and(|w| !w.contains(i64::from(x), i64::from(y)))
+    })
+    .into_iter()
+    .map(|(plane, b)| (usize::from(plane), (b.glass_pixels, b.window())))
+    .collect()
+}

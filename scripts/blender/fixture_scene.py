@@ -1,0 +1,140 @@
+"""What the fixture scripts of this folder share: their command lines, and the parts of a
+Blender scene each of them builds the same way (node trees on any Blender version, the grey
+world, the EXR output format).
+
+Imported by make_mask_fixtures.py, make_pass_fixtures.py and make_reflection_passes.py (each
+puts this folder on `sys.path`). Licence: same as the project, MIT OR Apache-2.0.
+"""
+
+import json
+import os
+import sys
+
+
+def script_args(argv):
+    """Arguments after `--` (inside blender) or all of argv[1:] (plain Python / bpy module)."""
+    if "--" in argv:
+        return argv[argv.index("--") + 1:]
+    return argv[1:]
+
+
+def parse_options(argv, script, doc, opts, paths=(), values=(), flags=None):
+    """The options of a fixture script into `opts` (its defaults): `--NAME DIR` for NAME in
+    `paths` (made absolute), `--NAME VALUE` for NAME in `values` (stored under NAME with `_`
+    for `-`), `flags` {"--flag": (key, value)}; `-h` prints `doc`; anything else exits with a
+    message naming `script`."""
+    argv = script_args(argv)
+    flags = flags or {}
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        name = a[2:] if a.startswith("--") else None
+        if name in paths + values and i + 1 < len(argv):
+            value = argv[i + 1]
+            opts[name.replace("-", "_")] = os.path.abspath(value) if name in paths else value
+            i += 2
+            continue
+        if a in flags:
+            key, value = flags[a]
+            opts[key] = value
+        elif a in ("-h", "--help"):
+            print(doc)
+            sys.exit(0)
+        else:
+            sys.exit("%s: unknown argument %r" % (script, a))
+        i += 1
+    return opts
+
+
+def set_use_nodes(idblock):
+    """Gives a material or world its node tree (Blender 5.0 deprecates `use_nodes`: new
+    materials and worlds always have one)."""
+    import bpy
+
+    if tuple(bpy.app.version) < (5, 0, 0):
+        idblock.use_nodes = True
+    if idblock.node_tree is None:
+        sys.exit("%s has no node tree" % idblock.name)
+
+
+def grey_world(scene):
+    """A uniform grey world (0.5, strength 1) as the scene's; returns its Background node."""
+    import bpy
+
+    world = bpy.data.worlds.new("World")
+    world.color = (0.5, 0.5, 0.5)
+    set_use_nodes(world)
+    bg = world.node_tree.nodes.get("Background")
+    if bg is None:
+        nt = world.node_tree
+        nt.nodes.clear()
+        bg = nt.nodes.new("ShaderNodeBackground")
+        wo = nt.nodes.new("ShaderNodeOutputWorld")
+        nt.links.new(bg.outputs["Background"], wo.inputs["Surface"])
+    bg.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1.0)
+    bg.inputs["Strength"].default_value = 1.0
+    scene.world = world
+    return bg
+
+
+def set_exr_format(im, multilayer=True, half=True):
+    """RGBA OpenEXR, ZIP, half or float, multi-layer or one layer, on image settings `im`."""
+    if hasattr(im, "media_type"):  # Blender 5.0: media type first, then the format
+        im.media_type = "MULTI_LAYER_IMAGE" if multilayer else "IMAGE"
+    im.file_format = "OPEN_EXR_MULTILAYER" if multilayer else "OPEN_EXR"
+    im.color_mode = "RGBA"
+    im.color_depth = "16" if half else "32"
+    im.exr_codec = "ZIP"
+
+
+def fixed_cycles(scene):
+    """Cycles on the CPU rendering the same pixels every time: seed 0, no denoising, no
+    adaptive sampling, two threads, no compositing or sequencer, resolution at 100 %, file
+    extensions added. Returns the render settings."""
+    r = scene.render
+    r.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.seed = 0
+    scene.cycles.use_animated_seed = False
+    scene.cycles.use_denoising = False
+    if hasattr(scene.cycles, "use_adaptive_sampling"):
+        scene.cycles.use_adaptive_sampling = False
+    r.resolution_percentage = 100
+    r.threads_mode = "FIXED"
+    r.threads = 2
+    r.use_compositing = False
+    r.use_sequencer = False
+    r.use_file_extension = True
+    vl = scene.view_layers[0]
+    if hasattr(vl, "cycles"):
+        vl.cycles.use_denoising = False
+    return r
+
+
+def write_json(path, doc):
+    """Writes `doc` to `path` as JSON indented by one space, with a final newline, and says so."""
+    with open(path, "w") as fh:
+        json.dump(doc, fh, indent=1)
+        fh.write("\n")
+    print("wrote", path)
+
+
+def render_still(scene, directory, name):
+    """Renders the scene's current frame to `directory/name` and returns the file's size.
+    Blender decides whether a still's name gets a frame number (versions differ), so it renders
+    to a scratch stem and moves the one file written there."""
+    import bpy
+
+    stem = "_render_" + name.split(".")[0]
+    for old in os.listdir(directory):
+        if old.startswith(stem):
+            os.remove(os.path.join(directory, old))
+    scene.render.filepath = os.path.join(directory, stem)
+    bpy.ops.render.render(write_still=True)
+    written = [f for f in os.listdir(directory) if f.startswith(stem)]
+    if len(written) != 1:
+        sys.exit("render of %s wrote %r" % (name, written))
+    path = os.path.join(directory, name)
+    os.replace(os.path.join(directory, written[0]), path)
+    print("wrote", path, os.path.getsize(path))
+    return os.path.getsize(path)
