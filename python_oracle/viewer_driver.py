@@ -45,6 +45,7 @@ SwiftShader when there is no GPU.
 
 import argparse
 import base64
+import contextlib
 import json
 import sys
 import time
@@ -114,11 +115,20 @@ def swap_through_ui(driver, spec, timeout):
     WebDriverWait(driver, timeout).until(lambda d: drawn(d) > before)
 
 
-def check(args):
-    driver = browser(args.gpu)
+@contextlib.contextmanager
+def ready_page(args, extra=()):
+    """A headless Chromium on `args.url` once the viewer says it is ready; quit on the way out."""
+    driver = browser(args.gpu, extra)
     try:
         driver.get(args.url)
         wait_ready(driver, args.timeout)
+        yield driver
+    finally:
+        driver.quit()
+
+
+def check(args):
+    with ready_page(args) as driver:
         for spec in args.swap:
             swap_through_ui(driver, spec, args.timeout)
         scene = driver.execute_script("return {w: window.glassdb.scene.width, h: window.glassdb.scene.height}")
@@ -137,8 +147,6 @@ def check(args):
             "renderer": renderer(driver),
         }
         print(json.dumps(report))
-    finally:
-        driver.quit()
 
 
 def bench(args):
@@ -219,17 +227,12 @@ def rebind(args):
 
 
 def export(args):
-    driver = browser(args.gpu)
-    try:
-        driver.get(args.url)
-        wait_ready(driver, args.timeout)
+    with ready_page(args) as driver:
         driver.find_element(By.ID, "export").click()
         WebDriverWait(driver, args.timeout).until(
             lambda d: d.find_element(By.ID, "status").text.startswith(("exported", "export failed")))
         print(json.dumps({"status": driver.find_element(By.ID, "status").text,
                           "errors": driver.execute_script("return window.glassdbErrors")}))
-    finally:
-        driver.quit()
 
 
 LAYOUT_JS = r"""
@@ -285,25 +288,17 @@ const done = arguments[arguments.length - 1];
 
 def layout(args):
     extra = [f"--window-size={args.window.replace('x', ',')}"] if args.window else []
-    driver = browser(args.gpu, extra)
-    try:
+    with ready_page(args, extra) as driver:
         driver.set_script_timeout(args.timeout)
-        driver.get(args.url)
-        wait_ready(driver, args.timeout)
         report = driver.execute_async_script(LAYOUT_JS, args.run)
         if args.screenshot:
             driver.save_screenshot(args.screenshot)
         print(json.dumps(report))
-    finally:
-        driver.quit()
 
 
 def build_unit(args):
     from selenium.webdriver.support.ui import Select
-    driver = browser(args.gpu)
-    try:
-        driver.get(args.url)
-        wait_ready(driver, args.timeout)
+    with ready_page(args) as driver:
         driver.find_element(By.CSS_SELECTOR, f'#glasses li[data-id="{args.glass}"]').click()
         parts = args.panes.split("|")
         # The builder starts as pane, gap, pane; add gap + pane pairs for more panes.
@@ -342,8 +337,6 @@ def build_unit(args):
             "errors": driver.execute_script("return window.glassdbErrors"),
             "renderer": renderer(driver),
         }))
-    finally:
-        driver.quit()
 
 
 def main():

@@ -165,8 +165,9 @@ def export(opts):
     else:
         frames = list(range(scene.frame_start, scene.frame_end + 1))
     cameras = {}
-    # Every object rendered in some frame (one hidden at first and shown later too).
-    all_objects = []
+    # Every object rendered in some frame (one hidden at first and shown later too), by name
+    # in the order first seen.
+    all_objects = {}
     # Every frame's geometry; a frame whose objects differ from the first frame's (a moving
     # object, a sliding door, a deforming mesh) gets its own OBJ, scene.NNNN.obj.
     first_lines = None
@@ -179,7 +180,7 @@ def export(opts):
         # Visibility is per frame: an object shown from frame 2 on (a car driving in) is in
         # that frame's scene and mask, one hidden from then on is not.
         objects = exported_objects(scene)
-        all_objects += [ob for ob in objects if ob not in all_objects]
+        all_objects.update((ob.name, ob) for ob in objects if ob.name not in all_objects)
         lines, names = scene_obj_lines(objects, materials)
         if first_lines is None:
             first_lines, first_names = lines, names
@@ -214,7 +215,7 @@ def export(opts):
         "file": bpy.data.filepath,
         "frames": frames,
         "materials": sorted(materials),
-        "objects": [ob.name for ob in all_objects],
+        "objects": list(all_objects),
         # Frames whose geometry differs from the first frame's: their OBJ and what moved.
         "moving": moving,
     }

@@ -382,14 +382,6 @@ layers = [
         &["igsdb_product_10693.json", "CLEAR_6.DAT"],
         &["--gap", "12.7:argon"],
     );
-    let curve = |c: &Value, cos: f64| -> f64 {
-        let p = c["powers"].as_array().unwrap();
-        let k = c["coefficients"].as_array().unwrap();
-        p.iter()
-            .zip(k)
-            .map(|(p, k)| k.as_f64().unwrap() * cos.powi(p.as_u64().unwrap() as i32))
-            .sum()
-    };
     for (i, a) in [0.0f64, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0]
         .iter()
         .enumerate()
@@ -401,7 +393,7 @@ layers = [
                 ("Rf", "r0", "c_r"),
                 ("Rb", "r0_back", "c_r_back"),
             ] {
-                let reg_v = g[r0][ch].as_f64().unwrap() * curve(&g[c][ch], cos);
+                let reg_v = g[r0][ch].as_f64().unwrap() * curve_at(&g[c][ch], cos);
                 let cli = us["rgb"][key][i][ch].as_f64().unwrap();
                 assert!(
                     (reg_v - cli).abs() < 0.0025,
@@ -411,10 +403,10 @@ layers = [
             let share: f64 = (0..2)
                 .map(|k| {
                     let gr = &u["groups"][k];
-                    gr["r0"][ch].as_f64().unwrap() * curve(&gr["c_r"][ch], cos)
+                    gr["r0"][ch].as_f64().unwrap() * curve_at(&gr["c_r"][ch], cos)
                 })
                 .sum();
-            let r = g["r0"][ch].as_f64().unwrap() * curve(&g["c_r"][ch], cos);
+            let r = g["r0"][ch].as_f64().unwrap() * curve_at(&g["c_r"][ch], cos);
             assert!((share - r).abs() < 0.006, "{a}°: shares {share} vs r {r}");
         }
     }
@@ -628,14 +620,6 @@ layers = [
             (v[0], v[1], v[2])
         })
         .collect();
-    let curve = |c: &Value, cos: f64| -> f64 {
-        let p = c["powers"].as_array().unwrap();
-        let k = c["coefficients"].as_array().unwrap();
-        p.iter()
-            .zip(k)
-            .map(|(p, k)| k.as_f64().unwrap() * cos.powi(p.as_u64().unwrap() as i32))
-            .sum()
-    };
     let g = glass(&reg["tables"][0], 1);
     assert_eq!(g["unit"]["elements"][0]["model"], "measured");
     assert_eq!(g["unit"]["elements"][1]["gas"], "krypton");
@@ -644,8 +628,8 @@ layers = [
         let cos = deg.to_radians().cos();
         let (t_unit, r_unit) = (t * t / (1.0 - r * r), r + t * t * r / (1.0 - r * r));
         for ch in 0..3 {
-            let tt = g["t0"][ch].as_f64().unwrap() * curve(&g["c_t"][ch], cos);
-            let rr = g["r0"][ch].as_f64().unwrap() * curve(&g["c_r"][ch], cos);
+            let tt = g["t0"][ch].as_f64().unwrap() * curve_at(&g["c_t"][ch], cos);
+            let rr = g["r0"][ch].as_f64().unwrap() * curve_at(&g["c_r"][ch], cos);
             assert!(
                 (tt - t_unit).abs() < 0.006 && (rr - r_unit).abs() < 0.006,
                 "{deg}°: T {tt} vs {t_unit}, R {rr} vs {r_unit}"
@@ -664,4 +648,14 @@ layers = [
     let clear_rb = mixed["unit"]["elements"][0]["r0_back"][1].as_f64().unwrap();
     let want = clear_t * 0.5 / (1.0 - clear_rb * 0.08);
     assert!((mixed["t0"][1].as_f64().unwrap() - want).abs() < 1e-12);
+}
+
+/// A registry curve object (`powers`, `coefficients`) at `cos`: Σ k·cosᵖ, read from the JSON.
+fn curve_at(c: &Value, cos: f64) -> f64 {
+    let p = c["powers"].as_array().unwrap();
+    let k = c["coefficients"].as_array().unwrap();
+    p.iter()
+        .zip(k)
+        .map(|(p, k)| k.as_f64().unwrap() * cos.powi(p.as_u64().unwrap() as i32))
+        .sum()
 }

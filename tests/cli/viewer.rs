@@ -1137,6 +1137,24 @@ fn a_blender_run_folder_opens_directly() {
 /// The catalog unit the page's builder makes in the tests: Solarban R67 (coating on #2), 12.7
 /// mm argon, clear 6 mm; the bundled catalog has it as id 12.
 const UNIT_PANES: &str = "6|12.7:argon|2";
+/// `viewer_driver.py unit`: builds the unit `panes` in glass 5's place through the page's
+/// controls (its canvas into `out` when given); the driver's report.
+fn build_unit_on_page(url: &str, panes: &str, out: Option<&Path>) -> serde_json::Value {
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "unit".as_ref(),
+        url.as_ref(),
+        "--glass".as_ref(),
+        "5".as_ref(),
+        "--panes".as_ref(),
+        panes.as_ref(),
+    ];
+    if let Some(out) = out {
+        args.extend(["--out".as_ref(), out.as_os_str()]);
+    }
+    let said = run_oracle("viewer_driver.py", &args);
+    serde_json::from_str(said.trim()).unwrap()
+}
+
 const CATALOG_UNIT: &str = "Solarban R67 #2 | 12.7 argon | clear 6";
 
 /// Issue 26: a unit built on the page through its controls (outer pane, gap width and gas,
@@ -1155,20 +1173,7 @@ fn a_unit_built_on_the_page_gives_composes_pixels_of_that_unit() {
     let want = compose_png(dir.path(), Some(&registry), "unit.png");
     let served = serve(&[]);
     let out = dir.path().join("unit.rgba");
-    let said = run_oracle(
-        "viewer_driver.py",
-        &[
-            "unit".as_ref(),
-            served.url.as_ref(),
-            "--glass".as_ref(),
-            "5".as_ref(),
-            "--panes".as_ref(),
-            UNIT_PANES.as_ref(),
-            "--out".as_ref(),
-            out.as_os_str(),
-        ],
-    );
-    let report: serde_json::Value = serde_json::from_str(said.trim()).unwrap();
+    let report = build_unit_on_page(&served.url, UNIT_PANES, Some(&out));
     assert_eq!(report["errors"], serde_json::json!([]), "{report}");
     assert_eq!(report["status_class"], "", "{report}");
     let name = report["products"]["A"]["5"].as_str().unwrap();
@@ -1182,18 +1187,7 @@ fn a_unit_built_on_the_page_gives_composes_pixels_of_that_unit() {
     assert!(db >= 50.0, "unit built on the page vs compose: {db:.1} dB");
 
     // The width box left empty: the server's reason on the page, nothing drawn.
-    let said = run_oracle(
-        "viewer_driver.py",
-        &[
-            "unit".as_ref(),
-            served.url.as_ref(),
-            "--glass".as_ref(),
-            "5".as_ref(),
-            "--panes".as_ref(),
-            "6|nan:argon|2".as_ref(),
-        ],
-    );
-    let report: serde_json::Value = serde_json::from_str(said.trim()).unwrap();
+    let report = build_unit_on_page(&served.url, "6|nan:argon|2", None);
     assert_eq!(report["status_class"], "error", "{report}");
     let status = report["status"].as_str().unwrap();
     assert!(
