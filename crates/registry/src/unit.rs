@@ -565,20 +565,31 @@ fn one_layer_unit(
     Ok(records)
 }
 
+/// How far a pane group's integrated share may stray outside [0, 1] and still be rounding:
+/// the facing group's share is 1 at grazing (90°) and the others 0, reached through sums of
+/// products that land just either side. In the bundled catalog under D65 the largest is
+/// `1 + 2.9e-11` (green, glass 13, a triple unit); such a share is not a defect and is stored
+/// as before lights (only the normal-incidence value clamped), so `data/registry.json` is
+/// unchanged. A colour out of the space's gamut strays by orders of magnitude more: a bundled
+/// unit's front group in sRGB red under LED-RGB1 is −1.8e-2 at every angle.
+pub(crate) const SHARE_ROUNDING: f64 = 1e-9;
+
 /// The pane groups' reflectance shares as the registry stores them (`[group][angle]`, per
 /// channel). A channel can integrate negative: an out-of-gamut colour, e.g. a blue coating's
-/// back reflectance in sRGB's red under the narrow-band LED-RGB1. In a channel where some
-/// group's share leaves [0, 1] at some angle, every angle's shares are redrawn as the unit's
-/// reflectance there (`unit`, clamped to [0, 1] as every stored value is) split between the
-/// groups as their shares of all three channels together split it, so that the shares stay
-/// non-negative and smooth and still sum to the unit's reflectance (eq. 6). Other channels are
-/// kept bit for bit.
+/// back reflectance in sRGB's red under the narrow-band LED-RGB1. A negative share is a real
+/// defect of the stored values: the compositor would subtract light in that channel, and a
+/// curve fitted as a ratio to a clamped `r0` of 0 is meaningless. So in a channel where some
+/// group's share leaves [0, 1] by more than [`SHARE_ROUNDING`] at some angle, every angle's
+/// shares are redrawn as the unit's reflectance there (`unit`, clamped to [0, 1] as every
+/// stored value is) split between the groups as their shares of all three channels together
+/// split it, so that the shares stay non-negative and smooth and still sum to the unit's
+/// reflectance (eq. 6). Every other channel is kept bit for bit, its normal-incidence value
+/// clamped to [0, 1] as every stored `r0` is. Under broad lights (the CIE daylights, A) no
+/// bundled unit strays beyond rounding, so their tables are what they were before lights.
 fn stored_shares(mut shares: Vec<Vec<[f64; 3]>>, unit: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
+    let outside = |v: f64| !(-SHARE_ROUNDING..=1.0 + SHARE_ROUNDING).contains(&v);
     for c in 0..3 {
-        let outside = shares
-            .iter()
-            .any(|s| s.iter().any(|v| !(0.0..=1.0).contains(&v[c])));
-        if !outside {
+        if !shares.iter().any(|s| s.iter().any(|v| outside(v[c]))) {
             continue;
         }
         for (a, total) in unit.iter().enumerate() {
@@ -598,5 +609,49 @@ fn stored_shares(mut shares: Vec<Vec<[f64; 3]>>, unit: &[[f64; 3]]) -> Vec<Vec<[
             }
         }
     }
+    for s in &mut shares {
+        if let Some(normal) = s.first_mut() {
+            *normal = clamp_unit(*normal);
+        }
+    }
     shares
+}
+
+#[cfg(test)]
+mod share_tests {
+    use super::stored_shares;
+
+    #[test]
+    fn rounding_outside_unit_interval_keeps_the_shares() {
+        // grazing: the facing group's share a rounding error above 1 in blue
+        let shares = vec![
+            vec![[0.04, 0.05, 0.06], [1.0, 1.0, 1.0 + 2e-16]],
+            vec![[0.03, 0.035, 0.02], [0.0, 0.0, -1e-17]],
+        ];
+        let unit = [[0.07, 0.085, 0.08], [1.0, 1.0, 1.0]];
+        let stored = stored_shares(shares.clone(), &unit);
+        assert_eq!(stored, shares);
+    }
+
+    #[test]
+    fn negative_share_is_redistributed_in_its_channel_only() {
+        // red integrates negative for group 2 (out of gamut): red is redrawn, green and blue kept
+        let shares = vec![
+            vec![[0.05, 0.05, 0.06], [0.5, 0.4, 0.4]],
+            vec![[-0.01, 0.02, 0.09], [0.1, 0.1, 0.2]],
+        ];
+        let unit = [[0.04, 0.07, 0.15], [0.6, 0.5, 0.6]];
+        let stored = stored_shares(shares.clone(), &unit);
+        for (g, s) in stored.iter().enumerate() {
+            for (a, v) in s.iter().enumerate() {
+                assert!((0.0..=1.0).contains(&v[0]), "{v:?}");
+                assert_eq!(v[1], shares[g][a][1]);
+                assert_eq!(v[2], shares[g][a][2]);
+            }
+        }
+        for (a, total) in unit.iter().enumerate() {
+            let red: f64 = stored.iter().map(|s| s[a][0]).sum();
+            assert!((red - total[0]).abs() < 1e-15, "{red} vs {}", total[0]);
+        }
+    }
 }
