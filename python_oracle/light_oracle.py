@@ -84,7 +84,10 @@ class Light:
             self.sd = SDS_ILLUMINANTS[name]
             self.white = np.asarray(colour.CCS_ILLUMINANTS[OBSERVERS[observer]][name], float)
         else:
-            data = np.loadtxt(spec, delimiter=",", comments="#", skiprows=1, ndmin=2)
+            with open(spec, encoding="utf-8") as f:
+                rows = [line for line in f if line.strip() and not line.lstrip().startswith("#")]
+            # the first row that is not a comment is the header (wavelength_nm,power)
+            data = np.loadtxt(rows[1:], delimiter=",", ndmin=2)
             self.sd = SpectralDistribution(data[:, 1], data[:, 0], name=spec,
                                            interpolator=colour.LinearInterpolator)
             ones = SpectralDistribution(np.ones(len(self.cmfs.wavelengths)),

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
+use crate::util::registry_glass as glass;
 use crate::util::{
     assert_names, fails_naming, glassdb, ok, registry_build, repo_path, run_oracle, write_file,
 };
@@ -270,15 +271,6 @@ fn catalog_with(dir: &Path, body: &str) -> PathBuf {
 
 fn read_json(path: &Path) -> Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
-}
-
-fn glass(table: &Value, id: u64) -> &Value {
-    table["glasses"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|g| g["id"] == id)
-        .unwrap_or_else(|| panic!("no glass {id}"))
 }
 
 /// A unit of one layer is that layer's registry entry exactly (turned round when flipped).

@@ -382,3 +382,13 @@ pub fn names(dir: &Path) -> Vec<String> {
     v.sort();
     v
 }
+
+/// The glass `id` of a registry JSON table (`tables[k]`).
+pub fn registry_glass(table: &serde_json::Value, id: u64) -> &serde_json::Value {
+    table["glasses"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|g| g["id"] == id)
+        .unwrap_or_else(|| panic!("no glass {id}"))
+}

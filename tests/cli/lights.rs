@@ -1,0 +1,188 @@
+//! End-to-end tests of lights (docs/colour.md): the per-light registry tables against
+//! colour-science (`python_oracle/light_oracle.py`), and the flat-emitter check of the
+//! composite under each light.
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::util::{glassdb, ok, registry_build, registry_glass, repo_path, run_oracle, write_file};
+
+/// The lights of the oracle comparison: daylight, tungsten, a CIE LED, a fluorescent and a
+/// custom SPD (a warm-white LED, fixtures/lights/warm_led.csv).
+const LIGHTS: [(&str, &str); 5] = [
+    ("sun", "D65"),
+    ("warm", "A"),
+    ("led", "LED-B3"),
+    ("office", "FL11"),
+    ("lamp", "fixtures/lights/warm_led.csv"),
+];
+
+/// The spaces of the oracle comparison (the bundled registry's).
+const SPACES: [&str; 4] = ["srgb", "acescg", "rec2020", "aces2065-1"];
+
+fn glazing(name: &str) -> PathBuf {
+    repo_path("fixtures/glazing").join(name)
+}
+
+/// The single glasses of the light tests, by id: tinted and coated products, where the light's
+/// spectrum matters most.
+fn single_glasses() -> Vec<(u16, PathBuf)> {
+    vec![
+        (5, glazing("913.json")),
+        (9, glazing("nfrc_9962.json")),
+        (10, glazing("nfrc_9223.json")),
+        (4, glazing("LOW-E_5.LOF")),
+    ]
+}
+
+/// A catalog of the single glasses (913.json as uncoated, as data/catalog.toml says) and one
+/// double unit, Arctic Blue 6 | 12.7 air | clear 6 (id 21).
+fn write_catalog(dir: &Path) -> PathBuf {
+    let mut text = String::new();
+    for (id, path) in single_glasses() {
+        let model = if id == 5 {
+            "model = \"uncoated\"\n"
+        } else {
+            ""
+        };
+        text += &format!(
+            "[[glass]]\nid = {id}\nname = \"glass {id}\"\nspectral = \"{}\"\n{model}\n",
+            path.display()
+        );
+    }
+    text += &format!(
+        "[[glass]]\nid = 21\nname = \"Arctic Blue | air | clear\"\nlayers = [\n  \
+         {{ spectral = \"{}\" }},\n  {{ gap_mm = 12.7, gas = \"air\" }},\n  \
+         {{ spectral = \"{}\" }},\n]\n",
+        glazing("nfrc_9962.json").display(),
+        glazing("CLEAR_6.DAT").display()
+    );
+    write_file(dir, "catalog.toml", text.as_bytes())
+}
+
+/// `--light NAME=SPEC` arguments, the custom SPD's path made absolute.
+fn light_args(lights: &[(&str, &str)]) -> Vec<String> {
+    lights
+        .iter()
+        .flat_map(|(name, spec)| {
+            let spec = if spec.ends_with(".csv") {
+                repo_path(spec).display().to_string()
+            } else {
+                spec.to_string()
+            };
+            ["--light".to_string(), format!("{name}={spec}")]
+        })
+        .collect()
+}
+
+/// The registry's table under `light` in `space`.
+fn table<'a>(registry: &'a Value, light: &str, space: &str) -> &'a Value {
+    registry["tables"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["light"] == light && t["spectral"]["space"] == space)
+        .unwrap_or_else(|| panic!("no table for light {light} in {space}"))
+}
+
+fn rgb(v: &Value) -> [f64; 3] {
+    [0, 1, 2].map(|c| v[c].as_f64().expect("a number"))
+}
+
+/// Builds a registry with every light of [`LIGHTS`] in every space of [`SPACES`].
+fn build_light_registry(dir: &Path) -> Value {
+    let catalog = write_catalog(dir);
+    let out = dir.join("lights.json");
+    let mut extra: Vec<String> = vec!["--space".into(), SPACES.join(",")];
+    extra.extend(light_args(&LIGHTS));
+    let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+    ok(&mut registry_build(&catalog, &out, &extra));
+    serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap()
+}
+
+/// The unit's system spectra at normal incidence, as the stack engine makes them
+/// (`glassdb stack --json --spectra`), for the oracle's `stack:FILE.json` source.
+fn unit_spectra(dir: &Path) -> PathBuf {
+    let json = ok(glassdb()
+        .arg("stack")
+        .arg(glazing("nfrc_9962.json"))
+        .arg(glazing("CLEAR_6.DAT"))
+        .args(["--gap", "12.7:air", "--angles", "0", "--json", "--spectra"]));
+    write_file(dir, "unit.json", json.as_bytes())
+}
+
+/// Every per-light table equals colour-science to 1e-9: the same integration (360–780 nm at
+/// 1 nm, CIE 1931), the light as the illuminant, CAT02 from the light's white to the space's
+/// (the camera balanced to each light), for bundled CIE illuminants and a custom SPD, on single
+/// glasses and a unit's system spectra. Stored values are clamped to [0, 1], so the oracle's are
+/// too before comparing.
+#[test]
+fn per_light_tables_equal_colour_science() {
+    let dir = tempfile::tempdir().unwrap();
+    let registry = build_light_registry(dir.path());
+    assert_eq!(registry["schema"], 5);
+    let unit = format!("stack:{}", unit_spectra(dir.path()).display());
+    let mut sources: Vec<(u16, String)> = single_glasses()
+        .into_iter()
+        .map(|(id, p)| (id, p.display().to_string()))
+        .collect();
+    sources.push((21, unit));
+    let mut args: Vec<String> = vec!["tables".into()];
+    for space in SPACES {
+        args.extend(["--space".into(), space.into()]);
+    }
+    args.extend(light_args(&LIGHTS));
+    args.extend(sources.iter().map(|(_, s)| s.clone()));
+    let args: Vec<&OsStr> = args.iter().map(OsStr::new).collect();
+    let oracle: Value = serde_json::from_str(&run_oracle("light_oracle.py", &args)).unwrap();
+    let fields = [
+        ("transmittance", "t0"),
+        ("reflectance", "r0"),
+        ("reflectance_back", "r0_back"),
+    ];
+    let mut compared = 0;
+    let mut worst = 0.0f64;
+    for (id, source) in &sources {
+        for (light, _) in LIGHTS {
+            for space in SPACES {
+                let record = registry_glass(table(&registry, light, space), u64::from(*id));
+                let want_all = &oracle[source.as_str()][light][space];
+                for (quantity, field) in fields {
+                    let want = rgb(&want_all[quantity]).map(|v| v.clamp(0.0, 1.0));
+                    let got = rgb(&record[field]);
+                    for c in 0..3 {
+                        let diff = (got[c] - want[c]).abs();
+                        worst = worst.max(diff);
+                        assert!(
+                            diff <= 1e-9,
+                            "glass {id} {field}[{c}] under {light} in {space}: glassdb {}, \
+                             colour-science {} (diff {diff:e})",
+                            got[c],
+                            want[c]
+                        );
+                        compared += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(compared, 5 * 5 * 4 * 3 * 3);
+    eprintln!("{compared} values, largest difference from colour-science {worst:e}");
+}
+
+/// The bundled illuminants (data/illuminants) are colour-science's datasets bit for bit: every
+/// SPD and every white, for both observers.
+#[test]
+fn bundled_illuminants_are_colour_science_datasets() {
+    let dir = repo_path("data/illuminants");
+    let out: Value = serde_json::from_str(&run_oracle(
+        "light_oracle.py",
+        &[OsStr::new("illuminants"), dir.as_os_str()],
+    ))
+    .unwrap();
+    assert_eq!(out["mismatches"], serde_json::json!([]), "{out}");
+    // 27 SPDs and 27 whites for each of the two observers
+    assert_eq!(out["checked"], 27 * 3, "{out}");
+}
