@@ -47,6 +47,17 @@ pub struct Args {
     /// channels instead of replacing the transmission pass's RGB.
     #[arg(long, value_name = "NAME")]
     pub output_layer: Option<String>,
+    /// Composite a frame split by light: each light group's layers (Cycles'
+    /// `ViewLayer.Combined_GROUP`, V-Ray's `VRayLightSelect_GROUP`, Corona's
+    /// `CShading_LightSelect_GROUP`, or `LightSelect_GROUP`) in every pass, with the registry's
+    /// table of the light of the same name (`glassdb registry build --light GROUP=…`), and
+    /// write the sum (docs/compose.md, "Light groups")
+    #[arg(long, value_name = "GROUP,...", value_delimiter = ',')]
+    pub light_groups: Vec<String>,
+    /// With --light-groups, EXR output: also write each group's composite as a layer of its
+    /// group's name, so that the lights can still be balanced afterwards
+    #[arg(long, requires = "light_groups")]
+    pub keep_groups: bool,
     /// Read the mask as the paper's binary mask (white = glass, black = not) showing glass ID
     /// at its normal-incidence values.
     #[arg(long, value_name = "ID")]
@@ -342,10 +353,40 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         inputs: args.inputs.files(),
         output: args.output.clone(),
     };
+    if !args.light_groups.is_empty() {
+        return run_light_groups(&args, &job, &settings);
+    }
     match &args.inputs.frames {
         None => run_frame(&args, &job, &settings, &luts),
         Some(spec) => run_sequence(&args, spec, &job, &settings, &luts),
     }
+}
+
+/// One frame split by light (`--light-groups`), each group with its light's tables.
+fn run_light_groups(
+    args: &Args,
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+) -> anyhow::Result<ExitCode> {
+    if args.inputs.frames.is_some() {
+        bail!("--light-groups: one frame at a time (without --frames) for now");
+    }
+    let (registry, label) = load_registry(args.registry.as_deref())?;
+    let groups = glassdb_compose::LightGroup::from_registry(&registry, &args.light_groups, &label)?;
+    let spinner = Spinner::on_terminal("compose");
+    let report =
+        glassdb_compose::compose_light_groups(job, settings, &groups, args.keep_groups, &spinner)?;
+    spinner.finish();
+    report_nonfinite(&report, "");
+    outln!(
+        "wrote {} ({}×{}, {}; light groups {})",
+        report.output.path.display(),
+        report.width,
+        report.height,
+        report.output.encoding,
+        args.light_groups.join(", ")
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 /// One frame, with a spinner naming its stage.

@@ -311,3 +311,188 @@ fn flat_emitter_through_tinted_glass_matches_its_light_table() {
         }
     }
 }
+
+/// The light-group fixture (fixtures/light_groups: Cycles' `ViewLayer.Combined_sun` and
+/// `ViewLayer.Combined_warm` in a transmission and a reflection pass, rendered by Blender 3.4).
+fn group_fixture(name: &str) -> PathBuf {
+    repo_path("fixtures/light_groups").join(name)
+}
+
+/// The R, G, B planes of `layer` (`""`: bare `R`, `G`, `B`) of an EXR read with the exr crate.
+fn layer_rgb(path: &Path, layer: &str) -> [Vec<f64>; 3] {
+    let planes = crate::util::read_exr_planes(path);
+    ["R", "G", "B"].map(|c| {
+        let name = if layer.is_empty() {
+            c.to_string()
+        } else {
+            format!("{layer}.{c}")
+        };
+        let k = planes
+            .names
+            .iter()
+            .position(|n| *n == name)
+            .unwrap_or_else(|| {
+                panic!(
+                    "{}: no channel {name} in {:?}",
+                    path.display(),
+                    planes.names
+                )
+            });
+        planes.channels[k].clone()
+    })
+}
+
+/// `compose` of the fixture's passes with `registry`, no output yet.
+fn compose_fixture(registry: &Path) -> std::process::Command {
+    let mut cmd = crate::util::compose();
+    cmd.arg("--registry")
+        .arg(registry)
+        .arg("--trans")
+        .arg(group_fixture("trans.exr"))
+        .arg("--refl")
+        .arg(group_fixture("refl.exr"))
+        .arg("--mask")
+        .arg(group_fixture("mask.png"));
+    cmd
+}
+
+/// `compose` of the fixture's passes (float output) with `extra` arguments.
+fn compose_groups(registry: &Path, out: &Path, extra: &[&str]) -> std::process::Command {
+    let mut cmd = compose_fixture(registry);
+    cmd.args(["--data-type", "float", "-o"])
+        .arg(out)
+        .args(extra);
+    cmd
+}
+
+/// `compose --light-groups sun,warm` is Σ_g (trans_g·t_g + refl_g·r_g): each group composited
+/// alone (its layers, a registry of its light only) and summed; `--keep-groups` writes each
+/// group's composite under its layer's name; the beauty replaces `ViewLayer.Combined`.
+#[test]
+fn light_groups_composite_is_the_sum_of_each_group_with_its_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let catalog = write_catalog(dir.path());
+    let build = |name: &str, lights: &[(&str, &str)]| {
+        let out = dir.path().join(name);
+        let args = light_args(lights);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        ok(&mut registry_build(&catalog, &out, &args));
+        out
+    };
+    let both = build("both.json", &[("sun", "D65"), ("warm", "A")]);
+    let out = dir.path().join("groups.exr");
+    ok(&mut compose_groups(
+        &both,
+        &out,
+        &["--light-groups", "sun,warm", "--keep-groups"],
+    ));
+    let beauty = layer_rgb(&out, "ViewLayer.Combined");
+    let mut sum = [0, 1, 2].map(|_| vec![0.0; beauty[0].len()]);
+    for (group, spec) in [("sun", "D65"), ("warm", "A")] {
+        let registry = build(&format!("{group}.json"), &[(group, spec)]);
+        let alone = dir.path().join(format!("{group}.exr"));
+        let layer = format!("ViewLayer.Combined_{group}");
+        ok(&mut compose_groups(
+            &registry,
+            &alone,
+            &[
+                "--trans-layer",
+                &layer,
+                "--refl-layer",
+                &layer,
+                "--keep-channels",
+                "none",
+            ],
+        ));
+        let alone = layer_rgb(&alone, "");
+        let kept = layer_rgb(&out, &layer);
+        for c in 0..3 {
+            for (i, (k, a)) in kept[c].iter().zip(&alone[c]).enumerate() {
+                assert!(
+                    (k - a).abs() <= 1e-6,
+                    "{layer} channel {c} pixel {i}: kept {k}, alone {a}"
+                );
+                sum[c][i] += a;
+            }
+        }
+    }
+    for c in 0..3 {
+        for (i, (b, s)) in beauty[c].iter().zip(&sum[c]).enumerate() {
+            assert!(
+                (b - s).abs() <= 1e-5,
+                "beauty channel {c} pixel {i}: {b}, groups' sum {s}"
+            );
+        }
+    }
+    // the warm group's table is not the sun's: the two differ where warm light crosses glass
+    let sun_table = dir.path().join("warm_as_sun.exr");
+    let sun_only = build("sun_only.json", &[("warm", "D65")]);
+    ok(&mut compose_groups(
+        &sun_only,
+        &sun_table,
+        &[
+            "--trans-layer",
+            "ViewLayer.Combined_warm",
+            "--refl-layer",
+            "ViewLayer.Combined_warm",
+        ],
+    ));
+    let as_sun = layer_rgb(&sun_table, "ViewLayer.Combined_warm");
+    let kept = layer_rgb(&out, "ViewLayer.Combined_warm");
+    let largest = (0..3)
+        .flat_map(|c| kept[c].iter().zip(&as_sun[c]).map(|(a, b)| (a - b).abs()))
+        .fold(0.0, f64::max);
+    assert!(
+        largest > 1e-3,
+        "the warm group under D65 and A agree ({largest})"
+    );
+}
+
+/// Groups in the passes without a table, tables without a group, a registry without a group's
+/// light and `--keep-groups` on a PNG are refused, naming what is missing.
+#[test]
+fn light_groups_refuse_what_does_not_match() {
+    let dir = tempfile::tempdir().unwrap();
+    let catalog = write_catalog(dir.path());
+    let registry = dir.path().join("lights.json");
+    ok(&mut registry_build(
+        &catalog,
+        &registry,
+        &[
+            "--light",
+            "sun=D65",
+            "--light",
+            "warm=A",
+            "--light",
+            "lamp=LED-B1",
+        ],
+    ));
+    let out = dir.path().join("out.exr");
+    // the warm group has no table given
+    crate::util::fails_naming(
+        &mut compose_groups(&registry, &out, &["--light-groups", "sun"]),
+        &["trans.exr", "warm", "without a table"],
+    );
+    // the lamp has a table but no layer
+    crate::util::fails_naming(
+        &mut compose_groups(&registry, &out, &["--light-groups", "sun,warm,lamp"]),
+        &["trans.exr", "lamp", "sun, warm"],
+    );
+    // a registry without the warm light
+    let sun_only = dir.path().join("sun.json");
+    ok(&mut registry_build(
+        &catalog,
+        &sun_only,
+        &["--light", "sun=D65"],
+    ));
+    crate::util::fails_naming(
+        &mut compose_groups(&sun_only, &out, &["--light-groups", "sun,warm"]),
+        &["sun.json", "warm", "sun (D65)"],
+    );
+    let png = dir.path().join("out.png");
+    let mut cmd = compose_fixture(&registry);
+    cmd.args(["--light-groups", "sun,warm", "--keep-groups", "-o"])
+        .arg(&png);
+    crate::util::fails_naming(&mut cmd, &["out.png", "EXR"]);
+    assert!(!out.exists() && !png.exists());
+}

@@ -196,6 +196,18 @@ impl RegistryLuts {
         }
     }
 
+    /// Lookup tables for every table of `registry` under the light named `light` (built when
+    /// first used); `None` when no table names that light.
+    pub fn for_light(registry: &Registry, light: &str) -> Option<RegistryLuts> {
+        let tables: Vec<(ColourBasis, LazyLut)> = registry
+            .tables()
+            .iter()
+            .filter(|t| t.light.as_deref() == Some(light))
+            .map(|t| (t.basis(), LazyLut::Table(t.clone(), OnceLock::new())))
+            .collect();
+        (!tables.is_empty()).then_some(RegistryLuts { tables })
+    }
+
     /// One lookup table in one basis (tests, benchmarks).
     pub fn single(basis: ColourBasis, lut: GlassLut) -> RegistryLuts {
         RegistryLuts {

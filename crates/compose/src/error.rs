@@ -152,6 +152,53 @@ pub enum ComposeError {
         /// How many reflection passes were given.
         passes: usize,
     },
+    /// A light group composited without a layer in one of the passes.
+    #[error(
+        "{path} has no layer for light group {group:?} (its light groups: {})",
+        if found.is_empty() { "none".to_string() } else { found.join(", ") }
+    )]
+    GroupWithoutLayer {
+        /// The pass.
+        path: PathBuf,
+        /// The group asked for.
+        group: String,
+        /// The groups the pass has.
+        found: Vec<String>,
+    },
+    /// Light groups in a pass that no table is given for: leaving them out would lose their
+    /// light.
+    #[error(
+        "{path} has light groups without a table: {} (the groups composited: {})",
+        groups.join(", "),
+        composited.join(", ")
+    )]
+    GroupWithoutTable {
+        /// The pass.
+        path: PathBuf,
+        /// Its groups that are not composited.
+        groups: Vec<String>,
+        /// The groups composited.
+        composited: Vec<String>,
+    },
+    /// A registry with no table under a light group's light.
+    #[error("{registry} has no table for light group {group:?} (its lights: {})", lights.join(", "))]
+    NoTableForGroup {
+        /// The registry's name.
+        registry: String,
+        /// The group.
+        group: String,
+        /// The lights it has (`warm (A)`).
+        lights: Vec<String>,
+    },
+    /// Light groups asked for with none named, or one named twice.
+    #[error("light groups: {0}")]
+    LightGroupList(String),
+    /// Each group's composite kept as a layer of a PNG output, which has none.
+    #[error("{output}: each light group's composite is kept as a layer of an EXR output only")]
+    KeepGroupsNotExr {
+        /// The output.
+        output: PathBuf,
+    },
     /// A compose job without any reflection pass.
     #[error("at least one reflection pass is needed")]
     NoReflectionPass,
@@ -205,6 +252,11 @@ impl ComposeError {
             | ComposeError::GlassOutsidePass { .. }
             | ComposeError::UnknownIds { .. }
             | ComposeError::PlaneWithoutPass { .. }
+            | ComposeError::GroupWithoutLayer { .. }
+            | ComposeError::GroupWithoutTable { .. }
+            | ComposeError::NoTableForGroup { .. }
+            | ComposeError::LightGroupList(_)
+            | ComposeError::KeepGroupsNotExr { .. }
             | ComposeError::NoReflectionPass => ErrorKind::Invalid,
         }
     }

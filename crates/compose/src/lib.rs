@@ -16,7 +16,9 @@
 //!
 //! [`compose_frame`] runs them for one image, with per-stage timings for `--stats`;
 //! [`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`. The
-//! viewer runs the first two ([`decode_frame`]), with no output at all.
+//! viewer runs the first two ([`decode_frame`]), with no output at all. A frame split into
+//! light groups is [`compose_light_groups`]: the phases once per group, each with its light's
+//! table, and the sum written ([`groups`]).
 
 #![warn(missing_docs)]
 
@@ -24,6 +26,7 @@ pub mod colour;
 mod composite;
 mod decode;
 pub mod error;
+pub mod groups;
 pub mod kernel;
 pub mod lut;
 pub mod memory;
@@ -42,6 +45,7 @@ use glassdb_image::ImageWindows;
 use glassdb_mask::MaskReadOptions;
 use glassdb_pass::{Carry, PassReadOptions};
 use glassdb_side::Side;
+pub use groups::{GroupPasses, LightGroup, compose_light_groups, group_passes};
 use memory::{MemoryBudget, MemoryEstimate};
 pub use plan::DecodeTarget;
 
@@ -303,12 +307,26 @@ pub fn compose_frame_within(
     budget: &MemoryBudget,
     progress: &dyn glassdb_io::Progress,
 ) -> Result<FrameReport, ComposeError> {
-    let [decode_stage, composite_stage, encode_stage] = FRAME_STAGES;
     let target = check_job(job, settings)?;
+    let (composited, timings) =
+        decode_and_composite(job, settings, &target, luts, budget, progress)?;
+    write_composited(job, settings, composited, timings, progress)
+}
 
+/// The header, decode and composite phases of a checked job, timed, telling `progress` as
+/// each begins.
+fn decode_and_composite(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    target: &DecodeTarget,
+    luts: &RegistryLuts,
+    budget: &MemoryBudget,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<(Composited, StageTimings), ComposeError> {
+    let [decode_stage, composite_stage, _] = FRAME_STAGES;
     progress.stage(decode_stage);
     let t0 = Instant::now();
-    let plan = plan::plan_frame(&job.inputs, &settings.decode, luts, budget, &target)?;
+    let plan = plan::plan_frame(&job.inputs, &settings.decode, luts, budget, target)?;
     let frame = decode::decode_planned(&job.inputs, &settings.decode, plan, target.carry)?;
     let decode = t0.elapsed();
 
@@ -316,11 +334,26 @@ pub fn compose_frame_within(
     let t1 = Instant::now();
     let composited = composite::composite(frame, settings)?;
     let compose = t1.elapsed();
+    let timings = StageTimings {
+        decode,
+        compose,
+        encode: Duration::ZERO,
+    };
+    Ok((composited, timings))
+}
 
-    progress.stage(encode_stage);
+/// The write phase of a composited frame, and its report.
+fn write_composited(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    composited: Composited,
+    mut timings: StageTimings,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<FrameReport, ComposeError> {
+    progress.stage(FRAME_STAGES[2]);
     let t2 = Instant::now();
     let (output, colour) = write::write(job, composited.image, settings)?;
-    let encode = t2.elapsed();
+    timings.encode = t2.elapsed();
 
     let Composited { facts, .. } = composited;
     Ok(FrameReport {
@@ -328,11 +361,7 @@ pub fn compose_frame_within(
         width: facts.width,
         height: facts.height,
         windows: facts.windows,
-        timings: StageTimings {
-            decode,
-            compose,
-            encode,
-        },
+        timings,
         id_counts: facts.id_counts,
         cos_range: facts.cos_range,
         counts: facts.counts,

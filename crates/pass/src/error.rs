@@ -50,6 +50,17 @@ pub enum PassError {
         /// Its RGB layers.
         candidates: Vec<String>,
     },
+    /// Two layers of a pass are the same light group's (`ViewLayer.Combined_sun` and
+    /// `LightSelect_sun`).
+    #[error("{path} has two layers for light group {group:?}: {}", layers.join(", "))]
+    TwoGroupLayers {
+        /// The pass.
+        path: PathBuf,
+        /// The group.
+        group: String,
+        /// Its layers.
+        layers: Vec<String>,
+    },
     /// The layer asked for is not in the file.
     #[error("{path} has no RGB layer {layer:?} (it has: {})", candidates.join(", "))]
     LayerNotFound {
@@ -100,6 +111,7 @@ impl PassError {
             PassError::NoRgb { .. } => ErrorKind::Unsupported,
             PassError::AmbiguousLayer { .. }
             | PassError::LayerNotFound { .. }
+            | PassError::TwoGroupLayers { .. }
             | PassError::PlaneLayers { .. } => ErrorKind::Invalid,
         }
     }

@@ -1,0 +1,269 @@
+//! Light groups (docs/compose.md, "Light groups"): a frame whose passes are split by light,
+//! one layer per group in the transmission pass and in every reflection pass, composited group
+//! by group with the registry table of each group's light and summed,
+//! `out = Σ_g (trans_g·t_g + refl_g·r_g)` (method eqs. 8–10 per group). One table is exact only
+//! for light of its spectrum; a dusk shot's sky and tungsten groups each get theirs
+//! (docs/colour.md, "Lights").
+//!
+//! [`group_passes`] is the reader: which layer of which file is each group's, from the headers
+//! alone, refusing a group without a layer and layers without a group. [`compose_light_groups`]
+//! runs the frame's phases once per group and writes the sum (and, asked, each group's
+//! composite as a layer).
+
+use std::path::Path;
+
+use glassdb_encode::OutputFormat;
+use glassdb_image::{ExactExr, ExactPart, FlatSamples};
+use glassdb_pass::{ExrCarried, light_group_layers_of};
+use glassdb_registry::Registry;
+
+use crate::colour::RegistryLuts;
+use crate::composite::Composited;
+use crate::memory::MemoryBudget;
+use crate::{ComposeError, ComposeJob, ComposeSettings, FrameFiles, FrameReport, InputLayers};
+
+/// A light group and the lookup tables of its light, one per colour basis.
+#[derive(Debug)]
+pub struct LightGroup {
+    /// The group's name, as the passes' layers and the registry's light name it (`sun`).
+    pub name: String,
+    /// The tables integrated under its light.
+    pub luts: RegistryLuts,
+}
+
+impl LightGroup {
+    /// The groups `names` with the tables of the registry's lights of the same names; an
+    /// error naming the group and the registry's lights when one has no table, or when the
+    /// list is empty or names a group twice. `registry_label` names the registry in messages.
+    pub fn from_registry(
+        registry: &Registry,
+        names: &[String],
+        registry_label: &str,
+    ) -> Result<Vec<LightGroup>, ComposeError> {
+        if names.is_empty() {
+            return Err(ComposeError::LightGroupList("none named".into()));
+        }
+        let mut groups: Vec<LightGroup> = Vec::with_capacity(names.len());
+        for name in names {
+            if groups.iter().any(|g| &g.name == name) {
+                return Err(ComposeError::LightGroupList(format!("{name} named twice")));
+            }
+            let luts = RegistryLuts::for_light(registry, name).ok_or_else(|| {
+                ComposeError::NoTableForGroup {
+                    registry: registry_label.to_string(),
+                    group: name.clone(),
+                    lights: registry.lights().iter().map(|l| l.describe()).collect(),
+                }
+            })?;
+            groups.push(LightGroup {
+                name: name.clone(),
+                luts,
+            });
+        }
+        Ok(groups)
+    }
+}
+
+/// One group's layers in a frame's passes: the transmission pass's and each reflection pass's.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GroupPasses {
+    /// The group.
+    pub group: String,
+    /// The layer of each input the group is read from.
+    pub layers: InputLayers,
+}
+
+/// Each group's layers in `files`' passes, from their headers alone, in the order of `groups`:
+/// every group must have a layer in every pass ([`ComposeError::GroupWithoutLayer`]), and
+/// every group layer of a pass must be one of `groups` ([`ComposeError::GroupWithoutTable`]),
+/// so that no light is lost or composited twice. `max_pixels` bounds each header read.
+pub fn group_passes(
+    files: &FrameFiles,
+    groups: &[&str],
+    max_pixels: u64,
+) -> Result<Vec<GroupPasses>, ComposeError> {
+    let layers_of = |path: &Path| -> Result<Vec<String>, ComposeError> {
+        let found = light_group_layers_of(path, max_pixels)?;
+        let extra: Vec<String> = found
+            .iter()
+            .filter(|l| !groups.contains(&l.group.as_str()))
+            .map(|l| l.group.clone())
+            .collect();
+        if !extra.is_empty() {
+            return Err(ComposeError::GroupWithoutTable {
+                path: path.to_path_buf(),
+                groups: extra,
+                composited: groups.iter().map(|g| g.to_string()).collect(),
+            });
+        }
+        groups
+            .iter()
+            .map(|&group| {
+                found
+                    .iter()
+                    .find(|l| l.group == group)
+                    .map(|l| l.layer.clone())
+                    .ok_or_else(|| ComposeError::GroupWithoutLayer {
+                        path: path.to_path_buf(),
+                        group: group.to_string(),
+                        found: found.iter().map(|l| l.group.clone()).collect(),
+                    })
+            })
+            .collect()
+    };
+    let trans = layers_of(&files.trans)?;
+    let refl: Vec<Vec<String>> = files
+        .refl
+        .iter()
+        .map(|p| layers_of(p))
+        .collect::<Result<_, _>>()?;
+    Ok(groups
+        .iter()
+        .enumerate()
+        .map(|(g, name)| GroupPasses {
+            group: name.to_string(),
+            layers: InputLayers {
+                trans: Some(trans[g].clone()),
+                refl: refl.iter().map(|r| Some(r[g].clone())).collect(),
+            },
+        })
+        .collect())
+}
+
+/// Composites a frame split into light groups: each group's passes ([`group_passes`])
+/// composited with its own light's tables, in turn (one group's passes decoded at a time, the
+/// frame's memory limit held per group), and the sum written as the output's beauty. With
+/// `keep_groups` (EXR output only) each group's composite is also written, as a layer of the
+/// transmission pass's name for that group (`ViewLayer.Combined_sun.R`, …), so that a
+/// compositor can still balance the lights. The report is the first group's, with the output
+/// written.
+pub fn compose_light_groups(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    groups: &[LightGroup],
+    keep_groups: bool,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<FrameReport, ComposeError> {
+    let names: Vec<&str> = groups.iter().map(|g| g.name.as_str()).collect();
+    if keep_groups && glassdb_encode::output_format(&job.output)? != OutputFormat::Exr {
+        return Err(ComposeError::KeepGroupsNotExr {
+            output: job.output.clone(),
+        });
+    }
+    let target = crate::check_job(job, settings)?;
+    let passes = group_passes(&job.inputs, &names, settings.decode.pass.max_pixels)?;
+    let budget = MemoryBudget::new(settings.decode.max_memory);
+    let mut sum: Option<Composited> = None;
+    let mut kept: Vec<(String, [Vec<f32>; 3])> = Vec::new();
+    let mut timings = crate::StageTimings::default();
+    for (group, group_passes) in groups.iter().zip(&passes) {
+        let mut one = settings.clone();
+        one.decode.layers = group_passes.layers.clone();
+        let (composited, t) =
+            crate::decode_and_composite(job, &one, &target, &group.luts, &budget, progress)?;
+        timings.decode += t.decode;
+        timings.compose += t.compose;
+        if keep_groups {
+            let layer = group_passes.layers.trans.clone().unwrap_or_default();
+            kept.push((layer, composited.image.trans.image.rgb.clone()));
+        }
+        match &mut sum {
+            None => sum = Some(composited),
+            Some(total) => add_rgb(
+                &mut total.image.trans.image.rgb,
+                &composited.image.trans.image.rgb,
+            ),
+        }
+    }
+    let mut total = sum.ok_or_else(|| ComposeError::LightGroupList("none named".into()))?;
+    carry_groups(&mut total.image.frame, &passes, kept);
+    crate::write_composited(job, settings, total, timings, progress)
+}
+
+/// `total += add`, plane by plane.
+fn add_rgb(total: &mut [Vec<f32>; 3], add: &[Vec<f32>; 3]) {
+    for (t, a) in total.iter_mut().zip(add) {
+        for (t, a) in t.iter_mut().zip(a) {
+            *t += a;
+        }
+    }
+}
+
+/// What the output carries beside the beauty (the sum): the passes' group layers are dropped
+/// (they hold the light behind the glass, not the composite) and, with `keep_groups`, each
+/// group's composite written in their place (`layer.R`, `.G`, `.B`). The sum replaces the
+/// file's beauty layer: the one the group layers are split from (`ViewLayer.Combined` for
+/// `ViewLayer.Combined_sun`), else bare `R`, `G`, `B`, else it is added as bare `R`, `G`, `B`.
+fn carry_groups(
+    frame: &mut glassdb_pass::CarriedFrame,
+    groups: &[GroupPasses],
+    kept: Vec<(String, [Vec<f32>; 3])>,
+) {
+    let window = frame.windows.data;
+    let n = window.pixel_count() as usize;
+    let rgb_names = |layer: &str| -> Vec<String> {
+        ["R", "G", "B"]
+            .iter()
+            .map(|c| {
+                if layer.is_empty() {
+                    c.to_string()
+                } else {
+                    format!("{layer}.{c}")
+                }
+            })
+            .collect()
+    };
+    let (mut file, part) = match frame.exr.take() {
+        Some(ExrCarried::Whole { file, part, .. }) => (file, part),
+        Some(ExrCarried::Attributes { image, part, .. }) => {
+            let file = ExactExr {
+                attributes: *image,
+                parts: vec![ExactPart {
+                    attributes: *part,
+                    data_window: window,
+                    channels: Vec::new(),
+                }],
+            };
+            (file, 0)
+        }
+        None => return,
+    };
+    let group_layers: Vec<String> = groups
+        .iter()
+        .filter_map(|g| g.layers.trans.clone())
+        .collect();
+    let channels = &mut file.parts[part].channels;
+    channels.retain(|(name, _)| {
+        !group_layers.iter().any(|l| {
+            name.strip_prefix(l.as_str())
+                .is_some_and(|rest| rest.starts_with('.'))
+        })
+    });
+    // the beauty: the layer the first group's is split from, else bare R, G, B
+    let split_from = group_layers
+        .first()
+        .and_then(|l| l.rsplit_once('_').map(|(base, _)| base.to_string()))
+        .unwrap_or_default();
+    let beauty = [split_from, String::new()]
+        .into_iter()
+        .map(|l| rgb_names(&l))
+        .find(|names| names.iter().all(|n| channels.iter().any(|(c, _)| c == n)))
+        .unwrap_or_else(|| {
+            let names = rgb_names("");
+            for name in &names {
+                channels.push((name.clone(), FlatSamples::F32(vec![0.0; n])));
+            }
+            names
+        });
+    for (layer, rgb) in kept {
+        for (name, plane) in rgb_names(&layer).into_iter().zip(rgb) {
+            channels.push((name, FlatSamples::F32(plane)));
+        }
+    }
+    channels.sort_by(|a, b| a.0.cmp(&b.0));
+    frame.exr = Some(ExrCarried::Whole {
+        file,
+        part,
+        channel_names: beauty,
+    });
+}
