@@ -305,6 +305,18 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
             Some("repeat --refl: the k-th is the pass of plane k".into())
         }
         ComposeError::NoReflectionPass => Some("give one with --refl".into()),
+        ComposeError::NoTableForGroup { group, .. } => Some(format!(
+            "build the registry with a light of each group's name: glassdb registry build \
+             CATALOG --light {group}=ILLUMINANT (D65, A, LED-B3, … or an SPD .csv)"
+        )),
+        ComposeError::GroupWithoutTable { groups, .. } => Some(format!(
+            "name every light group of the passes in --light-groups (add {})",
+            groups.join(",")
+        )),
+        ComposeError::GroupWithoutLayer { .. } => Some(
+            "--light-groups names the passes' light groups: each must be a layer of every pass"
+                .into(),
+        ),
         ComposeError::UnsupportedPassSpace { .. } | ComposeError::ConflictingColourTags { .. } => {
             Some(
                 "if the pixels are scene-linear RGB, say in which space with --input-space \
