@@ -235,28 +235,17 @@ def render_reflections(out_dir, geo_dir, scratch, working_space=None):
         nt = mat.node_tree
         out = [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputMaterial"][0]
         bsdf = [n for n in nt.nodes if n.bl_idname in bsdf_types][0]
-        geo = nt.nodes.new("ShaderNodeNewGeometry")
-        geo.location = (-1000, 400)
-        dot = nt.nodes.new("ShaderNodeVectorMath")
-        dot.operation = "DOT_PRODUCT"
-        dot.location = (-800, 400)
-        add = nt.nodes.new("ShaderNodeMath")
-        add.operation = "ADD"
-        add.location = (-600, 400)
-        gt = nt.nodes.new("ShaderNodeMath")
-        gt.operation = "GREATER_THAN"
+        new_node = fixture_scene.new_node
+        geo = new_node(nt, "ShaderNodeNewGeometry", (-1000, 400))
+        dot = new_node(nt, "ShaderNodeVectorMath", (-800, 400), "DOT_PRODUCT")
+        add = new_node(nt, "ShaderNodeMath", (-600, 400), "ADD")
+        gt = new_node(nt, "ShaderNodeMath", (-400, 400), "GREATER_THAN")
         gt.inputs[1].default_value = 0.0
-        gt.location = (-400, 400)
-        lp = nt.nodes.new("ShaderNodeLightPath")
-        lp.location = (-400, 700)
-        mul = nt.nodes.new("ShaderNodeMath")
-        mul.operation = "MULTIPLY"
-        mul.location = (-200, 400)
-        tr = nt.nodes.new("ShaderNodeBsdfTransparent")
+        lp = new_node(nt, "ShaderNodeLightPath", (-400, 700))
+        mul = new_node(nt, "ShaderNodeMath", (-200, 400), "MULTIPLY")
+        tr = new_node(nt, "ShaderNodeBsdfTransparent", (0, 200))
         tr.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-        tr.location = (0, 200)
-        mix = nt.nodes.new("ShaderNodeMixShader")
-        mix.location = (150, 0)
+        mix = new_node(nt, "ShaderNodeMixShader", (150, 0))
         nt.links.new(geo.outputs["Position"], dot.inputs[0])
         nt.links.new(dot.outputs["Value"], add.inputs[0])
         nt.links.new(add.outputs["Value"], gt.inputs[0])

@@ -650,17 +650,29 @@ fn a_dropped_digit_is_refused_naming_its_angle_and_line() {
     fails_naming(&mut fit(&table, &[]), &["R = 0.01 at 50° (line 8)"]);
 }
 
+/// The hand table `name` with `row` replaced fails naming `parts`: a lone value above 1 among
+/// fractions is a typo, not a sign of a table in percent. Returns the table.
+fn typo_above_one_fails(
+    dir: &Path,
+    (name, row): (&str, (u32, &str)),
+    parts: &[&str],
+) -> std::path::PathBuf {
+    let table = hand_table(dir, name, Some(row));
+    let e = fails(&mut fit(&table, &[]));
+    assert_names(&e, parts);
+    assert!(!e.contains("if the table is in percent"), "{e}");
+    table
+}
+
 #[test]
 fn a_shifted_decimal_point_is_named() {
     let dir = tempfile::tempdir().unwrap();
     // 0.80 written 8.0: a single value above 1 among fractions is a typo, not a percent table
-    let table = hand_table(dir.path(), "up.csv", Some((50, "0.100,8.0")));
-    let e = fails(&mut fit(&table, &[]));
-    assert_names(
-        &e,
+    typo_above_one_fails(
+        dir.path(),
+        ("up.csv", (50, "0.100,8.0")),
         &["up.csv", "line 8, column 3 (T): 8", "shifted decimal point"],
     );
-    assert!(!e.contains("if the table is in percent"), "{e}");
     // 0.80 written 0.080
     let table = hand_table(dir.path(), "down.csv", Some((50, "0.100,0.080")));
     fails_naming(
@@ -701,13 +713,11 @@ fn r_and_t_swapped_on_a_row_are_named() {
 #[test]
 fn a_percent_value_in_a_fraction_column_is_named() {
     let dir = tempfile::tempdir().unwrap();
-    let table = hand_table(dir.path(), "pct.csv", Some((50, "0.100,80")));
-    let e = fails(&mut fit(&table, &[]));
-    assert_names(
-        &e,
+    let table = typo_above_one_fails(
+        dir.path(),
+        ("pct.csv", (50, "0.100,80")),
         &["pct.csv", "line 8, column 3 (T): 80", "a percent value"],
     );
-    assert!(!e.contains("if the table is in percent"), "{e}");
     // --percent, as the old hint said, would read every other value a hundred times too small
     fails_naming(
         &mut fit(&table, &["--percent"]),

@@ -382,3 +382,31 @@ pub fn names(dir: &Path) -> Vec<String> {
     v.sort();
     v
 }
+
+/// The glass of a registry table (its JSON) whose `key` is `value`; panics naming it when none is.
+pub fn glass_where<'a, V>(
+    table: &'a serde_json::Value,
+    key: &str,
+    value: V,
+) -> &'a serde_json::Value
+where
+    V: std::fmt::Display,
+    serde_json::Value: PartialEq<V>,
+{
+    table["glasses"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|g| g[key] == value)
+        .unwrap_or_else(|| panic!("no glass with {key} {value}"))
+}
+
+/// Sends `SIG<signal>` (`TERM`, `INT`, …) to a started child with `kill`.
+pub fn send_signal(child: &std::process::Child, signal: &str) {
+    let status = Command::new("kill")
+        .arg(format!("-{signal}"))
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(status.success(), "kill -{signal}");
+}
