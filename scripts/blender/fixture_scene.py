@@ -160,6 +160,19 @@ def fixed_cycles(scene):
     return r
 
 
+def interior(mask, radius):
+    """The pixels of the boolean image `mask` whose whole (2·radius + 1)² neighbourhood is in
+    `mask` (outside the image counts as outside the mask)."""
+    import numpy as np
+
+    pad = np.pad(mask, radius, constant_values=False)
+    inner = np.ones_like(mask)
+    for dy in range(2 * radius + 1):
+        for dx in range(2 * radius + 1):
+            inner &= pad[dy:dy + mask.shape[0], dx:dx + mask.shape[1]]
+    return inner
+
+
 def write_json(path, doc):
     """Writes `doc` to `path` as JSON indented by one space, with a final newline, and says so."""
     with open(path, "w") as fh:

@@ -925,11 +925,7 @@ def check_all(out_dir, geo_dir):
                     problems.append("%s: id %d touches the frame edge" % (fname, gid))
         notch = notch_pixels(polys, cam, pane_poly[1])
         # Notch pixels well inside (3x3 neighbourhood all notch): not one of them may be the U.
-        pad = np.pad(notch, 1)
-        inner = np.ones_like(notch)
-        for dy in range(3):
-            for dx in range(3):
-                inner &= pad[dy:dy + notch.shape[0], dx:dx + notch.shape[1]]
+        inner = fixture_scene.interior(notch, 1)
         entry["u_notch"] = {
             "pixels": int(np.count_nonzero(notch)),
             "interior_pixels": int(np.count_nonzero(inner)),

@@ -431,11 +431,7 @@ def pixel_summary(path):
             if facing and entry["pixels"]:
                 # Interior: the 3x3 neighbourhood has the same id (no edge pixels, whose
                 # facing value averages samples that hit other surfaces or nothing).
-                pad = np.pad(sel, 1, constant_values=False)
-                inner = np.ones_like(sel)
-                for dy in (0, 1, 2):
-                    for dx in (0, 1, 2):
-                        inner &= pad[dy:dy + sel.shape[0], dx:dx + sel.shape[1]]
+                inner = fixture_scene.interior(sel, 1)
                 entry["interior_pixels"] = int(np.count_nonzero(inner))
                 if entry["interior_pixels"]:
                     fi = chans[facing].astype(np.float64)[inner]

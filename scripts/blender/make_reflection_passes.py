@@ -567,11 +567,7 @@ def check_reflections(out_dir, geo_dir, scratch):
                                for c in "RGB"], axis=-1)
             o_, dirs = mmf.camera_rays(cam)
             floor = ref == CHECK_IDS["Floor"]
-            padf = np.pad(floor, 2)
-            floor_in = np.ones_like(floor)
-            for dy in range(5):
-                for dx in range(5):
-                    floor_in &= padf[dy:dy + floor.shape[0], dx:dx + floor.shape[1]]
+            floor_in = fixture_scene.interior(floor, 2)
             to_sun = -np.array(info["sun_direction"])
             occluders = [np.array(pp) for o, _m, pp in opaque if o in hidden]
             shadow = np.zeros_like(floor)
@@ -615,13 +611,7 @@ def check_reflections(out_dir, geo_dir, scratch):
         panes = [np.array(pp) for _o, m_, pp in polys if m_ in mmf.GLASS_IDS]
 
         def interior(img, value):
-            msk = img == value
-            pad_ = np.pad(msk, 2)
-            out_ = np.ones_like(msk)
-            for dy in range(5):
-                for dx in range(5):
-                    out_ &= pad_[dy:dy + msk.shape[0], dx:dx + msk.shape[1]]
-            return out_
+            return fixture_scene.interior(img == value, 2)
 
         # Per pixel of the pass: its point Q, and what shades Q from the sun (0 nothing, 1 an
         # opaque object, 2 a pane); pixels next to a different class are left out (shadow
@@ -686,11 +676,7 @@ def check_reflections(out_dir, geo_dir, scratch):
         # index render (the 1.5 px filter's samples stay well inside it) have exactly the
         # world colour in the pass; alpha 1 everywhere.
         world = ob == 0
-        pad = np.pad(world, 2)
-        inner = np.ones_like(world)
-        for dy in range(5):
-            for dx in range(5):
-                inner &= pad[dy:dy + world.shape[0], dx:dx + world.shape[1]]
+        inner = fixture_scene.interior(world, 2)
         entry["combined"] = {
             "alpha_min": float(alpha.min()), "alpha_max": float(alpha.max()),
             "world_interior_pixels": int(np.count_nonzero(inner)),
