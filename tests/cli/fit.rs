@@ -8,8 +8,8 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::util::{
-    CURVE_FIT_STATS, assert_names, fails, fails_naming, glassdb, ok, repo_path, run, run_oracle,
-    write_file,
+    CURVE_FIT_STATS, assert_names, doc_after, fails, fails_naming, glassdb, ok, repo_path, run,
+    run_oracle, write_file,
 };
 
 #[path = "../../crates/fit/tests/common/inputs.rs"]
@@ -566,11 +566,7 @@ fn bundled_angle_tables_regenerate_byte_for_byte() {
 
 #[test]
 fn docs_first_example_fits_the_flagship_table_without_a_warning() {
-    let doc = std::fs::read_to_string(repo_path("docs/fit.md")).unwrap();
-    let block = doc
-        .split("```sh\n")
-        .nth(1)
-        .expect("docs/fit.md has an sh block");
+    let block = doc_after("docs/fit.md", "```sh\n");
     let first = block.lines().next().unwrap();
     let command = first.split(" # ").next().unwrap();
     let args: Vec<&str> = command.split_whitespace().collect();
