@@ -8,9 +8,9 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::util::registry_glass as glass;
 use crate::util::{
-    assert_names, fails_naming, glassdb, ok, registry_build, repo_path, run_oracle, write_file,
+    assert_names, fails_naming, glass_where, glassdb, ok, registry_build, repo_path, run_oracle,
+    write_file,
 };
 
 /// The angles every comparison uses: 0–80° in 10° steps.
@@ -271,6 +271,10 @@ fn catalog_with(dir: &Path, body: &str) -> PathBuf {
 
 fn read_json(path: &Path) -> Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+fn glass(table: &Value, id: u64) -> &Value {
+    glass_where(table, "id", id)
 }
 
 /// A unit of one layer is that layer's registry entry exactly (turned round when flipped).
