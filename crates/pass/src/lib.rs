@@ -19,6 +19,6 @@ pub use carry::{CarriedFrame, Carry, ExrCarried, carries_whole_file, read_transm
 pub use error::PassError;
 pub use pixels::{EncodedImage, EncodedSamples, InputTransfer, LinearImage, PngBits};
 pub use read::{
-    Pass, PassHeader, PassReadOptions, PassSource, plane_layers_of, read_pass, read_pass_bytes,
-    read_pass_header, read_pass_rows, read_refl_header,
+    Pass, PassHeader, PassReadOptions, PassSource, plane_group_layers_of, plane_layers_of,
+    read_pass, read_pass_bytes, read_pass_header, read_pass_rows, read_refl_header,
 };
