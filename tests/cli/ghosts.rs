@@ -131,3 +131,136 @@ fn a_unit_composites_each_pane_groups_pass_with_its_share() {
     );
 }
 
+/// The bundled registry's depths (m) of unit `id`'s pane groups, outside first.
+fn registry_depths(id: u64) -> Vec<f64> {
+    let reg: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(crate::util::repo_path("data/registry.json")).unwrap(),
+    )
+    .unwrap();
+    let tables = reg["tables"]
+        .as_array()
+        .map_or_else(|| vec![&reg], |t| t.iter().collect());
+    let glass = tables
+        .iter()
+        .flat_map(|t| t["glasses"].as_array().unwrap())
+        .find(|g| g["id"].as_u64() == Some(id))
+        .unwrap();
+    glass["unit"]["groups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| g["depth_mm"].as_f64().unwrap() * 1e-3)
+        .collect()
+}
+
+/// OBJ vertex positions.
+fn vertices(path: &Path) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+#[test]
+fn mirror_writes_a_virtual_scene_per_pane_group_at_its_depth() {
+    let dir = tempfile::tempdir().unwrap();
+    let room = crate::util::repo_path("fixtures/scene/room.obj");
+    let mono = dir.path().join("mono");
+    let units = dir.path().join("units");
+    let eye = ["--eye", "0.3,1.2,4"];
+    let run = |glass: &[&str], out: &Path| {
+        let mut c = crate::util::glassdb();
+        c.arg("mirror")
+            .arg(&room)
+            .args(glass)
+            .args(eye)
+            .arg("--out-dir")
+            .arg(out);
+        ok(&mut c)
+    };
+    run(
+        &["--glass-material", "Clear*", "--glass-material", "Tinted*"],
+        &mono,
+    );
+    // The facade (plane 0, z = 0, eye in front) a double unit; the side window monolithic.
+    let text = run(&["--glass", "Clear*=11", "--glass", "Tinted*=2"], &units);
+    assert!(text.contains("pane group 1:"), "{text}");
+    let depths = registry_depths(11);
+    assert_eq!(depths.len(), 2);
+    let planes: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(units.join("planes.json")).unwrap()).unwrap();
+    let facade = &planes["planes"][0];
+    let groups = facade["groups"].as_array().unwrap();
+    assert_eq!(groups.len(), 2);
+    // The face is surface #1, its normal outdoors (+z): group k's mid-plane is z = −depth_k.
+    assert_eq!(facade["equation"], serde_json::json!([0.0, 0.0, 1.0, 0.0]));
+    for (g, want) in groups.iter().zip(&depths) {
+        assert!((g["depth"].as_f64().unwrap() - want).abs() < 1e-12, "{g}");
+        assert!(
+            (g["equation"][3].as_f64().unwrap() - want).abs() < 1e-12,
+            "{g}"
+        );
+    }
+    assert_eq!(groups[1]["file"], "plane_0_group_1.obj");
+    // Each group's scene is the room mirrored about z = −depth: mirrored back, every vertex is
+    // one of the room's in front of that plane, or a clipped corner on it.
+    let original = vertices(&room);
+    for (file, depth) in [
+        ("plane_0.obj", depths[0]),
+        ("plane_0_group_1.obj", depths[1]),
+    ] {
+        let v = vertices(&units.join(file));
+        assert!(!v.is_empty(), "{file}");
+        for a in &v {
+            let back = [a[0], a[1], -a[2] - 2.0 * depth];
+            assert!(
+                back[2] >= -depth - 1e-9,
+                "{file}: {a:?} is behind its mirror plane"
+            );
+            let on_plane = (back[2] + depth).abs() < 1e-9;
+            let in_room = original
+                .iter()
+                .any(|o| (0..3).all(|k| (o[k] - back[k]).abs() < 1e-9));
+            assert!(
+                on_plane || in_room,
+                "{file}: {a:?} (mirrored back {back:?})"
+            );
+        }
+    }
+    let mono_face = vertices(&mono.join("plane_0.obj"));
+    assert!(
+        mono_face.iter().any(|v| v[2].abs() < 1e-12),
+        "the face's own scene at z = 0"
+    );
+    // The monolithic side window: no groups, the same scene as before.
+    assert!(planes["planes"][1].get("groups").is_none());
+    assert_eq!(
+        std::fs::read_to_string(units.join("plane_1.obj")).unwrap(),
+        std::fs::read_to_string(mono.join("plane_1.obj")).unwrap()
+    );
+    // An eye indoors (behind the face) meets the inner pane first.
+    let inside = dir.path().join("inside");
+    let mut c = crate::util::glassdb();
+    c.arg("mirror")
+        .arg(&room)
+        .args(["--glass", "Clear*=11", "--eye", "0.3,1.2,-1", "--out-dir"])
+        .arg(&inside);
+    ok(&mut c);
+    let planes: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(inside.join("planes.json")).unwrap())
+            .unwrap();
+    let facade = &planes["planes"][0];
+    assert_eq!(facade["eye_side"], "back");
+    let seen: Vec<f64> = facade["groups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| g["depth"].as_f64().unwrap())
+        .collect();
+    assert_eq!(seen, vec![depths[1], depths[0]]);
+}
