@@ -232,6 +232,18 @@ fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
         f64::from(r.width) * f64::from(r.height) / 1e6,
         r.planes
     );
+    if r.group_passes > 0 {
+        outln!(
+            "pane groups  {} reflection pass(es) of units' deeper pane groups",
+            r.group_passes
+        );
+    }
+    if r.folded_pixels > 0 {
+        outln!(
+            "pane groups  {} pixels of units composited with their deeper pane groups' reflectance on a nearer group's pass (--surfaces): no double image there",
+            r.folded_pixels
+        );
+    }
     if r.windows.data != r.windows.display {
         outln!(
             "windows      data {} in display {}",

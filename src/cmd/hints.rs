@@ -304,6 +304,12 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
         ComposeError::PlaneWithoutPass { .. } => {
             Some("repeat --refl: the k-th is the pass of plane k".into())
         }
+        ComposeError::GroupWithoutPass { plane, group, .. } => Some(format!(
+            "give it with --refl-group {plane}.{group}=FILE, or composite one pass per plane with --surfaces 1 (the deeper panes' reflectance added to it, no double image)"
+        )),
+        ComposeError::GroupPassWithoutPlane { .. } | ComposeError::GroupPassTwice { .. } => Some(
+            "--refl-group K.G=FILE: K a plane with its own --refl, G 1 or more, each once".into(),
+        ),
         ComposeError::NoReflectionPass => Some("give one with --refl".into()),
         ComposeError::NoTableForGroup { group, .. } => Some(format!(
             "build the registry with a light of each group's name: glassdb registry build \

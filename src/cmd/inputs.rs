@@ -3,11 +3,14 @@
 //! same masks (Cryptomatte included), layers and multi-part reflection files.
 
 use std::collections::BTreeMap;
+use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use glassdb_colour::RgbSpace;
-use glassdb_compose::{DecodeSettings, FrameFiles, InputLayers, OutsidePolicy, UnknownIds};
+use glassdb_compose::{
+    DecodeSettings, FrameFiles, GroupPassFile, InputLayers, OutsidePolicy, UnknownIds,
+};
 use glassdb_mask::{
     AovWeighting, CosSource, CryptomatteOptions, ExrMaskChannels, GlassMapping, GlassNames,
     MaskReadOptions, PlaneSource,
@@ -23,6 +26,17 @@ pub struct FrameInputArgs {
     /// layers or parts are `plane0`, `plane1`, … gives every plane's.
     #[arg(long, required = true, value_name = "FILE[:LAYER]")]
     pub refl: Vec<PathBuf>,
+    /// Reflection pass of a unit's pane group behind the first, `K.G=FILE[:LAYER]`: plane K's
+    /// group G (1: the second pane group the camera's rays meet), the scene mirrored about that
+    /// group's mid-plane (docs/compose.md, "Units"). One --refl EXR whose layers or parts are
+    /// `planeK.groupG` gives them too.
+    #[arg(long = "refl-group", value_name = "K.G=FILE[:LAYER]", value_parser = parse_group_spec)]
+    pub refl_group: Vec<GroupPassFile>,
+    /// How many of a unit's pane groups get a reflection pass of their own: `1` composites one
+    /// pass per plane, the deeper groups' reflectance added to it (no double image; faster).
+    /// Default: every group, each from its own pass.
+    #[arg(long, value_name = "N")]
+    pub surfaces: Option<NonZeroUsize>,
     /// Transmission pass (the scene without glass; `FILE.exr:LAYER` picks its layer); its
     /// alpha, windows, attributes and other channels are kept.
     #[arg(long, value_name = "FILE[:LAYER]")]
@@ -122,6 +136,7 @@ impl FrameInputArgs {
     pub fn files(&self) -> FrameFiles {
         FrameFiles {
             refl: self.refl.iter().map(|r| split_layer(r).0).collect(),
+            groups: self.refl_group.clone(),
             trans: split_layer(&self.trans).0,
             mask: split_layer(&self.mask).0,
         }
@@ -145,6 +160,7 @@ impl FrameInputArgs {
             input_space: self.input_space,
             unknown,
             outside,
+            max_groups: self.surfaces,
             registry_label,
             max_memory: self.max_memory(),
         })
@@ -266,6 +282,20 @@ impl FrameInputArgs {
                     .iter()
                     .map(|l| PathBuf::from(format!("{file}:{l}")))
                     .collect();
+                if self.refl_group.is_empty() {
+                    // The same file's pane-group layers `planeK.groupG` (issue 27).
+                    let groups = glassdb_pass::plane_group_layers_of(first, self.max_pixels)
+                        .unwrap_or_default();
+                    self.refl_group = groups
+                        .into_iter()
+                        .map(|(k, g, layer)| GroupPassFile {
+                            plane: k as usize,
+                            group: g as usize,
+                            path: PathBuf::from(&file),
+                            layer: Some(layer),
+                        })
+                        .collect();
+                }
                 Ok(())
             }
             Err(e @ glassdb_pass::PassError::PlaneLayers { .. }) => Err(e.into()),
@@ -450,6 +480,29 @@ pub(crate) fn split_layer(arg: &Path) -> (PathBuf, Option<String>) {
         return (PathBuf::from(file), Some(layer.to_string()));
     }
     (arg.to_path_buf(), None)
+}
+
+/// Parses a `--refl-group` value, `K.G=FILE[:LAYER]`.
+fn parse_group_spec(spec: &str) -> anyhow::Result<GroupPassFile> {
+    let bad = || {
+        anyhow::anyhow!(
+            "expected PLANE.GROUP=FILE[:LAYER] with GROUP 1 or more, e.g. 0.1=refl_0_1.exr"
+        )
+    };
+    let (key, file) = spec.split_once('=').ok_or_else(bad)?;
+    let (plane, group) = key.split_once('.').ok_or_else(bad)?;
+    let plane: usize = plane.trim().parse().map_err(|_| bad())?;
+    let group: usize = group.trim().parse().map_err(|_| bad())?;
+    if group == 0 || file.is_empty() {
+        return Err(bad());
+    }
+    let (path, layer) = split_layer(Path::new(file));
+    Ok(GroupPassFile {
+        plane,
+        group,
+        path,
+        layer,
+    })
 }
 
 /// Parses a `--side` value, `K=front` / `K=back` (plane index K).

@@ -25,6 +25,15 @@ pub struct MirrorArgs {
     /// Glob pattern of glass material names (e.g. "Glass*"); repeatable.
     #[arg(long = "glass-material", value_name = "PATTERN")]
     pub glass_material: Vec<String>,
+    /// Glass materials with their registry ids, `PATTERN=ID` (as `glassdb mask --glass`;
+    /// repeatable, with or instead of --glass-material): a unit's pane groups each get a
+    /// virtual scene, mirrored about the group's mid-plane behind the face (docs/scene.md,
+    /// "Units").
+    #[arg(long, value_name = "PATTERN=ID")]
+    pub glass: Vec<String>,
+    /// Registry the --glass ids are read from (default: the bundled one).
+    #[arg(long, value_name = "FILE")]
+    pub registry: Option<PathBuf>,
     /// One explicit plane a,b,c,d (a·x + b·y + c·z + d = 0) instead of detecting the planes.
     #[arg(long, value_name = "A,B,C,D", allow_hyphen_values = true)]
     pub plane: Option<String>,
@@ -42,6 +51,36 @@ pub struct MirrorArgs {
     /// bounding-box diagonal).
     #[arg(long)]
     pub distance_tolerance: Option<f64>,
+}
+
+/// `glassdb mirror`'s glass patterns (--glass-material's, then --glass's) and each one's pane
+/// groups' depths (a --glass id's unit from the registry; none for --glass-material).
+fn mirror_glass(args: &MirrorArgs) -> anyhow::Result<(Vec<String>, Vec<Vec<f64>>)> {
+    let mut patterns = args.glass_material.clone();
+    let mut depths = vec![Vec::new(); patterns.len()];
+    if args.glass.is_empty() {
+        return Ok((patterns, depths));
+    }
+    let (registry, label) = super::compose::load_registry(args.registry.as_deref())?;
+    let table = registry.default_table();
+    for spec in &args.glass {
+        let m = GlassMapping::parse(spec).with_context(|| format!("--glass {spec}"))?;
+        let Some(g) = table.glasses.iter().find(|g| g.id == m.id) else {
+            bail!("--glass {spec}: glass id {} is not in {label}", m.id);
+        };
+        let unit_depths = match &g.unit {
+            Some(u) if u.groups.len() > 1 => u.group_depths_m().with_context(|| {
+                format!(
+                    "--glass {spec}: unit {} ({}) does not record its pane groups' depths (every layer needs a thickness)",
+                    m.id, g.name
+                )
+            })?,
+            _ => Vec::new(),
+        };
+        patterns.push(m.pattern);
+        depths.push(unit_depths);
+    }
+    Ok((patterns, depths))
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -154,8 +193,11 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
         .as_deref()
         .map(|e| parse_numbers::<3>(e, "--eye"))
         .transpose()?;
-    if plane.is_none() && args.glass_material.is_empty() {
-        bail!("give the glass materials (--glass-material PATTERN) or one plane (--plane a,b,c,d)");
+    let (glass_patterns, pane_groups) = mirror_glass(&args)?;
+    if plane.is_none() && glass_patterns.is_empty() {
+        bail!(
+            "give the glass materials (--glass-material PATTERN or --glass PATTERN=ID) or one plane (--plane a,b,c,d)"
+        );
     }
     let scene = load_obj(&args.scene)?;
     print_warnings(&scene.warnings);
@@ -166,11 +208,12 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
     }
     let report = write_virtual_scenes(&MirrorRequest {
         scene: &scene,
-        glass_patterns: args.glass_material.clone(),
+        glass_patterns,
         explicit_plane: plane,
         eye,
         tolerance,
         out_dir: &args.out_dir,
+        pane_groups,
     })
     .map_err(anyhow::Error::new)?;
     outln!(
@@ -203,6 +246,16 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
             stats.clipped,
             stats.behind,
         );
+        for g in &p.groups {
+            outln!(
+                "  pane group {}: {:.1} mm behind the face -> {} ({} triangles, {} clipped)",
+                g.group,
+                g.depth * 1e3,
+                args.out_dir.join(&g.file).display(),
+                g.triangles_written,
+                g.triangles_clipped
+            );
+        }
     }
     outln!("wrote {}", report.planes_path.display());
     Ok(ExitCode::SUCCESS)

@@ -98,6 +98,12 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
             "nothing to view: give a `glassdb blender render` output folder, or the passes and the mask (--trans, --refl, --mask)"
         ),
     };
+    // The page composites one reflection pass per plane: a unit's deeper pane groups are shown
+    // on it (their reflectance added to it), as `compose --surfaces 1` does.
+    let settings = DecodeSettings {
+        max_groups: std::num::NonZeroUsize::new(1),
+        ..settings
+    };
     let viewer = Viewer::open(ViewerInputs {
         frames,
         settings,
@@ -192,6 +198,7 @@ fn blender_run_frames(dir: &Path) -> anyhow::Result<Vec<ViewerFrame>> {
             label: f.frame.to_string(),
             files: FrameFiles {
                 refl: f.refl.iter().map(|r| dir.join(r)).collect(),
+                groups: Vec::new(),
                 trans: dir.join(&f.trans),
                 mask: dir.join(&f.mask),
             },

@@ -237,6 +237,10 @@ fn emitter_delta_e(
         .arg(&refl)
         .arg("--mask")
         .arg(&mask)
+        // The emitter is seen through the glass; its reflection pass is black, so the unit's
+        // pane groups need no passes of their own.
+        .arg("--surfaces")
+        .arg("1")
         .arg("-o")
         .arg(&out));
     let mut args: Vec<String> = vec![

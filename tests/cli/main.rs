@@ -10,6 +10,7 @@ mod farm;
 mod first_contact;
 mod fit;
 mod fixtures;
+mod ghosts;
 mod lights;
 mod limits;
 mod masks;

@@ -99,13 +99,15 @@ fn swapped_registry(source: &Path, dir: &Path, id: u16, product: &str) -> PathBu
     path
 }
 
-/// compose's 8-bit PNG of the atrium (standard view, no dither) with `registry`.
+/// compose's 8-bit PNG of the atrium (standard view, no dither) with `registry`, one
+/// reflection pass per plane as the page composites it (`--surfaces 1`: a unit's inner panes'
+/// reflectance on its plane's pass).
 fn compose_png(dir: &Path, registry: Option<&Path>, name: &str) -> Vec<[f64; 3]> {
     let out = dir.join(name);
     let mut cmd = glassdb();
     cmd.arg("compose");
     atrium_inputs(&mut cmd)
-        .args(["--dither", "none", "-o"])
+        .args(["--surfaces", "1", "--dither", "none", "-o"])
         .arg(&out);
     if let Some(r) = registry {
         cmd.arg("--registry").arg(r);

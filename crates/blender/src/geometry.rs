@@ -83,6 +83,7 @@ pub fn planes_and_masks(
             eye: Some(eye),
             tolerance: PlaneTolerance::default_for(&scene),
             out_dir: &group.planes_dir,
+            pane_groups: Vec::new(),
         })?;
         frames.planes = report.planes.planes();
         frames.tolerance = report.planes.tolerance.distance;

@@ -443,6 +443,9 @@ pub fn compose_record(
         let settings = ComposeSettings {
             decode: DecodeSettings {
                 registry_label: registry.label.clone(),
+                // One reflection pass per plane is rendered: a unit's deeper pane groups are
+                // composited on it (issue 27's group passes are not rendered yet).
+                max_groups: std::num::NonZeroUsize::new(1),
                 ..DecodeSettings::default()
             },
             plane_sides: f
@@ -456,6 +459,7 @@ pub fn compose_record(
         let job = ComposeJob {
             inputs: FrameFiles {
                 refl: f.refl.iter().map(|r| dir.join(r)).collect(),
+                groups: Vec::new(),
                 trans: dir.join(&f.trans),
                 mask: dir.join(&f.mask),
             },

@@ -8,7 +8,7 @@ use glassdb_image::ImageWindows;
 use glassdb_side::Side;
 
 use crate::colour::{ChosenTable, PassSpace};
-use crate::kernel::{self, KernelCounts, KernelInput, OutsidePass, PlacedRefl};
+use crate::kernel::{self, KernelCounts, KernelInput, OutsidePass, PlacedGroupRefl, PlacedRefl};
 use crate::memory::MemoryEstimate;
 use crate::{ComposeError, ComposeSettings, DecodedFrame, OutsidePolicy};
 
@@ -36,6 +36,7 @@ pub(crate) struct FrameFacts {
     pub(crate) cos_range: Option<(f64, f64)>,
     pub(crate) counts: KernelCounts,
     pub(crate) outside_pixels: u64,
+    pub(crate) folded_pixels: u64,
     pub(crate) memory: MemoryEstimate,
 }
 
@@ -65,17 +66,32 @@ pub(crate) fn composite(
         OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
     };
     let [r, g, b] = &mut frame.trans.image.rgb;
-    let input = KernelInput::placed([r, g, b], &placed, &frame.mask, frame.lut, outside_mode)?;
+    let groups: Vec<PlacedGroupRefl<'_>> = frame
+        .groups
+        .iter()
+        .map(|g| {
+            let [r, gr, b] = &g.pass.image.rgb;
+            PlacedGroupRefl {
+                plane: g.plane,
+                group: g.group,
+                rgb: [r.as_slice(), gr.as_slice(), b.as_slice()],
+                window: g.window,
+            }
+        })
+        .collect();
+    let input = KernelInput::placed([r, g, b], &placed, &frame.mask, frame.lut, outside_mode)?
+        .with_groups(&groups, settings.decode.max_groups)?;
     let counts = kernel::compose_in_place(input);
     let cos_range = frame.mask.cos_theta_range();
     drop(placed);
+    drop(groups);
     // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
     // another thread does it while the encoder keeps both cores busy.
     // Where no thread can be started, the closure, and so the passes, are dropped here.
-    let (refl, mask) = (frame.refl, frame.mask);
+    let (refl, groups, mask) = (frame.refl, frame.groups, frame.mask);
     let _ = std::thread::Builder::new()
         .name("glassdb-free".into())
-        .spawn(move || drop((refl, mask)));
+        .spawn(move || drop((refl, groups, mask)));
     let trans = frame.trans;
     let facts = FrameFacts {
         width: trans.image.width,
@@ -85,6 +101,7 @@ pub(crate) fn composite(
         cos_range,
         counts,
         outside_pixels: frame.outside.values().map(|(n, _)| n).sum(),
+        folded_pixels: frame.folded_pixels,
         memory: frame.memory,
     };
     Ok(Composited {

@@ -4,7 +4,7 @@
 //! output file: what the transmission file carries over is a [`Carry`].
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glassdb_image::{ImageWindows, PixelWindow};
 use glassdb_mask::{MaskImage, PlacedMask};
@@ -29,6 +29,11 @@ pub struct DecodedFrame<'a> {
     pub refl: Vec<Pass>,
     /// Each reflection pass's data window relative to the frame's top-left pixel.
     pub refl_windows: Vec<PixelWindow>,
+    /// The pane groups' reflection passes, as `FrameFiles::groups` lists them.
+    pub groups: Vec<DecodedGroupPass>,
+    /// Glass pixels of units whose deeper pane groups are composited on a nearer group's pass
+    /// (`DecodeSettings::max_groups`).
+    pub folded_pixels: u64,
     /// The mask, moved into the frame's data window.
     pub mask: MaskImage,
     /// The passes' colour space.
@@ -45,6 +50,18 @@ pub struct DecodedFrame<'a> {
     pub memory: MemoryEstimate,
     /// The estimate held from the budget until this is dropped.
     pub reservation: memory::Reservation<'a>,
+}
+
+/// A pane group's reflection pass, decoded and placed in the frame.
+pub struct DecodedGroupPass {
+    /// Its plane.
+    pub plane: usize,
+    /// Its pane group (1 or more).
+    pub group: usize,
+    /// The pass.
+    pub pass: Pass,
+    /// Its data window relative to the frame's top-left pixel.
+    pub window: PixelWindow,
 }
 
 /// The decoded inputs of one image, as read.
@@ -75,16 +92,33 @@ pub(crate) fn decode_planned<'a>(
         reservation,
     } = plan;
     let inputs = decode_inputs(files, settings, &reads, &display, carry)?;
-    let placed = place_inputs(files, inputs)?;
+    let mut placed = place_inputs(files, inputs)?;
     let id_counts = placed.mask.id_pixel_counts();
-    check_inputs(
+    let planes = files.refl.len();
+    check_inputs(files, settings, lut, planes, &placed.mask, &id_counts)?;
+    let folded_pixels = crate::pane_groups::check_group_passes(
         files,
         settings,
         lut,
-        placed.refl.len(),
         &placed.mask,
-        &id_counts,
+        &placed.refl_windows[planes..],
+        &placed.stored_windows[planes..],
+        &placed.trans.windows.data,
     )?;
+    let groups = files
+        .groups
+        .iter()
+        .zip(placed.refl.drain(planes..))
+        .zip(&placed.refl_windows[planes..])
+        .map(|((g, pass), &window)| DecodedGroupPass {
+            plane: g.plane,
+            group: g.group,
+            pass,
+            window,
+        })
+        .collect();
+    placed.refl_windows.truncate(planes);
+    placed.stored_windows.truncate(planes);
     let outside = glass_outside_passes(&placed.mask, lut, &placed.refl_windows);
     if let (OutsidePolicy::Error, Some((&plane, &(pixels, bounds)))) =
         (settings.outside, outside.iter().next())
@@ -104,6 +138,8 @@ pub(crate) fn decode_planned<'a>(
         frame: placed.frame,
         refl: placed.refl,
         refl_windows: placed.refl_windows,
+        groups,
+        folded_pixels,
         mask: placed.mask,
         space,
         table,
@@ -168,14 +204,15 @@ fn read_reflections(
     rows: &BTreeMap<u16, (i64, i64)>,
 ) -> Result<Vec<Pass>, ComposeError> {
     let at_once = memory::decoding_at_once();
-    let mut passes = Vec::with_capacity(files.refl.len());
-    for (c, chunk) in files.refl.chunks(at_once).enumerate() {
+    let inputs = files.reflection_inputs();
+    let mut passes = Vec::with_capacity(inputs.len());
+    for (c, chunk) in inputs.chunks(at_once).enumerate() {
         let decoded = chunk
             .par_iter()
             .enumerate()
-            .map(|(i, p)| {
+            .map(|(i, &(plane, p))| {
                 let k = c * at_once + i;
-                let rows = u16::try_from(k)
+                let rows = u16::try_from(plane)
                     .ok()
                     .and_then(|plane| rows.get(&plane))
                     .copied()
@@ -221,9 +258,9 @@ fn place_inputs(files: &FrameFiles, inputs: DecodedInputs) -> Result<PlacedInput
     let mut others: Vec<(&Path, ImageWindows)> = vec![(files.mask.as_path(), mask_windows)];
     others.extend(
         files
-            .refl
-            .iter()
-            .map(PathBuf::as_path)
+            .reflection_inputs()
+            .into_iter()
+            .map(|(_, p)| p)
             .zip(refl_windows.iter().copied()),
     );
     check_frames(&files.trans, &trans.windows, &others)?;

@@ -199,6 +199,59 @@ pub enum ComposeError {
         /// The output.
         output: PathBuf,
     },
+    /// A unit on a plane without the reflection pass of one of its pane groups.
+    #[error(
+        "mask {mask} has {pixels} pixels of glass {id} (a unit of {groups} pane groups) on plane {plane}, but no reflection pass of its pane group {group} was given: the scene mirrored about that group's mid-plane (a file refl_{plane}_{group}, or a layer plane{plane}.group{group} of a multi-part file), beside the plane's own pass {}",
+        plane_pass.display()
+    )]
+    GroupWithoutPass {
+        /// The mask.
+        mask: PathBuf,
+        /// The plane.
+        plane: u16,
+        /// The pane group without a pass (1 or more).
+        group: usize,
+        /// The unit.
+        id: u16,
+        /// Its pane groups.
+        groups: usize,
+        /// Its pixels on the plane.
+        pixels: u64,
+        /// The plane's own pass.
+        plane_pass: PathBuf,
+    },
+    /// A pane group's pass on a plane without a pass of its own, or numbered 0.
+    #[error(
+        "{} is given as the reflection pass of pane group {group} of plane {plane}, but {}",
+        pass.display(),
+        if *group == 0 { "group 0 is the plane's own pass".to_string() } else { format!("only {planes} plane pass(es) were given (planes count from 0)") }
+    )]
+    GroupPassWithoutPlane {
+        /// The pass.
+        pass: PathBuf,
+        /// Its plane.
+        plane: usize,
+        /// Its group.
+        group: usize,
+        /// Plane passes given.
+        planes: usize,
+    },
+    /// Two passes for one pane group of one plane.
+    #[error(
+        "pane group {group} of plane {plane} is given twice: {} and {}",
+        first.display(),
+        second.display()
+    )]
+    GroupPassTwice {
+        /// The plane.
+        plane: usize,
+        /// The group.
+        group: usize,
+        /// The first pass.
+        first: PathBuf,
+        /// The second.
+        second: PathBuf,
+    },
     /// A compose job without any reflection pass.
     #[error("at least one reflection pass is needed")]
     NoReflectionPass,
@@ -257,6 +310,9 @@ impl ComposeError {
             | ComposeError::NoTableForGroup { .. }
             | ComposeError::LightGroupList(_)
             | ComposeError::KeepGroupsNotExr { .. }
+            | ComposeError::GroupWithoutPass { .. }
+            | ComposeError::GroupPassWithoutPlane { .. }
+            | ComposeError::GroupPassTwice { .. }
             | ComposeError::NoReflectionPass => ErrorKind::Invalid,
         }
     }

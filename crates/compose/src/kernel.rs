@@ -21,6 +21,12 @@ use glassdb_side::Side;
 use rayon::prelude::*;
 
 use crate::lut::{GlassLut, GlassSideLut, RtTriple};
+use crate::shares::ShareSideLut;
+
+mod pane_groups;
+
+pub use pane_groups::PlacedGroupRefl;
+use pane_groups::{PaneGroupPasses, UnitPixel};
 
 /// Rows per parallel task.
 const BAND_ROWS: usize = 16;
@@ -82,6 +88,7 @@ pub struct KernelInput<'a> {
     mask: &'a MaskImage,
     lut: &'a GlassLut,
     outside: OutsidePass,
+    groups: PaneGroupPasses<'a>,
 }
 
 /// The kernel's inputs do not fit together (the caller checks files first; this guards the
@@ -116,6 +123,44 @@ pub enum KernelShapeError {
         samples: usize,
         /// The pixels it should hold.
         pixels: usize,
+    },
+    /// A pane group's reflection pass is on a plane without a reflection pass.
+    #[error(
+        "kernel input sizes disagree: the pass of pane group {group} of plane {plane} has no plane pass ({planes} planes)"
+    )]
+    GroupPlane {
+        /// The plane.
+        plane: usize,
+        /// The pane group.
+        group: usize,
+        /// Planes with a pass.
+        planes: usize,
+    },
+    /// A plane of a pane group's reflection pass has the wrong number of samples.
+    #[error(
+        "kernel input sizes disagree: the pass of pane group {group} of plane {plane}, channel {channel}, has {samples} samples for the {pixels} pixels of its window"
+    )]
+    GroupSamples {
+        /// The plane.
+        plane: usize,
+        /// The pane group.
+        group: usize,
+        /// The channel (0 R, 1 G, 2 B).
+        channel: usize,
+        /// Its samples.
+        samples: usize,
+        /// The pixels it should hold.
+        pixels: usize,
+    },
+    /// A pane group's pass given twice, or as group 0 (the plane's own pass).
+    #[error(
+        "kernel input sizes disagree: pane group {group} of plane {plane} is given twice (group 0 is the plane's own pass)"
+    )]
+    GroupRepeated {
+        /// The plane.
+        plane: usize,
+        /// The pane group.
+        group: usize,
     },
     /// The reflection passes and the sides of their planes are not one to one.
     #[error("kernel input sizes disagree: {passes} reflection passes but {sides} plane sides")]
@@ -176,18 +221,12 @@ impl<'a> KernelInput<'a> {
         }
         let frame = PixelWindow::at_origin(mask.width as usize, mask.height as usize);
         for (pass, placed) in refl.iter().enumerate() {
-            let expected = placed.window.width * placed.window.height;
-            if let Some((channel, p)) = placed
-                .rgb
-                .iter()
-                .enumerate()
-                .find(|(_, p)| p.len() != expected)
-            {
+            if let Some((channel, samples, pixels)) = wrong_channel(&placed.rgb, &placed.window) {
                 return Err(KernelShapeError::Reflection {
                     pass,
                     channel,
-                    samples: p.len(),
-                    pixels: expected,
+                    samples,
+                    pixels,
                 });
             }
         }
@@ -208,8 +247,19 @@ impl<'a> KernelInput<'a> {
             mask,
             lut,
             outside,
+            groups: PaneGroupPasses::default(),
         })
     }
+}
+
+/// The first channel of `rgb` without one sample per pixel of `window`: (channel, samples,
+/// pixels).
+fn wrong_channel(rgb: &[&[f32]; 3], window: &PixelWindow) -> Option<(usize, usize, usize)> {
+    let pixels = window.width * window.height;
+    rgb.iter()
+        .enumerate()
+        .find(|(_, p)| p.len() != pixels)
+        .map(|(c, p)| (c, p.len(), pixels))
 }
 
 /// Counts the kernel gathers in its sweep.
@@ -243,6 +293,8 @@ trait CosLookup: Sync {
     fn band(&self, range: Range<usize>) -> Self;
     /// r and t at pixel `j` of the band.
     fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple;
+    /// A pane group's share of r at pixel `j` of the band.
+    fn share(&self, lut: &ShareSideLut, j: usize) -> [f32; 3];
 }
 
 #[derive(Clone, Copy)]
@@ -262,6 +314,10 @@ impl CosLookup for Code8<'_> {
     fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
         lut.at_code8(self.0[j])
     }
+    #[inline(always)]
+    fn share(&self, lut: &ShareSideLut, j: usize) -> [f32; 3] {
+        lut.at_code8(self.0[j])
+    }
 }
 impl CosLookup for Code16<'_> {
     fn band(&self, range: Range<usize>) -> Self {
@@ -269,6 +325,10 @@ impl CosLookup for Code16<'_> {
     }
     #[inline(always)]
     fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
+        lut.at_cos(CosCode::Bits16.decode_f32(self.0[j]))
+    }
+    #[inline(always)]
+    fn share(&self, lut: &ShareSideLut, j: usize) -> [f32; 3] {
         lut.at_cos(CosCode::Bits16.decode_f32(self.0[j]))
     }
 }
@@ -280,6 +340,10 @@ impl CosLookup for FloatCos<'_> {
     fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
         lut.at_cos(self.0[j])
     }
+    #[inline(always)]
+    fn share(&self, lut: &ShareSideLut, j: usize) -> [f32; 3] {
+        lut.at_cos(self.0[j])
+    }
 }
 impl CosLookup for Normal {
     fn band(&self, _range: Range<usize>) -> Self {
@@ -287,6 +351,10 @@ impl CosLookup for Normal {
     }
     #[inline(always)]
     fn rt(&self, lut: &GlassSideLut, _j: usize) -> RtTriple {
+        lut.normal
+    }
+    #[inline(always)]
+    fn share(&self, lut: &ShareSideLut, _j: usize) -> [f32; 3] {
         lut.normal
     }
 }
@@ -299,6 +367,7 @@ pub fn compose_in_place(input: KernelInput<'_>) -> KernelCounts {
         mask,
         lut,
         outside,
+        groups,
     } = input;
     if mask.pixel_count() == 0 {
         return KernelCounts::default();
@@ -308,6 +377,10 @@ pub fn compose_in_place(input: KernelInput<'_>) -> KernelCounts {
         mask,
         lut,
         outside,
+        // Units' deeper pane groups only where their passes are given and some glass has
+        // them: the one-group frame keeps its own sweeps.
+        with_groups: groups.active(lut),
+        groups: &groups,
     };
     match &mask.cos_theta {
         CosTheta::Quantized8(c) => sweep.run(trans, &Code8(c)),
@@ -323,6 +396,8 @@ struct Sweep<'a> {
     mask: &'a MaskImage,
     lut: &'a GlassLut,
     outside: OutsidePass,
+    with_groups: bool,
+    groups: &'a PaneGroupPasses<'a>,
 }
 
 impl Sweep<'_> {
@@ -332,7 +407,8 @@ impl Sweep<'_> {
         let [tr, tg, tb] = trans;
         let simple = self.planes.len() == 1
             && self.mask.coverage.is_none()
-            && self.planes[0].window.is_none();
+            && self.planes[0].window.is_none()
+            && !self.with_groups;
         tr.par_chunks_mut(band)
             .zip(tg.par_chunks_mut(band))
             .zip(tb.par_chunks_mut(band))
@@ -393,7 +469,7 @@ impl Sweep<'_> {
         counts
     }
 
-    /// Any number of planes, with or without coverage.
+    /// Any number of planes and pane groups, with or without coverage.
     fn band_any_planes<C: CosLookup>(
         &self,
         pixels: Range<usize>,
@@ -433,6 +509,21 @@ impl Sweep<'_> {
                     rt.t[c] = 1.0 - k + k * rt.t[c];
                     rt.r[c] *= k;
                 }
+            }
+            if let Some(shares) = self.unit_shares(id, pass.side) {
+                let at = UnitPixel {
+                    pass,
+                    plane: usize::from(plane),
+                    frame_index: base + j,
+                    band_index: j,
+                    width,
+                    coverage: coverage.map_or(1.0, |c| c[j]),
+                };
+                let out = [r_out, g_out, b_out];
+                if !self.composite_unit(&mut counts, out, rt.t, shares, &at, cos) {
+                    counts.passthrough_pixels += 1;
+                }
+                continue;
             }
             let rf = match pass.index(base + j, width) {
                 Some(i) => [pass.refl[0][i], pass.refl[1][i], pass.refl[2][i]],

@@ -18,7 +18,7 @@
 //! [`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`. The
 //! viewer runs the first two ([`decode_frame`]), with no output at all. A frame split into
 //! light groups is [`compose_light_groups`]: the phases once per group, each with its light's
-//! table, and the sum written ([`groups`]).
+//! table, and the sum written ([`light_groups`]).
 
 #![warn(missing_docs)]
 
@@ -26,26 +26,29 @@ pub mod colour;
 mod composite;
 mod decode;
 pub mod error;
-pub mod groups;
 pub mod kernel;
+pub mod light_groups;
 pub mod lut;
 pub mod memory;
+mod pane_groups;
 mod place;
 mod plan;
+pub mod shares;
 mod write;
 
 use std::collections::BTreeMap;
+use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-pub use decode::DecodedFrame;
+pub use decode::{DecodedFrame, DecodedGroupPass};
 pub use error::ComposeError;
 use glassdb_encode::{OutputFormat, OutputOptions, WrittenOutput};
 use glassdb_image::ImageWindows;
 use glassdb_mask::MaskReadOptions;
 use glassdb_pass::{Carry, PassReadOptions};
 use glassdb_side::Side;
-pub use groups::{GroupPasses, LightGroup, compose_light_groups, group_passes};
+pub use light_groups::{GroupPasses, LightGroup, compose_light_groups, group_passes};
 use memory::{MemoryBudget, MemoryEstimate};
 pub use plan::DecodeTarget;
 
@@ -89,21 +92,61 @@ pub struct InputLayers {
 /// The input files of one frame.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FrameFiles {
-    /// Reflection passes; the k-th belongs to plane k of the mask.
+    /// Reflection passes; the k-th belongs to plane k of the mask (the first pane group its
+    /// rays meet).
     pub refl: Vec<PathBuf>,
+    /// The reflection passes of units' deeper pane groups (issue 27), each on a plane of
+    /// `refl`.
+    pub groups: Vec<GroupPassFile>,
     /// The transmission pass: its image is the frame.
     pub trans: PathBuf,
     /// The id + cos θ mask.
     pub mask: PathBuf,
 }
 
+/// The reflection pass of a unit's pane group behind the first: the scene mirrored about the
+/// group's mid-plane (docs/compose.md, "Units").
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GroupPassFile {
+    /// The plane (its own pass is `FrameFiles::refl[plane]`).
+    pub plane: usize,
+    /// The pane group, 1 or more, counted in the order the camera's rays meet the groups (from
+    /// the front: the outer pane is 0; from the back: the inner pane is 0).
+    pub group: usize,
+    /// The file.
+    pub path: PathBuf,
+    /// Its EXR layer (`None`: the default choice).
+    pub layer: Option<String>,
+}
+
 impl FrameFiles {
+    /// The input files of one frame without pane-group passes.
+    pub fn new(refl: Vec<PathBuf>, trans: PathBuf, mask: PathBuf) -> FrameFiles {
+        FrameFiles {
+            refl,
+            groups: Vec::new(),
+            trans,
+            mask,
+        }
+    }
+
     /// Every input file.
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
         self.refl
             .iter()
             .map(PathBuf::as_path)
+            .chain(self.groups.iter().map(|g| g.path.as_path()))
             .chain([self.trans.as_path(), self.mask.as_path()])
+    }
+
+    /// Every reflection pass with its plane: the planes' own, then the pane groups'.
+    pub(crate) fn reflection_inputs(&self) -> Vec<(usize, &Path)> {
+        self.refl
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (k, p.as_path()))
+            .chain(self.groups.iter().map(|g| (g.plane, g.path.as_path())))
+            .collect()
     }
 
     /// The files of frame `frame`: every path with a `#` run expanded (paths without one, such
@@ -114,6 +157,16 @@ impl FrameFiles {
                 .refl
                 .iter()
                 .map(|p| frame_path(p, frame))
+                .collect::<Result<_, _>>()?,
+            groups: self
+                .groups
+                .iter()
+                .map(|g| {
+                    Ok(GroupPassFile {
+                        path: frame_path(&g.path, frame)?,
+                        ..g.clone()
+                    })
+                })
                 .collect::<Result<_, _>>()?,
             trans: frame_path(&self.trans, frame)?,
             mask: frame_path(&self.mask, frame)?,
@@ -165,6 +218,9 @@ pub struct DecodeSettings {
     pub unknown: UnknownIds,
     /// Glass outside its plane's (cropped) reflection pass.
     pub outside: OutsidePolicy,
+    /// How many of a unit's pane groups get a reflection pass of their own (`None`: all; the
+    /// deeper groups' reflectance goes to the last one's pass, so `1` is one pass per plane).
+    pub max_groups: Option<NonZeroUsize>,
     /// The registry's name for messages (its path, or "the bundled catalog").
     pub registry_label: String,
     /// Bytes a frame may hold (estimated from the headers, [`memory`]); the frames of a
@@ -181,6 +237,7 @@ impl Default for DecodeSettings {
             input_space: None,
             unknown: UnknownIds::Error,
             outside: OutsidePolicy::Error,
+            max_groups: None,
             registry_label: "the registry".into(),
             max_memory: memory::DEFAULT_MAX_MEMORY,
         }
@@ -237,6 +294,11 @@ pub struct FrameReport {
     pub counts: KernelCounts,
     /// Number of reflection passes (planes).
     pub planes: usize,
+    /// Number of pane groups' reflection passes (beyond the planes' own).
+    pub group_passes: usize,
+    /// Glass pixels of units whose deeper pane groups were composited on a nearer group's pass
+    /// ([`DecodeSettings::max_groups`]).
+    pub folded_pixels: u64,
     /// Glass pixels outside their plane's reflection pass (composited as the chosen
     /// [`OutsidePolicy`] says).
     pub outside_pixels: u64,
@@ -366,6 +428,8 @@ fn write_composited(
         cos_range: facts.cos_range,
         counts: facts.counts,
         planes: job.inputs.refl.len(),
+        group_passes: job.inputs.groups.len(),
+        folded_pixels: facts.folded_pixels,
         outside_pixels: facts.outside_pixels,
         colour,
         memory: facts.memory,
@@ -410,5 +474,7 @@ fn check_job(job: &ComposeJob, settings: &ComposeSettings) -> Result<DecodeTarge
     })
 }
 
+#[cfg(test)]
+mod pane_groups_tests;
 #[cfg(test)]
 mod tests;

@@ -14,6 +14,13 @@ use glassdb_registry::{GlassRecord, RegistryTable};
 use glassdb_side::Side;
 use rayon::prelude::*;
 
+use crate::shares::{GroupShares, group_shares};
+
+/// The share tables of a glass of one group.
+fn no_groups() -> GroupShares {
+    [Box::new([]), Box::new([])]
+}
+
 /// Intervals of the fine table over cos θ ∈ [0, 1].
 pub const FINE_STEPS: usize = 4096;
 
@@ -38,6 +45,19 @@ impl RtTriple {
     }
 }
 
+/// Where cos θ lies in a fine table: the interval's start and the fraction into it (cos θ
+/// clamped to [0, 1]; NaN → normal incidence).
+#[inline(always)]
+pub(crate) fn fine_position(cos_theta: f32) -> (usize, f32) {
+    let x = if cos_theta.is_nan() {
+        1.0
+    } else {
+        cos_theta.clamp(0.0, 1.0)
+    } * FINE_STEPS as f32;
+    let i = (x as usize).min(FINE_STEPS - 1);
+    (i, x - i as f32)
+}
+
 /// One glass seen from one side.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GlassSideLut {
@@ -54,13 +74,7 @@ impl GlassSideLut {
     /// interpolation in the fine table.
     #[inline]
     pub fn at_cos(&self, cos_theta: f32) -> RtTriple {
-        let x = if cos_theta.is_nan() {
-            1.0
-        } else {
-            cos_theta.clamp(0.0, 1.0)
-        } * FINE_STEPS as f32;
-        let i = (x as usize).min(FINE_STEPS - 1);
-        let f = x - i as f32;
+        let (i, f) = fine_position(cos_theta);
         RtTriple::lerp(&self.fine[i], &self.fine[i + 1], f)
     }
 
@@ -78,6 +92,8 @@ pub struct GlassLut {
     index: Vec<u32>,
     /// Front and back per glass.
     slots: Vec<[GlassSideLut; 2]>,
+    /// Per slot, the pane groups' shares of r (empty for a glass of one group).
+    groups: Vec<GroupShares>,
     /// Largest |interpolated − exact| of the fine table over all glasses, sides, channels, r
     /// and t, at every interval midpoint.
     pub fine_table_error: f64,
@@ -149,9 +165,11 @@ impl GlassLut {
             })
             .collect();
         let worst = built.iter().map(|b| b.1).fold(0.0, f64::max);
+        let groups = built.iter().map(|_| no_groups()).collect();
         GlassLut {
             index,
             slots: built.into_iter().map(|b| b.0).collect(),
+            groups,
             fine_table_error: worst,
         }
     }
@@ -169,7 +187,7 @@ impl GlassLut {
     pub fn from_records(records: &[(u16, &GlassRecord)]) -> GlassLut {
         let ids: Vec<u16> = records.iter().map(|(id, _)| *id).collect();
         let record = |id: u16| records.iter().find(|(i, _)| *i == id).map(|(_, g)| *g);
-        GlassLut::from_fn(
+        let mut lut = GlassLut::from_fn(
             &ids,
             |id, side, cos| record(id).map_or(([0.0; 3], [0.0; 3]), |g| g.eval(side, cos)),
             |id, side| {
@@ -181,7 +199,45 @@ impl GlassLut {
                     (r, g.t0)
                 })
             },
-        )
+        );
+        lut.add_group_shares(&record);
+        lut
+    }
+
+    /// Adds the pane-group share tables of every unit of two or more groups among the
+    /// glasses of `lut` (`record` finds an id's record).
+    fn add_group_shares<'r>(&mut self, record: &(impl Fn(u16) -> Option<&'r GlassRecord> + Sync)) {
+        let ids: Vec<Option<u16>> = {
+            let mut by_slot = vec![None; self.slots.len()];
+            for (id, &slot) in self.index.iter().enumerate() {
+                if slot != NONE {
+                    by_slot[slot as usize] = Some(id as u16);
+                }
+            }
+            by_slot
+        };
+        self.groups = ids
+            .par_iter()
+            .map(|id| id.and_then(record).map_or_else(no_groups, group_shares))
+            .collect();
+    }
+
+    /// How many pane groups `id` reflects from (1 for a monolithic glass or an unknown id).
+    pub fn group_count(&self, id: u16) -> usize {
+        self.group_shares(id).map_or(1, |g| g[0].len().max(1))
+    }
+
+    /// Whether some glass of the table has two or more pane groups.
+    pub fn has_units(&self) -> bool {
+        self.groups.iter().any(|g| !g[0].is_empty())
+    }
+
+    /// The pane groups' share tables of `id`, front and back, in the order the rays meet them
+    /// (empty for a glass of one group).
+    #[inline]
+    pub fn group_shares(&self, id: u16) -> Option<&GroupShares> {
+        let slot = *self.index.get(id as usize)?;
+        self.groups.get(slot as usize)
     }
 
     /// Whether `id` has an entry.

@@ -48,7 +48,7 @@ impl DecodeTarget {
 pub(crate) struct InputReads {
     /// The transmission pass's.
     pub(crate) trans: PassReadOptions,
-    /// Reflection pass k's at k.
+    /// Reflection pass k's at k, then the pane groups' passes' in order.
     pub(crate) refl: Vec<PassReadOptions>,
 }
 
@@ -67,6 +67,7 @@ impl InputReads {
             trans: with_layer(Some(&settings.layers.trans)),
             refl: (0..files.refl.len())
                 .map(|k| with_layer(settings.layers.refl.get(k)))
+                .chain(files.groups.iter().map(|g| with_layer(Some(&g.layer))))
                 .collect(),
         }
     }
@@ -107,22 +108,23 @@ pub(crate) fn plan_frame<'a>(
     if files.refl.is_empty() {
         return Err(ComposeError::NoReflectionPass);
     }
+    crate::pane_groups::check_group_files(files)?;
     let reads = InputReads::of(files, settings);
     let trans = glassdb_pass::read_pass_header(&files.trans, &reads.trans)?;
     let mask = glassdb_mask::read_mask_header(&files.mask, &settings.mask)?;
-    let refl = files
-        .refl
+    let refl_files = files.reflection_inputs();
+    let refl = refl_files
         .iter()
         .zip(&reads.refl)
-        .map(|(p, opts)| glassdb_pass::read_refl_header(p, opts))
+        .map(|((_, p), opts)| glassdb_pass::read_refl_header(p, opts))
         .collect::<Result<Vec<_>, _>>()?;
 
     let display = trans.windows.display;
     let mask_windows = in_frame(mask.windows, !mask.has_coordinates, &display);
     let mut others: Vec<(&Path, ImageWindows)> = vec![(files.mask.as_path(), mask_windows)];
-    others.extend(files.refl.iter().zip(&refl).map(|(path, p)| {
+    others.extend(refl_files.iter().zip(&refl).map(|((_, path), p)| {
         (
-            path.as_path(),
+            *path,
             in_frame(p.windows, !p.source.has_coordinates(), &display),
         )
     }));
@@ -130,10 +132,10 @@ pub(crate) fn plan_frame<'a>(
     let refl_windows = others.iter().skip(1).map(|(_, w)| *w).collect();
 
     let space = frame_space(files, settings, &trans, &refl)?;
-    if refl.len() > 1 && !mask.stores_planes {
+    if files.refl.len() > 1 && !mask.stores_planes {
         return Err(ComposeError::MaskWithoutPlanes {
             mask: files.mask.clone(),
-            passes: refl.len(),
+            passes: files.refl.len(),
         });
     }
     let (table, lut) = luts.for_space(&space, &files.trans, &settings.registry_label)?;
@@ -172,12 +174,12 @@ fn frame_space(
     let declared = settings.input_space;
     let trans_space = colour::pass_space(&files.trans, &trans.colour, declared)?;
     let refl_spaces = files
-        .refl
-        .iter()
+        .reflection_inputs()
+        .into_iter()
         .zip(refl)
-        .map(|(path, pass)| {
+        .map(|((_, path), pass)| {
             Ok((
-                path.clone(),
+                path.to_path_buf(),
                 colour::pass_space(path, &pass.colour, declared)?,
             ))
         })
@@ -316,16 +318,12 @@ impl Shares {
             what: file_label(&files.trans),
             bytes: self.trans,
         }];
-        items.extend(
-            files
-                .refl
-                .iter()
-                .zip(self.refl)
-                .map(|(path, bytes)| MemoryItem {
-                    what: file_label(path),
-                    bytes,
-                }),
-        );
+        items.extend(files.reflection_inputs().into_iter().zip(self.refl).map(
+            |((_, path), bytes)| MemoryItem {
+                what: file_label(path),
+                bytes,
+            },
+        ));
         items.push(MemoryItem {
             what: format!("{} (the mask)", file_label(&files.mask)),
             bytes: self.mask,

@@ -205,7 +205,7 @@ fn kernel_input_of_the_wrong_shape_is_refused_once() {
 }
 
 /// Writes `planes` (R, G, B of `width × height` pixels) as a float EXR pass.
-fn write_float_pass(path: &Path, width: u32, height: u32, planes: [Vec<f32>; 3]) {
+pub(crate) fn write_float_pass(path: &Path, width: u32, height: u32, planes: [Vec<f32>; 3]) {
     let img = LinearImage {
         width,
         height,
@@ -247,7 +247,7 @@ proptest! {
         write(&t_path, &trans);
         write(&r_path, &refl);
         glassdb_mask::write_mask(&m_path, &m, glassdb_mask::MaskFormat::Png8).unwrap();
-        let job = ComposeJob { inputs: FrameFiles { refl: vec![r_path], trans: t_path, mask: m_path }, output: dir.path().join("o.exr") };
+        let job = ComposeJob { inputs: FrameFiles::new(vec![r_path], t_path, m_path), output: dir.path().join("o.exr") };
         let luts = RegistryLuts::single(glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb), lut);
         compose_frame(&job, &ComposeSettings::default(), &luts).unwrap();
         let out = glassdb_pass::read_pass(&job.output, &PassReadOptions::default()).unwrap();
@@ -303,11 +303,7 @@ fn a_frame_reports_its_stages_in_order() {
     let m_path = dir.path().join("m.png");
     glassdb_mask::write_mask(&m_path, &m, glassdb_mask::MaskFormat::Png8).unwrap();
     let job = ComposeJob {
-        inputs: FrameFiles {
-            refl: vec![write("r.exr", 0.25)],
-            trans: write("t.exr", 0.5),
-            mask: m_path,
-        },
+        inputs: FrameFiles::new(vec![write("r.exr", 0.25)], write("t.exr", 0.5), m_path),
         output: dir.path().join("o.exr"),
     };
     let basis = glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb);

@@ -261,6 +261,30 @@ pub fn plane_layers(parts: &[ExrPart]) -> Vec<(u32, String)> {
     out
 }
 
+/// The reflection passes of units' pane groups in one file (issue 27): the RGB layers named
+/// `plane<K>.group<G>` (G ≥ 1; group 0 is the plane's own layer `plane<K>`), as (K, G, layer
+/// name) by increasing K, then G.
+pub fn plane_group_layers(parts: &[ExrPart]) -> Vec<(u32, u32, String)> {
+    let number = |s: &str| -> Option<u32> {
+        (!s.is_empty()
+            && s.bytes().all(|b| b.is_ascii_digit())
+            && (s == "0" || !s.starts_with('0')))
+        .then(|| s.parse().ok())
+        .flatten()
+    };
+    let mut out: Vec<(u32, u32, String)> = rgb_layers(parts)
+        .into_iter()
+        .filter_map(|l| {
+            let name = l.name.strip_suffix(".Combined").unwrap_or(&l.name);
+            let (plane, group) = name.strip_prefix("plane")?.split_once(".group")?;
+            let (k, g) = (number(plane)?, number(group)?);
+            (g >= 1).then(|| (k, g, l.name.clone()))
+        })
+        .collect();
+    out.sort();
+    out
+}
+
 /// Why no RGB layer could be chosen.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum LayerChoiceError {

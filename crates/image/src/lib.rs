@@ -35,7 +35,7 @@ pub use exr_header::{
 };
 pub use exr_layers::{
     ChannelMatch, LayerChoiceError, RgbLayer, all_channel_names, choose_rgb_layer, find_channel,
-    plane_layers, rgb_layers,
+    plane_group_layers, plane_layers, rgb_layers,
 };
 pub use exr_read::{
     ExactExr, ExactPart, check_exr_readable, read_exr_attributes, read_exr_channel_rows,

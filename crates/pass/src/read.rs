@@ -94,6 +94,19 @@ pub struct PassHeader {
     pub memory: ReadMemory,
 }
 
+/// The pane groups' reflection layers `plane<K>.group<G>` of an EXR file (issue 27), as (K, G,
+/// layer name); empty for a PNG or a file without them.
+pub fn plane_group_layers_of(
+    path: &Path,
+    max_pixels: u64,
+) -> Result<Vec<(u32, u32, String)>, PassError> {
+    let (_, header, _) = open_seekable(path, max_pixels)?;
+    Ok(match header {
+        ImageHeader::Exr(headers) => glassdb_image::plane_group_layers(&headers.parts),
+        _ => Vec::new(),
+    })
+}
+
 /// The plane layers of a reflection file holding several planes' passes (docs/compose.md,
 /// "Several planes in one file"): the layer names `plane0`, `plane1`, … in plane order, from
 /// the header alone; `None` for a PNG or an EXR without such layers. Planes must be numbered

@@ -30,6 +30,17 @@ pub struct UnitRecord {
     pub solar: Option<SystemValues>,
 }
 
+impl UnitRecord {
+    /// Its pane groups' mid-plane depths behind surface #1, outside first, in metres (as a
+    /// scene places its mirror planes, issue 27); `None` when a depth is not recorded.
+    pub fn group_depths_m(&self) -> Option<Vec<f64>> {
+        self.groups
+            .iter()
+            .map(|g| g.depth_mm.map(|d| d * 1e-3))
+            .collect()
+    }
+}
+
 /// One element of a unit's build-up.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]

@@ -13,6 +13,7 @@ pub mod mask_frames;
 pub mod math;
 pub mod mirror;
 pub mod obj;
+pub mod pane_groups;
 pub mod planes;
 pub mod planes_file;
 pub mod raster;
@@ -31,6 +32,7 @@ pub use mask_frames::{
 };
 pub use mirror::{MirrorStats, mirror_scene};
 pub use obj::{MTL_FILE, Mesh, OBJ_FILE, Scene, load_obj, stage_obj};
+pub use pane_groups::{GroupEntry, group_scene_name};
 pub use planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_planes};
 pub use planes_file::{PlanesFile, sides_from_planes_json};
 pub use raster::{CosMode, RasterOptions, RasterOutput, RasterScene, rasterize};

@@ -61,6 +61,11 @@ pub struct PlaneEntry {
     pub triangles_written: usize,
     /// Scene triangles that crossed the plane and were clipped.
     pub triangles_clipped: usize,
+    /// A unit's pane groups, in the order the eye meets them, each with its mirror plane and
+    /// virtual scene (group 0's is `file`); empty for glass of one group, mirrored about the
+    /// face (issue 27).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<crate::pane_groups::GroupEntry>,
 }
 
 impl PlanesFile {

@@ -8,6 +8,7 @@ use crate::error::SceneError;
 use crate::math::Vec3;
 use crate::mirror::{MirrorStats, mirror_scene};
 use crate::obj::{Mesh, Scene, stage_obj};
+use crate::pane_groups::{GroupEntry, group_scene_name, plane_group_depths, shifted};
 use crate::planes::{GlassPlane, MaterialMatcher, Plane, PlaneTolerance, detect_planes};
 use crate::planes_file::{PLANES_FORMAT, PlaneEntry, PlanesFile, ToleranceJson};
 
@@ -26,6 +27,10 @@ pub struct MirrorRequest<'a> {
     pub tolerance: PlaneTolerance,
     /// Where the virtual scenes and `planes.json` go.
     pub out_dir: &'a Path,
+    /// Per glass pattern (as `glass_patterns`), the depths behind the face of its glass's pane
+    /// groups, outside first, in scene units (metres): a unit's groups get a virtual scene
+    /// each (issue 27). Empty, or one depth: glass of one group, mirrored about the face.
+    pub pane_groups: Vec<Vec<f64>>,
 }
 
 /// What was written.
@@ -100,20 +105,61 @@ fn write_virtual_scenes_staged(req: &MirrorRequest<'_>) -> Result<MirrorReport, 
     let mut staged = glassdb_io::StagedOutput::new();
     let mut entries = Vec::with_capacity(planes.len());
     let mut all_stats = Vec::with_capacity(planes.len());
+    let matcher = if req.glass_patterns.is_empty() {
+        None
+    } else {
+        Some(MaterialMatcher::new(&req.glass_patterns)?)
+    };
     for gp in &planes {
-        let (kept, eye_side) = kept_side(gp, req.eye, req.tolerance.distance)?;
-        let (meshes, stats) = mirror_scene(scene, &kept, req.tolerance.distance, |m, _| {
-            is_glass(scene.meshes[m].material)
-        });
-        let file = write_plane_scene(
-            &mut staged,
-            scene,
-            gp,
-            eye_side,
-            &mtllibs,
-            &meshes,
-            req.out_dir,
-        )?;
+        let (_, eye_side) = kept_side(gp, req.eye, req.tolerance.distance)?;
+        let depths = plane_group_depths(gp, matcher.as_ref(), &req.pane_groups, eye_side)?;
+        let mut groups = Vec::with_capacity(depths.len());
+        let mut first = None;
+        for (g, &depth) in depths
+            .iter()
+            .enumerate()
+            .chain(depths.is_empty().then_some((0, &0.0)))
+        {
+            let mirror_plane = GlassPlane {
+                plane: shifted(&gp.plane, depth),
+                ..gp.clone()
+            };
+            let (kept, _) = kept_side(&mirror_plane, req.eye, req.tolerance.distance)?;
+            let (meshes, stats) = mirror_scene(scene, &kept, req.tolerance.distance, |m, _| {
+                is_glass(scene.meshes[m].material)
+            });
+            let name = if g == 0 {
+                virtual_scene_name(gp.index)
+            } else {
+                group_scene_name(gp.index, g)
+            };
+            let file = write_plane_scene(
+                &mut staged,
+                scene,
+                (&mirror_plane, &name),
+                eye_side,
+                &mtllibs,
+                &meshes,
+                req.out_dir,
+            )?;
+            if !depths.is_empty() {
+                groups.push(GroupEntry {
+                    group: g,
+                    depth,
+                    equation: mirror_plane.plane.equation(),
+                    reflection_matrix: mirror_plane.plane.reflection_matrix(),
+                    file: file.clone(),
+                    triangles_written: stats.written,
+                    triangles_clipped: stats.clipped,
+                });
+            }
+            if g == 0 {
+                first = Some((mirror_plane.plane, file, stats));
+            }
+        }
+        let Some((first_plane, file, stats)) = first else {
+            continue;
+        };
         entries.push(PlaneEntry {
             index: gp.index,
             equation: gp.plane.equation(),
@@ -121,10 +167,11 @@ fn write_virtual_scenes_staged(req: &MirrorRequest<'_>) -> Result<MirrorReport, 
             materials: gp.materials.clone(),
             triangles: gp.triangles,
             eye_side,
-            reflection_matrix: gp.plane.reflection_matrix(),
+            reflection_matrix: first_plane.reflection_matrix(),
             file,
             triangles_written: stats.written,
             triangles_clipped: stats.clipped,
+            groups,
         });
         all_stats.push(stats);
     }
@@ -257,18 +304,18 @@ fn kept_side(
     })
 }
 
-/// Stages plane `gp`'s virtual scene for `out_dir`; returns its file name.
+/// Stages the virtual scene `name` mirrored about `gp`'s plane (a glass plane, or a pane
+/// group's mid-plane behind it) for `out_dir`; returns its file name.
 fn write_plane_scene(
     staged: &mut glassdb_io::StagedOutput,
     scene: &Scene,
-    gp: &GlassPlane,
+    (gp, name): (&GlassPlane, &str),
     eye_side: Side,
     mtllibs: &[String],
     meshes: &[Mesh],
     out_dir: &Path,
 ) -> Result<String, SceneError> {
-    let name = virtual_scene_name(gp.index);
-    let path = out_dir.join(&name);
+    let path = out_dir.join(name);
     glassdb_io::refuse_input_as_output(&path)?;
     let header = vec![
         format!(
@@ -284,7 +331,7 @@ fn write_plane_scene(
             .to_string(),
     ];
     stage_obj(staged, &path, &header, mtllibs, &scene.materials, meshes)?;
-    Ok(name)
+    Ok(name.to_string())
 }
 
 /// Stages `planes.json` for `out_dir`; returns its path.
