@@ -18,7 +18,8 @@ pub mod thin_pane;
 pub use error::BlenderError;
 pub use job::{PixelBounds, RunRecord};
 pub use pipeline::{
-    ComposeReport, RegistryChoice, RenderReport, RenderRequest, compose_dir, render,
+    ComposeReport, DEFAULT_MASK_SAMPLES, RegistryChoice, RenderReport, RenderRequest, compose_dir,
+    render,
 };
 pub use program::{Blender, Launcher};
 pub use thin_pane::ThinPane;

@@ -33,6 +33,12 @@ const STAGING: &str = ".glassdb-blender";
 /// Blender's log in the output directory.
 pub const LOG_NAME: &str = "blender.log";
 
+/// K of the masks' K×K coverage rays per pixel by default: 4 (16 rays and the centre). Centre
+/// sampling leaves the glass part of a pane-edge pixel untinted (or tints all of it), which a
+/// swap to a dark glass shows as outlines; with coverage compose blends an edge pixel by its
+/// glass fraction (method eq. 10). docs/blender.md, "Pane edges", has what it gains and costs.
+pub const DEFAULT_MASK_SAMPLES: u32 = 4;
+
 /// What `glassdb blender render` is asked to do.
 #[derive(Debug, Clone)]
 pub struct RenderRequest {
@@ -59,7 +65,7 @@ pub struct RenderRequest {
     /// Render threads, or Blender's choice.
     pub threads: Option<u32>,
     /// K×K rays per pixel for the masks' glass coverage (1: the pixel centre only, no
-    /// coverage channel).
+    /// coverage channel); [`DEFAULT_MASK_SAMPLES`] unless asked otherwise.
     pub mask_samples: u32,
     /// Also render the Cycles reference (the glass as a thin pane seen by the camera) as
     /// `reference.####.exr`.
