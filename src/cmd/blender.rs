@@ -129,6 +129,9 @@ fn print_composites(dir: &std::path::Path, report: &ComposeReport) {
         dir.display(),
         report.seconds
     );
+    for w in &report.swap {
+        eprintln!("warning: {w}");
+    }
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {

@@ -10,7 +10,7 @@ use std::process::Command;
 use std::sync::OnceLock;
 
 use crate::util::{
-    Planes, fails, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path,
+    Planes, fails, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path, run,
     write_executable, write_file,
 };
 
@@ -408,8 +408,21 @@ fn compose_dir_recomposites_with_another_registry() {
     let dir = r.root.join("recompose");
     copy_dir(&r.runs[0], &dir);
     let first = read_exr_planes(&dir.join("composite.0001.exr"));
-    // The bundled registry again: the same composite, sample for sample.
-    ok(glassdb().args(["blender", "compose"]).arg(&dir));
+    // The bundled registry again: the same composite, sample for sample, and no warning (the
+    // run record names the glasses that lit the passes: the bundled ones).
+    let record = json(&dir.join("glassdb-blender.json"));
+    let lit_by: Vec<u64> = record["lit_by"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no lit_by in {record}"))
+        .iter()
+        .map(|g| g["id"].as_u64().unwrap())
+        .collect();
+    assert_eq!(lit_by, [1, 5], "{record}");
+    let (status, _, stderr) = run(glassdb().args(["blender", "compose"]).arg(&dir));
+    assert!(
+        status.status.success() && !stderr.contains("warning"),
+        "{stderr}"
+    );
     let again = read_exr_planes(&dir.join("composite.0001.exr"));
     assert_eq!(first.channels, again.channels);
     // Other glasses with the same ids: glass pixels change, the rest stays the transmission.
@@ -419,12 +432,24 @@ fn compose_dir_recomposites_with_another_registry() {
         &registry,
         &[],
     ));
-    let out = ok(glassdb()
+    let (status, out, stderr) = run(glassdb()
         .args(["blender", "compose"])
         .arg(&dir)
         .arg("--registry")
         .arg(&registry));
+    assert!(status.status.success(), "{stderr}");
     assert!(out.contains("composited 2 frame(s)"), "{out}");
+    // The swap says what it leaves wrong: the passes keep no light-path split, so the light
+    // that came in through each swapped glass stays the rendered glass's.
+    for id in [1, 5] {
+        assert!(
+            stderr.contains(&format!(
+                "warning: glass id {id}: the passes were rendered with"
+            )),
+            "{stderr}"
+        );
+    }
+    assert!(stderr.contains("stays that of"), "{stderr}");
     let other = read_exr_planes(&dir.join("composite.0001.exr"));
     let trans = read_exr_planes(&dir.join("trans.0001.exr"));
     let mask = read_exr_planes(&dir.join("mask.0001.exr"));

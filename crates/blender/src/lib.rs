@@ -13,6 +13,7 @@ pub mod job;
 mod passes;
 pub mod pipeline;
 pub mod program;
+pub mod swap;
 pub mod thin_pane;
 
 pub use error::BlenderError;
@@ -22,4 +23,5 @@ pub use pipeline::{
     render,
 };
 pub use program::{Blender, Launcher};
+pub use swap::{PassGlass, SwapWarning, swap_warnings};
 pub use thin_pane::ThinPane;
