@@ -66,9 +66,9 @@ pub struct RenderArgs {
     /// Blender's render threads (default: Blender's choice).
     #[arg(long)]
     pub threads: Option<u32>,
-    /// K×K rays per pixel for the masks' glass coverage at pane edges (1: the pixel centre
-    /// only).
-    #[arg(long, default_value_t = 1)]
+    /// K×K rays per pixel for the masks' glass coverage at pane edges, which compose blends
+    /// by (1: the pixel centre only, no coverage: edge pixels all glass or none).
+    #[arg(long, default_value_t = glassdb_blender::DEFAULT_MASK_SAMPLES)]
     pub mask_samples: u32,
     /// Also render the Cycles reference (the glass as a thin pane the camera sees, no passes)
     /// as DIR/reference.####.exr, for validation.
@@ -129,6 +129,9 @@ fn print_composites(dir: &std::path::Path, report: &ComposeReport) {
         dir.display(),
         report.seconds
     );
+    for w in &report.swap {
+        eprintln!("warning: {w}");
+    }
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {

@@ -185,6 +185,11 @@ fn blender_run_frames(dir: &Path) -> anyhow::Result<Vec<ViewerFrame>> {
         );
     }
     let record = glassdb_blender::RunRecord::load(dir)?;
+    // A product change on the page is a glass swap: say what it cannot change (issue 28).
+    eprintln!(
+        "note: {}'s passes keep no light-path split: a product chosen on the page re-tints the glass pixels only; the light that came into the scene through the glazing stays that of the glasses the passes were rendered with",
+        dir.display()
+    );
     if record.frames.is_empty() {
         bail!(
             "{}: the run records no frame",

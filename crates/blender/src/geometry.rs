@@ -6,10 +6,8 @@
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
-use glassdb_colour::RgbSpace;
 use glassdb_image::PixelWindow;
 use glassdb_mask::{GlassMapping, MaskFormat};
-use glassdb_registry::ColourBasis;
 use glassdb_scene::{
     CameraSource, FrameMask, MaskJob, MaskPlanes, MirrorRequest, PlaneSource, PlaneTolerance,
     label_scene, load_obj, mask_frames, write_virtual_scenes,
@@ -263,10 +261,7 @@ fn thin_panes(
     glass_materials: &[(String, u16)],
     registry: &RegistryChoice,
 ) -> Result<Vec<ThinPane>, BlenderError> {
-    let table = registry
-        .registry
-        .table(ColourBasis::Space(RgbSpace::Srgb))
-        .unwrap_or_else(|| registry.registry.default_table());
+    let table = crate::swap::shader_table(registry);
     glass_materials
         .iter()
         .map(|(material, id)| {

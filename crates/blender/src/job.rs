@@ -182,6 +182,10 @@ pub struct RunRecord {
     pub overrides: Vec<String>,
     /// Every frame rendered.
     pub frames: Vec<FrameRecord>,
+    /// The glasses whose thin-pane shader lit the passes (absent in runs before they were
+    /// recorded): what a swap to other glasses cannot change ([`crate::swap`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lit_by: Vec<crate::swap::PassGlass>,
 }
 
 impl RunRecord {

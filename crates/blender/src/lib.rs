@@ -13,12 +13,15 @@ pub mod job;
 mod passes;
 pub mod pipeline;
 pub mod program;
+pub mod swap;
 pub mod thin_pane;
 
 pub use error::BlenderError;
 pub use job::{PixelBounds, RunRecord};
 pub use pipeline::{
-    ComposeReport, RegistryChoice, RenderReport, RenderRequest, compose_dir, render,
+    ComposeReport, DEFAULT_MASK_SAMPLES, RegistryChoice, RenderReport, RenderRequest, compose_dir,
+    render,
 };
 pub use program::{Blender, Launcher};
+pub use swap::{PassGlass, SwapWarning, swap_warnings};
 pub use thin_pane::ThinPane;

@@ -33,6 +33,12 @@ const STAGING: &str = ".glassdb-blender";
 /// Blender's log in the output directory.
 pub const LOG_NAME: &str = "blender.log";
 
+/// K of the masks' K×K coverage rays per pixel by default: 4 (16 rays and the centre). Centre
+/// sampling leaves the glass part of a pane-edge pixel untinted (or tints all of it), which a
+/// swap to a dark glass shows as outlines; with coverage compose blends an edge pixel by its
+/// glass fraction (method eq. 10). docs/blender.md, "Pane edges", has what it gains and costs.
+pub const DEFAULT_MASK_SAMPLES: u32 = 4;
+
 /// What `glassdb blender render` is asked to do.
 #[derive(Debug, Clone)]
 pub struct RenderRequest {
@@ -59,7 +65,7 @@ pub struct RenderRequest {
     /// Render threads, or Blender's choice.
     pub threads: Option<u32>,
     /// K×K rays per pixel for the masks' glass coverage (1: the pixel centre only, no
-    /// coverage channel).
+    /// coverage channel); [`DEFAULT_MASK_SAMPLES`] unless asked otherwise.
     pub mask_samples: u32,
     /// Also render the Cycles reference (the glass as a thin pane seen by the camera) as
     /// `reference.####.exr`.
@@ -111,6 +117,9 @@ pub struct RenderReport {
 pub struct ComposeReport {
     /// Each frame's composite.
     pub frames: Vec<(u32, FrameReport)>,
+    /// What compositing with this registry leaves lit by the render's glasses
+    /// ([`crate::swap_warnings`]); empty when the glasses are the render's.
+    pub swap: Vec<crate::SwapWarning>,
     /// Wall seconds of them all.
     pub seconds: f64,
 }
@@ -144,7 +153,8 @@ pub fn render(
     let job = render_passes(&work, &masks)?;
     let render_s = t.elapsed().as_secs_f64();
     let render_cpu_s = cpu_since(cpu);
-    let record = write_record(&work, masks.frames, masks.size, info.overrides())?;
+    let lit_by = crate::swap::pass_glasses(masks.glass_materials.iter().map(|m| m.1), registry);
+    let record = write_record(&work, masks.frames, masks.size, info.overrides(), lit_by)?;
 
     let (mut reference_s, mut reference_cpu_s) = (0.0, None);
     if request.reference {
@@ -162,6 +172,7 @@ pub fn render(
     } else {
         ComposeReport {
             frames: Vec::new(),
+            swap: Vec::new(),
             seconds: 0.0,
         }
     };
@@ -344,6 +355,7 @@ fn write_record(
     frames: Vec<FrameRecord>,
     (width, height): (u32, u32),
     overrides: Vec<String>,
+    lit_by: Vec<crate::swap::PassGlass>,
 ) -> Result<RunRecord, BlenderError> {
     let request = work.request;
     let record = RunRecord {
@@ -356,6 +368,7 @@ fn write_record(
         height,
         overrides,
         frames,
+        lit_by,
     };
     let record_path = work.dir.join(RECORD_NAME);
     let text = serde_json::to_string_pretty(&record).map_err(|e| BlenderError::BadRecord {
@@ -472,6 +485,7 @@ pub fn compose_record(
     }
     Ok(ComposeReport {
         frames,
+        swap: crate::swap_warnings(record, registry),
         seconds: t.elapsed().as_secs_f64(),
     })
 }

@@ -18,7 +18,8 @@ use crate::catalog_files::{CatalogFiles, sha256_hex};
 use crate::curves::{GlassCurves, fit_glass_curves};
 use crate::normal::{NormalValues, normal_values, read_layer};
 use crate::{
-    AngleModelRecord, FileRef, GlassRecord, Provenance, Registry, RegistryError, RegistryTable,
+    AngleModelRecord, FileRef, GlassRecord, HemisphericalRecord, Provenance, Registry,
+    RegistryError, RegistryTable,
 };
 
 /// Where the angle model is applied (the stack engine's choice, for every layer).
@@ -133,6 +134,7 @@ pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Regist
     for records in built {
         for (table, mut g) in tables.iter_mut().zip(records?) {
             g.provenance.catalog = Some(catalog_ref.clone());
+            g.hemispherical = Some(HemisphericalRecord::of(&g));
             table.glasses.push(g);
         }
     }
@@ -306,6 +308,7 @@ pub(crate) fn glass_record(
         angle_model,
         provenance,
         unit: None,
+        hemispherical: None,
     }
 }
 

@@ -261,6 +261,23 @@ pub enum RegistryError {
         what: String,
     },
 
+    /// A stored hemispherical value is not the integral of the glass's curves.
+    #[error(
+        "{source_name}: glass {glass}: {field} = {stored} is not the hemispherical integral of its curves ({computed:.6}); remove the `hemispherical` values or rebuild the registry from its catalog"
+    )]
+    Hemispherical {
+        /// The registry's name.
+        source_name: String,
+        /// The glass.
+        glass: String,
+        /// Which value and channel.
+        field: String,
+        /// The stored value.
+        stored: f64,
+        /// The integral of the curves.
+        computed: f64,
+    },
+
     /// A curve object is malformed (no terms, powers and coefficients of different lengths, …).
     #[error("{source_name}: glass {glass}: curve {field}")]
     CurveShape {

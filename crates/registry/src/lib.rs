@@ -24,6 +24,7 @@ pub mod catalog;
 mod catalog_files;
 mod curves;
 mod error;
+mod hemispherical;
 mod lights;
 mod normal;
 mod record;
@@ -47,6 +48,7 @@ pub use error::RegistryError;
 pub use glassdb_fit::MAX_CURVE_TOLERANCE;
 /// The face of a pane a record's values are for (the `glassdb-side` crate's type).
 pub use glassdb_side::{Side, UnknownSide};
+pub use hemispherical::HemisphericalRecord;
 pub use lights::{MAX_LIGHT_NAME, NamedLight, RegistryLight, check_light_name};
 pub use record::{
     AngleCurve, AngleModelRecord, FileRef, GlassRecord, LuminousRecord, ProductRecord, Provenance,

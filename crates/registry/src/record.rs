@@ -36,6 +36,11 @@ pub struct GlassRecord {
     /// glass: one pane group whose reflectance is `r`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unit: Option<crate::unit_record::UnitRecord>,
+    /// Hemispherical (diffuse-diffuse) values integrated from the curves (stored by every build
+    /// since they were added; [`GlassRecord::hemispherical`] integrates them for a record
+    /// without).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hemispherical: Option<crate::hemispherical::HemisphericalRecord>,
 }
 
 /// One angle curve: the fitted polynomial `C(cos θ)` with the summary of its fit, under the
@@ -205,6 +210,7 @@ impl GlassRecord {
             },
             provenance: Provenance::default(),
             unit: None,
+            hemispherical: None,
         }
     }
 
@@ -216,6 +222,7 @@ impl GlassRecord {
         if let Some(l) = &mut self.luminous {
             std::mem::swap(&mut l.reflectance, &mut l.reflectance_back);
         }
+        self.hemispherical = self.hemispherical.map(|h| h.turned_round());
     }
 
     /// "id 3 (\"Clear 6 mm\")", for messages.

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use glassdb_fit::MAX_CURVE_TOLERANCE;
 
 use crate::RegistryError;
+use crate::hemispherical::{HEMISPHERICAL_TOLERANCE, HemisphericalRecord};
 use crate::record::{AngleCurve, GlassRecord};
 use crate::registry::{CHANNELS, Registry, RegistryTable};
 use crate::unit_record::{UnitElement, UnitRecord};
@@ -382,6 +383,34 @@ fn validate_glass(g: &GlassRecord, source_name: &str) -> Result<(), RegistryErro
     }
     if let Some(unit) = &g.unit {
         validate_unit(g, unit, source_name)?;
+    }
+    if let Some(stored) = &g.hemispherical {
+        check_hemispherical(g, stored, source_name)?;
+    }
+    Ok(())
+}
+
+/// Stored hemispherical values must be the integral of the curves they sit beside (a registry
+/// edited by hand, or curves changed without them, would otherwise light a room with one glass
+/// and tint its panes with another).
+fn check_hemispherical(
+    g: &GlassRecord,
+    stored: &HemisphericalRecord,
+    source_name: &str,
+) -> Result<(), RegistryError> {
+    let computed = HemisphericalRecord::of(g);
+    for ((field, values), (_, expected)) in stored.fields().into_iter().zip(computed.fields()) {
+        for c in 0..3 {
+            if !(values[c] - expected[c]).abs().le(&HEMISPHERICAL_TOLERANCE) {
+                return Err(RegistryError::Hemispherical {
+                    source_name: source_name.to_string(),
+                    glass: g.label(),
+                    field: format!("{field}[{c}] ({})", CHANNELS[c]),
+                    stored: values[c],
+                    computed: expected[c],
+                });
+            }
+        }
     }
     Ok(())
 }
