@@ -4,11 +4,13 @@
 
 use std::collections::BTreeMap;
 
-use glassdb_image::ImageWindows;
+use glassdb_image::{ImageWindows, PixelWindow};
+use glassdb_mask::MaskImage;
 use glassdb_side::Side;
 
 use crate::colour::{ChosenTable, PassSpace};
 use crate::kernel::{self, KernelCounts, KernelInput, OutsidePass, PlacedRefl};
+use crate::lut::GlassLut;
 use crate::memory::MemoryEstimate;
 use crate::{ComposeError, ComposeSettings, DecodedFrame, OutsidePolicy};
 
@@ -39,6 +41,33 @@ pub(crate) struct FrameFacts {
     pub(crate) memory: MemoryEstimate,
 }
 
+/// The kernel over one frame: each reflection pass (its R, G, B planes and its window relative
+/// to the frame) placed with its plane's side, composited in place on `trans`, glass outside a
+/// cropped pass treated as `settings` says. Files and arrays (`compose_in_memory`) alike.
+pub(crate) fn run_kernel<'a>(
+    trans: &mut [Vec<f32>; 3],
+    refl: impl Iterator<Item = (&'a [Vec<f32>; 3], PixelWindow)>,
+    mask: &MaskImage,
+    lut: &GlassLut,
+    settings: &ComposeSettings,
+) -> Result<KernelCounts, ComposeError> {
+    let placed: Vec<PlacedRefl<'_>> = refl
+        .enumerate()
+        .map(|(k, ([r, g, b], window))| PlacedRefl {
+            rgb: [r.as_slice(), g.as_slice(), b.as_slice()],
+            window,
+            side: settings.plane_sides.get(&k).copied().unwrap_or(Side::Front),
+        })
+        .collect();
+    let outside_mode = match settings.decode.outside {
+        OutsidePolicy::Transmission => OutsidePass::Transmission,
+        OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
+    };
+    let [r, g, b] = trans;
+    let input = KernelInput::placed([r, g, b], &placed, mask, lut, outside_mode)?;
+    Ok(kernel::compose_in_place(input))
+}
+
 /// The composite phase: every reflection pass placed in the frame with its plane's side, the
 /// kernel run in place on the transmission pass, and the decoded passes freed beside the
 /// encoder.
@@ -46,29 +75,19 @@ pub(crate) fn composite(
     mut frame: DecodedFrame<'_>,
     settings: &ComposeSettings,
 ) -> Result<Composited, ComposeError> {
-    let placed: Vec<PlacedRefl<'_>> = frame
+    let refl = frame
         .refl
         .iter()
-        .zip(&frame.refl_windows)
-        .enumerate()
-        .map(|(k, (p, &window))| {
-            let [r, g, b] = &p.image.rgb;
-            PlacedRefl {
-                rgb: [r.as_slice(), g.as_slice(), b.as_slice()],
-                window,
-                side: settings.plane_sides.get(&k).copied().unwrap_or(Side::Front),
-            }
-        })
-        .collect();
-    let outside_mode = match settings.decode.outside {
-        OutsidePolicy::Transmission => OutsidePass::Transmission,
-        OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
-    };
-    let [r, g, b] = &mut frame.trans.image.rgb;
-    let input = KernelInput::placed([r, g, b], &placed, &frame.mask, frame.lut, outside_mode)?;
-    let counts = kernel::compose_in_place(input);
+        .map(|p| &p.image.rgb)
+        .zip(frame.refl_windows.iter().copied());
+    let counts = run_kernel(
+        &mut frame.trans.image.rgb,
+        refl,
+        &frame.mask,
+        frame.lut,
+        settings,
+    )?;
     let cos_range = frame.mask.cos_theta_range();
-    drop(placed);
     // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
     // another thread does it while the encoder keeps both cores busy.
     // Where no thread can be started, the closure, and so the passes, are dropped here.

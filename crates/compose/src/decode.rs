@@ -78,7 +78,7 @@ pub(crate) fn decode_planned<'a>(
     let placed = place_inputs(files, inputs)?;
     let id_counts = placed.mask.id_pixel_counts();
     check_inputs(
-        files,
+        &files.mask,
         settings,
         lut,
         placed.refl.len(),
@@ -250,8 +250,8 @@ fn place_inputs(files: &FrameFiles, inputs: DecodedInputs) -> Result<PlacedInput
 
 /// Checks ids and planes of the mask (placed in the frame) before compositing (that a mask
 /// without planes is not given several passes is checked from its header, `plan`).
-fn check_inputs(
-    files: &FrameFiles,
+pub(crate) fn check_inputs(
+    mask_path: &Path,
     settings: &DecodeSettings,
     lut: &GlassLut,
     refl_count: usize,
@@ -265,7 +265,7 @@ fn check_inputs(
         .collect();
     if !unknown.is_empty() && settings.unknown == UnknownIds::Error {
         return Err(ComposeError::UnknownIds {
-            mask: files.mask.clone(),
+            mask: mask_path.to_path_buf(),
             registry: settings.registry_label.clone(),
             none_known: unknown.len() == id_counts.len(),
             ids: unknown,
@@ -280,7 +280,7 @@ fn check_inputs(
         }
         if let Some((&plane, &pixels)) = per_plane.iter().next() {
             return Err(ComposeError::PlaneWithoutPass {
-                mask: files.mask.clone(),
+                mask: mask_path.to_path_buf(),
                 plane,
                 pixels,
                 passes: refl_count,

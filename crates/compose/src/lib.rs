@@ -16,7 +16,8 @@
 //!
 //! [`compose_frame`] runs them for one image, with per-stage timings for `--stats`;
 //! [`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`. The
-//! viewer runs the first two ([`decode_frame`]), with no output at all.
+//! viewer runs the first two ([`decode_frame`]), with no output at all; [`compose_in_memory`]
+//! composites a host application's arrays with the same checks and kernel, without files.
 
 #![warn(missing_docs)]
 
@@ -24,6 +25,7 @@ pub mod colour;
 mod composite;
 mod decode;
 pub mod error;
+mod in_memory;
 pub mod kernel;
 pub mod lut;
 pub mod memory;
@@ -42,6 +44,10 @@ use glassdb_image::ImageWindows;
 use glassdb_mask::MaskReadOptions;
 use glassdb_pass::{Carry, PassReadOptions};
 use glassdb_side::Side;
+pub use in_memory::{
+    MemoryComposite, MemoryFrame, MemoryLabels, compose_in_memory, interleave,
+    planes_from_interleaved,
+};
 use memory::{MemoryBudget, MemoryEstimate};
 pub use plan::DecodeTarget;
 
