@@ -266,3 +266,39 @@ def test_blender_loads_the_wheel(tmp_path):
     import glassdb_python_example as example
     want = example.composite_frame(B34, reg)
     assert got["composite_sum"] == float(want.astype(np.float64).sum())
+
+
+def test_stubs_match_the_module():
+    """Every public name of the extension is in its .pyi, with the same parameters, and has a
+    docstring."""
+    import ast
+    import inspect
+
+    from glassdb import _glassdb
+
+    stub = ast.parse((Path(glassdb.__file__).parent / "_glassdb.pyi").read_text())
+    declared = {}
+    for node in stub.body:
+        if isinstance(node, ast.FunctionDef):
+            declared[node.name] = [a.arg for a in node.args.args + node.args.kwonlyargs]
+        elif isinstance(node, ast.ClassDef):
+            for item in node.body:
+                if isinstance(item, ast.FunctionDef):
+                    args = [a.arg for a in item.args.args + item.args.kwonlyargs]
+                    declared[f"{node.name}.{item.name}"] = [a for a in args if a != "self"]
+            declared[node.name] = None
+    public = [n for n in dir(_glassdb) if not n.startswith("_")]
+    assert sorted(n for n in declared if "." not in n) == sorted(public)
+    for name, params in declared.items():
+        obj = _glassdb
+        for part in name.split("."):
+            obj = getattr(obj, part)
+        assert (obj.__doc__ or "").strip(), f"{name} has no docstring"
+        if params is None or isinstance(obj, property) or not callable(obj):
+            continue
+        try:
+            sig = inspect.signature(obj)
+        except (TypeError, ValueError):
+            continue
+        got = [p for p in sig.parameters if p not in ("self", "cls")]
+        assert got == params, (name, got, params)
