@@ -2,9 +2,12 @@
 crates/compose/benches/in_memory.rs (the same library calls from Rust), so that the two times
 compare the Python binding with the library call (docs/performance.md).
 
-    python python/bench/compose_4k.py [RUNS]
+    python python/bench/compose_4k.py [RUNS] [--no-hugepages]
 
 Prints the median and the smallest of RUNS timed calls (after one warm-up call), in ms.
+numpy asks for transparent huge pages for its large arrays (madvise); Rust's `Vec`s of the
+criterion benchmark get plain 4 KiB pages. `--no-hugepages` turns numpy's request off, so that
+both read their inputs from the same kind of memory.
 """
 
 import statistics
@@ -34,7 +37,11 @@ def frame():
     return pass_(0.1), [pass_(0.05 * (k + 1)) for k in range(3)], mask
 
 
-def main(runs):
+def main(runs, hugepages=True):
+    if not hugepages:
+        from numpy._core import multiarray
+
+        multiarray._set_madvise_hugepage(False)
     trans, refl, mask = frame()
     registry = glassdb.Registry.load()
     glassdb.compose(trans, refl, mask, registry=registry)
@@ -47,4 +54,5 @@ def main(runs):
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 20)
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    main(int(args[0]) if args else 20, hugepages="--no-hugepages" not in sys.argv)
