@@ -27,13 +27,11 @@ for tool in oiiotool /usr/bin/time; do
     }
 done
 
-cargo build --release --quiet --bin compose
-cargo build --release --quiet -p glassdb-compose --example make_bench_inputs --example oiiotool_colormaps
-COMPOSE=target/release/compose
-EXAMPLES=target/release/examples
+# shellcheck source=scripts/bench_common.sh
+. scripts/bench_common.sh
 
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/glassdb-bench.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
+build_compose_and_examples make_bench_inputs oiiotool_colormaps
+make_work_dir glassdb-bench
 
 # CHSUM_WEIGHTS, R_KNOTS, T_KNOTS for ids 0…6.
 eval "$("$EXAMPLES/oiiotool_colormaps" 6)"
@@ -53,10 +51,9 @@ timed() {
 # Keeps the smaller time of "SECONDS RSS" pairs read on stdin.
 best() { sort -n | head -1; }
 
-echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), oiiotool $(oiiotool --version), threads $THREADS"
-echo
-echo "| size | passes | compose (s) | oiiotool (s) | speed-up | compose RSS (MB) | oiiotool RSS (MB) | max abs diff |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "machine: $(machine_and_peer), threads $THREADS"
+markdown_header size passes "compose (s)" "oiiotool (s)" speed-up "compose RSS (MB)" \
+    "oiiotool RSS (MB)" "max abs diff"
 for size in $SIZES; do
     w=${size%x*}
     h=${size#*x}
@@ -79,11 +76,8 @@ for size in $SIZES; do
         done
         read -r c_s c_rss < <(printf '%s\n' "${c_runs[@]}" | best)
         read -r o_s o_rss < <(printf '%s\n' "${o_runs[@]}" | best)
-        # Largest |compose − oiiotool| over all pixels and channels (scaled by 1e6 because
-        # --printstats prints 6 decimals).
-        max_diff=$(oiiotool "$dir/compose.exr" "$dir/oiiotool.exr" --absdiff --mulc 1e6 --printstats |
-            awk '/Stats Max/ { m = 0; for (i = 3; i <= 5; i++) if ($i > m) m = $i; printf "%.2g", m / 1e6 }')
-        speedup=$(awk -v a="$o_s" -v b="$c_s" 'BEGIN { printf "%.2f", a / b }')
+        max_diff=$(max_abs_diff "$dir/compose.exr" "$dir/oiiotool.exr")
+        speedup=$(ratio "$o_s" "$c_s")
         echo "| ${w}×${h} | $type, $comp | $c_s | $o_s | ${speedup}× | $c_rss | $o_rss | ${max_diff:-?} |"
         rm -rf "$dir"
     done

@@ -19,15 +19,11 @@ TYPES=${TYPES:-"half float"}
 PLANES=${PLANES:-17}
 REPEATS=${REPEATS:-5}
 THREADS=${THREADS:-$(nproc)}
-TARGET=${CARGO_TARGET_DIR:-target}
+# shellcheck source=scripts/bench_common.sh
+. scripts/bench_common.sh
 
-cargo build --release --quiet --bin compose
-cargo build --release --quiet -p glassdb-compose --example make_plane_bench_inputs --example oiiotool_colormaps
-COMPOSE=$TARGET/release/compose
-EXAMPLES=$TARGET/release/examples
-
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/glassdb-planes.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
+build_compose_and_examples make_plane_bench_inputs oiiotool_colormaps
+make_work_dir glassdb-planes
 eval "$("$EXAMPLES/oiiotool_colormaps" 6)"
 
 # Runs "$@"; prints "SECONDS MAX_RSS_MIB" from GNU time's verbose report.
@@ -42,10 +38,9 @@ measure() {
 }
 median() { sort -n | awk '{ v[NR] = $0 } END { print v[int((NR + 1) / 2)] }'; }
 
-echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), oiiotool $(oiiotool --version), threads $THREADS, $PLANES planes, ZIP, medians of $REPEATS paired runs; load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
-echo
-echo "| size | samples | case | compose (s) | compose RSS (MiB) | oiiotool (s) | oiiotool RSS (MiB) | speed-up | max abs diff to oiiotool |"
-echo "|---|---|---|---|---|---|---|---|---|"
+echo "machine: $(machine_and_peer), threads $THREADS, $PLANES planes, ZIP, medians of $REPEATS paired runs; load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+markdown_header size samples case "compose (s)" "compose RSS (MiB)" "oiiotool (s)" \
+    "oiiotool RSS (MiB)" speed-up "max abs diff to oiiotool"
 for size in $SIZES; do
     w=${size%x*}
     h=${size#*x}
@@ -79,20 +74,16 @@ for size in $SIZES; do
             runs[o_crop]+="$(measure oiiotool --threads "$THREADS" "$d/mask_planes.png" "${composite[@]}" "${oiio_crop[@]}" --mul --swap --colormap "$T_KNOTS" "$d/trans.exr" --mul --add -d "$type" --compression zip -o "$d/o_crop.exr")"$'\n'
         done
         med() { printf '%s' "${runs[$1]}" | awk 'NF' | cut -d' ' -f"$2" | median; }
-        max_diff() {
-            oiiotool "$1" "$2" --absdiff --mulc 1e6 --printstats |
-                awk '/Stats Max/ { m = 0; for (i = 3; i <= 5; i++) if ($i > m) m = $i; printf "%.2g", m / 1e6 }'
-        }
         row() { # LABEL COMPOSE_KEY OIIO_KEY COMPOSE_OUT OIIO_OUT
             local cs cr os or
             cs=$(med "$2" 1) cr=$(med "$2" 2) os=$(med "$3" 1) or=$(med "$3" 2)
-            echo "| ${w}×${h} | $type | $1 | $cs | $cr | $os | $or | $(awk -v a="$os" -v b="$cs" 'BEGIN { printf "%.2f", a / b }')× | $(max_diff "$4" "$5") |"
+            echo "| ${w}×${h} | $type | $1 | $cs | $cr | $os | $or | $(ratio "$os" "$cs")× | $(max_abs_diff "$4" "$5") |"
         }
         row "1 plane, 1 full-frame pass (same glass)" one o_one "$d/c_one.exr" "$d/o_one.exr"
         row "$PLANES planes, full-frame passes" full o_full "$d/c_full.exr" "$d/o_full.exr"
         row "$PLANES planes, cropped passes" crop o_crop "$d/c_crop.exr" "$d/o_crop.exr"
         row "$PLANES planes, one multi-part file of the crops" parts o_crop "$d/c_parts.exr" "$d/o_crop.exr"
-        echo "|  |  | cropped ÷ 1 plane: time $(awk -v a="$(med crop 1)" -v b="$(med one 1)" 'BEGIN { printf "%.2f", a / b }')×, memory $(awk -v a="$(med crop 2)" -v b="$(med one 2)" 'BEGIN { printf "%.2f", a / b }')×; multi-part ÷ 1 plane: time $(awk -v a="$(med parts 1)" -v b="$(med one 1)" 'BEGIN { printf "%.2f", a / b }')×, memory $(awk -v a="$(med parts 2)" -v b="$(med one 2)" 'BEGIN { printf "%.2f", a / b }')× |  |  |  |  |  |  |"
+        echo "|  |  | cropped ÷ 1 plane: time $(ratio "$(med crop 1)" "$(med one 1)")×, memory $(ratio "$(med crop 2)" "$(med one 2)")×; multi-part ÷ 1 plane: time $(ratio "$(med parts 1)" "$(med one 1)")×, memory $(ratio "$(med parts 2)" "$(med one 2)")× |  |  |  |  |  |  |"
         unset runs
         rm -rf "$d"
     done

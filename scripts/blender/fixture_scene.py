@@ -1,9 +1,10 @@
-"""What the fixture scripts of this folder share: their command lines, and the parts of a
-Blender scene each of them builds the same way (node trees on any Blender version, the grey
-world, the EXR output format).
+"""What the Blender scripts of this folder share: their command lines, and the parts of a
+Blender scene each of them builds the same way (materials, nodes and AOVs on any Blender
+version, the grey world, the EXR output format).
 
-Imported by make_mask_fixtures.py, make_pass_fixtures.py and make_reflection_passes.py (each
-puts this folder on `sys.path`). Licence: same as the project, MIT OR Apache-2.0.
+Imported by make_mask_fixtures.py, make_pass_fixtures.py, make_reflection_passes.py,
+make_glassdb_scene.py and render_mask_aovs.py (each puts this folder on `sys.path`).
+Licence: same as the project, MIT OR Apache-2.0.
 """
 
 import json
@@ -55,6 +56,54 @@ def set_use_nodes(idblock):
         idblock.use_nodes = True
     if idblock.node_tree is None:
         sys.exit("%s has no node tree" % idblock.name)
+
+
+def new_material(name, pass_index):
+    """A material `name` with pass index `pass_index` and an emptied node tree holding only its
+    Material Output (at (300, 0)); returns (material, node tree, output node)."""
+    import bpy
+
+    mat = bpy.data.materials.new(name)
+    set_use_nodes(mat)
+    mat.pass_index = pass_index
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    out.location = (300, 0)
+    return mat, nt, out
+
+
+def new_node(nt, kind, location, operation=None):
+    """A node of type `kind` (`ShaderNodeMath`, …) in node tree `nt` at `location`, with its
+    `operation` set when one is given."""
+    node = nt.nodes.new(kind)
+    if operation is not None:
+        node.operation = operation
+    node.location = location
+    return node
+
+
+def aov_output(nt, name, location):
+    """An AOV Output node of node tree `nt` writing the AOV `name`."""
+    aov = nt.nodes.new("ShaderNodeOutputAOV")
+    aov.location = location
+    if "aov_name" in aov.bl_rna.properties:
+        aov.aov_name = name
+    else:  # Blender 3.x: the node's `name` property is the AOV name
+        aov.name = name
+    return aov
+
+
+def facing_aov(nt, at=(-200, -300)):
+    """The AOV `facing` = |N . I| from a Geometry node, its output node at `at`."""
+    x, y = at
+    geo = new_node(nt, "ShaderNodeNewGeometry", (x - 600, y))
+    dot = new_node(nt, "ShaderNodeVectorMath", (x - 400, y), "DOT_PRODUCT")
+    ab = new_node(nt, "ShaderNodeMath", (x - 200, y), "ABSOLUTE")
+    nt.links.new(geo.outputs["Normal"], dot.inputs[0])
+    nt.links.new(geo.outputs["Incoming"], dot.inputs[1])
+    nt.links.new(dot.outputs["Value"], ab.inputs[0])
+    nt.links.new(ab.outputs["Value"], aov_output(nt, "facing", at).inputs["Value"])
 
 
 def grey_world(scene):
@@ -109,6 +158,19 @@ def fixed_cycles(scene):
     if hasattr(vl, "cycles"):
         vl.cycles.use_denoising = False
     return r
+
+
+def interior(mask, radius):
+    """The pixels of the boolean image `mask` whose whole (2·radius + 1)² neighbourhood is in
+    `mask` (outside the image counts as outside the mask)."""
+    import numpy as np
+
+    pad = np.pad(mask, radius, constant_values=False)
+    inner = np.ones_like(mask)
+    for dy in range(2 * radius + 1):
+        for dx in range(2 * radius + 1):
+            inner &= pad[dy:dy + mask.shape[0], dx:dx + mask.shape[1]]
+    return inner
 
 
 def write_json(path, doc):

@@ -29,6 +29,9 @@ import sys
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fixture_scene  # noqa: E402
+
 # name: (rgb, roughness, pass index); glass materials are placeholders the pipeline replaces.
 MATERIALS = {
     "Floor": ((0.40, 0.36, 0.30), 0.8, 0),
@@ -175,11 +178,7 @@ def render_index(scene, out_dir):
     vl.use_pass_material_index = True
     scene.cycles.samples = 1
     scene.cycles.filter_width = 0.01
-    im = scene.render.image_settings
-    if hasattr(im, "media_type"):
-        im.media_type = "MULTI_LAYER_IMAGE"
-    im.file_format = "OPEN_EXR_MULTILAYER"
-    im.color_depth = "32"
+    fixture_scene.set_exr_format(scene.render.image_settings, multilayer=True, half=False)
     for frame in range(scene.frame_start, scene.frame_end + 1):
         scene.frame_set(frame)
         scene.render.filepath = os.path.join(out_dir, "index.%04d.exr" % frame)

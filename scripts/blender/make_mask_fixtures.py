@@ -50,7 +50,6 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fixture_scene  # noqa: E402
-from fixture_scene import set_use_nodes  # noqa: E402
 
 # --------------------------------------------------------------------------------------------
 # The scene, as plain data (metres, z up). Every coordinate is a multiple of 1/8, so it is
@@ -292,15 +291,6 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
     version = tuple(bpy.app.version)
     scene = bpy.context.scene
 
-    def aov_out(nt, name, location):
-        aov = nt.nodes.new("ShaderNodeOutputAOV")
-        aov.location = location
-        if "aov_name" in aov.bl_rna.properties:
-            aov.aov_name = name
-        else:  # Blender 3.x: the node's `name` property is the AOV name
-            aov.name = name
-        return aov
-
     def input_named(node, *names):
         for n in names:
             if n in node.inputs:
@@ -313,40 +303,21 @@ def render_all(out_dir, geo_dir, write_geometry, working_space=None):
     # materials have no AOV node (their samples add 0).
     mats = {}
     for name, (kind, rgb, pass_index) in MATERIALS.items():
-        mat = bpy.data.materials.new(name)
-        set_use_nodes(mat)
-        mat.pass_index = pass_index
-        nt = mat.node_tree
-        nt.nodes.clear()
-        out = nt.nodes.new("ShaderNodeOutputMaterial")
-        out.location = (300, 0)
+        mat, nt, out = fixture_scene.new_material(name, pass_index)
         if kind == "glass":
             bsdf = nt.nodes.new("ShaderNodeBsdfPrincipled")
             bsdf.inputs["Base Color"].default_value = (*rgb, 1.0)
             bsdf.inputs["Roughness"].default_value = 0.0
             bsdf.inputs["IOR"].default_value = 1.5
             input_named(bsdf, "Transmission Weight", "Transmission").default_value = 1.0
-            geo = nt.nodes.new("ShaderNodeNewGeometry")
-            geo.location = (-800, -300)
-            dot = nt.nodes.new("ShaderNodeVectorMath")
-            dot.operation = "DOT_PRODUCT"
-            dot.location = (-600, -300)
-            ab = nt.nodes.new("ShaderNodeMath")
-            ab.operation = "ABSOLUTE"
-            ab.location = (-400, -300)
-            nt.links.new(geo.outputs["Normal"], dot.inputs[0])
-            nt.links.new(geo.outputs["Incoming"], dot.inputs[1])
-            nt.links.new(dot.outputs["Value"], ab.inputs[0])
-            nt.links.new(ab.outputs["Value"], aov_out(nt, "facing", (-200, -300)).inputs["Value"])
-            info = nt.nodes.new("ShaderNodeObjectInfo")
-            info.location = (-800, -600)
-            sub = nt.nodes.new("ShaderNodeMath")
-            sub.operation = "SUBTRACT"
-            sub.location = (-400, -600)
+            fixture_scene.facing_aov(nt, at=(-200, -300))
+            info = fixture_scene.new_node(nt, "ShaderNodeObjectInfo", (-800, -600))
+            sub = fixture_scene.new_node(nt, "ShaderNodeMath", (-400, -600), "SUBTRACT")
             sub.inputs[1].default_value = 1.0
             nt.links.new(info.outputs["Object Index"], sub.inputs[0])
-            nt.links.new(sub.outputs["Value"], aov_out(nt, "plane", (-200, -600)).inputs["Value"])
-            cov = aov_out(nt, "glass_coverage", (-200, -900))
+            plane_aov = fixture_scene.aov_output(nt, "plane", (-200, -600))
+            nt.links.new(sub.outputs["Value"], plane_aov.inputs["Value"])
+            cov = fixture_scene.aov_output(nt, "glass_coverage", (-200, -900))
             cov.inputs["Value"].default_value = 1.0
         else:
             bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
@@ -954,11 +925,7 @@ def check_all(out_dir, geo_dir):
                     problems.append("%s: id %d touches the frame edge" % (fname, gid))
         notch = notch_pixels(polys, cam, pane_poly[1])
         # Notch pixels well inside (3x3 neighbourhood all notch): not one of them may be the U.
-        pad = np.pad(notch, 1)
-        inner = np.ones_like(notch)
-        for dy in range(3):
-            for dx in range(3):
-                inner &= pad[dy:dy + notch.shape[0], dx:dx + notch.shape[1]]
+        inner = fixture_scene.interior(notch, 1)
         entry["u_notch"] = {
             "pixels": int(np.count_nonzero(notch)),
             "interior_pixels": int(np.count_nonzero(inner)),

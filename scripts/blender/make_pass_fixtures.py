@@ -32,7 +32,6 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fixture_scene  # noqa: E402
-from fixture_scene import set_use_nodes  # noqa: E402
 
 WIDTH, HEIGHT = 64, 48
 SAMPLES = 4
@@ -80,35 +79,8 @@ def render_all(out_dir):
     version = tuple(bpy.app.version)
     scene = bpy.context.scene
 
-    def add_facing_aov(nt, at_x=-200):
-        """AOV `facing` = |N . I| from a Geometry node."""
-        geo = nt.nodes.new("ShaderNodeNewGeometry")
-        geo.location = (at_x - 600, -300)
-        dot = nt.nodes.new("ShaderNodeVectorMath")
-        dot.operation = "DOT_PRODUCT"
-        dot.location = (at_x - 400, -300)
-        ab = nt.nodes.new("ShaderNodeMath")
-        ab.operation = "ABSOLUTE"
-        ab.location = (at_x - 200, -300)
-        aov = nt.nodes.new("ShaderNodeOutputAOV")
-        aov.location = (at_x, -300)
-        if "aov_name" in aov.bl_rna.properties:
-            aov.aov_name = "facing"
-        else:  # Blender 2.9x
-            aov.name = "facing"
-        nt.links.new(geo.outputs["Normal"], dot.inputs[0])
-        nt.links.new(geo.outputs["Incoming"], dot.inputs[1])
-        nt.links.new(dot.outputs["Value"], ab.inputs[0])
-        nt.links.new(ab.outputs["Value"], aov.inputs["Value"])
-
     def make_material(name, rgb, pass_index, principled):
-        mat = bpy.data.materials.new(name)
-        set_use_nodes(mat)
-        mat.pass_index = pass_index
-        nt = mat.node_tree
-        nt.nodes.clear()
-        out = nt.nodes.new("ShaderNodeOutputMaterial")
-        out.location = (300, 0)
+        mat, nt, out = fixture_scene.new_material(name, pass_index)
         if principled:
             bsdf = nt.nodes.new("ShaderNodeBsdfPrincipled")
             bsdf.inputs["Base Color"].default_value = (*rgb, 1.0)
@@ -117,7 +89,7 @@ def render_all(out_dir):
             bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
             bsdf.inputs["Color"].default_value = (*rgb, 1.0)
         nt.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-        add_facing_aov(nt)
+        fixture_scene.facing_aov(nt)
         return mat
 
     def add_plane(name, size, location, rotation_deg, mat, pass_index):
@@ -459,11 +431,7 @@ def pixel_summary(path):
             if facing and entry["pixels"]:
                 # Interior: the 3x3 neighbourhood has the same id (no edge pixels, whose
                 # facing value averages samples that hit other surfaces or nothing).
-                pad = np.pad(sel, 1, constant_values=False)
-                inner = np.ones_like(sel)
-                for dy in (0, 1, 2):
-                    for dx in (0, 1, 2):
-                        inner &= pad[dy:dy + sel.shape[0], dx:dx + sel.shape[1]]
+                inner = fixture_scene.interior(sel, 1)
                 entry["interior_pixels"] = int(np.count_nonzero(inner))
                 if entry["interior_pixels"]:
                     fi = chans[facing].astype(np.float64)[inner]

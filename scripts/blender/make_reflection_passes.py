@@ -235,28 +235,17 @@ def render_reflections(out_dir, geo_dir, scratch, working_space=None):
         nt = mat.node_tree
         out = [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputMaterial"][0]
         bsdf = [n for n in nt.nodes if n.bl_idname in bsdf_types][0]
-        geo = nt.nodes.new("ShaderNodeNewGeometry")
-        geo.location = (-1000, 400)
-        dot = nt.nodes.new("ShaderNodeVectorMath")
-        dot.operation = "DOT_PRODUCT"
-        dot.location = (-800, 400)
-        add = nt.nodes.new("ShaderNodeMath")
-        add.operation = "ADD"
-        add.location = (-600, 400)
-        gt = nt.nodes.new("ShaderNodeMath")
-        gt.operation = "GREATER_THAN"
+        new_node = fixture_scene.new_node
+        geo = new_node(nt, "ShaderNodeNewGeometry", (-1000, 400))
+        dot = new_node(nt, "ShaderNodeVectorMath", (-800, 400), "DOT_PRODUCT")
+        add = new_node(nt, "ShaderNodeMath", (-600, 400), "ADD")
+        gt = new_node(nt, "ShaderNodeMath", (-400, 400), "GREATER_THAN")
         gt.inputs[1].default_value = 0.0
-        gt.location = (-400, 400)
-        lp = nt.nodes.new("ShaderNodeLightPath")
-        lp.location = (-400, 700)
-        mul = nt.nodes.new("ShaderNodeMath")
-        mul.operation = "MULTIPLY"
-        mul.location = (-200, 400)
-        tr = nt.nodes.new("ShaderNodeBsdfTransparent")
+        lp = new_node(nt, "ShaderNodeLightPath", (-400, 700))
+        mul = new_node(nt, "ShaderNodeMath", (-200, 400), "MULTIPLY")
+        tr = new_node(nt, "ShaderNodeBsdfTransparent", (0, 200))
         tr.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-        tr.location = (0, 200)
-        mix = nt.nodes.new("ShaderNodeMixShader")
-        mix.location = (150, 0)
+        mix = new_node(nt, "ShaderNodeMixShader", (150, 0))
         nt.links.new(geo.outputs["Position"], dot.inputs[0])
         nt.links.new(dot.outputs["Value"], add.inputs[0])
         nt.links.new(add.outputs["Value"], gt.inputs[0])
@@ -578,11 +567,7 @@ def check_reflections(out_dir, geo_dir, scratch):
                                for c in "RGB"], axis=-1)
             o_, dirs = mmf.camera_rays(cam)
             floor = ref == CHECK_IDS["Floor"]
-            padf = np.pad(floor, 2)
-            floor_in = np.ones_like(floor)
-            for dy in range(5):
-                for dx in range(5):
-                    floor_in &= padf[dy:dy + floor.shape[0], dx:dx + floor.shape[1]]
+            floor_in = fixture_scene.interior(floor, 2)
             to_sun = -np.array(info["sun_direction"])
             occluders = [np.array(pp) for o, _m, pp in opaque if o in hidden]
             shadow = np.zeros_like(floor)
@@ -626,13 +611,7 @@ def check_reflections(out_dir, geo_dir, scratch):
         panes = [np.array(pp) for _o, m_, pp in polys if m_ in mmf.GLASS_IDS]
 
         def interior(img, value):
-            msk = img == value
-            pad_ = np.pad(msk, 2)
-            out_ = np.ones_like(msk)
-            for dy in range(5):
-                for dx in range(5):
-                    out_ &= pad_[dy:dy + msk.shape[0], dx:dx + msk.shape[1]]
-            return out_
+            return fixture_scene.interior(img == value, 2)
 
         # Per pixel of the pass: its point Q, and what shades Q from the sun (0 nothing, 1 an
         # opaque object, 2 a pane); pixels next to a different class are left out (shadow
@@ -697,11 +676,7 @@ def check_reflections(out_dir, geo_dir, scratch):
         # index render (the 1.5 px filter's samples stay well inside it) have exactly the
         # world colour in the pass; alpha 1 everywhere.
         world = ob == 0
-        pad = np.pad(world, 2)
-        inner = np.ones_like(world)
-        for dy in range(5):
-            for dx in range(5):
-                inner &= pad[dy:dy + world.shape[0], dx:dx + world.shape[1]]
+        inner = fixture_scene.interior(world, 2)
         entry["combined"] = {
             "alpha_min": float(alpha.min()), "alpha_max": float(alpha.max()),
             "world_interior_pixels": int(np.count_nonzero(inner)),

@@ -10,18 +10,13 @@ one Cycles render of a frame with Cryptomatte Material (6 levels) and the shader
 Licence: same as the project, MIT OR Apache-2.0.
 """
 
+import os
 import sys
 
 import bpy
 
-
-def aov_out(nt, name):
-    aov = nt.nodes.new("ShaderNodeOutputAOV")
-    if "aov_name" in aov.bl_rna.properties:
-        aov.aov_name = name
-    else:  # Blender 3.x: the node's `name` is the AOV name
-        aov.name = name
-    return aov
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fixture_scene  # noqa: E402
 
 
 def main():
@@ -37,16 +32,9 @@ def main():
     scene = bpy.context.scene
     for name, k in planes.items():
         nt = bpy.data.materials[name].node_tree
-        geo = nt.nodes.new("ShaderNodeNewGeometry")
-        dot = nt.nodes.new("ShaderNodeVectorMath")
-        dot.operation = "DOT_PRODUCT"
-        nt.links.new(geo.outputs["Normal"], dot.inputs[0])
-        nt.links.new(geo.outputs["Incoming"], dot.inputs[1])
-        ab = nt.nodes.new("ShaderNodeMath")
-        ab.operation = "ABSOLUTE"
-        nt.links.new(dot.outputs["Value"], ab.inputs[0])
-        nt.links.new(ab.outputs["Value"], aov_out(nt, "facing").inputs["Value"])
-        aov_out(nt, "plane").inputs["Value"].default_value = k
+        fixture_scene.facing_aov(nt)
+        plane = fixture_scene.aov_output(nt, "plane", (-200, -600))
+        plane.inputs["Value"].default_value = k
     vl = scene.view_layers[0]
     vl.use_pass_cryptomatte_material = True
     vl.pass_cryptomatte_depth = 6
@@ -58,11 +46,7 @@ def main():
     scene.cycles.seed = int(opts.get("--seed", 0))
     scene.render.threads_mode = "FIXED"
     scene.render.threads = 2
-    im = scene.render.image_settings
-    if hasattr(im, "media_type"):
-        im.media_type = "MULTI_LAYER_IMAGE"
-    im.file_format = "OPEN_EXR_MULTILAYER"
-    im.color_depth = "32"
+    fixture_scene.set_exr_format(scene.render.image_settings, multilayer=True, half=False)
     scene.frame_set(int(opts.get("--frame", 1)))
     scene.render.use_file_extension = False
     scene.render.filepath = opts["--out"]

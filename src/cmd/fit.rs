@@ -350,25 +350,16 @@ pub fn run_eval(args: EvalArgs) -> anyhow::Result<ExitCode> {
                 let mut o = serde_json::Map::new();
                 o.insert("name".into(), g.name.clone().into());
                 o.insert("angle_deg".into(), angles.clone().into());
-                if let Some(c) = &g.reflectance {
-                    o.insert(
-                        "reflectance".into(),
-                        angles
-                            .iter()
-                            .map(|&a| c.eval_angle_deg(a))
-                            .collect::<Vec<_>>()
-                            .into(),
-                    );
-                }
-                if let Some(c) = &g.transmittance {
-                    o.insert(
-                        "transmittance".into(),
-                        angles
-                            .iter()
-                            .map(|&a| c.eval_angle_deg(a))
-                            .collect::<Vec<_>>()
-                            .into(),
-                    );
+                let curves = [
+                    ("reflectance", &g.reflectance),
+                    ("transmittance", &g.transmittance),
+                ];
+                for (key, curve) in curves {
+                    if let Some(c) = curve {
+                        let values: Vec<f64> =
+                            angles.iter().map(|&a| c.eval_angle_deg(a)).collect();
+                        o.insert(key.into(), values.into());
+                    }
                 }
                 serde_json::Value::Object(o)
             })

@@ -210,11 +210,7 @@ pub fn run_mirror(args: MirrorArgs) -> anyhow::Result<ExitCode> {
 
 /// The mask format from `--format` or the output's extension.
 fn mask_format(output: &Path, format: Option<FormatArg>) -> anyhow::Result<MaskFormat> {
-    let ext = output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let by_ext = match ext.as_deref() {
+    let by_ext = match glassdb_io::lowercase_extension(output).as_deref() {
         Some("png") => Some(MaskFormat::Png8),
         Some("exr") => Some(MaskFormat::Exr),
         _ => None,

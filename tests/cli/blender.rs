@@ -11,7 +11,7 @@ use std::sync::OnceLock;
 
 use crate::util::{
     Planes, fails, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path,
-    write_executable, write_file,
+    send_signal, write_executable, write_file,
 };
 
 /// The tiny scene, its facts, Cycles' index renders and two glassdb runs (seeds 0 and 1).
@@ -611,12 +611,7 @@ fn a_stopped_or_timed_out_render_leaves_no_blender_running() {
             .unwrap();
         let both: Vec<String> = pid_in(&pids).split(' ').map(str::to_string).collect();
         assert!(both.iter().all(|p| running(p)), "{both:?}");
-        let sent = Command::new("kill")
-            .arg(format!("-{signal}"))
-            .arg(child.id().to_string())
-            .status()
-            .unwrap();
-        assert!(sent.success());
+        send_signal(&child, signal);
         assert_eq!(child.wait().unwrap().code(), Some(code), "SIG{signal}");
         assert_stop(&both, &format!("SIG{signal}"));
     }

@@ -3,14 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use glassdb_encode::{ExrDataType, OutputOptions};
-use glassdb_image::ExrSampleType;
+use glassdb_encode::OutputOptions;
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 use glassdb_pass::{LinearImage, PassSource, PngBits};
 
 use crate::util::{
     Planes, compose, fails, fails_naming, glassdb, ok, read_exr_planes, read_png_planes, run,
-    write_pass,
+    write_pass, write_rgb,
 };
 
 /// A constant curve C = 1 (so r = r0 and t = t0 at every angle).
@@ -52,32 +51,6 @@ fn write_registry(dir: &Path) -> PathBuf {
     let p = dir.join("registry.json");
     std::fs::write(&p, serde_json::to_string_pretty(&reg).unwrap()).unwrap();
     p
-}
-
-fn float_src() -> PassSource {
-    PassSource::Exr {
-        sample_type: ExrSampleType::Float,
-        compression: exr::compression::Compression::ZIP16,
-        layer: String::new(),
-        part: 0,
-        channel_names: vec!["R".into(), "G".into(), "B".into()],
-    }
-}
-
-/// Writes a float EXR (or PNG, by extension) from per-pixel RGB values, row-major.
-fn write_image(path: &Path, w: u32, h: u32, px: &[[f32; 3]]) {
-    let img = LinearImage {
-        width: w,
-        height: h,
-        rgb: [0, 1, 2].map(|c| px.iter().map(|p| p[c]).collect()),
-        alpha: None,
-    };
-    let opts = OutputOptions {
-        exr_data_type: Some(ExrDataType::Float),
-        dither: false,
-        ..OutputOptions::default()
-    };
-    write_pass(path, img, &float_src(), &opts).unwrap();
 }
 
 /// The channel of an output EXR whose name is `name` or ends in `.name`, read with the `exr`
@@ -161,8 +134,8 @@ fn golden() -> Golden {
     let registry = write_registry(dir.path());
     let trans = dir.path().join("t.exr");
     let refl = dir.path().join("r.exr");
-    write_image(&trans, 3, 1, &[[1.0, 2.0, 4.0]; 3]);
-    write_image(&refl, 3, 1, &[[8.0; 3]; 3]);
+    write_rgb(&trans, 3, 1, &[[1.0, 2.0, 4.0]; 3]);
+    write_rgb(&refl, 3, 1, &[[8.0; 3]; 3]);
     Golden {
         dir,
         registry,
@@ -329,7 +302,7 @@ fn golden_two_planes_with_back_side() {
     // (r = 0.5): R = 1·0.5 + 2·0.5 = 1.5, G = 2·0.25 + 2·0.5 = 1.5, B = 4·0.125 + 1 = 1.5.
     let g = golden();
     let r2 = g.path("r2.exr");
-    write_image(&r2, 3, 1, &[[2.0; 3]; 3]);
+    write_rgb(&r2, 3, 1, &[[2.0; 3]; 3]);
     let m = g.mask8("m.png", vec![0, 1, 1], vec![255; 3], vec![0, 0, 1]);
     let out = g.path("o.exr");
     ok(g.cmd(&m, &out)
@@ -564,7 +537,7 @@ fn sequences_report_bad_frames_and_go_on() {
             &g.path(&format!("m.{f:04}.png")),
             mask8(3, 1, vec![0, 1, 1], vec![255; 3], vec![0; 3]),
         );
-        write_image(
+        write_rgb(
             &g.path(&format!("t.{f:04}.exr")),
             3,
             1,
@@ -610,7 +583,7 @@ fn sequences_report_bad_frames_and_go_on() {
 fn passes_of_different_sizes_name_both_files_and_sizes() {
     let g = golden();
     let small = g.path("small.exr");
-    write_image(&small, 2, 1, &[[1.0; 3]; 2]);
+    write_rgb(&small, 2, 1, &[[1.0; 3]; 2]);
     let m = g.mask8("m.png", vec![0; 3], vec![0; 3], vec![0; 3]);
     let mut c = g.cmd_with(&small, &g.trans, &m, g.path("o.exr"));
     let err = fails(&mut c);
@@ -650,13 +623,13 @@ fn unknown_ids_are_listed_with_pixel_counts_unless_passed_through() {
 #[test]
 fn nan_in_a_pass_is_counted_reported_and_propagated() {
     let g = golden();
-    write_image(
+    write_rgb(
         &g.trans,
         3,
         1,
         &[[f32::NAN, 2.0, 4.0], [1.0, 2.0, 4.0], [1.0, 2.0, 4.0]],
     );
-    write_image(
+    write_rgb(
         &g.refl,
         3,
         1,

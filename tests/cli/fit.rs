@@ -8,8 +8,8 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::util::{
-    CURVE_FIT_STATS, assert_names, fails, fails_naming, glassdb, ok, repo_path, run, run_oracle,
-    write_file,
+    CURVE_FIT_STATS, assert_names, doc_after, fails, fails_naming, glassdb, ok, repo_path, run,
+    run_oracle, write_file,
 };
 
 #[path = "../../crates/fit/tests/common/inputs.rs"]
@@ -566,11 +566,7 @@ fn bundled_angle_tables_regenerate_byte_for_byte() {
 
 #[test]
 fn docs_first_example_fits_the_flagship_table_without_a_warning() {
-    let doc = std::fs::read_to_string(repo_path("docs/fit.md")).unwrap();
-    let block = doc
-        .split("```sh\n")
-        .nth(1)
-        .expect("docs/fit.md has an sh block");
+    let block = doc_after("docs/fit.md", "```sh\n");
     let first = block.lines().next().unwrap();
     let command = first.split(" # ").next().unwrap();
     let args: Vec<&str> = command.split_whitespace().collect();
@@ -650,17 +646,29 @@ fn a_dropped_digit_is_refused_naming_its_angle_and_line() {
     fails_naming(&mut fit(&table, &[]), &["R = 0.01 at 50° (line 8)"]);
 }
 
+/// The hand table `name` with `row` replaced fails naming `parts`: a lone value above 1 among
+/// fractions is a typo, not a sign of a table in percent. Returns the table.
+fn typo_above_one_fails(
+    dir: &Path,
+    (name, row): (&str, (u32, &str)),
+    parts: &[&str],
+) -> std::path::PathBuf {
+    let table = hand_table(dir, name, Some(row));
+    let e = fails(&mut fit(&table, &[]));
+    assert_names(&e, parts);
+    assert!(!e.contains("if the table is in percent"), "{e}");
+    table
+}
+
 #[test]
 fn a_shifted_decimal_point_is_named() {
     let dir = tempfile::tempdir().unwrap();
     // 0.80 written 8.0: a single value above 1 among fractions is a typo, not a percent table
-    let table = hand_table(dir.path(), "up.csv", Some((50, "0.100,8.0")));
-    let e = fails(&mut fit(&table, &[]));
-    assert_names(
-        &e,
+    typo_above_one_fails(
+        dir.path(),
+        ("up.csv", (50, "0.100,8.0")),
         &["up.csv", "line 8, column 3 (T): 8", "shifted decimal point"],
     );
-    assert!(!e.contains("if the table is in percent"), "{e}");
     // 0.80 written 0.080
     let table = hand_table(dir.path(), "down.csv", Some((50, "0.100,0.080")));
     fails_naming(
@@ -701,13 +709,11 @@ fn r_and_t_swapped_on_a_row_are_named() {
 #[test]
 fn a_percent_value_in_a_fraction_column_is_named() {
     let dir = tempfile::tempdir().unwrap();
-    let table = hand_table(dir.path(), "pct.csv", Some((50, "0.100,80")));
-    let e = fails(&mut fit(&table, &[]));
-    assert_names(
-        &e,
+    let table = typo_above_one_fails(
+        dir.path(),
+        ("pct.csv", (50, "0.100,80")),
         &["pct.csv", "line 8, column 3 (T): 80", "a percent value"],
     );
-    assert!(!e.contains("if the table is in percent"), "{e}");
     // --percent, as the old hint said, would read every other value a hundred times too small
     fails_naming(
         &mut fit(&table, &["--percent"]),

@@ -10,7 +10,9 @@
 
 use std::path::PathBuf;
 
-use crate::util::{compose, fails, fails_naming, ok, read_exr_planes, repo_path, run_oracle};
+use crate::util::{
+    atrium_planes_file, compose, doc_after, fails, fails_naming, ok, read_exr_planes, repo_path,
+};
 
 /// CRC-32 (ISO-HDLC, PNG's chunk checksum).
 fn crc32(bytes: &[u8]) -> u32 {
@@ -306,21 +308,7 @@ fn frames_of_a_sequence_share_the_limit_and_one_over_it_fails_alone() {
 /// A multi-part `--refl` of many planes (written by OpenEXR: the atrium's three passes, then
 /// 1×1 parts up to `parts`), in `dir`.
 fn padded_planes_file(dir: &std::path::Path, parts: usize) -> PathBuf {
-    let a = |f: &str| repo_path("fixtures/atrium").join(f);
-    let out = dir.join(format!("planes{parts}.exr"));
-    let mut args: Vec<std::ffi::OsString> = vec![
-        "parts".into(),
-        "--mask".into(),
-        a("mask.png").into(),
-        "--out".into(),
-        out.clone().into(),
-        "--pad".into(),
-        parts.to_string().into(),
-    ];
-    args.extend((0..3).map(|k| a(&format!("refl_{k}.exr")).into_os_string()));
-    let refs: Vec<&std::ffi::OsStr> = args.iter().map(|s| s.as_os_str()).collect();
-    run_oracle("plane_parts.py", &refs);
-    out
+    atrium_planes_file(&dir.join(format!("planes{parts}.exr")), Some(parts))
 }
 
 /// 300 parts compose as their three real planes do (each pass's headers parsed once for the
@@ -385,11 +373,7 @@ fn input_limits() -> [glassdb_io::InputLimit; 10] {
 
 #[test]
 fn the_documented_table_lists_every_limit_in_order() {
-    let doc = std::fs::read_to_string(repo_path("docs/reliability.md")).unwrap();
-    let table = doc
-        .split("| kind | limit | read by |")
-        .nth(1)
-        .expect("docs/reliability.md has the limits table");
+    let table = doc_after("docs/reliability.md", "| kind | limit | read by |");
     let documented: Vec<&str> = table
         .lines()
         .skip(2)

@@ -210,20 +210,12 @@ fn cryptomatte_errors_name_what_is_missing() {
         err.contains("CryptoLight") && err.contains("ViewLayer.CryptoObject"),
         "{err}"
     );
-    let err = fails(&mut base(&[
-        "--mask-glass",
-        "Glass*=1",
-        "--mask-channels",
-        "cos=Nope",
-    ]));
-    assert!(err.contains("Nope"), "{err}");
-    let err = fails(&mut base(&[
-        "--mask-glass",
-        "Glass*=1",
-        "--mask-channels",
-        "normal=Normal",
-    ]));
-    assert!(err.contains("position="), "{err}");
+    // An unknown channel, and a normal without the position it needs.
+    for (channels, named) in [("cos=Nope", "Nope"), ("normal=Normal", "position=")] {
+        let args = ["--mask-glass", "Glass*=1", "--mask-channels", channels];
+        let err = fails(&mut base(&args));
+        assert!(err.contains(named), "{err}");
+    }
     // The pass fixture's AOV is written by every material: read as glass-only it is refused
     // only where dividing makes it exceed 1; read as written it composites.
     ok(&mut base(&[

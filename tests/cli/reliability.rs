@@ -10,7 +10,8 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::util::{
-    assert_names, compose, fails, glassdb, names, ok, registry_build, repo_path, write_file,
+    assert_names, compose, fails, glassdb, names, ok, registry_build, repo_path, send_signal,
+    write_file,
 };
 
 /// Runs `cmd` (no standard input) and returns its output, failing the test if it runs longer
@@ -557,12 +558,7 @@ fn signal_when(
             return Some((status.code(), stderr));
         }
         if !sent && ready() {
-            let status = Command::new("kill")
-                .arg(format!("-{signal}"))
-                .arg(child.id().to_string())
-                .status()
-                .unwrap();
-            assert!(status.success());
+            send_signal(&child, signal);
             sent = true;
         }
         assert!(

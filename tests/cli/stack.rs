@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::util::{
-    assert_names, fails_naming, glassdb, ok, registry_build, repo_path, run_oracle, write_file,
+    assert_names, fails_naming, glass_where, glassdb, ok, registry_build, repo_path, run_oracle,
+    write_file,
 };
 
 /// The angles every comparison uses: 0–80° in 10° steps.
@@ -273,12 +274,7 @@ fn read_json(path: &Path) -> Value {
 }
 
 fn glass(table: &Value, id: u64) -> &Value {
-    table["glasses"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|g| g["id"] == id)
-        .unwrap_or_else(|| panic!("no glass {id}"))
+    glass_where(table, "id", id)
 }
 
 /// A unit of one layer is that layer's registry entry exactly (turned round when flipped).

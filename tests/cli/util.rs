@@ -79,6 +79,16 @@ pub fn assert_names(text: &str, parts: &[&str]) {
     }
 }
 
+/// The text of the repository's file `rel` (a doc) after the first `marker`; panics naming both
+/// when the marker is not there.
+pub fn doc_after(rel: &str, marker: &str) -> String {
+    let doc = std::fs::read_to_string(repo_path(rel)).unwrap();
+    match doc.split_once(marker) {
+        Some((_, after)) => after.to_string(),
+        None => panic!("{rel} has no {marker:?}"),
+    }
+}
+
 /// `glassdb registry build <catalog> -o <out> [extra…]`.
 pub fn registry_build(catalog: &Path, out: &Path, extra: &[&str]) -> Command {
     let mut cmd = glassdb();
@@ -328,6 +338,33 @@ pub fn write_pass(
     glassdb_encode::write_output(path, image, frame, src, opts)
 }
 
+/// The source a float RGB EXR pass is written like (ZIP16, channels R, G, B, no layer).
+fn float_src() -> glassdb_pass::PassSource {
+    glassdb_pass::PassSource::Exr {
+        sample_type: glassdb_image::ExrSampleType::Float,
+        compression: exr::compression::Compression::ZIP16,
+        layer: String::new(),
+        part: 0,
+        channel_names: vec!["R".into(), "G".into(), "B".into()],
+    }
+}
+
+/// Writes a float EXR (or PNG, by extension) from per-pixel RGB values, row-major.
+pub fn write_rgb(path: &Path, w: u32, h: u32, px: &[[f32; 3]]) {
+    let img = glassdb_pass::LinearImage {
+        width: w,
+        height: h,
+        rgb: [0, 1, 2].map(|c| px.iter().map(|p| p[c]).collect()),
+        alpha: None,
+    };
+    let opts = glassdb_encode::OutputOptions {
+        exr_data_type: Some(glassdb_encode::ExrDataType::Float),
+        dither: false,
+        ..glassdb_encode::OutputOptions::default()
+    };
+    write_pass(path, img, &float_src(), &opts).unwrap();
+}
+
 /// The bundled example's inputs as `compose` takes them, relative to [`example_copy`]'s folder.
 pub const EXAMPLE_INPUTS: [&str; 6] = [
     "--refl",
@@ -337,6 +374,26 @@ pub const EXAMPLE_INPUTS: [&str; 6] = [
     "--mask",
     "mask.png",
 ];
+
+/// The atrium's three reflection passes as one multi-part EXR at `out`, each part cropped to
+/// its plane's glass (written by OpenEXR, `plane_parts.py`), then 1×1 parts up to `pad` parts.
+pub fn atrium_planes_file(out: &Path, pad: Option<usize>) -> PathBuf {
+    let a = |f: &str| repo_path("fixtures/atrium").join(f);
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "parts".into(),
+        "--mask".into(),
+        a("mask.png").into(),
+        "--out".into(),
+        out.into(),
+    ];
+    if let Some(parts) = pad {
+        args.extend(["--pad".into(), parts.to_string().into()]);
+    }
+    args.extend((0..3).map(|k| a(&format!("refl_{k}.exr")).into_os_string()));
+    let refs: Vec<&std::ffi::OsStr> = args.iter().map(|s| s.as_os_str()).collect();
+    run_oracle("plane_parts.py", &refs);
+    out.to_path_buf()
+}
 
 /// A temporary folder holding a copy of `fixtures/example`'s passes and mask.
 pub fn example_copy() -> tempfile::TempDir {
@@ -381,4 +438,32 @@ pub fn names(dir: &Path) -> Vec<String> {
         .collect();
     v.sort();
     v
+}
+
+/// The glass of a registry table (its JSON) whose `key` is `value`; panics naming it when none is.
+pub fn glass_where<'a, V>(
+    table: &'a serde_json::Value,
+    key: &str,
+    value: V,
+) -> &'a serde_json::Value
+where
+    V: std::fmt::Display,
+    serde_json::Value: PartialEq<V>,
+{
+    table["glasses"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|g| g[key] == value)
+        .unwrap_or_else(|| panic!("no glass with {key} {value}"))
+}
+
+/// Sends `SIG<signal>` (`TERM`, `INT`, …) to a started child with `kill`.
+pub fn send_signal(child: &std::process::Child, signal: &str) {
+    let status = Command::new("kill")
+        .arg(format!("-{signal}"))
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(status.success(), "kill -{signal}");
 }

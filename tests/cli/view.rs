@@ -3,11 +3,9 @@
 //! against OpenColorIO applying the same file (python_oracle/cube_oracle.py).
 
 use glassdb_colour::CubeLut;
-use glassdb_encode::{ExrDataType, OutputOptions};
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
-use glassdb_pass::{LinearImage, PassSource};
 
-use crate::util::{compose, fails_naming, ok, read_png_planes, run_oracle, write_pass};
+use crate::util::{compose, fails_naming, ok, read_png_planes, run_oracle, write_rgb};
 
 const W: u32 = 16;
 const H: u32 = 8;
@@ -73,27 +71,10 @@ fn cube_view_matches_opencolorio() {
     let lut_path = d.join("view.cube");
     std::fs::write(&lut_path, lut_text()).unwrap();
     let px = pixels();
-    let image = |px: &[[f32; 3]]| LinearImage {
-        width: W,
-        height: H,
-        rgb: [0, 1, 2].map(|c| px.iter().map(|p| p[c]).collect()),
-        alpha: None,
-    };
-    let float_out = OutputOptions {
-        exr_data_type: Some(ExrDataType::Float),
-        ..OutputOptions::default()
-    };
-    let src = PassSource::Exr {
-        sample_type: glassdb_image::ExrSampleType::Float,
-        compression: exr::compression::Compression::ZIP16,
-        layer: String::new(),
-        part: 0,
-        channel_names: vec!["R".into(), "G".into(), "B".into()],
-    };
     let trans = d.join("t.exr");
     let refl = d.join("r.exr");
-    write_pass(&trans, image(&px), &src, &float_out).unwrap();
-    write_pass(&refl, image(&vec![[0.0; 3]; px.len()]), &src, &float_out).unwrap();
+    write_rgb(&trans, W, H, &px);
+    write_rgb(&refl, W, H, &vec![[0.0; 3]; px.len()]);
     // No glass anywhere: the composite is the transmission pass.
     let mask = d.join("m.png");
     let n = (W * H) as usize;

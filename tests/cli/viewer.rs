@@ -11,7 +11,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
 use crate::util::{
-    fails_naming, glassdb, ok, read_png_planes, registry_build, repo_path, run_oracle,
+    atrium_planes_file, fails_naming, glassdb, ok, read_png_planes, registry_build, repo_path,
+    run_oracle,
 };
 
 const SWAP_ID: u16 = 5;
@@ -786,17 +787,7 @@ fn a_second_frame_with_a_float_mask_gives_composes_pixels() {
 fn a_multi_part_reflection_file_gives_composes_pixels() {
     let dir = tempfile::tempdir().unwrap();
     let a = |f: &str| repo_path("fixtures/atrium").join(f);
-    let parts = dir.path().join("planes.exr");
-    let mut args: Vec<std::ffi::OsString> = vec![
-        "parts".into(),
-        "--mask".into(),
-        a("mask.png").into(),
-        "--out".into(),
-        parts.clone().into(),
-    ];
-    args.extend((0..3).map(|k| a(&format!("refl_{k}.exr")).into_os_string()));
-    let refs: Vec<&std::ffi::OsStr> = args.iter().map(|s| s.as_os_str()).collect();
-    run_oracle("plane_parts.py", &refs);
+    let parts = atrium_planes_file(&dir.path().join("planes.exr"), None);
     let want = compose_png(dir.path(), None, "separate.png");
 
     let mut cmd = glassdb();

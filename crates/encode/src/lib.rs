@@ -45,11 +45,7 @@ pub enum OutputFormat {
 
 /// The output format from the extension (`.exr`, `.png`, any case).
 pub fn output_format(path: &Path) -> Result<OutputFormat, EncodeError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
+    match glassdb_io::lowercase_extension(path).as_deref() {
         Some("exr") => Ok(OutputFormat::Exr),
         Some("png") => Ok(OutputFormat::Png),
         _ => Err(EncodeError::OutputExtension {

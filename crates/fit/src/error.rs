@@ -201,18 +201,15 @@ pub enum FitError {
         header: String,
     },
     /// An angle outside 0–90°.
-    #[error("{path}, line {line}, column {column} ({header}): angle {value}° is outside 0–90°")]
+    #[error(
+        "{path}, line {}, column {} ({}): angle {}° is outside 0–90°",
+        cell.line, cell.column, cell.header, cell.value
+    )]
     AngleOutOfRange {
         /// The file.
         path: PathBuf,
-        /// The line (1-based).
-        line: u64,
-        /// The column (1-based).
-        column: usize,
-        /// The column's header.
-        header: String,
-        /// The value as written.
-        value: f64,
+        /// The angle's cell.
+        cell: CellRef,
     },
     /// Most R and T values are above 1 in a table read as fractions: it is in percent.
     #[error(

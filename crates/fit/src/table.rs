@@ -295,10 +295,12 @@ impl RowReader<'_> {
         if !(0.0..=90.0).contains(&angle_deg) {
             return Err(FitError::AngleOutOfRange {
                 path: self.path.to_path_buf(),
-                line,
-                column: col + 1,
-                header: self.names[col].clone(),
-                value: angle_deg,
+                cell: CellRef {
+                    line,
+                    column: col + 1,
+                    header: self.names[col].clone(),
+                    value: angle_deg,
+                },
             });
         }
         let r = self.value(record, line, self.columns.r)?;

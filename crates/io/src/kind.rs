@@ -1,6 +1,7 @@
 //! What a path names, for messages that refuse an input or output that is not a regular file.
 
 use std::fs::FileType;
+use std::path::Path;
 
 /// The kind of a file system entry.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -72,4 +73,12 @@ impl std::fmt::Display for FileKind {
             FileKind::Other => "not a file",
         })
     }
+}
+
+/// The extension of `path` in lower case (`None`: no extension, or not UTF-8): what readers and
+/// writers choose a format by.
+pub fn lowercase_extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
 }

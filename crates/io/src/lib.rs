@@ -35,7 +35,7 @@ pub use input::{
     InputError, InputLimit, limits, open_input, read_input, read_input_string, read_open_input,
     read_previous_output,
 };
-pub use kind::FileKind;
+pub use kind::{FileKind, lowercase_extension};
 pub use output::{
     OutputError, StagedOutput, SyncingFile, create_output_dirs, refuse_input_as_output,
     write_atomic, write_bytes_atomic,

@@ -25,11 +25,7 @@ pub enum ImageFormat {
 impl ImageFormat {
     /// The format named by `path`'s extension (case-insensitive `png` or `svg`).
     pub fn from_path(path: &Path) -> Result<Self, PlotError> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
+        match glassdb_io::lowercase_extension(path).as_deref() {
             Some("png") => Ok(Self::Png),
             Some("svg") => Ok(Self::Svg),
             _ => Err(PlotError::UnknownFormat {

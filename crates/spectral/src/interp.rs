@@ -188,25 +188,19 @@ impl<'a> Sprague<'a> {
 /// per data sample, per channel, its weight ([`for_each_on_grid`]'s uniform branch with the
 /// values left symbolic: each grid value is the padded values around it times the Sprague
 /// polynomial's coefficients, and each padded end value a combination of six data values).
-pub(crate) fn sprague_kernel(
-    x: &[f64],
-    grid: &[f64],
-    weights: &[[f64; 3]],
-    kernel: &mut Vec<[f64; 3]>,
-) {
+pub(crate) fn sprague_kernel(x: &[f64], grid: &[f64], weights: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let n = x.len();
-    kernel.clear();
-    kernel.resize(n, [0.0; 3]);
+    let mut kernel = vec![[0.0; 3]; n];
     // The nodes only: `Sprague::xp` does not look at the values.
     let sp = Sprague::new(x, x);
-    let add = |kernel: &mut Vec<[f64; 3]>, i: usize, w: &[f64; 3], f: f64| {
+    let add = |kernel: &mut [[f64; 3]], i: usize, w: &[f64; 3], f: f64| {
         let k = &mut kernel[i];
         k[0] += w[0] * f;
         k[1] += w[1] * f;
         k[2] += w[2] * f;
     };
     // padded value j (numpy's wrap-around for j = -1) times f, onto the data samples
-    let add_padded = |kernel: &mut Vec<[f64; 3]>, j: isize, w: &[f64; 3], f: f64| {
+    let add_padded = |kernel: &mut [[f64; 3]], j: isize, w: &[f64; 3], f: f64| {
         let j = if j < 0 { j + n as isize + 4 } else { j } as usize;
         let pad = match j {
             0 => Some((0, 0)),
@@ -228,11 +222,11 @@ pub(crate) fn sprague_kernel(
     for (j, &t) in grid.iter().enumerate() {
         let Some(w) = weights.get(j) else { break };
         if t < x[0] {
-            add(kernel, 0, w, 1.0);
+            add(&mut kernel, 0, w, 1.0);
             continue;
         }
         if t > x[n - 1] {
-            add(kernel, n - 1, w, 1.0);
+            add(&mut kernel, n - 1, w, 1.0);
             continue;
         }
         while cnt < sp.len_padded() && sp.xp(cnt) < t {
@@ -251,9 +245,10 @@ pub(crate) fn sprague_kernel(
             }
         }
         for (m, c) in coefficients.iter().enumerate() {
-            add_padded(kernel, i as isize - 2 + m as isize, w, *c);
+            add_padded(&mut kernel, i as isize - 2 + m as isize, w, *c);
         }
     }
+    kernel
 }
 
 thread_local! {
@@ -426,7 +421,7 @@ mod tests {
     }
 
     /// `sprague_kernel` or `spline_kernel`.
-    type KernelBuilder = fn(&[f64], &[f64], &[[f64; 3]], &mut Vec<[f64; 3]>);
+    type KernelBuilder = fn(&[f64], &[f64], &[[f64; 3]]) -> Vec<[f64; 3]>;
 
     /// `Σ kernel·y` against the direct evaluation of the same interpolant onto `grid`, for a
     /// wiggly spectrum on `x` and arbitrary weights.
@@ -451,8 +446,7 @@ mod tests {
                 *d += w * v;
             }
         });
-        let mut kernel = Vec::new();
-        build(x, grid, &weights, &mut kernel);
+        let kernel = build(x, grid, &weights);
         for (c, d) in direct.iter().enumerate() {
             let k: f64 = kernel.iter().zip(&y).map(|(k, v)| k[c] * v).sum();
             assert!(

@@ -51,11 +51,7 @@ pub fn read_spectral_bytes(
 
 /// Chooses the reader: by extension, then by the first non-blank bytes.
 pub fn detect_format(bytes: &[u8], source_name: &str) -> SpectralFormat {
-    let ext = Path::new(source_name)
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase());
-    match ext.as_deref() {
+    match glassdb_io::lowercase_extension(Path::new(source_name)).as_deref() {
         Some("csv" | "tsv") => return SpectralFormat::Csv,
         Some("json") => return SpectralFormat::IgsdbJson,
         Some(

@@ -120,21 +120,15 @@ pub(crate) fn spline_window(x: &[f64], grid: &[f64]) -> (usize, usize) {
 /// `y_k·h00 + y_{k+1}·h01 + h·s_k·h10 + h·s_{k+1}·h11`, so the channels are `αᵀy + βᵀs` with
 /// `A·s = B·y` the not-a-knot system of [`spline_slopes`]; then `βᵀs = (A⁻ᵀβ)ᵀ B y`, one
 /// transposed tridiagonal solve for all three channels.
-pub(crate) fn spline_kernel(
-    x: &[f64],
-    grid: &[f64],
-    weights: &[[f64; 3]],
-    kernel: &mut Vec<[f64; 3]>,
-) {
-    let n = x.len();
-    kernel.clear();
-    kernel.resize(n, [0.0; 3]);
+pub(crate) fn spline_kernel(x: &[f64], grid: &[f64], weights: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let mut kernel = vec![[0.0; 3]; x.len()];
     let (lo, hi) = spline_window(x, grid);
     let xw = &x[lo..hi];
     let dxs: Vec<f64> = xw.windows(2).map(|p| p[1] - p[0]).collect();
-    let beta = hermite_weights(x, (lo, hi), &dxs, grid, weights, kernel);
+    let beta = hermite_weights(x, (lo, hi), &dxs, grid, weights, &mut kernel);
     let z = transposed_slopes_solve(xw, &dxs, beta);
     add_slope_weights(xw, &dxs, &z, &mut kernel[lo..]);
+    kernel
 }
 
 /// `dst += w · f`, per channel.

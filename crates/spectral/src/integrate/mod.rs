@@ -407,8 +407,7 @@ impl Integrator {
         // First sight of this irregular wavelength array: build its spline kernel now and
         // remember it, so that every spectrum on these wavelengths is integrated by the same
         // arithmetic (the same spectrum gives the same bits whatever was integrated before).
-        let mut kernel = Vec::new();
-        spline_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
+        let kernel = spline_kernel(wavelength_nm, &self.grid_nm, &self.weights);
         let acc = dot_kernel(&kernel, values);
         KERNELS.with(|cell| {
             let mut cache = cell.borrow_mut();
@@ -458,12 +457,11 @@ impl Integrator {
             self.settings.extrapolate,
             &self.description(),
         )?;
-        let mut kernel = Vec::new();
-        if uniform {
-            sprague_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
+        let kernel = if uniform {
+            sprague_kernel(wavelength_nm, &self.grid_nm, &self.weights)
         } else {
-            spline_kernel(wavelength_nm, &self.grid_nm, &self.weights, &mut kernel);
-        }
+            spline_kernel(wavelength_nm, &self.grid_nm, &self.weights)
+        };
         Ok(GridIntegrator {
             wavelength_nm: wavelength_nm.to_vec(),
             kernel,
