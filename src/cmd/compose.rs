@@ -135,7 +135,7 @@ pub enum DitherArg {
 }
 
 /// The registry at `path`, or the bundled one, with the label outputs and messages name it by.
-pub(crate) fn load_registry(path: Option<&Path>) -> anyhow::Result<(Registry, String)> {
+pub fn load_registry(path: Option<&Path>) -> anyhow::Result<(Registry, String)> {
     Ok(match path {
         Some(p) => (
             Registry::from_json_file(p).map_err(anyhow::Error::new)?,

@@ -181,14 +181,15 @@ fn table_settings(a: &BuildArgs) -> anyhow::Result<Vec<IntegrationSettings>> {
         .collect())
 }
 
-fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
+/// The registry `glassdb registry build` writes (`a.output` is not written here), for the
+/// command and the Python package alike.
+pub fn build_registry(a: &BuildArgs) -> anyhow::Result<Registry> {
     if !(a.tol.is_finite() && a.tol > 0.0) {
         anyhow::bail!("--tol must be a positive number, got {}", a.tol);
     }
     if a.max_degree == 0 || a.max_degree > 20 {
         anyhow::bail!("--max-degree must be 1–20, got {}", a.max_degree);
     }
-    let tables = table_settings(&a)?;
     let lights = a
         .lights
         .iter()
@@ -196,6 +197,22 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
         .collect::<Result<Vec<_>, _>>()
         .map_err(anyhow::Error::new)
         .context("--light")?;
+    let opts = BuildOptions {
+        tables: table_settings(a)?,
+        lights,
+        mask_ids: mask_ids(&a.masks)?,
+        fit_tol: a.tol,
+        max_degree: a.max_degree,
+        application: if a.per_channel {
+            Application::PerChannel
+        } else {
+            Application::PerWavelength
+        },
+    };
+    glassdb_registry::build_registry(&a.catalog, &opts).map_err(anyhow::Error::new)
+}
+
+fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     // The catalog, every spectral file and angle table it names, the masks and the lights'
     // SPD files.
     let mut inputs = glassdb_registry::catalog_inputs(&a.catalog).map_err(anyhow::Error::new)?;
@@ -208,20 +225,7 @@ fn build(a: BuildArgs) -> anyhow::Result<ExitCode> {
     );
     glassdb_io::declare_inputs(inputs.iter().map(PathBuf::as_path));
     glassdb_io::refuse_input_as_output(&a.output)?;
-    let opts = BuildOptions {
-        tables,
-        lights,
-        mask_ids: mask_ids(&a.masks)?,
-        fit_tol: a.tol,
-        max_degree: a.max_degree,
-        application: if a.per_channel {
-            Application::PerChannel
-        } else {
-            Application::PerWavelength
-        },
-    };
-    let registry =
-        glassdb_registry::build_registry(&a.catalog, &opts).map_err(anyhow::Error::new)?;
+    let registry = build_registry(&a)?;
     registry.write_json(&a.output)?;
     let glasses = &registry.default_table().glasses;
     let ids: Vec<String> = glasses.iter().map(|g| g.id.to_string()).collect();

@@ -195,6 +195,26 @@ struct QuantityResult {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let (data, method, results) = integrate_file(&args)?;
+    let out = if args.json {
+        let mut s = serde_json::to_string_pretty(&to_json(&data, &method, &results))?;
+        s.push('\n');
+        s
+    } else {
+        to_text(&data, &method, &results)
+    };
+    out!("{out}");
+    Ok(ExitCode::SUCCESS)
+}
+
+/// What `glassdb spectral --json` prints, for the command and the Python package alike.
+pub fn report_json(args: &Args) -> anyhow::Result<Value> {
+    let (data, method, results) = integrate_file(args)?;
+    Ok(to_json(&data, &method, &results))
+}
+
+/// The file of `args` read, checked and integrated as its settings say.
+fn integrate_file(args: &Args) -> anyhow::Result<(SpectralData, Method, Vec<QuantityResult>)> {
     let settings = args.settings.settings()?;
     let method = settings.method.clone();
     let data = read_spectral_file(&args.file, &args.settings.read_options())
@@ -212,15 +232,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     .with_context(|| data.source.clone())?;
     let results = integrate_all(&data, &integrator, settings.extrapolate)?;
     check_channel_balance(&data, &results)?;
-    let out = if args.json {
-        let mut s = serde_json::to_string_pretty(&to_json(&data, &method, &results))?;
-        s.push('\n');
-        s
-    } else {
-        to_text(&data, &method, &results)
-    };
-    out!("{out}");
-    Ok(ExitCode::SUCCESS)
+    Ok((data, method, results))
 }
 
 fn integrate_all(

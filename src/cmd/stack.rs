@@ -244,9 +244,32 @@ fn colour_settings(args: &Args) -> anyhow::Result<IntegrationSettings> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let text = if args.json {
+        let mut s = serde_json::to_string_pretty(&report_json(&args)?)?;
+        s.push('\n');
+        s
+    } else {
+        let u = evaluate(&args)?;
+        to_text(&u.built, &u.eval, &u.settings)
+    };
+    out!("{text}");
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A unit built from the command line and evaluated at its angles.
+struct EvaluatedUnit {
+    built: CommandStack,
+    eval: Evaluation,
+    /// Each layer's own photopic T, Rf, Rb per angle.
+    layers: Vec<Option<Vec<[f64; 3]>>>,
+    settings: IntegrationSettings,
+}
+
+/// The unit of `args` built and evaluated at its angles, with each layer's own photopic values.
+fn evaluate(args: &Args) -> anyhow::Result<EvaluatedUnit> {
     let angles = crate::cmd::fit::parse_angles(&args.angles)?;
     let built = args.stack.build()?;
-    let settings = colour_settings(&args)?;
+    let settings = colour_settings(args)?;
     let integrator = Integrator::new(&settings)?;
     let eval = built
         .stack
@@ -255,22 +278,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let layers = built
         .stack
         .layer_averages(&angles, WindowMethod::Photopic)?;
-    let text = if args.json {
-        let mut v = to_json(&built, &eval, &layers, &settings);
-        if args.spectra {
-            v["spectra"] = spectra_json(&built.stack, &angles)?;
-        }
-        let mut s = serde_json::to_string_pretty(&v)?;
-        s.push('\n');
-        s
-    } else {
-        to_text(&built, &eval, &settings)
-    };
-    out!("{text}");
-    Ok(ExitCode::SUCCESS)
+    Ok(EvaluatedUnit {
+        built,
+        eval,
+        layers,
+        settings,
+    })
 }
 
-/// `f` of every angle's optics.
+/// What `glassdb stack --json` prints (with `--spectra`, the system's spectra too), for the
+/// command and the Python package alike.
+pub fn report_json(args: &Args) -> anyhow::Result<Value> {
+    let u = evaluate(args)?;
+    let mut v = to_json(&u.built, &u.eval, &u.layers, &u.settings);
+    if args.spectra {
+        let angles = crate::cmd::fit::parse_angles(&args.angles)?;
+        v["spectra"] = spectra_json(&u.built.stack, &angles)?;
+    }
+    Ok(v)
+}
+
 fn column<V, U>(per_angle: &[Optics<V>], f: impl Fn(&Optics<V>) -> U) -> Vec<U> {
     per_angle.iter().map(f).collect()
 }

@@ -4,11 +4,13 @@
 
 use std::collections::BTreeMap;
 
-use glassdb_image::ImageWindows;
+use glassdb_image::{ImageWindows, PixelWindow};
+use glassdb_mask::MaskImage;
 use glassdb_side::Side;
 
 use crate::colour::{ChosenTable, PassSpace};
 use crate::kernel::{self, KernelCounts, KernelInput, OutsidePass, PlacedGroupRefl, PlacedRefl};
+use crate::lut::GlassLut;
 use crate::memory::MemoryEstimate;
 use crate::{ComposeError, ComposeSettings, DecodedFrame, OutsidePolicy};
 
@@ -40,6 +42,37 @@ pub(crate) struct FrameFacts {
     pub(crate) memory: MemoryEstimate,
 }
 
+/// The kernel over one frame: each reflection pass (its R, G, B planes and its window relative
+/// to the frame) placed with its plane's side, composited in place on `trans`, glass outside a
+/// cropped pass treated as `settings` says; a unit's pane groups from `groups` (none: each
+/// plane's pass takes every group's share, as `--surfaces 1`). Files and arrays
+/// (`compose_in_memory`) alike.
+pub(crate) fn run_kernel<'a>(
+    trans: &mut [Vec<f32>; 3],
+    refl: impl Iterator<Item = (&'a [Vec<f32>; 3], PixelWindow)>,
+    groups: &[PlacedGroupRefl<'a>],
+    mask: &MaskImage,
+    lut: &GlassLut,
+    settings: &ComposeSettings,
+) -> Result<KernelCounts, ComposeError> {
+    let placed: Vec<PlacedRefl<'_>> = refl
+        .enumerate()
+        .map(|(k, ([r, g, b], window))| PlacedRefl {
+            rgb: [r.as_slice(), g.as_slice(), b.as_slice()],
+            window,
+            side: settings.plane_sides.get(&k).copied().unwrap_or(Side::Front),
+        })
+        .collect();
+    let outside_mode = match settings.decode.outside {
+        OutsidePolicy::Transmission => OutsidePass::Transmission,
+        OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
+    };
+    let [r, g, b] = trans;
+    let input = KernelInput::placed([r, g, b], &placed, mask, lut, outside_mode)?
+        .with_groups(groups, settings.decode.max_groups)?;
+    Ok(kernel::compose_in_place(input))
+}
+
 /// The composite phase: every reflection pass placed in the frame with its plane's side, the
 /// kernel run in place on the transmission pass, and the decoded passes freed beside the
 /// encoder.
@@ -47,25 +80,11 @@ pub(crate) fn composite(
     mut frame: DecodedFrame<'_>,
     settings: &ComposeSettings,
 ) -> Result<Composited, ComposeError> {
-    let placed: Vec<PlacedRefl<'_>> = frame
+    let refl = frame
         .refl
         .iter()
-        .zip(&frame.refl_windows)
-        .enumerate()
-        .map(|(k, (p, &window))| {
-            let [r, g, b] = &p.image.rgb;
-            PlacedRefl {
-                rgb: [r.as_slice(), g.as_slice(), b.as_slice()],
-                window,
-                side: settings.plane_sides.get(&k).copied().unwrap_or(Side::Front),
-            }
-        })
-        .collect();
-    let outside_mode = match settings.decode.outside {
-        OutsidePolicy::Transmission => OutsidePass::Transmission,
-        OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
-    };
-    let [r, g, b] = &mut frame.trans.image.rgb;
+        .map(|p| &p.image.rgb)
+        .zip(frame.refl_windows.iter().copied());
     let groups: Vec<PlacedGroupRefl<'_>> = frame
         .groups
         .iter()
@@ -79,11 +98,15 @@ pub(crate) fn composite(
             }
         })
         .collect();
-    let input = KernelInput::placed([r, g, b], &placed, &frame.mask, frame.lut, outside_mode)?
-        .with_groups(&groups, settings.decode.max_groups)?;
-    let counts = kernel::compose_in_place(input);
+    let counts = run_kernel(
+        &mut frame.trans.image.rgb,
+        refl,
+        &groups,
+        &frame.mask,
+        frame.lut,
+        settings,
+    )?;
     let cos_range = frame.mask.cos_theta_range();
-    drop(placed);
     drop(groups);
     // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
     // another thread does it while the encoder keeps both cores busy.

@@ -95,7 +95,7 @@ pub(crate) fn decode_planned<'a>(
     let mut placed = place_inputs(files, inputs)?;
     let id_counts = placed.mask.id_pixel_counts();
     let planes = files.refl.len();
-    check_inputs(files, settings, lut, planes, &placed.mask, &id_counts)?;
+    check_inputs(&files.mask, settings, lut, planes, &placed.mask, &id_counts)?;
     let folded_pixels = crate::pane_groups::check_group_passes(
         files,
         settings,
@@ -287,8 +287,8 @@ fn place_inputs(files: &FrameFiles, inputs: DecodedInputs) -> Result<PlacedInput
 
 /// Checks ids and planes of the mask (placed in the frame) before compositing (that a mask
 /// without planes is not given several passes is checked from its header, `plan`).
-fn check_inputs(
-    files: &FrameFiles,
+pub(crate) fn check_inputs(
+    mask_path: &Path,
     settings: &DecodeSettings,
     lut: &GlassLut,
     refl_count: usize,
@@ -302,7 +302,7 @@ fn check_inputs(
         .collect();
     if !unknown.is_empty() && settings.unknown == UnknownIds::Error {
         return Err(ComposeError::UnknownIds {
-            mask: files.mask.clone(),
+            mask: mask_path.to_path_buf(),
             registry: settings.registry_label.clone(),
             none_known: unknown.len() == id_counts.len(),
             ids: unknown,
@@ -317,7 +317,7 @@ fn check_inputs(
         }
         if let Some((&plane, &pixels)) = per_plane.iter().next() {
             return Err(ComposeError::PlaneWithoutPass {
-                mask: files.mask.clone(),
+                mask: mask_path.to_path_buf(),
                 plane,
                 pixels,
                 passes: refl_count,

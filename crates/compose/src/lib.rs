@@ -18,7 +18,8 @@
 //! [`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`. The
 //! viewer runs the first two ([`decode_frame`]), with no output at all. A frame split into
 //! light groups is [`compose_light_groups`]: the phases once per group, each with its light's
-//! table, and the sum written ([`light_groups`]).
+//! table, and the sum written ([`light_groups`]). [`compose_in_memory`] composites a host
+//! application's arrays with the same checks and kernel, without files.
 
 #![warn(missing_docs)]
 
@@ -26,6 +27,7 @@ pub mod colour;
 mod composite;
 mod decode;
 pub mod error;
+mod in_memory;
 pub mod kernel;
 pub mod light_groups;
 pub mod lut;
@@ -48,6 +50,10 @@ use glassdb_image::ImageWindows;
 use glassdb_mask::MaskReadOptions;
 use glassdb_pass::{Carry, PassReadOptions};
 use glassdb_side::Side;
+pub use in_memory::{
+    MemoryComposite, MemoryFrame, MemoryLabels, compose_in_memory, interleave,
+    planes_from_interleaved,
+};
 pub use light_groups::{GroupPasses, LightGroup, compose_light_groups, group_passes};
 use memory::{MemoryBudget, MemoryEstimate};
 pub use plan::DecodeTarget;

@@ -325,3 +325,97 @@ fn a_frame_reports_its_stages_in_order() {
     );
     assert!(log.stages().is_empty());
 }
+
+/// Three pixels on two planes: glass 1 front (plane 0), glass 2 back (plane 1, cos 0.6), no
+/// glass; trans 0.5 and refl 0.25 (plane 0), 0.75 (plane 1), per channel c + 0.01·c.
+fn in_memory_frame() -> (MemoryFrame, ComposeSettings) {
+    let ch = |v: f32| -> [Vec<f32>; 3] { std::array::from_fn(|c| vec![v + 0.01 * c as f32; 3]) };
+    let frame = MemoryFrame {
+        trans: ch(0.5),
+        refl: vec![ch(0.25), ch(0.75)],
+        mask: mask8(vec![1, 2, 0], vec![255, 153, 0], vec![0, 1, 0]),
+        space: None,
+    };
+    let mut settings = ComposeSettings::default();
+    settings.plane_sides.insert(1, Side::Back);
+    (frame, settings)
+}
+
+fn labels() -> MemoryLabels {
+    MemoryLabels {
+        trans: "trans".into(),
+        mask: "mask".into(),
+    }
+}
+
+#[test]
+fn a_frame_in_memory_is_the_frame_compose_writes() {
+    let (frame, settings) = in_memory_frame();
+    let basis = glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb);
+    let luts = RegistryLuts::single(basis, test_lut());
+    let got = compose_in_memory(frame.clone(), &settings, &luts, &labels()).unwrap();
+    // Glass 1 front: trans·t + refl·r; glass 2 at cos 0.6 (code 153): r = 0.2, t = 0.6.
+    let c = 153.0f32 / 255.0;
+    assert_eq!(got.rgb[0][0], 0.5 * 0.5 + 0.25 * 0.1);
+    assert!((got.rgb[0][1] - (0.5 * c + 0.75 * 0.5 * (1.0 - c))).abs() < 1e-6);
+    assert_eq!(got.rgb[2][2], 0.52);
+    assert_eq!(got.id_counts, BTreeMap::from([(1, 1), (2, 1)]));
+
+    // The same frame through files and compose_frame, read back: the same samples.
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, planes: &[Vec<f32>; 3]| {
+        let path = dir.path().join(name);
+        write_float_pass(&path, 3, 1, planes.clone());
+        path
+    };
+    let m_path = dir.path().join("m.png");
+    glassdb_mask::write_mask(&m_path, &frame.mask, glassdb_mask::MaskFormat::Png8).unwrap();
+    let job = ComposeJob {
+        inputs: FrameFiles {
+            refl: vec![
+                write("r0.exr", &frame.refl[0]),
+                write("r1.exr", &frame.refl[1]),
+            ],
+            groups: Vec::new(),
+            trans: write("t.exr", &frame.trans),
+            mask: m_path,
+        },
+        output: dir.path().join("o.exr"),
+    };
+    compose_frame(&job, &settings, &luts).unwrap();
+    let written = glassdb_pass::read_pass(&job.output, &PassReadOptions::default()).unwrap();
+    assert_eq!(written.image.rgb, got.rgb);
+}
+
+#[test]
+fn a_frame_in_memory_is_checked_as_files_are() {
+    let basis = glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb);
+    let luts = RegistryLuts::single(basis, test_lut());
+    let (mut frame, settings) = in_memory_frame();
+    frame.mask.id[2] = 9;
+    let err = compose_in_memory(frame, &settings, &luts, &labels()).unwrap_err();
+    assert!(matches!(err, ComposeError::UnknownIds { ref mask, .. } if mask == Path::new("mask")));
+    let (mut frame, settings) = in_memory_frame();
+    frame.refl.pop();
+    let err = compose_in_memory(frame, &settings, &luts, &labels()).unwrap_err();
+    assert!(
+        matches!(err, ComposeError::PlaneWithoutPass { plane: 1, .. }),
+        "{err}"
+    );
+    let (mut frame, settings) = in_memory_frame();
+    frame.trans[1].pop();
+    let err = compose_in_memory(frame, &settings, &luts, &labels()).unwrap_err();
+    assert_eq!(err.kind(), glassdb_io::ErrorKind::Internal, "{err}");
+}
+
+#[test]
+fn interleaved_samples_round_trip_through_planes() {
+    let samples: Vec<f32> = (0..4 * 40_000).map(|i| i as f32).collect();
+    let (rgb, alpha) = planes_from_interleaved(&samples, 4);
+    assert_eq!(rgb[1][2], 9.0);
+    assert_eq!(alpha.as_ref().unwrap()[2], 11.0);
+    assert_eq!(interleave(&rgb, alpha.as_deref()), samples);
+    let (rgb, alpha) = planes_from_interleaved(&samples[..3 * 40_000], 3);
+    assert!(alpha.is_none());
+    assert_eq!(interleave(&rgb, None), samples[..3 * 40_000]);
+}

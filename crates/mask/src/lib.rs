@@ -42,7 +42,8 @@ pub use glass_names::{GlassMapping, GlassNames};
 pub use glassdb_image::DEFAULT_MAX_PIXELS;
 use glassdb_image::PixelWindow;
 pub use read::{
-    read_mask, read_mask_bytes, read_mask_header, read_placed_mask, read_placed_mask_bytes,
+    FloatMaskChannels, mask_from_floats, read_mask, read_mask_bytes, read_mask_header,
+    read_placed_mask, read_placed_mask_bytes,
 };
 pub use write::{MaskFormat, write_mask, write_mask_bytes};
 
@@ -104,6 +105,29 @@ fn glass_range<T: Sync>(
 }
 
 impl MaskImage {
+    /// The packed 8-bit mask (docs/mask.md): per pixel R = plane, G = id, B = the cos θ code
+    /// ([`CosCode::encode8`]), `channels` samples per pixel (3, or 4 with an ignored alpha),
+    /// row-major. The caller checks that `samples` holds `width × height` pixels.
+    pub fn from_packed8(width: u32, height: u32, channels: usize, samples: &[u8]) -> MaskImage {
+        let n = width as usize * height as usize;
+        let mut id = Vec::with_capacity(n);
+        let mut plane = Vec::with_capacity(n);
+        let mut cos = Vec::with_capacity(n);
+        for px in samples.chunks_exact(channels).take(n) {
+            plane.push(u16::from(px[0]));
+            id.push(u16::from(px[1]));
+            cos.push(px[2]);
+        }
+        MaskImage {
+            width,
+            height,
+            id,
+            cos_theta: CosTheta::Quantized8(cos),
+            plane,
+            coverage: None,
+        }
+    }
+
     /// The mask over window `to` of the frame, from a mask holding window `from`: pixels of
     /// `to` outside `from` have no glass (id 0).
     pub fn placed(&self, from: &PixelWindow, to: &PixelWindow) -> MaskImage {

@@ -15,7 +15,7 @@ use crate::channels::{
     MaskHeader, PixelError, decode_channels, decode_err, locate_channel, plan_channels,
 };
 use crate::cryptomatte::{CryptomattePlan, decode_cryptomatte, plan_cryptomatte};
-use crate::{CosTheta, MaskError, MaskImage, MaskReadOptions, PlacedMask};
+use crate::{CosTheta, ExrMaskChannels, MaskError, MaskImage, MaskReadOptions, PlacedMask};
 
 /// Reads a mask file's header only (a PNG's chunks up to its pixel data, an EXR's headers; no
 /// pixel is decompressed) and checks the layout `opts` asks for: a packed PNG is RGB, a binary
@@ -228,17 +228,7 @@ fn packed_from_png(png: &PngPixels, path: &Path) -> Result<MaskImage, MaskError>
     let n = png.width as usize * png.height as usize;
     let ch = png.channels;
     let (id, plane, cos_theta) = match &png.samples {
-        PngSamples::U8(s) => {
-            let mut id = Vec::with_capacity(n);
-            let mut plane = Vec::with_capacity(n);
-            let mut cos = Vec::with_capacity(n);
-            for px in s.chunks_exact(ch) {
-                plane.push(u16::from(px[0]));
-                id.push(u16::from(px[1]));
-                cos.push(px[2]);
-            }
-            (id, plane, CosTheta::Quantized8(cos))
-        }
+        PngSamples::U8(s) => return Ok(MaskImage::from_packed8(png.width, png.height, ch, s)),
         PngSamples::U16(s) => {
             let mut id = Vec::with_capacity(n);
             let mut plane = Vec::with_capacity(n);
@@ -306,40 +296,84 @@ fn mask_from_exr(
     // Back to the four slots, in order: id, cos θ, plane, coverage (the absent ones None).
     decoded.reverse();
     let [id_f, cos_f, plane_f, cov_f] = wanted.map(|w| w.and_then(|_| decoded.pop()));
+    let channels = FloatMaskChannels {
+        id: &id_f.unwrap_or_default(),
+        cos_theta: cos_f.unwrap_or_default(),
+        plane: plane_f.as_deref(),
+        coverage: cov_f,
+    };
     let (w, h) = (windows.data.width, windows.data.height);
+    Ok(PlacedMask {
+        image: mask_from_floats(path, names, (w, h), channels)?,
+        windows,
+        stores_planes,
+        has_coordinates: true,
+    })
+}
+
+/// A mask's channels as float samples, one per pixel, row-major: what an EXR mask stores, or
+/// what a host application (Python, a compositor plug-in) holds as arrays.
+pub struct FloatMaskChannels<'a> {
+    /// Glass id per pixel: integers 0–65535 (0: no glass).
+    pub id: &'a [f32],
+    /// cos θ per pixel, in [0, 1] on glass (rounding up to 1e-3 outside is clamped).
+    pub cos_theta: Vec<f32>,
+    /// Plane per pixel (integers 0–65535); `None`: every pixel on plane 0.
+    pub plane: Option<&'a [f32]>,
+    /// Coverage per pixel in [0, 1]; `None`: whole pixels.
+    pub coverage: Option<Vec<f32>>,
+}
+
+/// The mask of `channels` over `size` (width, height) pixels, checked as an EXR mask's
+/// channels are (ids and planes integers, cos θ and coverage in [0, 1]); errors name `path`
+/// (the file, or the host's label for its arrays), the channel (`names`) and the pixel.
+pub fn mask_from_floats(
+    path: &Path,
+    names: &ExrMaskChannels,
+    size: (usize, usize),
+    channels: FloatMaskChannels<'_>,
+) -> Result<MaskImage, MaskError> {
+    let (w, h) = size;
     let layout_err = |detail: &str| MaskError::Layout {
         path: path.to_path_buf(),
         detail: detail.into(),
     };
     let width = u32::try_from(w).map_err(|_| layout_err("too wide"))?;
     let height = u32::try_from(h).map_err(|_| layout_err("too tall"))?;
+    let n = w * h;
+    let lengths = [
+        Some(channels.id.len()),
+        Some(channels.cos_theta.len()),
+        channels.plane.map(<[f32]>::len),
+        channels.coverage.as_ref().map(Vec::len),
+    ];
+    if let Some(len) = lengths.into_iter().flatten().find(|&l| l != n) {
+        return Err(layout_err(&format!(
+            "a channel holds {len} samples for {w}×{h} pixels"
+        )));
+    }
     let pixel_err = PixelError { path, width: w };
-    let id = indices_from_floats(&id_f.unwrap_or_default(), "glass id", &names.id, &pixel_err)?;
-    let mut cos_f = cos_f.unwrap_or_default();
+    let id = indices_from_floats(channels.id, "glass id", &names.id, &pixel_err)?;
+    let mut cos_f = channels.cos_theta;
     clamp_cos_theta(&mut cos_f, &id, &names.cos_theta, &pixel_err)?;
-    let plane = match plane_f {
-        Some(p) => indices_from_floats(&p, "plane", &names.plane, &pixel_err)?,
-        None => vec![0; w * h],
+    let plane = match channels.plane {
+        Some(p) => indices_from_floats(p, "plane", &names.plane, &pixel_err)?,
+        None => vec![0; n],
     };
-    let coverage = match cov_f {
+    let coverage = match channels.coverage {
         Some(mut c) => {
             clamp_coverage(&mut c, &names.coverage, &pixel_err)?;
             Some(c)
         }
         None => None,
     };
-    Ok(PlacedMask {
-        image: MaskImage {
-            width,
-            height,
-            id,
-            cos_theta: CosTheta::Float(cos_f),
-            plane,
-            coverage,
-        },
-        windows,
-        stores_planes,
-        has_coordinates: true,
+    Ok(MaskImage {
+        width,
+        height,
+        id,
+        cos_theta: CosTheta::Float(cos_f),
+        plane,
+        coverage,
     })
 }
 

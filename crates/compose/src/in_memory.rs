@@ -1,0 +1,185 @@
+//! Frames held in memory: a host application's arrays (the Python package, a compositor's
+//! plug-in) composited with the same table choice, the same checks of ids and planes and the
+//! same kernel as a frame read from files (`compose_frame`), with no file read or written. The
+//! passes cover the same pixels as the mask (the frame); the result is the transmission pass's
+//! planes composited in place, the samples `compose` writes to a float EXR.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use glassdb_colour::RgbSpace;
+use glassdb_image::PixelWindow;
+use glassdb_mask::MaskImage;
+
+use crate::colour::{ChosenTable, PassSpace, RegistryLuts, SpaceSource};
+use crate::kernel::KernelCounts;
+use crate::{ComposeError, ComposeSettings, composite, decode};
+
+/// One frame in memory: planes of `mask.width × mask.height` samples, row-major, row 0 at the
+/// top, linear and premultiplied as `glassdb_pass` decodes a pass.
+#[derive(Debug, Clone)]
+pub struct MemoryFrame {
+    /// The transmission pass's R, G, B planes (composited in place).
+    pub trans: [Vec<f32>; 3],
+    /// The reflection passes' R, G, B planes; the k-th belongs to plane k of the mask.
+    pub refl: Vec<[Vec<f32>; 3]>,
+    /// The id + cos θ mask.
+    pub mask: MaskImage,
+    /// The passes' linear RGB space; `None`: untagged (linear Rec.709, as an untagged file).
+    pub space: Option<RgbSpace>,
+}
+
+/// What [`compose_in_memory`] labels the arrays by in its messages (there are no files).
+#[derive(Debug, Clone)]
+pub struct MemoryLabels {
+    /// The transmission pass.
+    pub trans: String,
+    /// The mask.
+    pub mask: String,
+}
+
+/// The composite of a [`MemoryFrame`] and what its report says.
+#[derive(Debug, Clone)]
+pub struct MemoryComposite {
+    /// The composite's R, G, B planes (the transmission pass's, composited).
+    pub rgb: [Vec<f32>; 3],
+    /// The passes' space and how it was known.
+    pub space: PassSpace,
+    /// The registry table composited with.
+    pub table: ChosenTable,
+    /// Glass pixels per id (id 0 not counted).
+    pub id_counts: BTreeMap<u16, u64>,
+    /// What the kernel counted.
+    pub counts: KernelCounts,
+}
+
+/// Composites a frame held in memory as [`crate::compose_frame`] composites one read from
+/// files: the registry table for the passes' space (`luts`), ids and planes checked as
+/// `settings.decode` says (unknown ids, a plane without a reflection pass), each plane with its
+/// side from `settings.plane_sides`, then the kernel in place. The reflection passes hold the
+/// whole frame, so no glass lies outside them.
+pub fn compose_in_memory(
+    frame: MemoryFrame,
+    settings: &ComposeSettings,
+    luts: &RegistryLuts,
+    labels: &MemoryLabels,
+) -> Result<MemoryComposite, ComposeError> {
+    let MemoryFrame {
+        mut trans,
+        refl,
+        mask,
+        space,
+    } = frame;
+    if refl.is_empty() {
+        return Err(ComposeError::NoReflectionPass);
+    }
+    let space = match space {
+        Some(space) => PassSpace {
+            space,
+            source: SpaceSource::Declared,
+        },
+        None => PassSpace {
+            space: RgbSpace::Srgb,
+            source: SpaceSource::Untagged,
+        },
+    };
+    let (table, lut) = luts.for_space(
+        &space,
+        Path::new(&labels.trans),
+        &settings.decode.registry_label,
+    )?;
+    let id_counts = mask.id_pixel_counts();
+    decode::check_inputs(
+        Path::new(&labels.mask),
+        &settings.decode,
+        lut,
+        refl.len(),
+        &mask,
+        &id_counts,
+    )?;
+    let whole = PixelWindow::at_origin(mask.width as usize, mask.height as usize);
+    let counts = composite::run_kernel(
+        &mut trans,
+        refl.iter().map(|p| (p, whole)),
+        &[],
+        &mask,
+        lut,
+        settings,
+    )?;
+    Ok(MemoryComposite {
+        rgb: trans,
+        space,
+        table,
+        id_counts,
+        counts,
+    })
+}
+
+/// Pixels per parallel task of the layout conversions.
+const LAYOUT_CHUNK: usize = 1 << 14;
+
+/// Interleaved samples (`channels` per pixel: R, G, B, then A when 4; row-major, as a host's
+/// (H, W, C) array holds them) as the R, G, B planes the compositor works on, and the alpha
+/// plane when there is one. `samples` holds whole pixels (the caller checks its length).
+pub fn planes_from_interleaved(
+    samples: &[f32],
+    channels: usize,
+) -> ([Vec<f32>; 3], Option<Vec<f32>>) {
+    use rayon::prelude::*;
+    let pixels = samples.len() / channels.max(1);
+    let mut planes: [Vec<f32>; 4] = std::array::from_fn(|c| {
+        if c < channels.min(4) {
+            vec![0.0; pixels]
+        } else {
+            Vec::new()
+        }
+    });
+    let [r, g, b, a] = &mut planes;
+    let with_alpha = channels >= 4;
+    r.par_chunks_mut(LAYOUT_CHUNK)
+        .zip(g.par_chunks_mut(LAYOUT_CHUNK))
+        .zip(b.par_chunks_mut(LAYOUT_CHUNK))
+        .zip(samples.par_chunks(LAYOUT_CHUNK * channels))
+        .for_each(|(((r, g), b), src)| {
+            for (i, px) in src.chunks_exact(channels).enumerate() {
+                r[i] = px[0];
+                g[i] = px[1];
+                b[i] = px[2];
+            }
+        });
+    if with_alpha {
+        a.par_chunks_mut(LAYOUT_CHUNK)
+            .zip(samples.par_chunks(LAYOUT_CHUNK * channels))
+            .for_each(|(a, src)| {
+                for (v, px) in a.iter_mut().zip(src.chunks_exact(channels)) {
+                    *v = px[3];
+                }
+            });
+    }
+    let [r, g, b, a] = planes;
+    ([r, g, b], with_alpha.then_some(a))
+}
+
+/// R, G, B planes (and alpha) interleaved into (H, W, C) samples, C = 3 or 4 with alpha: the
+/// layout [`planes_from_interleaved`] reads.
+pub fn interleave(rgb: &[Vec<f32>; 3], alpha: Option<&[f32]>) -> Vec<f32> {
+    use rayon::prelude::*;
+    let channels = if alpha.is_some() { 4 } else { 3 };
+    let pixels = rgb[0].len();
+    let mut out = vec![0.0f32; pixels * channels];
+    out.par_chunks_mut(LAYOUT_CHUNK * channels)
+        .enumerate()
+        .for_each(|(k, dst)| {
+            let start = k * LAYOUT_CHUNK;
+            for (i, px) in dst.chunks_exact_mut(channels).enumerate() {
+                let j = start + i;
+                px[0] = rgb[0][j];
+                px[1] = rgb[1][j];
+                px[2] = rgb[2][j];
+                if let Some(a) = alpha {
+                    px[3] = a[j];
+                }
+            }
+        });
+    out
+}
