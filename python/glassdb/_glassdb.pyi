@@ -25,14 +25,17 @@ class Registry:
         *,
         method: str = "colorimetric",
         observer: str = "cie1931",
-        illuminant: str = "D65",
+        illuminant: _Path | None = None,
+        lights: Sequence[str | tuple[str, _Path]] | None = None,
+        white_balance: str | None = None,
         extrapolate: bool = False,
         tol: float | None = None,
         max_degree: int = 12,
         per_channel: bool = False,
         masks: Sequence[_Path] | None = None,
     ) -> Registry:
-        """A registry built from a catalog as `glassdb registry build` builds it."""
+        """A registry built from a catalog as `glassdb registry build` builds it; `lights`
+        (`"NAME=ILLUMINANT"` or (name, illuminant or SPD path)) as its `--light`."""
     def spaces(self) -> list[str]:
         """The colour bases of its tables, the default first."""
     def ids(self, space: str | None = None) -> list[int]:
@@ -75,16 +78,19 @@ class Pass:
     def display_window(self) -> tuple[int, int, int, int]: ...
 
 def compose(
-    trans: _F32Image,
-    refl: _F32Image | Sequence[_F32Image],
+    trans: _F32Image | Mapping[str, _F32Image],
+    refl: _F32Image | Sequence[_F32Image] | Mapping[str, _F32Image] | Sequence[Mapping[str, _F32Image]],
     mask: npt.NDArray[np.uint8] | Mapping[str, npt.NDArray[np.float32]],
     registry: Registry | None = None,
     planes: _Path | None = None,
     space: str | None = None,
     sides: Mapping[int, Literal["front", "back"]] | None = None,
     unknown: Literal["error", "passthrough"] = "error",
+    light_groups: Sequence[str] | str | None = None,
 ) -> _F32Image:
-    """The composite, bit for bit as `compose` writes it to a float EXR."""
+    """The composite, bit for bit as `compose` writes it to a float EXR; with `light_groups`
+    (`trans` and each `refl` then dicts {group: array}), the sum of the groups' composites,
+    bit for bit the beauty `compose --light-groups` writes."""
 
 def read_passes(path: _Path, layer: str | None = None) -> list[Pass]:
     """The passes of a file as `compose` reads them."""

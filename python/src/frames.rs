@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use glassdb_colour::RgbSpace;
 use glassdb_compose::colour::SpaceSource;
 use glassdb_compose::{
-    ComposeSettings, MemoryFrame, MemoryLabels, OutsidePolicy, UnknownIds, compose_in_memory,
+    ComposeError, ComposeSettings, LightGroup, MemoryFrame, MemoryGroup, MemoryLabels,
+    OutsidePolicy, UnknownIds, compose_in_memory, compose_light_groups_in_memory,
 };
 use glassdb_image::PixelWindow;
 use glassdb_mask::{
@@ -313,6 +314,83 @@ fn plane_sides(
     Ok(out)
 }
 
+/// The reflection passes of a `compose` call: one array or a list of them.
+fn refl_arrays<'py>(
+    py: Python<'py>,
+    refl: &Bound<'py, PyAny>,
+) -> PyResult<Vec<PyReadonlyArray3<'py, f32>>> {
+    if refl.is_instance_of::<PyList>() {
+        return refl.extract();
+    }
+    Ok(vec![refl.extract().map_err(|_| {
+        invalid(
+            py,
+            "refl: a float32 (H, W, 3) array or a list of them".into(),
+        )
+    })?])
+}
+
+/// The light groups named: a list of names or one comma-separated string (`"sun,warm"`).
+fn group_names(py: Python<'_>, groups: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+    if let Ok(text) = groups.extract::<String>() {
+        return Ok(text.split(',').map(|g| g.trim().to_string()).collect());
+    }
+    groups.extract().map_err(|_| {
+        invalid(
+            py,
+            "light_groups: a list of group names or a comma-separated string (\"sun,warm\")".into(),
+        )
+    })
+}
+
+/// One group's arrays of each dict `{group: array}` (`what` names the pass in messages), in
+/// the order of `names`, refused as `compose --light-groups` refuses a pass's layers: a group
+/// of the dict not composited, or a group without an array.
+fn group_arrays<'py>(
+    py: Python<'py>,
+    what: &str,
+    dict: &Bound<'py, PyAny>,
+    names: &[String],
+) -> PyResult<Vec<PyReadonlyArray3<'py, f32>>> {
+    let dict = dict.cast::<PyDict>().map_err(|_| {
+        invalid(
+            py,
+            format!("{what}: with light_groups, a dict {{group: float32 (H, W, 3) array}}"),
+        )
+    })?;
+    let found: Vec<String> = dict.keys().extract()?;
+    let extra: Vec<String> = found
+        .iter()
+        .filter(|g| !names.contains(g))
+        .cloned()
+        .collect();
+    if !extra.is_empty() {
+        return Err(ComposeError::GroupWithoutTable {
+            path: what.into(),
+            groups: extra,
+            composited: names.to_vec(),
+        })
+        .or_raise(py);
+    }
+    names
+        .iter()
+        .map(|group| match dict.get_item(group)? {
+            Some(a) => a.extract().map_err(|_| {
+                invalid(
+                    py,
+                    format!("{what}[{group:?}]: a float32 (H, W, 3) or (H, W, 4) array"),
+                )
+            }),
+            None => Err(ComposeError::GroupWithoutLayer {
+                path: what.into(),
+                group: group.clone(),
+                found: found.clone(),
+            })
+            .or_raise(py),
+        })
+        .collect()
+}
+
 /// Composites a frame from arrays, bit for bit as `compose` writes it to a float EXR from the
 /// same passes and mask: `trans` float32 (H, W, 3) or (H, W, 4) (alpha kept), linear and
 /// premultiplied; `refl` one such array or a list, one per glass plane; `mask` the packed
@@ -321,14 +399,21 @@ fn plane_sides(
 /// one); `planes` a planes.json giving each plane's side, `sides` {plane: "front"|"back"} over
 /// it; `space` the passes' linear RGB space (default: untagged, linear Rec.709), which chooses
 /// the registry's table; `unknown` "error" or "passthrough" for ids the registry lacks.
+/// There are no pane-group passes: a unit's plane pass takes every pane group's share (as
+/// `compose --surfaces 1`).
+/// `light_groups` (a list of names, or "sun,warm"): the passes split by light, as
+/// `compose --light-groups`: `trans` a dict {group: array}, `refl` one such dict or a list, one
+/// per plane; each group composited with the table of the registry's light of its name and the
+/// groups summed in the order named, Σ_g (trans_g·t_g + refl_g·r_g); the alpha is the first
+/// group's (when its array has one).
 /// Returns a new float32 (H, W, C) array; the GIL is released while it composites.
 #[pyfunction]
 #[pyo3(signature = (trans, refl, mask, registry=None, planes=None, space=None, sides=None,
-    unknown="error"))]
+    unknown="error", light_groups=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn compose<'py>(
     py: Python<'py>,
-    trans: PyReadonlyArray3<'py, f32>,
+    trans: &Bound<'py, PyAny>,
     refl: &Bound<'py, PyAny>,
     mask: &Bound<'py, PyAny>,
     registry: Option<Bound<'py, PyRegistry>>,
@@ -336,22 +421,69 @@ pub fn compose<'py>(
     space: Option<&str>,
     sides: Option<BTreeMap<usize, String>>,
     unknown: &str,
+    light_groups: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let refl: Vec<PyReadonlyArray3<'py, f32>> = if refl.is_instance_of::<PyList>() {
-        refl.extract()?
-    } else {
-        vec![refl.extract().map_err(|_| {
-            invalid(
-                py,
-                "refl: a float32 (H, W, 3) array or a list of them".into(),
-            )
-        })?]
+    let names = light_groups.map(|g| group_names(py, g)).transpose()?;
+    let registry: &PyRegistry = match &registry {
+        Some(r) => r.get(),
+        None => bundled(py)?,
     };
-    let trans_samples = pass_samples(py, "trans", &trans, None)?;
-    let (channels, hw) = (trans_samples.channels, trans_samples.hw);
-    let mut refl_samples = Vec::with_capacity(refl.len());
-    for (k, r) in refl.iter().enumerate() {
-        refl_samples.push(pass_samples(py, &format!("refl[{k}]"), r, Some(hw))?);
+    // Each light group's tables (the registry's light of its name), refused as the command
+    // refuses them, before its passes.
+    let groups = names
+        .as_ref()
+        .map(|n| LightGroup::from_registry(&registry.registry, n, &registry.label))
+        .transpose()
+        .or_raise(py)?;
+    // Each group's transmission pass and reflection passes (one group: the frame's own).
+    let (trans, refl): (
+        Vec<PyReadonlyArray3<'py, f32>>,
+        Vec<Vec<PyReadonlyArray3<'py, f32>>>,
+    ) = match &names {
+        None => (
+            vec![trans.extract().map_err(|_| {
+                invalid(py, "trans: a float32 (H, W, 3) or (H, W, 4) array".into())
+            })?],
+            vec![refl_arrays(py, refl)?],
+        ),
+        Some(names) => {
+            // the transmission pass first, as the command checks its passes
+            let trans = group_arrays(py, "trans", trans, names)?;
+            let dicts: Vec<Bound<'py, PyAny>> = if refl.is_instance_of::<PyList>() {
+                refl.extract()?
+            } else {
+                vec![refl.clone()]
+            };
+            let mut per_plane = Vec::with_capacity(dicts.len());
+            for (k, d) in dicts.iter().enumerate() {
+                per_plane.push(group_arrays(py, &format!("refl[{k}]"), d, names)?);
+            }
+            // per group, its pass of each plane
+            let refl = (0..names.len())
+                .map(|g| per_plane.iter().map(|p| p[g].clone()).collect())
+                .collect();
+            (trans, refl)
+        }
+    };
+    // how messages name a group's pass: `trans`, `refl[0]`; `trans["sun"]` with groups
+    let of_group = |what: String, g: usize| match &names {
+        Some(names) => format!("{what}[{:?}]", names[g]),
+        None => what,
+    };
+    let first = pass_samples(py, &of_group("trans".into(), 0), &trans[0], None)?;
+    let (channels, hw) = (first.channels, first.hw);
+    let mut trans_samples = vec![first];
+    for (g, t) in trans.iter().enumerate().skip(1) {
+        trans_samples.push(pass_samples(py, &of_group("trans".into(), g), t, Some(hw))?);
+    }
+    let mut refl_samples: Vec<Vec<PassSamples<'_>>> = Vec::with_capacity(refl.len());
+    for (g, group) in refl.iter().enumerate() {
+        let mut planes = Vec::with_capacity(group.len());
+        for (k, r) in group.iter().enumerate() {
+            let what = of_group(format!("refl[{k}]"), g);
+            planes.push(pass_samples(py, &what, r, Some(hw))?);
+        }
+        refl_samples.push(planes);
     }
     let mask = decode_mask(py, &mask_arg(py, mask)?, hw)?;
     let space = space
@@ -368,34 +500,54 @@ pub fn compose<'py>(
             ));
         }
     };
-    let registry: &PyRegistry = match &registry {
-        Some(r) => r.get(),
-        None => bundled(py)?,
-    };
     let mut settings = ComposeSettings::default();
     settings.decode.unknown = unknown;
     settings.decode.outside = OutsidePolicy::Error;
     settings.decode.registry_label = registry.label.clone();
-    settings.plane_sides = plane_sides(py, planes, sides, refl_samples.len())?;
+    let passes = refl_samples.first().map_or(0, Vec::len);
+    settings.plane_sides = plane_sides(py, planes, sides, passes)?;
     let labels = MemoryLabels {
         trans: "trans".into(),
         mask: "mask".into(),
     };
     let composite = py.detach(|| {
-        let (trans, alpha) =
-            glassdb_compose::planes_from_interleaved(&trans_samples.samples, channels);
-        let refl = refl_samples
-            .iter()
-            .map(|p| glassdb_compose::planes_from_interleaved(&p.samples, p.channels).0)
-            .collect();
-        let frame = MemoryFrame {
-            trans,
-            refl,
-            mask,
-            space,
+        let deinterleave =
+            |p: &PassSamples<'_>| glassdb_compose::planes_from_interleaved(&p.samples, p.channels);
+        // the first group's alpha (the frame's, without groups) is the composite's
+        let mut alpha = None;
+        let composited = match &groups {
+            None => {
+                let (trans, a) = deinterleave(&trans_samples[0]);
+                alpha = a;
+                let frame = MemoryFrame {
+                    trans,
+                    refl: refl_samples[0].iter().map(|p| deinterleave(p).0).collect(),
+                    mask,
+                    space,
+                };
+                compose_in_memory(frame, &settings, &registry.luts, &labels)
+            }
+            Some(groups) => {
+                // each group's planes made when its turn comes
+                let each = groups
+                    .iter()
+                    .zip(trans_samples.iter().zip(&refl_samples))
+                    .enumerate()
+                    .map(|(g, (group, (trans, refl)))| {
+                        let (trans, a) = deinterleave(trans);
+                        if g == 0 {
+                            alpha = a;
+                        }
+                        MemoryGroup {
+                            luts: &group.luts,
+                            trans,
+                            refl: refl.iter().map(|p| deinterleave(p).0).collect(),
+                        }
+                    });
+                compose_light_groups_in_memory(each, &mask, space, &settings, &labels)
+            }
         };
-        compose_in_memory(frame, &settings, &registry.luts, &labels)
-            .map(|c| glassdb_compose::interleave(&c.rgb, alpha.as_deref()))
+        composited.map(|c| glassdb_compose::interleave(&c.rgb, alpha.as_deref()))
     });
     let out = composite.or_raise(py)?;
     PyArray1::from_vec(py, out).reshape([hw.0, hw.1, channels])

@@ -76,6 +76,24 @@ fn parse_side(py: Python<'_>, side: &str) -> PyResult<Side> {
         .map_err(|e| invalid(py, format!("side: {e}")))
 }
 
+/// A light of `Registry.build`: `"NAME=ILLUMINANT"`, or a (name, illuminant or SPD path)
+/// pair, as the `--light` argument.
+fn light_arg(py: Python<'_>, light: &Bound<'_, PyAny>) -> PyResult<std::ffi::OsString> {
+    if let Ok(text) = light.extract::<String>() {
+        return Ok(text.into());
+    }
+    let (name, spec): (String, PathBuf) = light.extract().map_err(|_| {
+        invalid(
+            py,
+            "lights: each a \"NAME=ILLUMINANT\" string or a (name, illuminant or SPD path) pair"
+                .into(),
+        )
+    })?;
+    let mut arg = std::ffi::OsString::from(format!("{name}="));
+    arg.push(spec.as_os_str());
+    Ok(arg)
+}
+
 /// Python's `json.loads` of `text`.
 fn json_loads<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
     py.import("json")?.call_method1("loads", (text,))
@@ -95,12 +113,16 @@ impl PyRegistry {
 
     /// Builds a registry from a catalog (catalog.toml) as `glassdb registry build` does: one
     /// table per space in `spaces` (the first the default; default `["srgb"]`), the spectral
-    /// `method` (colorimetric, paper or luminous) with its observer and illuminant, curves
-    /// fitted within `tol` up to degree `max_degree`; `masks`: only the ids they use.
+    /// `method` (colorimetric, paper or luminous) with its observer and illuminant (default
+    /// D65: a name or an SPD CSV), curves fitted within `tol` up to degree `max_degree`;
+    /// `masks`: only the ids they use. `lights`: one table per (space, light), as `--light`:
+    /// each a `"NAME=ILLUMINANT"` string or a (name, illuminant name or SPD path) pair, the
+    /// first the default (not with `illuminant`); `white_balance` as `--white-balance`
+    /// (`"light"`, or an illuminant name the camera is balanced to).
     #[staticmethod]
     #[pyo3(signature = (catalog, spaces=None, *, method="colorimetric", observer="cie1931",
-        illuminant="D65", extrapolate=false, tol=None, max_degree=12, per_channel=false,
-        masks=None))]
+        illuminant=None, lights=None, white_balance=None, extrapolate=false, tol=None,
+        max_degree=12, per_channel=false, masks=None))]
     #[allow(clippy::too_many_arguments)]
     fn build(
         py: Python<'_>,
@@ -108,7 +130,9 @@ impl PyRegistry {
         spaces: Option<Vec<String>>,
         method: &str,
         observer: &str,
-        illuminant: &str,
+        illuminant: Option<String>,
+        lights: Option<Vec<Bound<'_, PyAny>>>,
+        white_balance: Option<String>,
         extrapolate: bool,
         tol: Option<f64>,
         max_degree: u32,
@@ -118,12 +142,17 @@ impl PyRegistry {
         let mut argv: Vec<std::ffi::OsString> = vec!["build".into(), catalog.clone().into()];
         // The output is not written: the registry is returned.
         argv.extend(["--output".into(), "registry.json".into()]);
-        for (flag, value) in [
-            ("--method", method),
-            ("--observer", observer),
-            ("--illuminant", illuminant),
-        ] {
+        for (flag, value) in [("--method", method), ("--observer", observer)] {
             argv.extend([flag.into(), value.into()]);
+        }
+        if let Some(illuminant) = illuminant {
+            argv.extend(["--illuminant".into(), illuminant.into()]);
+        }
+        for light in lights.unwrap_or_default() {
+            argv.extend(["--light".into(), light_arg(py, &light)?]);
+        }
+        if let Some(white) = white_balance {
+            argv.extend(["--white-balance".into(), white.into()]);
         }
         if let Some(spaces) = spaces {
             argv.extend(["--space".into(), spaces.join(",").into()]);

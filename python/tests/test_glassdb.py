@@ -166,6 +166,129 @@ def test_registry_build_is_the_commands(tmp_path):
             assert record["tau_v"] == (g.get("luminous") or {}).get("transmittance")
 
 
+LIGHT_GROUPS = ROOT / "fixtures" / "light_groups"
+WARM_LED = ROOT / "fixtures" / "lights" / "warm_led.csv"
+
+
+def light_catalog(tmp_path):
+    """A catalog of the light-group fixture's glasses: Arctic Blue (id 9) and the bronze film
+    (id 10), whose colours under D65 and A differ most (docs/colour.md, "Lights")."""
+    text = "".join(
+        f'[[glass]]\nid = {gid}\nname = "glass {gid}"\nspectral = "{GLAZING / name}"\n\n'
+        for gid, name in ((9, "nfrc_9962.json"), (10, "nfrc_9223.json"))
+    )
+    catalog = tmp_path / "catalog.toml"
+    catalog.write_text(text)
+    return catalog
+
+
+def test_registry_build_with_lights_is_the_commands(tmp_path):
+    catalog = light_catalog(tmp_path)
+    out = tmp_path / "cli.json"
+    run("glassdb", "registry", "build", catalog, "-o", out, "--space", "srgb,acescg",
+        "--light", "sun=D65", "--light", "warm=A", "--light", f"led={WARM_LED}")
+    built = glassdb.Registry.build(
+        catalog, spaces=["srgb", "acescg"], lights=["sun=D65", ("warm", "A"), ("led", WARM_LED)]
+    )
+    assert built.to_json() == out.read_text()
+    tables = json.loads(built.to_json())["tables"]
+    assert [t["light"] for t in tables] == ["sun", "sun", "warm", "warm", "led", "led"]
+    # --white-balance as the command takes it
+    out = tmp_path / "balanced.json"
+    run("glassdb", "registry", "build", catalog, "-o", out, "--light", "warm=A", "--white-balance", "D65")
+    assert glassdb.Registry.build(catalog, lights=[("warm", "A")], white_balance="D65").to_json() == out.read_text()
+    # The command's refusals, with its messages.
+    for args, kwargs in [
+        (["--light", "sun"], {"lights": ["sun"]}),
+        (["--light", "sun=D65", "--illuminant", "A"], {"lights": ["sun=D65"], "illuminant": "A"}),
+        (["--light", "sun=D65", "--light", "sun=A"], {"lights": ["sun=D65", ("sun", "A")]}),
+    ]:
+        done = subprocess.run([str(BIN / "glassdb"), "registry", "build", str(catalog), "-o",
+                               str(tmp_path / "no.json"), *args], capture_output=True, text=True)
+        assert done.returncode != 0
+        with pytest.raises(glassdb.InvalidInput) as e:
+            glassdb.Registry.build(catalog, **kwargs)
+        assert done.stderr.splitlines()[0] == f"error: {e.value}", args
+    with pytest.raises(glassdb.InvalidInput):
+        glassdb.Registry.build(catalog, lights=[("sun",)])
+
+
+def light_group_passes():
+    """The fixture's passes as {group: float32 (H, W, 3)} (its `ViewLayer.Combined_<group>`)."""
+    def groups(path):
+        return {g: glassdb.read_passes(path, layer=f"ViewLayer.Combined_{g}")[0].pixels
+                for g in ("sun", "warm")}
+    mask = np.ascontiguousarray(read_png(str(LIGHT_GROUPS / "mask.png"))[..., :3].astype(np.uint8))
+    return groups(LIGHT_GROUPS / "trans.exr"), groups(LIGHT_GROUPS / "refl.exr"), mask
+
+
+def test_compose_light_groups_bit_for_bit(tmp_path):
+    registry = tmp_path / "lights.json"
+    run("glassdb", "registry", "build", light_catalog(tmp_path), "-o", registry,
+        "--light", "sun=D65", "--light", "warm=A")
+    out = tmp_path / "cli.exr"
+    run("compose", "--registry", registry, "--trans", LIGHT_GROUPS / "trans.exr",
+        "--refl", LIGHT_GROUPS / "refl.exr", "--mask", LIGHT_GROUPS / "mask.png",
+        "--light-groups", "sun,warm", "--data-type", "float", "-o", out)
+    ch = exr_channels(out)
+    want = np.stack([ch[f"ViewLayer.Combined.{c}"] for c in "RGB"], axis=-1)
+    trans, refl, mask = light_group_passes()
+    reg = glassdb.Registry.load(registry)
+    got = glassdb.compose(trans, refl, mask, registry=reg, light_groups=["sun", "warm"])
+    assert_bits_equal(got, want)
+    # the same with a list of reflection planes and the groups as one string
+    assert_bits_equal(glassdb.compose(trans, [refl], mask, registry=reg, light_groups="sun,warm"), want)
+    # Σ_g: each group alone under its own light's registry, summed in float32 in order
+    alone = []
+    for group, spec in (("sun", "D65"), ("warm", "A")):
+        one = tmp_path / f"{group}.json"
+        run("glassdb", "registry", "build", light_catalog(tmp_path), "-o", one, "--light", f"{group}={spec}")
+        alone.append(glassdb.compose(trans[group], refl[group], mask, registry=glassdb.Registry.load(one)))
+    assert_bits_equal(got, alone[0] + alone[1])
+    # the warm group under its own table is not the sun's
+    assert not np.array_equal(alone[1], glassdb.compose(trans["warm"], refl["warm"], mask, registry=reg))
+
+
+def test_compose_light_groups_refuse_what_does_not_match(tmp_path):
+    catalog = light_catalog(tmp_path)
+    trans, refl, mask = light_group_passes()
+    registry = tmp_path / "lights.json"
+    run("glassdb", "registry", "build", catalog, "-o", registry,
+        "--light", "sun=D65", "--light", "warm=A", "--light", "lamp=LED-B1")
+    reg = glassdb.Registry.load(registry)
+    # the warm group has no table given
+    with pytest.raises(glassdb.InvalidInput) as e:
+        glassdb.compose(trans, refl, mask, registry=reg, light_groups=["sun"])
+    assert str(e.value) == "trans has light groups without a table: warm (the groups composited: sun)"
+    # the lamp has a table but no pass
+    with pytest.raises(glassdb.InvalidInput) as e:
+        glassdb.compose(trans, refl, mask, registry=reg, light_groups=["sun", "warm", "lamp"])
+    assert "lamp" in str(e.value) and "sun, warm" in str(e.value)
+    with pytest.raises(glassdb.InvalidInput):
+        glassdb.compose(trans, refl["sun"], mask, registry=reg, light_groups=["sun", "warm"])
+    with pytest.raises(glassdb.InvalidInput):
+        glassdb.compose(trans, refl, mask, registry=reg, light_groups=["sun", "sun"])
+    # a group's array of another size, named by its group
+    with pytest.raises(glassdb.InvalidInput) as e:
+        glassdb.compose({**trans, "warm": trans["warm"][:4]}, refl, mask, registry=reg,
+                        light_groups=["sun", "warm"])
+    assert str(e.value).startswith('trans["warm"]: shape [4, 8, 3]'), str(e.value)
+    # a registry without the warm light: the command's message
+    sun_only = tmp_path / "sun.json"
+    run("glassdb", "registry", "build", catalog, "-o", sun_only, "--light", "sun=D65")
+    done = subprocess.run(
+        [str(BIN / "compose"), "--registry", str(sun_only), "--trans", str(LIGHT_GROUPS / "trans.exr"),
+         "--refl", str(LIGHT_GROUPS / "refl.exr"), "--mask", str(LIGHT_GROUPS / "mask.png"),
+         "--light-groups", "sun,warm", "-o", str(tmp_path / "out.exr")],
+        capture_output=True, text=True,
+    )
+    assert done.returncode != 0
+    with pytest.raises(glassdb.InvalidInput) as e:
+        glassdb.compose(trans, refl, mask, registry=glassdb.Registry.load(sun_only),
+                        light_groups=["sun", "warm"])
+    assert done.stderr.splitlines()[0] == f"error: {e.value}"
+
+
 def test_registry_eval_is_registry_show(tmp_path):
     out = tmp_path / "r.json"
     run("glassdb", "registry", "build", ATRIUM / "catalog.toml", "-o", out)

@@ -57,7 +57,8 @@ pub struct MemoryComposite {
 /// files: the registry table for the passes' space (`luts`), ids and planes checked as
 /// `settings.decode` says (unknown ids, a plane without a reflection pass), each plane with its
 /// side from `settings.plane_sides`, then the kernel in place. The reflection passes hold the
-/// whole frame, so no glass lies outside them.
+/// whole frame, so no glass lies outside them. There are no pane-group passes: a unit's plane
+/// pass takes every pane group's share (as `compose --surfaces 1`).
 pub fn compose_in_memory(
     frame: MemoryFrame,
     settings: &ComposeSettings,
@@ -65,11 +66,67 @@ pub fn compose_in_memory(
     labels: &MemoryLabels,
 ) -> Result<MemoryComposite, ComposeError> {
     let MemoryFrame {
-        mut trans,
+        trans,
         refl,
         mask,
         space,
     } = frame;
+    compose_planes(trans, &refl, &mask, space, settings, luts, labels)
+}
+
+/// One light group of a frame held in memory: its passes (as [`MemoryFrame`]'s) and the
+/// tables of its light.
+#[derive(Debug)]
+pub struct MemoryGroup<'a> {
+    /// The tables of the group's light.
+    pub luts: &'a RegistryLuts,
+    /// The group's transmission pass: R, G, B planes.
+    pub trans: [Vec<f32>; 3],
+    /// The group's reflection passes, one per plane of the mask.
+    pub refl: Vec<[Vec<f32>; 3]>,
+}
+
+/// Composites a frame held in memory split into light groups as [`crate::compose_light_groups`]
+/// composites one read from files: each group composited alone with its light's tables
+/// ([`compose_in_memory`]), in turn (a group's planes are taken from `groups` when its turn
+/// comes), and the groups summed in their order, `Σ_g (trans_g·t_g + refl_g·r_g)`. The counts
+/// are the first group's. An error when `groups` is empty.
+pub fn compose_light_groups_in_memory<'a>(
+    groups: impl IntoIterator<Item = MemoryGroup<'a>>,
+    mask: &MaskImage,
+    space: Option<RgbSpace>,
+    settings: &ComposeSettings,
+    labels: &MemoryLabels,
+) -> Result<MemoryComposite, ComposeError> {
+    let mut sum: Option<MemoryComposite> = None;
+    for group in groups {
+        let one = compose_planes(
+            group.trans,
+            &group.refl,
+            mask,
+            space,
+            settings,
+            group.luts,
+            labels,
+        )?;
+        match &mut sum {
+            None => sum = Some(one),
+            Some(total) => crate::light_groups::add_group_composite(&mut total.rgb, &one.rgb),
+        }
+    }
+    sum.ok_or_else(|| ComposeError::LightGroupList("none named".into()))
+}
+
+/// [`compose_in_memory`] of a frame's parts.
+fn compose_planes(
+    mut trans: [Vec<f32>; 3],
+    refl: &[[Vec<f32>; 3]],
+    mask: &MaskImage,
+    space: Option<RgbSpace>,
+    settings: &ComposeSettings,
+    luts: &RegistryLuts,
+    labels: &MemoryLabels,
+) -> Result<MemoryComposite, ComposeError> {
     if refl.is_empty() {
         return Err(ComposeError::NoReflectionPass);
     }
@@ -94,7 +151,7 @@ pub fn compose_in_memory(
         &settings.decode,
         lut,
         refl.len(),
-        &mask,
+        mask,
         &id_counts,
     )?;
     let whole = PixelWindow::at_origin(mask.width as usize, mask.height as usize);
@@ -102,7 +159,7 @@ pub fn compose_in_memory(
         &mut trans,
         refl.iter().map(|p| (p, whole)),
         &[],
-        &mask,
+        mask,
         lut,
         settings,
     )?;

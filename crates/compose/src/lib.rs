@@ -51,8 +51,8 @@ use glassdb_mask::MaskReadOptions;
 use glassdb_pass::{Carry, PassReadOptions};
 use glassdb_side::Side;
 pub use in_memory::{
-    MemoryComposite, MemoryFrame, MemoryLabels, compose_in_memory, interleave,
-    planes_from_interleaved,
+    MemoryComposite, MemoryFrame, MemoryGroup, MemoryLabels, compose_in_memory,
+    compose_light_groups_in_memory, interleave, planes_from_interleaved,
 };
 pub use light_groups::{GroupPasses, LightGroup, compose_light_groups, group_passes};
 use memory::{MemoryBudget, MemoryEstimate};

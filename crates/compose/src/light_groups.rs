@@ -169,7 +169,7 @@ pub fn compose_light_groups(
         }
         match &mut sum {
             None => sum = Some(composited),
-            Some(total) => add_rgb(
+            Some(total) => add_group_composite(
                 &mut total.image.trans.image.rgb,
                 &composited.image.trans.image.rgb,
             ),
@@ -180,8 +180,10 @@ pub fn compose_light_groups(
     crate::write_composited(job, settings, total, timings, progress)
 }
 
-/// `total += add`, plane by plane.
-fn add_rgb(total: &mut [Vec<f32>; 3], add: &[Vec<f32>; 3]) {
+/// `total += add`, plane by plane, in f32: the sum of the groups' composites, the next group
+/// added to the groups before it (the file and in-memory composites alike, so that they agree
+/// bit for bit).
+pub(crate) fn add_group_composite(total: &mut [Vec<f32>; 3], add: &[Vec<f32>; 3]) {
     for (t, a) in total.iter_mut().zip(add) {
         for (t, a) in t.iter_mut().zip(a) {
             *t += a;
