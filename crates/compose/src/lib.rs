@@ -30,6 +30,7 @@ pub mod error;
 mod in_memory;
 pub mod kernel;
 pub mod light_groups;
+pub mod light_parts;
 pub mod lut;
 pub mod memory;
 mod pane_groups;
