@@ -496,6 +496,7 @@ def render(opts):
             nodes = add_clip(mat)
             if nodes:
                 clips.append(nodes)
+    split = LightSplit.of_job(scene, job)
     real = scene.camera
     mirror_data = None
     mirror = None
@@ -505,7 +506,9 @@ def render(opts):
         scene.camera = real
         r.use_border = False
         set_clip(clips, glass_clips, None)
-        render_still(scene, frame["trans"])
+        if split is not None:
+            split.start_frame(scene, frame)
+        render_pass(scene, frame["trans"], split)
         m_real = real.matrix_world.copy()
         for plane in frame["planes"]:
             if mirror is None:
@@ -523,10 +526,132 @@ def render(opts):
             r.use_crop_to_border = True
             r.border_min_x, r.border_max_x = x0, x1
             r.border_min_y, r.border_max_y = y0, y1
-            render_still(scene, plane["output"])
+            render_pass(scene, plane["output"], split)
         scene.camera = real
         r.use_border = False
     print("glassdb_blender: rendered %d frames" % len(job["frames"]))
+
+
+def split_path(path, state):
+    """The pass `path` rendered in light-split state `state` (0: every aperture's glazing
+    opaque to light rays; k: aperture k clear): `trans.0001.exr` -> `trans.0001.s2.exr`
+    (crates/blender/src/light_split.rs names them the same way)."""
+    stem, ext = os.path.splitext(path)
+    return "%s.s%d%s" % (stem, state, ext)
+
+
+def render_pass(scene, path, split):
+    """One pass: as it is (no split), or once per light-split state."""
+    if split is None:
+        render_still(scene, path)
+        return
+    for state in range(len(split.apertures) + 1):
+        split.set_state(state)
+        render_still(scene, split_path(path, state))
+
+
+def add_light_opening(mat):
+    """Light rays (not camera rays) meet mat's glazing as a Transparent BSDF of colour `open`:
+    1 (white, clear) where the shading point lies on the plane set by LightSplit.set_state and
+    the material is that aperture's glass, else 0 (black: the glazing blocks light). Camera
+    rays keep the surface the material has. Returns the nodes set per state."""
+    nt = mat.node_tree
+    out = output_node(nt)
+    source = out.inputs["Surface"].links[0].from_socket
+    geo = nt.nodes.new("ShaderNodeNewGeometry")
+    dot = nt.nodes.new("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    add = nt.nodes.new("ShaderNodeMath")
+    add.operation = "ADD"
+    dist = nt.nodes.new("ShaderNodeMath")
+    dist.operation = "ABSOLUTE"
+    near = nt.nodes.new("ShaderNodeMath")
+    near.operation = "LESS_THAN"
+    enable = nt.nodes.new("ShaderNodeMath")
+    enable.operation = "MULTIPLY"
+    enable.inputs[1].default_value = 0.0
+    opening = nt.nodes.new("ShaderNodeBsdfTransparent")
+    lp = nt.nodes.new("ShaderNodeLightPath")
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    x, y = out.location
+    for k, node in enumerate((geo, dot, add, dist, near, enable, opening, lp, mix)):
+        node.location = (x - 1400 + 150 * k, y - 600)
+    nt.links.new(geo.outputs["Position"], dot.inputs[0])
+    nt.links.new(dot.outputs["Value"], add.inputs[0])
+    nt.links.new(add.outputs["Value"], dist.inputs[0])
+    nt.links.new(dist.outputs["Value"], near.inputs[0])
+    nt.links.new(near.outputs["Value"], enable.inputs[0])
+    nt.links.new(enable.outputs["Value"], opening.inputs["Color"])
+    nt.links.new(lp.outputs["Is Camera Ray"], mix.inputs["Fac"])
+    nt.links.new(opening.outputs["BSDF"], mix.inputs[1])
+    nt.links.new(source, mix.inputs[2])
+    nt.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+    return {"dot": dot, "add": add, "near": near, "enable": enable}
+
+
+class LightSplit:
+    """The passes split by the light's path (docs/blender.md, "Light parts"): Cycles light
+    groups by source (each sun lamp, the world as `sky`, every other emitter as `other`),
+    and each pass rendered once with all glazing opaque to light rays (state 0) and once per
+    aperture (the glass of one id on one plane) with that glazing clear (state k). Camera rays
+    see what they see without the split."""
+
+    def __init__(self, scene, job):
+        self.openings = {}
+        for g in job["glass"]:
+            self.openings[g["material"]] = add_light_opening(bpy.data.materials[g["material"]])
+        self.apertures = []
+        vl = bpy.context.view_layer
+        scene.render.use_single_layer = True
+        suns = [ob for ob in scene.objects
+                if ob.type == "LIGHT" and ob.data.type == "SUN" and not ob.hide_render]
+        self.suns = [(ob, "sun" if len(suns) == 1 else "sun%d" % k) for k, ob in enumerate(suns)]
+        names = [n for _, n in self.suns] + ["sky", "other"]
+        for lg in list(vl.lightgroups):
+            if lg.name not in names:
+                print("glassdb_blender: light group %s replaced by the light split" % lg.name)
+                vl.lightgroups.remove(lg)
+        for name in names:
+            if name not in vl.lightgroups:
+                vl.lightgroups.add(name=name)
+        by_sun = {ob.name: n for ob, n in self.suns}
+        for ob in scene.objects:
+            ob.lightgroup = by_sun.get(ob.name, "other")
+        if scene.world is not None:
+            scene.world.lightgroup = "sky"
+        self.groups = names
+        im = scene.render.image_settings
+        im.file_format = "OPEN_EXR_MULTILAYER"
+
+    @staticmethod
+    def of_job(scene, job):
+        return LightSplit(scene, job) if job.get("light_split") else None
+
+    def start_frame(self, scene, frame):
+        """This frame's apertures; writes its light sources (each sun's group and direction
+        towards it, world axes) to frame["lights"]."""
+        self.apertures = frame.get("apertures", [])
+        from mathutils import Vector
+
+        suns = []
+        for ob, name in self.suns:
+            # A sun lamp shines along its local -Z: +Z is towards the sun.
+            d = ob.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))
+            suns.append({"group": name, "direction_to_sun": list(d.normalized())})
+        with open(frame["lights"], "w") as fh:
+            json.dump({"suns": suns, "groups": self.groups, "sky": scene.world is not None}, fh)
+
+    def set_state(self, state):
+        """0: every glazing opaque to light rays; k: aperture k - 1 clear, the others opaque."""
+        ap = self.apertures[state - 1] if state > 0 else None
+        for name, n in self.openings.items():
+            on = ap is not None and name in ap["materials"]
+            n["enable"].inputs[1].default_value = 1.0 if on else 0.0
+            if on:
+                a, b, c, d = ap["equation"]
+                n["dot"].inputs[1].default_value = (a, b, c)
+                n["add"].inputs[1].default_value = d
+                n["near"].inputs[1].default_value = ap["tolerance"]
 
 
 # ----------------------------------------------------------------------------------------------

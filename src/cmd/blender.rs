@@ -74,10 +74,25 @@ pub struct RenderArgs {
     /// as DIR/reference.####.exr, for validation.
     #[arg(long)]
     pub reference: bool,
+    /// Keep the light's path apart in the passes (`on`, the default): Cycles light groups for
+    /// the sun, sky and other emitters, and each pass rendered once per aperture (the glass of
+    /// one id on one plane) plus once with all glazing opaque to light, so that a swap
+    /// (`glassdb blender compose DIR --registry B.json`) relights the room: (A+1)(1+P) renders
+    /// per frame instead of 1+P for A apertures and P reflection passes. `off`: each pass once,
+    /// lit through the render's glass (a swap leaves the room lit by it).
+    #[arg(long, value_enum, default_value_t = LightSplit::On)]
+    pub light_split: LightSplit,
     /// Stop after the passes, masks and run record: `glassdb blender compose DIR` composites
     /// them (a farm's render step, then its composite step).
     #[arg(long)]
     pub no_composite: bool,
+}
+
+/// `--light-split`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightSplit {
+    On,
+    Off,
 }
 
 #[derive(ClapArgs, Debug)]
@@ -168,6 +183,7 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         threads: a.threads,
         reference: a.reference,
         mask_samples: a.mask_samples,
+        light_split: a.light_split == LightSplit::On,
         composite: !a.no_composite,
     };
     let spinner = Spinner::on_terminal("blender");

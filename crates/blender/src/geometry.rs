@@ -63,6 +63,7 @@ pub fn planes_and_masks(
         work,
         planes: Vec::new(),
         tolerance: 0.0,
+        apertures: Vec::new(),
         first_frame,
         size: None,
         records: Vec::new(),
@@ -92,6 +93,8 @@ pub fn planes_and_masks(
         };
         let labelled = label_scene(&scene, &work.mappings, &MaskPlanes::Given(source), false)?;
         drop(scene);
+        frames.apertures =
+            crate::light_split::apertures(&labelled, &glass_materials, frames.tolerance);
         let job = MaskJob {
             labelled: &labelled,
             cameras: &cameras,
@@ -169,6 +172,8 @@ struct FramesOfMasks<'w, 'a> {
     planes: Vec<glassdb_scene::Plane>,
     /// planes.json's distance tolerance.
     tolerance: f64,
+    /// The apertures of the frames being added.
+    apertures: Vec<crate::light_split::ScriptAperture>,
     first_frame: u32,
     /// The first frame's size, which every frame must have.
     size: Option<(u32, u32)>,
@@ -238,6 +243,8 @@ impl FramesOfMasks<'_, '_> {
             frame,
             trans: self.work.staging.join(frame_name("trans", frame)),
             planes: script_planes,
+            apertures: self.apertures.clone(),
+            lights: None,
         });
         let windows: Vec<Option<PixelWindow>> =
             rectangles.iter().map(|r| r.map(|r| r.window())).collect();
@@ -249,6 +256,7 @@ impl FramesOfMasks<'_, '_> {
             sides,
             bounds: windows.iter().map(|w| w.map(PixelBounds::from)).collect(),
             composite: frame_name("composite", frame),
+            light_parts: None,
         });
         self.crops.push(windows);
         Ok(())

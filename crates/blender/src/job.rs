@@ -32,6 +32,10 @@ pub struct ScriptJob {
     pub glass: Vec<ThinPane>,
     /// The frames to render.
     pub frames: Vec<ScriptFrame>,
+    /// Render every pass once per light-split state, with light groups by source
+    /// ([`crate::light_split`]).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub light_split: bool,
 }
 
 /// One frame of a [`ScriptJob`].
@@ -43,6 +47,12 @@ pub struct ScriptFrame {
     pub trans: PathBuf,
     /// The reflection passes to render, one per plane with glass.
     pub planes: Vec<ScriptPlane>,
+    /// The frame's apertures, opened one at a time by a light-split render.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub apertures: Vec<crate::light_split::ScriptAperture>,
+    /// Where a light-split render writes the frame's light sources.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lights: Option<PathBuf>,
 }
 
 /// One reflection pass of a [`ScriptFrame`].
@@ -156,6 +166,10 @@ pub struct FrameRecord {
     pub bounds: Vec<Option<PixelBounds>>,
     /// The composite, relative to the output folder.
     pub composite: String,
+    /// The frame's light parts (`light_parts.####.json`, [`glassdb_compose::light_parts`]),
+    /// when the passes keep the light's path apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light_parts: Option<String>,
 }
 
 /// `glassdb-blender.json`: what `glassdb blender render` made, for re-compositing.
@@ -211,7 +225,10 @@ impl RunRecord {
                     f.frame
                 )));
             }
-            let files = [&f.trans, &f.mask, &f.composite].into_iter().chain(&f.refl);
+            let files = [&f.trans, &f.mask, &f.composite]
+                .into_iter()
+                .chain(&f.refl)
+                .chain(&f.light_parts);
             if let Some(p) = files.into_iter().find(|p| !is_plain_name(p)) {
                 return Err(bad(format!(
                     "frame {}: {p:?} is not a file name in the directory",

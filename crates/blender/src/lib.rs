@@ -10,6 +10,7 @@
 pub mod error;
 pub mod geometry;
 pub mod job;
+pub mod light_split;
 mod passes;
 pub mod pipeline;
 pub mod program;

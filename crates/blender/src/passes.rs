@@ -81,7 +81,7 @@ pub(crate) fn place_crop(
     write_exr(to, image)
 }
 
-fn write_exr(to: &Path, image: ExrImageOut) -> Result<(), BlenderError> {
+pub(crate) fn write_exr(to: &Path, image: ExrImageOut) -> Result<(), BlenderError> {
     glassdb_io::write_atomic(to, |w| {
         glassdb_image::write_exr_image(w, image, EXR_OPTIONS)
             .map(|_| ())

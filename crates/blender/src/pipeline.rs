@@ -70,6 +70,10 @@ pub struct RenderRequest {
     /// Also render the Cycles reference (the glass as a thin pane seen by the camera) as
     /// `reference.####.exr`.
     pub reference: bool,
+    /// Keep the light's path apart in the passes ([`crate::light_split`]): light groups by
+    /// source and one render per aperture, so that a swap relights the room; `false` renders
+    /// each pass once, lit through the render's glass (a swap then leaves the room as lit).
+    pub light_split: bool,
     /// Composite every frame at the end (else the run stops at its passes, masks and record,
     /// for [`compose_dir`] to composite: a farm's render and composite steps).
     pub composite: bool,
@@ -144,13 +148,13 @@ pub fn render(
 
     progress.stage("planes and masks");
     let t = Instant::now();
-    let masks = planes_and_masks(&work, &info, registry)?;
+    let mut masks = planes_and_masks(&work, &info, registry)?;
     let mask_s = t.elapsed().as_secs_f64();
 
     progress.stage("render passes");
     let t = Instant::now();
     let cpu = children_cpu_seconds();
-    let job = render_passes(&work, &masks)?;
+    let job = render_passes(&work, &mut masks)?;
     let render_s = t.elapsed().as_secs_f64();
     let render_cpu_s = cpu_since(cpu);
     let lit_by = crate::swap::pass_glasses(masks.glass_materials.iter().map(|m| m.1), registry);
@@ -322,10 +326,12 @@ pub(crate) fn moving_obj_name(frame: u32) -> String {
 
 /// Blender renders every frame's transmission pass and one cropped reflection pass per plane
 /// with glass; glassdb moves them into the output folder, each crop placed at its pixel
-/// rectangle (a plane without glass gets a one-pixel pass). Returns the job it rendered.
-pub fn render_passes(work: &Workspace<'_>, masks: &Masks) -> Result<ScriptJob, BlenderError> {
+/// rectangle (a plane without glass gets a one-pixel pass); with the light split, each pass
+/// is assembled from its light-split renders and each frame gets its light parts
+/// ([`crate::light_split::place_split_passes`]). Returns the job it rendered.
+pub fn render_passes(work: &Workspace<'_>, masks: &mut Masks) -> Result<ScriptJob, BlenderError> {
     let request = work.request;
-    let job = ScriptJob {
+    let mut job = ScriptJob {
         resolution: work.resolution(),
         samples: request.samples,
         seed: request.seed,
@@ -333,8 +339,16 @@ pub fn render_passes(work: &Workspace<'_>, masks: &Masks) -> Result<ScriptJob, B
         reference: false,
         glass: masks.panes.clone(),
         frames: masks.script_frames.clone(),
+        light_split: request.light_split,
     };
+    if request.light_split {
+        crate::light_split::prepare_job(&work.staging, &mut job);
+    }
     run_job(work, &work.staging.join("job.json"), "render", &job)?;
+    if request.light_split {
+        crate::light_split::place_split_passes(work, masks, &job)?;
+        return Ok(job);
+    }
     let (width, height) = masks.size;
     for ((f, script), windows) in masks.frames.iter().zip(&job.frames).zip(&masks.crops) {
         rename(&script.trans, &work.dir.join(&f.trans))?;
@@ -395,8 +409,11 @@ pub fn render_reference(
                 frame: f.frame,
                 trans: work.staging.join(frame_name("reference", f.frame)),
                 planes: Vec::new(),
+                apertures: Vec::new(),
+                lights: None,
             })
             .collect(),
+        light_split: false,
         ..job
     };
     run_job(
