@@ -175,6 +175,7 @@ impl FrameInputArgs {
                 TransferArg::Linear => InputTransfer::Linear,
             },
             max_pixels: self.max_pixels,
+            light_mix: None,
         }
     }
 

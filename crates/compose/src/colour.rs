@@ -223,6 +223,17 @@ impl RegistryLuts {
             .map(|(_, l)| l.get())
     }
 
+    /// The registry table in `basis` (`None` for one given built, [`RegistryLuts::single`]).
+    pub fn table(&self, basis: ColourBasis) -> Option<&RegistryTable> {
+        self.tables
+            .iter()
+            .find(|(b, _)| *b == basis)
+            .and_then(|(_, l)| match l {
+                LazyLut::Built(_) => None,
+                LazyLut::Table(table, _) => Some(table),
+            })
+    }
+
     /// The bases held, in the registry's order.
     pub fn bases(&self) -> Vec<ColourBasis> {
         self.tables.iter().map(|(b, _)| *b).collect()

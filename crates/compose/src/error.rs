@@ -190,6 +190,71 @@ pub enum ComposeError {
         /// The lights it has (`warm (A)`).
         lights: Vec<String>,
     },
+    /// A light-parts record that cannot be used (docs/compose.md, "Relit swap").
+    #[error("light parts {record}: {problem}")]
+    LightPartsRecord {
+        /// The record (its path, or what gave it).
+        record: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A light part through an aperture whose glass id the registry has no table for.
+    #[error(
+        "light part {group:?} came through glass id {id} on plane {plane}, which {registry} does not have"
+    )]
+    LightPartUnknownId {
+        /// The part's group.
+        group: String,
+        /// The aperture's glass id.
+        id: u32,
+        /// The aperture's plane.
+        plane: usize,
+        /// The registry's name.
+        registry: String,
+    },
+    /// A light part with no layer in one of the passes: its light would be lost.
+    #[error(
+        "{path} has no layer for light part {group:?} (its light groups: {})",
+        if found.is_empty() { "none".to_string() } else { found.join(", ") }
+    )]
+    PartWithoutLayer {
+        /// The pass.
+        path: PathBuf,
+        /// The part's group.
+        group: String,
+        /// The groups the pass has.
+        found: Vec<String>,
+    },
+    /// Light-group layers of a pass that no light part names: leaving them out would lose
+    /// their light, and nothing says which glass they came through.
+    #[error(
+        "{path} has light-group layers without a light part: {} (the parts: {})",
+        groups.join(", "),
+        parts.join(", ")
+    )]
+    LayerWithoutPart {
+        /// The pass.
+        path: PathBuf,
+        /// Its groups no part names.
+        groups: Vec<String>,
+        /// The parts' groups.
+        parts: Vec<String>,
+    },
+    /// A light part through an aperture on a plane the frame's mask does not have.
+    #[error(
+        "light part {group:?} came through plane {plane}, but {mask} has {planes} plane(s) (0 to {})",
+        planes.saturating_sub(1)
+    )]
+    AperturePlaneNotInMask {
+        /// The part's group.
+        group: String,
+        /// The aperture's plane.
+        plane: usize,
+        /// The mask.
+        mask: PathBuf,
+        /// How many planes the frame has (its reflection passes).
+        planes: usize,
+    },
     /// Light groups asked for with none named, or one named twice.
     #[error("light groups: {0}")]
     LightGroupList(String),
@@ -309,6 +374,11 @@ impl ComposeError {
             | ComposeError::GroupWithoutTable { .. }
             | ComposeError::NoTableForGroup { .. }
             | ComposeError::LightGroupList(_)
+            | ComposeError::LightPartsRecord { .. }
+            | ComposeError::LightPartUnknownId { .. }
+            | ComposeError::PartWithoutLayer { .. }
+            | ComposeError::LayerWithoutPart { .. }
+            | ComposeError::AperturePlaneNotInMask { .. }
             | ComposeError::KeepGroupsNotExr { .. }
             | ComposeError::GroupWithoutPass { .. }
             | ComposeError::GroupPassWithoutPlane { .. }

@@ -18,7 +18,10 @@
 //! [`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`. The
 //! viewer runs the first two ([`decode_frame`]), with no output at all. A frame split into
 //! light groups is [`compose_light_groups`]: the phases once per group, each with its light's
-//! table, and the sum written ([`light_groups`]). [`compose_in_memory`] composites a host
+//! table, and the sum written ([`light_groups`]). A frame split by the light's path is
+//! [`compose_light_parts`]: each part scaled by what its aperture's glass passes, the parts
+//! summed as each pass is read, composited once ([`relight`], the relit swap).
+//! [`compose_in_memory`] composites a host
 //! application's arrays with the same checks and kernel, without files.
 
 #![warn(missing_docs)]
@@ -36,6 +39,7 @@ pub mod memory;
 mod pane_groups;
 mod place;
 mod plan;
+pub mod relight;
 pub mod shares;
 mod write;
 
@@ -58,6 +62,10 @@ pub use in_memory::{
 pub use light_groups::{GroupPasses, LightGroup, compose_light_groups, group_passes};
 use memory::{MemoryBudget, MemoryEstimate};
 pub use plan::DecodeTarget;
+pub use relight::{
+    ApertureGlass, FactorKind, PartFactor, PartTables, RelitReport, compose_light_parts,
+    part_factors, part_passes,
+};
 
 use crate::colour::{ChosenTable, PassSpace, RegistryLuts};
 use crate::composite::Composited;

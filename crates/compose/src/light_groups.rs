@@ -196,7 +196,7 @@ pub(crate) fn add_group_composite(total: &mut [Vec<f32>; 3], add: &[Vec<f32>; 3]
 /// group's composite written in their place (`layer.R`, `.G`, `.B`). The sum replaces the
 /// file's beauty layer: the one the group layers are split from (`ViewLayer.Combined` for
 /// `ViewLayer.Combined_sun`), else bare `R`, `G`, `B`, else it is added as bare `R`, `G`, `B`.
-fn carry_groups(
+pub(crate) fn carry_groups(
     frame: &mut glassdb_pass::CarriedFrame,
     groups: &[GroupPasses],
     kept: Vec<(String, [Vec<f32>; 3])>,

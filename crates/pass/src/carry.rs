@@ -12,8 +12,8 @@ use glassdb_image::{
 
 use crate::PassError;
 use crate::read::{
-    Pass, PassReadOptions, PassSource, channel_names, choose_layer, decode_err, layer_channels,
-    open_seekable, read_err, read_exr_pass, read_pass_bytes, rewind,
+    Pass, PassReadOptions, PassSource, channel_names, decode_err, layer_channels, open_seekable,
+    read_err, read_exr_pass, read_layer, read_pass_bytes, rewind,
 };
 
 /// Which of the transmission file's channels an output carries over besides the composite.
@@ -174,7 +174,7 @@ pub fn read_transmission(
 ) -> Result<(Pass, CarriedFrame), PassError> {
     let (mut file, header, len) = open_seekable(path, opts.max_pixels)?;
     if let ImageHeader::Exr(headers) = &header {
-        let chosen = choose_layer(&headers.parts, opts.layer.as_deref(), path)?;
+        let (chosen, _) = read_layer(&headers.parts, opts, path)?;
         let names = headers
             .parts
             .get(chosen.part)

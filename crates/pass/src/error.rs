@@ -87,6 +87,21 @@ pub enum PassError {
         /// Its plane layers.
         layers: Vec<String>,
     },
+    /// A pass read as a sum of light-group layers ([`crate::read::LightMix`]) whose groups lie in
+    /// different parts of the file.
+    #[error("{path}: the light-group layers {} are in different parts; a light mix reads one part", layers.join(" and "))]
+    LightMixParts {
+        /// The pass.
+        path: PathBuf,
+        /// Two layers in different parts.
+        layers: Vec<String>,
+    },
+    /// A pass read as a sum of light-group layers that is not an EXR (a PNG has no layers).
+    #[error("{path} is not an EXR: light-group layers are read from multilayer EXR passes only")]
+    LightMixNotExr {
+        /// The pass.
+        path: PathBuf,
+    },
     /// The transmission file's other channels could not be read to be carried over.
     #[error("cannot carry over the other channels of {path}")]
     KeepChannels {
@@ -112,6 +127,8 @@ impl PassError {
             PassError::AmbiguousLayer { .. }
             | PassError::LayerNotFound { .. }
             | PassError::TwoGroupLayers { .. }
+            | PassError::LightMixParts { .. }
+            | PassError::LightMixNotExr { .. }
             | PassError::PlaneLayers { .. } => ErrorKind::Invalid,
         }
     }

@@ -22,6 +22,7 @@ pub use error::PassError;
 pub use groups::{GroupLayer, GroupNaming, light_group_layers_of, light_group_of_layer};
 pub use pixels::{EncodedImage, EncodedSamples, InputTransfer, LinearImage, PngBits};
 pub use read::{
-    Pass, PassHeader, PassReadOptions, PassSource, plane_group_layers_of, plane_layers_of,
-    read_pass, read_pass_bytes, read_pass_header, read_pass_rows, read_refl_header,
+    LightMix, Pass, PassHeader, PassReadOptions, PassSource, plane_group_layers_of,
+    plane_layers_of, read_pass, read_pass_bytes, read_pass_header, read_pass_rows,
+    read_refl_header,
 };

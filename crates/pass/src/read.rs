@@ -25,6 +25,9 @@ pub struct PassReadOptions {
     pub transfer: InputTransfer,
     /// Pixel limit, checked from the header before allocating.
     pub max_pixels: u64,
+    /// Read the pass as this weighted sum of its light-group layers instead of `layer`
+    /// (`None`: one layer).
+    pub light_mix: Option<LightMix>,
 }
 
 impl Default for PassReadOptions {
@@ -33,8 +36,112 @@ impl Default for PassReadOptions {
             layer: None,
             transfer: InputTransfer::Srgb,
             max_pixels: glassdb_image::DEFAULT_MAX_PIXELS,
+            light_mix: None,
         }
     }
+}
+
+/// A pass read as a weighted sum of its light-group layers, `Σ_g w_g · layer_g` per channel
+/// (the relit swap, docs/compose.md "Relit swap"): every group's layer of one EXR part decoded
+/// in one pass over the file, so that P parts cost one read, not P.
+#[derive(Debug, Clone, Default)]
+pub struct LightMix {
+    /// Each light group (as [`crate::light_group_of_layer`] names it) and its R, G, B weights.
+    pub weights: Vec<(String, [f32; 3])>,
+}
+
+impl PartialEq for LightMix {
+    /// Equal weights bit for bit (so that options stay `Eq`).
+    fn eq(&self, other: &Self) -> bool {
+        self.weights.len() == other.weights.len()
+            && self.weights.iter().zip(&other.weights).all(|(a, b)| {
+                a.0 == b.0
+                    && a.1
+                        .iter()
+                        .zip(&b.1)
+                        .all(|(x, y)| x.to_bits() == y.to_bits())
+            })
+    }
+}
+
+impl Eq for LightMix {}
+
+/// The layers of `mix`'s groups in an EXR with parts `parts`, in the mix's order: each group's
+/// layer must exist and all must lie in one part (decoded together).
+fn mix_layers(
+    parts: &[ExrPart],
+    mix: &LightMix,
+    path: &Path,
+) -> Result<Vec<glassdb_image::RgbLayer>, PassError> {
+    let layers = glassdb_image::rgb_layers(parts);
+    let mut out: Vec<glassdb_image::RgbLayer> = Vec::with_capacity(mix.weights.len());
+    for (group, _) in &mix.weights {
+        let layer = layers
+            .iter()
+            .find(|l| crate::light_group_of_layer(&l.name).is_some_and(|(g, _)| g == group))
+            .ok_or_else(|| PassError::LayerNotFound {
+                path: path.to_path_buf(),
+                layer: format!("of light group {group}"),
+                candidates: layers.iter().map(|l| l.label()).collect(),
+            })?;
+        if let Some(first) = out.first().filter(|f| f.part != layer.part) {
+            return Err(PassError::LightMixParts {
+                path: path.to_path_buf(),
+                layers: vec![first.name.clone(), layer.name.clone()],
+            });
+        }
+        out.push(layer.clone());
+    }
+    if out.is_empty() {
+        return Err(PassError::LayerNotFound {
+            path: path.to_path_buf(),
+            layer: "of no light group (an empty mix)".into(),
+            candidates: layers.iter().map(|l| l.label()).collect(),
+        });
+    }
+    Ok(out)
+}
+
+/// The layer a pass is read from, and the channels decoded: `opts.layer`'s (R, G, B, then A),
+/// or with a [`LightMix`] the first group's layer and every group's R, G, B.
+pub(crate) fn read_layer(
+    parts: &[ExrPart],
+    opts: &PassReadOptions,
+    path: &Path,
+) -> Result<(glassdb_image::RgbLayer, Vec<usize>), PassError> {
+    match &opts.light_mix {
+        None => {
+            let chosen = choose_layer(parts, opts.layer.as_deref(), path)?;
+            let channels = layer_channels(&chosen);
+            Ok((chosen, channels))
+        }
+        Some(mix) => {
+            let layers = mix_layers(parts, mix, path)?;
+            let channels = layers.iter().flat_map(|l| l.rgb).collect();
+            let mut first = layers[0].clone();
+            first.alpha = None;
+            Ok((first, channels))
+        }
+    }
+}
+
+/// `Σ_g w_g · buffers[3g + c]` per channel `c`: the weighted sum of the groups' R, G, B planes
+/// decoded in mix order.
+fn mix_planes(mix: &LightMix, buffers: Vec<Vec<f32>>) -> [Vec<f32>; 3] {
+    let mut planes = buffers.into_iter();
+    let mut out: [Vec<f32>; 3] = Default::default();
+    for (_, w) in &mix.weights {
+        for (c, sum) in out.iter_mut().enumerate() {
+            let plane = planes.next().unwrap_or_default();
+            if sum.is_empty() {
+                *sum = plane;
+                sum.iter_mut().for_each(|v| *v *= w[c]);
+            } else {
+                sum.iter_mut().zip(&plane).for_each(|(s, v)| *s += w[c] * v);
+            }
+        }
+    }
+    out
 }
 
 /// What a pass was stored as (to pick output defaults, report, and write the output like it).
@@ -160,6 +267,9 @@ fn pass_header(
 ) -> Result<PassHeader, PassError> {
     let (_, header, file_len) = open_seekable(path, opts.max_pixels)?;
     match header {
+        ImageHeader::Png(_) if opts.light_mix.is_some() => Err(PassError::LightMixNotExr {
+            path: path.to_path_buf(),
+        }),
         ImageHeader::Png(h) => {
             let planes = 3 + u64::from(h.channels == 2 || h.channels == 4);
             Ok(PassHeader {
@@ -179,8 +289,7 @@ fn pass_header(
         }
         ImageHeader::Exr(headers) => {
             let parts = headers.parts;
-            let chosen = choose_layer(&parts, opts.layer.as_deref(), path)?;
-            let channels = layer_channels(&chosen);
+            let (chosen, channels) = read_layer(&parts, opts, path)?;
             let info = parts.get(chosen.part).ok_or_else(|| {
                 decode_err(
                     path,
@@ -191,7 +300,7 @@ fn pass_header(
             })?;
             glassdb_image::check_exr_readable(info, &channels, opts.max_pixels)
                 .map_err(|source| decode_err(path, source))?;
-            let source = exr_source(info, chosen, &channels);
+            let source = exr_source(info, chosen.clone(), &layer_channels(&chosen));
             Ok(PassHeader {
                 windows: info.windows(),
                 colour: info.colour.clone(),
@@ -305,6 +414,9 @@ pub fn read_pass_bytes(
     let decoded = glassdb_image::open_image(bytes, opts.max_pixels)
         .map_err(|source| decode_err(path, source))?;
     match decoded {
+        ImageFile::Png(_) if opts.light_mix.is_some() => Err(PassError::LightMixNotExr {
+            path: path.to_path_buf(),
+        }),
         ImageFile::Png(png) => Ok(pass_from_png(png, opts.transfer)),
         ImageFile::Exr(exr) => read_exr_pass(exr.parts(), path, opts, |part, channels| {
             exr.read_channels(part, channels)
@@ -353,10 +465,13 @@ pub(crate) fn read_exr_pass(
     opts: &PassReadOptions,
     decode: impl FnOnce(usize, &[usize]) -> Result<(ExrPart, Vec<Vec<f32>>), ImageError>,
 ) -> Result<Pass, PassError> {
-    let chosen = choose_layer(parts, opts.layer.as_deref(), path)?;
-    let channels = layer_channels(&chosen);
+    let (chosen, channels) = read_layer(parts, opts, path)?;
     let (info, mut buffers) =
         decode(chosen.part, &channels).map_err(|source| decode_err(path, source))?;
+    if let Some(mix) = &opts.light_mix {
+        buffers = mix_planes(mix, buffers).into();
+    }
+    let channels = layer_channels(&chosen);
     let alpha_plane = if chosen.alpha.is_some() {
         buffers.pop()
     } else {
