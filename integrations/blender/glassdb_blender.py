@@ -589,6 +589,33 @@ def add_light_opening(mat):
     return {"dot": dot, "add": add, "near": near, "enable": enable}
 
 
+def source_light_groups(scene):
+    """Cycles light groups by source: each sun lamp (`sun`, or `sun0`, `sun1`, ... for
+    several), the world (`sky`) and every other emitter (`other`), written as the layers
+    `ViewLayer.Combined_<group>` of multilayer EXRs. A scene's own light groups are replaced.
+    Returns the sun lamps with their groups, and the groups."""
+    vl = bpy.context.view_layer
+    scene.render.use_single_layer = True
+    suns = [ob for ob in scene.objects
+            if ob.type == "LIGHT" and ob.data.type == "SUN" and not ob.hide_render]
+    suns = [(ob, "sun" if len(suns) == 1 else "sun%d" % k) for k, ob in enumerate(suns)]
+    names = [n for _, n in suns] + ["sky", "other"]
+    for lg in list(vl.lightgroups):
+        if lg.name not in names:
+            print("glassdb_blender: light group %s replaced by the light split" % lg.name)
+            vl.lightgroups.remove(lg)
+    for name in names:
+        if name not in vl.lightgroups:
+            vl.lightgroups.add(name=name)
+    by_sun = {ob.name: n for ob, n in suns}
+    for ob in scene.objects:
+        ob.lightgroup = by_sun.get(ob.name, "other")
+    if scene.world is not None:
+        scene.world.lightgroup = "sky"
+    scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+    return suns, names
+
+
 class LightSplit:
     """The passes split by the light's path (docs/blender.md, "Light parts"): Cycles light
     groups by source (each sun lamp, the world as `sky`, every other emitter as `other`),
@@ -601,30 +628,14 @@ class LightSplit:
         for g in job["glass"]:
             self.openings[g["material"]] = add_light_opening(bpy.data.materials[g["material"]])
         self.apertures = []
-        vl = bpy.context.view_layer
-        scene.render.use_single_layer = True
-        suns = [ob for ob in scene.objects
-                if ob.type == "LIGHT" and ob.data.type == "SUN" and not ob.hide_render]
-        self.suns = [(ob, "sun" if len(suns) == 1 else "sun%d" % k) for k, ob in enumerate(suns)]
-        names = [n for _, n in self.suns] + ["sky", "other"]
-        for lg in list(vl.lightgroups):
-            if lg.name not in names:
-                print("glassdb_blender: light group %s replaced by the light split" % lg.name)
-                vl.lightgroups.remove(lg)
-        for name in names:
-            if name not in vl.lightgroups:
-                vl.lightgroups.add(name=name)
-        by_sun = {ob.name: n for ob, n in self.suns}
-        for ob in scene.objects:
-            ob.lightgroup = by_sun.get(ob.name, "other")
-        if scene.world is not None:
-            scene.world.lightgroup = "sky"
-        self.groups = names
-        im = scene.render.image_settings
-        im.file_format = "OPEN_EXR_MULTILAYER"
+        self.suns, self.groups = source_light_groups(scene)
 
     @staticmethod
     def of_job(scene, job):
+        """The job's light split, or None; a reference job with `light_groups` gets the
+        sources' light groups only (the validation's error by source)."""
+        if job.get("light_groups"):
+            source_light_groups(scene)
         return LightSplit(scene, job) if job.get("light_split") else None
 
     def start_frame(self, scene, frame):

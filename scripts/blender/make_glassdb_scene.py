@@ -11,6 +11,10 @@
   walls, a table and a cabinet) with a glazed facade (two `Glass_clear` panes either side of a
   mullion, plane y = 2) and a `Tinted_bronze` side window (plane x = 3), buildings outside,
   the sun shining in and a blue world; the camera moves and turns over frames 1-3.
+- `relit` (docs/blender.md, "Light parts"): 160 × 120, 64 samples, a closed room lit only
+  through two windows (`Glass_clear` in the plane y = 3, `Tinted_bronze` in the plane x = 3)
+  by the sun and a blue world; frame 1 looks into the room from inside, frame 2 at the daylit
+  room from outside through both windows.
 
 Every coordinate is a multiple of 1/8 (exact in float32 and in text). With `--index DIR` the
 saved scene is also rendered once per frame with 1 sample through each pixel centre
@@ -40,6 +44,7 @@ MATERIALS = {
     "Box_green": ((0.15, 0.50, 0.15), 0.7, 0),
     "Building": ((0.55, 0.52, 0.48), 0.9, 0),
     "Lamp": ((1.0, 0.95, 0.85), 4.0, 0),  # emission colour and strength
+    "Plaster": ((0.70, 0.68, 0.64), 0.9, 0),
     "Glass_clear": ((1.0, 1.0, 1.0), 0.0, 1),
     "Tinted_bronze": ((0.55, 0.40, 0.25), 0.0, 5),
 }
@@ -103,6 +108,42 @@ def example():
     return objects, cameras, (320, 240), 64, (50.0, 0.0, 200.0)
 
 
+def relit():
+    """A room lit by the sun through two windows of different glass (issue 28's validation of
+    the relit swap): frame 1 looks into the room from inside, frame 2 at the daylit room from
+    outside, through both windows."""
+    objects = [
+        ("Ground", "Floor", quad((-20.0, -20.0, 0.0), (20.0, -20.0, 0.0), (20.0, 20.0, 0.0), (-20.0, 20.0, 0.0))),
+        ("Ceiling", "Plaster", quad((-3.0, -3.0, 3.0), (-3.0, 3.0, 3.0), (3.0, 3.0, 3.0), (3.0, -3.0, 3.0))),
+        ("BackWall", "Plaster", quad((-3.0, -3.0, 0.0), (3.0, -3.0, 0.0), (3.0, -3.0, 3.0), (-3.0, -3.0, 3.0))),
+        ("LeftWall", "Plaster", quad((-3.0, -3.0, 0.0), (-3.0, -3.0, 3.0), (-3.0, 3.0, 3.0), (-3.0, 3.0, 0.0))),
+        ("Table", "Box_red", box(-1.25, -0.5, 0.0, 0.25, 0.75, 0.75)),
+        ("Cabinet", "Box_green", box(-2.75, 1.75, 0.0, -2.0, 2.75, 1.5)),
+        ("Tree", "Building", box(6.0, 7.0, 0.0, 7.0, 8.0, 4.0)),
+    ]
+    # Facade y = 3 with a window x in [-2, 0], z in [0.75, 2.5]; side wall x = 3 with a window
+    # y in [-1.5, 1.5], z in [0.75, 2.5].
+    for name, corners in (
+        ("Front_below", ((-3.0, 3.0, 0.0), (3.0, 3.0, 0.0), (3.0, 3.0, 0.75), (-3.0, 3.0, 0.75))),
+        ("Front_above", ((-3.0, 3.0, 2.5), (3.0, 3.0, 2.5), (3.0, 3.0, 3.0), (-3.0, 3.0, 3.0))),
+        ("Front_left", ((-3.0, 3.0, 0.75), (-2.0, 3.0, 0.75), (-2.0, 3.0, 2.5), (-3.0, 3.0, 2.5))),
+        ("Front_right", ((0.0, 3.0, 0.75), (3.0, 3.0, 0.75), (3.0, 3.0, 2.5), (0.0, 3.0, 2.5))),
+        ("Side_below", ((3.0, -3.0, 0.0), (3.0, 3.0, 0.0), (3.0, 3.0, 0.75), (3.0, -3.0, 0.75))),
+        ("Side_above", ((3.0, -3.0, 2.5), (3.0, 3.0, 2.5), (3.0, 3.0, 3.0), (3.0, -3.0, 3.0))),
+        ("Side_left", ((3.0, -3.0, 0.75), (3.0, -1.5, 0.75), (3.0, -1.5, 2.5), (3.0, -3.0, 2.5))),
+        ("Side_right", ((3.0, 1.5, 0.75), (3.0, 3.0, 0.75), (3.0, 3.0, 2.5), (3.0, 1.5, 2.5))),
+    ):
+        objects.append((name, "Plaster", quad(*corners)))
+    objects.append(("Window_front", "Glass_clear",
+                    quad((-2.0, 3.0, 0.75), (0.0, 3.0, 0.75), (0.0, 3.0, 2.5), (-2.0, 3.0, 2.5))))
+    objects.append(("Window_side", "Tinted_bronze",
+                    quad((3.0, -1.5, 0.75), (3.0, 1.5, 0.75), (3.0, 1.5, 2.5), (3.0, -1.5, 2.5))))
+    cameras = {1: ((-2.5, -2.5, 1.75), (0.5, 1.5, 0.5)),
+               2: ((5.0, 6.5, 1.6), (1.0, 1.5, 1.2))}
+    # The sun from +x, +y, 40 degrees up: in through both windows onto the floor.
+    return objects, cameras, (160, 120), 64, (50.0, 0.0, 135.0)
+
+
 def material(name):
     rgb, rough, index = MATERIALS[name]
     mat = bpy.data.materials.new(name)
@@ -124,7 +165,7 @@ def material(name):
 
 
 def build(kind):
-    objects, cameras, (w, h), samples, sun_rot = {"tiny": tiny, "example": example}[kind]()
+    objects, cameras, (w, h), samples, sun_rot = {"tiny": tiny, "example": example, "relit": relit}[kind]()
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     mats = {}

@@ -202,6 +202,13 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
             .collect::<Vec<_>>()
             .join(", ")
     );
+    let (renders, unsplit) = report.renders;
+    if request.light_split {
+        outln!(
+            "passes: light split: {renders} Blender renders ({unsplit} with --light-split off, \
+             whose swaps leave the room lit by the rendered glass)"
+        );
+    }
     for o in &report.record.overrides {
         outln!("passes: {o}");
     }

@@ -36,6 +36,10 @@ pub struct ScriptJob {
     /// ([`crate::light_split`]).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub light_split: bool,
+    /// Render with light groups by source, without the split (the reference of a split run:
+    /// its layers `ViewLayer.Combined_<group>` say each source's light).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub light_groups: bool,
 }
 
 /// One frame of a [`ScriptJob`].

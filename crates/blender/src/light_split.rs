@@ -119,6 +119,17 @@ struct SunLamp {
     direction_to_sun: [f64; 3],
 }
 
+/// Blender's pass renders of `frames`, with the split (`light_split`) or without, and without
+/// it: `(A + 1)(1 + P)` or `1 + P` per frame, A apertures, P reflection passes.
+pub(crate) fn render_counts(frames: &[ScriptFrame], light_split: bool) -> (usize, usize) {
+    let unsplit: usize = frames.iter().map(|f| 1 + f.planes.len()).sum();
+    let split: usize = frames
+        .iter()
+        .map(|f| (f.apertures.len() + 1) * (1 + f.planes.len()))
+        .sum();
+    (if light_split { split } else { unsplit }, unsplit)
+}
+
 /// Asks the script for each frame's light sources (the job's frames already hold their
 /// apertures).
 pub(crate) fn prepare_job(staging: &Path, job: &mut ScriptJob) {
@@ -163,6 +174,33 @@ pub(crate) fn place_split_passes(
     Ok(())
 }
 
+/// Composites one frame of a split run with its light parts `name` (in `dir`): each part
+/// scaled by what its aperture's glass passes ([`glassdb_compose::compose_light_parts`]).
+pub(crate) fn compose_relit(
+    dir: &Path,
+    name: &str,
+    job: &glassdb_compose::ComposeJob,
+    settings: &glassdb_compose::ComposeSettings,
+    tables: &glassdb_compose::PartTables,
+) -> Result<glassdb_compose::FrameReport, BlenderError> {
+    let path = dir.join(name);
+    let text = glassdb_io::read_input_string(&path, glassdb_io::limits::JSON)?;
+    let parts: LightParts = serde_json::from_str(&text).map_err(|e| BlenderError::BadRecord {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    let record = path.display().to_string();
+    let report = glassdb_compose::compose_light_parts(
+        job,
+        settings,
+        tables,
+        &parts,
+        &record,
+        &glassdb_io::NoProgress,
+    )?;
+    Ok(report.frame)
+}
+
 /// One pass of a frame: what Blender wrote (before [`split_path`]), where it goes, and the
 /// pixels it covers in the frame (`None`: a plane without glass in this frame).
 pub(crate) struct SplitPass {
@@ -184,9 +222,6 @@ fn read_state(pass: &Path, groups: &[String]) -> Result<StateImage, BlenderError
         path: pass.to_path_buf(),
         message,
     };
-    if !pass.is_file() {
-        return Err(bad("Blender did not write this pass".into()));
-    }
     let bytes = glassdb_io::read_input(pass, glassdb_image::IMAGE_FILE)?;
     let exact = glassdb_image::read_exr_exact(&bytes, glassdb_image::DEFAULT_MAX_PIXELS)?;
     let nparts = exact.parts.len();
@@ -242,12 +277,29 @@ pub(crate) fn assemble_frame(
     passes: &[SplitPass],
     (width, height): (u32, u32),
 ) -> Result<LightParts, BlenderError> {
+    let states = frame.apertures.len() + 1;
+    for pass in passes.iter().filter(|p| p.window.is_some()) {
+        for s in 0..states {
+            let path = split_path(&pass.rendered, s);
+            if !path.is_file() {
+                return Err(BlenderError::BadRender {
+                    message: format!(
+                        "Blender did not write this pass (light-split state {s} of {})",
+                        pass.rendered
+                            .file_name()
+                            .unwrap_or_default()
+                            .to_string_lossy()
+                    ),
+                    path,
+                });
+            }
+        }
+    }
     let text = glassdb_io::read_input_string(lights, glassdb_io::limits::JSON)?;
     let lights: FrameLights = serde_json::from_str(&text).map_err(|e| BlenderError::BadRender {
         path: lights.to_path_buf(),
         message: e.to_string(),
     })?;
-    let states = frame.apertures.len() + 1;
     // First the sources that carry light anywhere, so that every pass has the same layers.
     let mut lit = vec![false; lights.groups.len()];
     for pass in passes.iter().filter(|p| p.window.is_some()) {

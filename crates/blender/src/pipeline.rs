@@ -114,6 +114,10 @@ pub struct RenderReport {
     pub reference_cpu_s: Option<f64>,
     /// The composites.
     pub compose: ComposeReport,
+    /// Blender's pass renders over all frames, and how many the same frames take without the
+    /// light split (`(A + 1)(1 + P)` against `1 + P` per frame: A apertures, P reflection
+    /// passes).
+    pub renders: (usize, usize),
 }
 
 /// The composites of a run.
@@ -151,6 +155,7 @@ pub fn render(
     let mut masks = planes_and_masks(&work, &info, registry)?;
     let mask_s = t.elapsed().as_secs_f64();
 
+    let renders = crate::light_split::render_counts(&masks.script_frames, request.light_split);
     progress.stage("render passes");
     let t = Instant::now();
     let cpu = children_cpu_seconds();
@@ -193,6 +198,7 @@ pub fn render(
         render_cpu_s,
         reference_cpu_s,
         compose,
+        renders,
     })
 }
 
@@ -340,6 +346,7 @@ pub fn render_passes(work: &Workspace<'_>, masks: &mut Masks) -> Result<ScriptJo
         glass: masks.panes.clone(),
         frames: masks.script_frames.clone(),
         light_split: request.light_split,
+        light_groups: false,
     };
     if request.light_split {
         crate::light_split::prepare_job(&work.staging, &mut job);
@@ -414,6 +421,7 @@ pub fn render_reference(
             })
             .collect(),
         light_split: false,
+        light_groups: true,
         ..job
     };
     run_job(
@@ -468,6 +476,7 @@ pub fn compose_record(
 ) -> Result<ComposeReport, BlenderError> {
     let t = Instant::now();
     let luts = RegistryLuts::new(&registry.registry);
+    let part_tables = glassdb_compose::PartTables::new(&registry.registry, &registry.label);
     let mut frames = Vec::new();
     for f in &record.frames {
         let settings = ComposeSettings {
@@ -495,10 +504,13 @@ pub fn compose_record(
             },
             output: dir.join(&f.composite),
         };
-        frames.push((
-            f.frame,
-            glassdb_compose::compose_frame(&job, &settings, &luts)?,
-        ));
+        let report = match &f.light_parts {
+            Some(name) => {
+                crate::light_split::compose_relit(dir, name, &job, &settings, &part_tables)?
+            }
+            None => glassdb_compose::compose_frame(&job, &settings, &luts)?,
+        };
+        frames.push((f.frame, report));
     }
     Ok(ComposeReport {
         frames,
