@@ -249,6 +249,7 @@ impl FramesOfMasks<'_, '_> {
             sides,
             bounds: windows.iter().map(|w| w.map(PixelBounds::from)).collect(),
             composite: frame_name("composite", frame),
+            light_parts: None,
         });
         self.crops.push(windows);
         Ok(())

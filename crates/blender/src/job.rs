@@ -156,6 +156,10 @@ pub struct FrameRecord {
     pub bounds: Vec<Option<PixelBounds>>,
     /// The composite, relative to the output folder.
     pub composite: String,
+    /// The frame's light parts (`light_parts.####.json`, [`glassdb_compose::light_parts`]),
+    /// when the passes keep the light's path apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light_parts: Option<String>,
 }
 
 /// `glassdb-blender.json`: what `glassdb blender render` made, for re-compositing.
@@ -211,7 +215,10 @@ impl RunRecord {
                     f.frame
                 )));
             }
-            let files = [&f.trans, &f.mask, &f.composite].into_iter().chain(&f.refl);
+            let files = [&f.trans, &f.mask, &f.composite]
+                .into_iter()
+                .chain(&f.refl)
+                .chain(&f.light_parts);
             if let Some(p) = files.into_iter().find(|p| !is_plain_name(p)) {
                 return Err(bad(format!(
                     "frame {}: {p:?} is not a file name in the directory",

@@ -13,6 +13,7 @@ pub mod job;
 mod passes;
 pub mod pipeline;
 pub mod program;
+pub mod relit;
 pub mod swap;
 pub mod thin_pane;
 

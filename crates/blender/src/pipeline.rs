@@ -122,6 +122,9 @@ pub struct ComposeReport {
     pub swap: Vec<crate::SwapWarning>,
     /// Wall seconds of them all.
     pub seconds: f64,
+    /// The factors of each frame composited with its light parts (the relit swap,
+    /// [`crate::relit`]), by frame.
+    pub light_parts: Vec<(u32, Vec<glassdb_compose::PartFactor>)>,
 }
 
 /// Pattern names of the frame's files.
@@ -174,6 +177,7 @@ pub fn render(
             frames: Vec::new(),
             swap: Vec::new(),
             seconds: 0.0,
+            light_parts: Vec::new(),
         }
     };
     std::fs::remove_dir_all(&work.staging).map_err(BlenderError::io("remove", &work.staging))?;
@@ -451,7 +455,9 @@ pub fn compose_record(
 ) -> Result<ComposeReport, BlenderError> {
     let t = Instant::now();
     let luts = RegistryLuts::new(&registry.registry);
+    let tables = glassdb_compose::PartTables::new(&registry.registry, &registry.label);
     let mut frames = Vec::new();
+    let mut light_parts = Vec::new();
     for f in &record.frames {
         let settings = ComposeSettings {
             decode: DecodeSettings {
@@ -478,15 +484,21 @@ pub fn compose_record(
             },
             output: dir.join(&f.composite),
         };
-        frames.push((
-            f.frame,
-            glassdb_compose::compose_frame(&job, &settings, &luts)?,
-        ));
+        let report = match &f.light_parts {
+            Some(name) => {
+                let relit = crate::relit::compose_frame_parts(dir, name, &job, &settings, &tables)?;
+                light_parts.push((f.frame, relit.factors));
+                relit.frame
+            }
+            None => glassdb_compose::compose_frame(&job, &settings, &luts)?,
+        };
+        frames.push((f.frame, report));
     }
     Ok(ComposeReport {
         frames,
-        swap: crate::swap_warnings(record, registry),
+        swap: crate::relit::swap_warnings_relit(record, registry),
         seconds: t.elapsed().as_secs_f64(),
+        light_parts,
     })
 }
 
