@@ -160,3 +160,23 @@ pub fn note_unsplit(trans: &Path, max_pixels: u64, stats: bool) {
         );
     }
 }
+
+/// `glassdb blender compose`'s line per frame relit by its light parts: each part's factors.
+pub fn print_blender_factors(frames: &[(u32, Vec<PartFactor>)]) {
+    for (frame, factors) in frames {
+        let parts: Vec<String> = factors
+            .iter()
+            .map(|f| {
+                format!(
+                    "{} ×({:.3}, {:.3}, {:.3})",
+                    f.group, f.factor[0], f.factor[1], f.factor[2]
+                )
+            })
+            .collect();
+        outln!(
+            "frame {frame}: relit by {} light part(s): {}",
+            factors.len(),
+            parts.join(", ")
+        );
+    }
+}

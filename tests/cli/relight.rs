@@ -294,3 +294,75 @@ fn split_passes_without_their_record_and_unsplit_passes_say_so() {
         "{stdout}"
     );
 }
+
+/// A `glassdb blender` folder of the two synthetic frames: its run record names each frame's
+/// light parts when `relit`; the passes were "rendered" with a glass named otherwise.
+fn write_blender_dir(dir: &Path, g: &GlassRecord, relit: bool) {
+    write_frames(dir, g.id);
+    let frames: Vec<serde_json::Value> = [1u32, 2]
+        .iter()
+        .map(|f| {
+            let mut v = serde_json::json!({
+                "frame": f, "trans": format!("t.{f:04}.exr"), "mask": format!("m.{f:04}.png"),
+                "refl": [format!("r.{f:04}.exr")], "sides": ["front"], "bounds": [null],
+                "composite": format!("composite.{f:04}.exr"),
+            });
+            if relit {
+                v["light_parts"] = format!("lp.{f:04}.json").into();
+            }
+            v
+        })
+        .collect();
+    let record = serde_json::json!({
+        "format": "glassdb-blender/1", "blend": "room.blend", "blender": "3.4.1",
+        "glass": ["Glass=1"], "samples": 8, "width": W, "height": H, "overrides": [],
+        "frames": frames,
+        "lit_by": [{"id": g.id, "name": "another glass", "t0": [0.5, 0.5, 0.5], "t_dif": [0.4, 0.4, 0.4]}],
+    });
+    std::fs::write(dir.join("glassdb-blender.json"), record.to_string()).unwrap();
+}
+
+/// `glassdb blender compose DIR` composites a frame with its light parts when the run record
+/// names them (the same image as `compose --light-parts`, each part's factors printed, no
+/// warning that the room keeps the old glass), and warns as before when it does not.
+#[test]
+fn blender_compose_relights_frames_whose_record_names_their_light_parts() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = glass();
+    write_blender_dir(dir.path(), &g, true);
+    let (out, stdout, stderr) = run(crate::util::glassdb()
+        .args(["blender", "compose"])
+        .arg(dir.path()));
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stdout.contains("frame 1: relit by 3 light part(s): interior ×(1.000, 1.000, 1.000)"),
+        "{stdout}"
+    );
+    assert!(!stderr.contains("only its pixels change"), "{stderr}");
+    ok(compose_in(dir.path(), "0001").args(["--light-parts", "lp.0001.json", "-o", "cli.exr"]));
+    let a = read_exr_planes(&dir.path().join("composite.0001.exr"));
+    let b = read_exr_planes(&dir.path().join("cli.exr"));
+    let rgb = |p: &crate::util::Planes| -> Vec<Vec<f64>> {
+        ["R", "G", "B"]
+            .iter()
+            .map(|c| {
+                let k = p
+                    .names
+                    .iter()
+                    .position(|n| n == &format!("ViewLayer.Combined.{c}"))
+                    .unwrap();
+                p.channels[k].clone()
+            })
+            .collect()
+    };
+    assert_eq!(rgb(&a), rgb(&b));
+
+    let old = tempfile::tempdir().unwrap();
+    write_blender_dir(old.path(), &g, false);
+    let (out, stdout, stderr) = run(crate::util::glassdb()
+        .args(["blender", "compose"])
+        .arg(old.path()));
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stdout.contains("relit by"), "{stdout}");
+    assert!(stderr.contains("only its pixels change"), "{stderr}");
+}
