@@ -147,6 +147,7 @@ fn print_composites(dir: &std::path::Path, report: &ComposeReport) {
     for w in &report.swap {
         eprintln!("warning: {w}");
     }
+    crate::cmd::relight::print_blender_factors(&report.light_parts);
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {

@@ -54,6 +54,12 @@ pub struct Args {
     /// write the sum (docs/compose.md, "Light groups")
     #[arg(long, value_name = "GROUP,...", value_delimiter = ',')]
     pub light_groups: Vec<String>,
+    /// Composite a frame whose passes keep the light's path apart with its light parts
+    /// (`light_parts.json`, written by `glassdb blender render`): each part scaled by what the
+    /// glass of the aperture it came through passes, so that a swap relights the room
+    /// (docs/compose.md, "Relit swap"); with --frames, a pattern with ####
+    #[arg(long, value_name = "FILE", conflicts_with = "light_groups")]
+    pub light_parts: Option<PathBuf>,
     /// With --light-groups, EXR output: also write each group's composite as a layer of its
     /// group's name, so that the lights can still be balanced afterwards
     #[arg(long, requires = "light_groups")]
@@ -218,7 +224,7 @@ fn output_options(args: &Args, registry: &Registry, label: &str) -> anyhow::Resu
     })
 }
 
-fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
+pub(crate) fn print_stats(r: &FrameReport, luts: &RegistryLuts, limit: u64) {
     let colour = &r.colour;
     let Some(lut) = luts.get(colour.table.basis) else {
         return;
@@ -365,8 +371,25 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
         inputs: args.inputs.files(),
         output: args.output.clone(),
     };
+    if let Some(record) = &args.light_parts {
+        return crate::cmd::relight::run(&args, record, &job, &settings, &luts);
+    }
     if !args.light_groups.is_empty() {
         return run_light_groups(&args, &job, &settings);
+    }
+    let first = match &args.inputs.frames {
+        Some(spec) => glassdb_io::parse_frame_list(spec)?
+            .first()
+            .map(|&f| job.for_frame(f))
+            .transpose()?,
+        None => Some(job.clone()),
+    };
+    if let Some(first) = first {
+        crate::cmd::relight::note_unsplit(
+            &first.inputs.trans,
+            settings.decode.pass.max_pixels,
+            args.stats,
+        );
     }
     match &args.inputs.frames {
         None => run_frame(&args, &job, &settings, &luts),

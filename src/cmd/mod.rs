@@ -28,6 +28,7 @@ pub mod out;
 pub mod plot;
 pub mod progress;
 pub mod registry;
+pub mod relight;
 pub mod report;
 pub mod scene;
 pub mod spectral;

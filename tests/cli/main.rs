@@ -18,6 +18,7 @@ mod passes;
 mod plot;
 mod registry;
 mod reliability;
+mod relight;
 mod scene;
 mod spectral;
 mod spectral_formats;

@@ -14,6 +14,7 @@ pub mod light_split;
 mod passes;
 pub mod pipeline;
 pub mod program;
+pub mod relit;
 pub mod swap;
 pub mod thin_pane;
 

@@ -174,33 +174,6 @@ pub(crate) fn place_split_passes(
     Ok(())
 }
 
-/// Composites one frame of a split run with its light parts `name` (in `dir`): each part
-/// scaled by what its aperture's glass passes ([`glassdb_compose::compose_light_parts`]).
-pub(crate) fn compose_relit(
-    dir: &Path,
-    name: &str,
-    job: &glassdb_compose::ComposeJob,
-    settings: &glassdb_compose::ComposeSettings,
-    tables: &glassdb_compose::PartTables,
-) -> Result<glassdb_compose::FrameReport, BlenderError> {
-    let path = dir.join(name);
-    let text = glassdb_io::read_input_string(&path, glassdb_io::limits::JSON)?;
-    let parts: LightParts = serde_json::from_str(&text).map_err(|e| BlenderError::BadRecord {
-        path: path.clone(),
-        message: e.to_string(),
-    })?;
-    let record = path.display().to_string();
-    let report = glassdb_compose::compose_light_parts(
-        job,
-        settings,
-        tables,
-        &parts,
-        &record,
-        &glassdb_io::NoProgress,
-    )?;
-    Ok(report.frame)
-}
-
 /// One pass of a frame: what Blender wrote (before [`split_path`]), where it goes, and the
 /// pixels it covers in the frame (`None`: a plane without glass in this frame).
 pub(crate) struct SplitPass {

@@ -130,6 +130,9 @@ pub struct ComposeReport {
     pub swap: Vec<crate::SwapWarning>,
     /// Wall seconds of them all.
     pub seconds: f64,
+    /// The factors of each frame composited with its light parts (the relit swap,
+    /// [`crate::relit`]), by frame.
+    pub light_parts: Vec<(u32, Vec<glassdb_compose::PartFactor>)>,
 }
 
 /// Pattern names of the frame's files.
@@ -183,6 +186,7 @@ pub fn render(
             frames: Vec::new(),
             swap: Vec::new(),
             seconds: 0.0,
+            light_parts: Vec::new(),
         }
     };
     std::fs::remove_dir_all(&work.staging).map_err(BlenderError::io("remove", &work.staging))?;
@@ -476,8 +480,9 @@ pub fn compose_record(
 ) -> Result<ComposeReport, BlenderError> {
     let t = Instant::now();
     let luts = RegistryLuts::new(&registry.registry);
-    let part_tables = glassdb_compose::PartTables::new(&registry.registry, &registry.label);
+    let tables = glassdb_compose::PartTables::new(&registry.registry, &registry.label);
     let mut frames = Vec::new();
+    let mut light_parts = Vec::new();
     for f in &record.frames {
         let settings = ComposeSettings {
             decode: DecodeSettings {
@@ -506,7 +511,9 @@ pub fn compose_record(
         };
         let report = match &f.light_parts {
             Some(name) => {
-                crate::light_split::compose_relit(dir, name, &job, &settings, &part_tables)?
+                let relit = crate::relit::compose_frame_parts(dir, name, &job, &settings, &tables)?;
+                light_parts.push((f.frame, relit.factors));
+                relit.frame
             }
             None => glassdb_compose::compose_frame(&job, &settings, &luts)?,
         };
@@ -514,8 +521,9 @@ pub fn compose_record(
     }
     Ok(ComposeReport {
         frames,
-        swap: crate::swap_warnings(record, registry),
+        swap: crate::relit::swap_warnings_relit(record, registry),
         seconds: t.elapsed().as_secs_f64(),
+        light_parts,
     })
 }
 

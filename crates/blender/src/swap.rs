@@ -116,12 +116,6 @@ impl fmt::Display for SwapWarning {
 /// the registry holds differently (another name, t0 or t_dif), or one saying the record does
 /// not know its glasses. A glass the registry lacks is compose's error, not a warning.
 pub fn swap_warnings(record: &RunRecord, registry: &RegistryChoice) -> Vec<SwapWarning> {
-    // Passes split by the light's path are relit by the glass composited
-    // (crate::light_split): a swap leaves nothing lit by the render's glass but what
-    // docs/blender.md lists (glass seen through glass or in a mirror).
-    if !record.frames.is_empty() && record.frames.iter().all(|f| f.light_parts.is_some()) {
-        return Vec::new();
-    }
     if record.lit_by.is_empty() {
         return vec![SwapWarning::GlassesOfThePassesUnknown {
             registry: registry.label.clone(),

@@ -64,7 +64,7 @@ use memory::{MemoryBudget, MemoryEstimate};
 pub use plan::DecodeTarget;
 pub use relight::{
     ApertureGlass, FactorKind, PartFactor, PartTables, RelitReport, compose_light_parts,
-    part_factors, part_passes,
+    part_factors, part_passes, read_light_parts,
 };
 
 use crate::colour::{ChosenTable, PassSpace, RegistryLuts};

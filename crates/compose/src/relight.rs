@@ -233,6 +233,21 @@ pub struct RelitReport {
     pub factors: Vec<PartFactor>,
 }
 
+/// Reads and checks a light-parts record (`light_parts.json`): JSON of at most
+/// [`glassdb_io::limits::JSON`], [`LightParts::check`]ed; an error names the file and,
+/// for bad JSON, the line and column.
+pub fn read_light_parts(path: &Path) -> Result<LightParts, ComposeError> {
+    let bad = |problem: String| ComposeError::LightPartsRecord {
+        record: path.display().to_string(),
+        problem,
+    };
+    let text = glassdb_io::read_input_string(path, glassdb_io::limits::JSON)
+        .map_err(|e| bad(glassdb_io::ErrorChain(&e).to_string()))?;
+    let parts: LightParts = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    parts.check().map_err(|p| bad(p.0))?;
+    Ok(parts)
+}
+
 /// Each light part's layers in `files`' passes, from their headers alone, in the order of
 /// `groups`: a part without a layer in some pass ([`ComposeError::PartWithoutLayer`]) or a
 /// pass's light-group layer without a part ([`ComposeError::LayerWithoutPart`]) is refused, so
