@@ -338,7 +338,7 @@ pub(crate) fn moving_obj_name(frame: u32) -> String {
 /// with glass; glassdb moves them into the output folder, each crop placed at its pixel
 /// rectangle (a plane without glass gets a one-pixel pass); with the light split, each pass
 /// is assembled from its light-split renders and each frame gets its light parts
-/// ([`crate::light_split::place_split_passes`]). Returns the job it rendered.
+/// ([`crate::light_split`]). Returns the job it rendered.
 pub fn render_passes(work: &Workspace<'_>, masks: &mut Masks) -> Result<ScriptJob, BlenderError> {
     let request = work.request;
     let mut job = ScriptJob {
