@@ -366,3 +366,119 @@ fn blender_compose_relights_frames_whose_record_names_their_light_parts() {
     assert!(!stdout.contains("relit by"), "{stdout}");
     assert!(stderr.contains("only its pixels change"), "{stderr}");
 }
+
+/// The registry with glass `id`'s records replaced, in every table, by those of the product
+/// named `product` (kept under `id`): the swap compose makes as the page's choice.
+fn swapped_registry(dir: &Path, id: u16, product: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(crate::util::repo_path("data/registry.json")).unwrap();
+    let mut reg: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for table in reg["tables"].as_array_mut().unwrap() {
+        let glasses = table["glasses"].as_array_mut().unwrap();
+        let mut record = glasses
+            .iter()
+            .find(|g| g["name"] == product)
+            .expect("the product in every table")
+            .clone();
+        record["id"] = id.into();
+        let slot = glasses.iter().position(|g| g["id"] == id).unwrap();
+        glasses[slot] = record;
+    }
+    let path = dir.join("swapped.json");
+    std::fs::write(&path, reg.to_string()).unwrap();
+    path
+}
+
+/// `glassdb view DIR` on a run whose record names light parts: a product chosen on the page
+/// rescales the room's light too, giving `compose --light-parts`'s pixels with that product
+/// (8-bit PNG, standard view, undithered), not the glass-pixels-only swap; a part's exposure
+/// slider scales its factor by 2^EV.
+#[test]
+fn a_product_chosen_in_the_viewer_relights_the_room_as_compose_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = glass();
+    write_blender_dir(dir.path(), &g, true);
+    // the darkest product of the table the page composites with
+    let reg = glassdb_registry::default_registry().unwrap();
+    let table = reg.table(ColourBasis::Space(RgbSpace::Srgb)).unwrap();
+    let (index, dark) = table
+        .glasses
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.t0[1].total_cmp(&b.1.t0[1]))
+        .unwrap();
+    assert!(dark.t0[1] < 0.5 * g.t0[1], "{} vs {}", dark.name, g.name);
+    let swapped = swapped_registry(dir.path(), g.id, &dark.name);
+    let png = |name: &str, relit: bool| -> Vec<[f64; 3]> {
+        let mut cmd = compose_in(dir.path(), "0001");
+        cmd.args(["--dither", "none", "--registry"]).arg(&swapped);
+        if relit {
+            cmd.args(["--light-parts", "lp.0001.json"]);
+        } else {
+            cmd.args(["--layer", "ViewLayer.Combined"]);
+        }
+        ok(cmd.arg("-o").arg(name));
+        let p = crate::util::read_png_planes(&dir.path().join(name));
+        (0..p.width * p.height)
+            .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
+            .collect()
+    };
+    let relit = png("relit.png", true);
+    let glass_only = png("glass_only.png", false);
+
+    let export = dir.path().join("export");
+    ok(crate::util::glassdb()
+        .arg("view")
+        .arg(dir.path())
+        .arg("--export")
+        .arg(&export));
+    let url = format!("file://{}", export.join("index.html").display());
+    let choose = format!(
+        "window.glassdb.choose({}, {index}); return Array.from(atob(window.glassdb.readPixels()), (c) => c.charCodeAt(0));",
+        g.id
+    );
+    let ev = "window.glassdb.setPartEv('interior', 1); return window.glassdb.partFactors();";
+    let out = crate::util::run_oracle(
+        "viewer_driver.py",
+        &[
+            "layout".as_ref(),
+            url.as_ref(),
+            "--run".as_ref(),
+            "return window.glassdb.partFactors();".as_ref(),
+            "--run".as_ref(),
+            choose.as_ref(),
+            "--run".as_ref(),
+            "return window.glassdb.partFactors();".as_ref(),
+            "--run".as_ref(),
+            ev.as_ref(),
+        ],
+    );
+    let report: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    let results = &report["results"];
+    let bytes: Vec<f64> = results[1]
+        .as_array()
+        .unwrap_or_else(|| panic!("{report}"))
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let canvas: Vec<[f64; 3]> = bytes.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect();
+    let worst = |a: &[[f64; 3]], b: &[[f64; 3]]| {
+        a.iter()
+            .zip(b)
+            .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+            .fold(0.0, f64::max)
+    };
+    assert!(worst(&canvas, &relit) <= 1.0, "{canvas:?}\n{relit:?}");
+    assert!(
+        worst(&canvas, &glass_only) >= 10.0,
+        "the room did not change"
+    );
+    // factors: the sky part's is t_dif of the product, before and after the choice
+    let sky = |r: &serde_json::Value| r[2]["A"][1].as_f64().unwrap();
+    assert!((sky(&results[0]) - g.t_dif()[1]).abs() < 1e-6, "{report}");
+    assert!(
+        (sky(&results[2]) - dark.t_dif()[1]).abs() < 1e-6,
+        "{report}"
+    );
+    let interior = results[3][0]["A"][0].as_f64().unwrap();
+    assert!((interior - 2.0).abs() < 1e-12, "{report}");
+}
