@@ -43,3 +43,24 @@ for parts in 3 7; do
     done
     echo "| $parts | $(median <"$work/a") | $(median <"$work/b") | $(median <"$work/r") |"
 done
+
+# The viewer (docs/performance.md, "Relit swap"): a product choice to the frame drawn, on the
+# same folders served by `glassdb view DIR` (headless Chromium, SwiftShader without a GPU),
+# today's frame against the relit one (its parts' passes summed with their factors in the
+# shader). VIEWER=0 skips it.
+if [ "${VIEWER:-1}" != 0 ]; then
+    products="AGC Stopray Titanium 34T on grey 8 mm (NFRC 20748)|AGC green-tinted float 4.8 mm (IGSDB 185)|Pilkington Solar-E Plus Arctic Blue 6 mm (NFRC 9962)"
+    for parts in 3 7; do
+        for side in today relit; do
+            "$glassdb" view "$work/p$parts/$side" --port 0 >"$work/url" 2>/dev/null &
+            server=$!
+            for _ in $(seq 100); do [ -s "$work/url" ] && break; sleep 0.1; done
+            url=$(head -1 "$work/url" | sed 's/^serving //')
+            echo "== viewer, $parts light parts, $side"
+            "$python" python_oracle/viewer_driver.py bench "$url" --id 1 --products "$products" \
+                --repeat "${REPEAT:-10}"
+            kill "$server"
+            wait "$server" 2>/dev/null || true
+        done
+    done
+fi

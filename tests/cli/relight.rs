@@ -367,27 +367,6 @@ fn blender_compose_relights_frames_whose_record_names_their_light_parts() {
     assert!(stderr.contains("only its pixels change"), "{stderr}");
 }
 
-/// The registry with glass `id`'s records replaced, in every table, by those of the product
-/// named `product` (kept under `id`): the swap compose makes as the page's choice.
-fn swapped_registry(dir: &Path, id: u16, product: &str) -> std::path::PathBuf {
-    let text = std::fs::read_to_string(crate::util::repo_path("data/registry.json")).unwrap();
-    let mut reg: serde_json::Value = serde_json::from_str(&text).unwrap();
-    for table in reg["tables"].as_array_mut().unwrap() {
-        let glasses = table["glasses"].as_array_mut().unwrap();
-        let mut record = glasses
-            .iter()
-            .find(|g| g["name"] == product)
-            .expect("the product in every table")
-            .clone();
-        record["id"] = id.into();
-        let slot = glasses.iter().position(|g| g["id"] == id).unwrap();
-        glasses[slot] = record;
-    }
-    let path = dir.join("swapped.json");
-    std::fs::write(&path, reg.to_string()).unwrap();
-    path
-}
-
 /// `glassdb view DIR` on a run whose record names light parts: a product chosen on the page
 /// rescales the room's light too, giving `compose --light-parts`'s pixels with that product
 /// (8-bit PNG, standard view, undithered), not the glass-pixels-only swap; a part's exposure
@@ -407,7 +386,12 @@ fn a_product_chosen_in_the_viewer_relights_the_room_as_compose_does() {
         .min_by(|a, b| a.1.t0[1].total_cmp(&b.1.t0[1]))
         .unwrap();
     assert!(dark.t0[1] < 0.5 * g.t0[1], "{} vs {}", dark.name, g.name);
-    let swapped = swapped_registry(dir.path(), g.id, &dark.name);
+    let swapped = crate::viewer::swapped_registry(
+        &crate::util::repo_path("data/registry.json"),
+        dir.path(),
+        g.id,
+        &dark.name,
+    );
     let png = |name: &str, relit: bool| -> Vec<[f64; 3]> {
         let mut cmd = compose_in(dir.path(), "0001");
         cmd.args(["--dither", "none", "--registry"]).arg(&swapped);
