@@ -384,17 +384,18 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
             .transpose()?,
         None => Some(job.clone()),
     };
-    if let Some(first) = first {
-        crate::cmd::relight::note_unsplit(
-            &first.inputs.trans,
-            settings.decode.pass.max_pixels,
-            args.stats,
-        );
-    }
-    match &args.inputs.frames {
+    let unsplit = first.is_some_and(|first| {
+        crate::cmd::relight::warn_split(&first.inputs.trans, settings.decode.pass.max_pixels)
+    });
+    let code = match &args.inputs.frames {
         None => run_frame(&args, &job, &settings, &luts),
         Some(spec) => run_sequence(&args, spec, &job, &settings, &luts),
+    }?;
+    // after the output: a closed standard output must not stop it being written
+    if args.stats && unsplit {
+        crate::cmd::relight::print_unsplit_note();
     }
+    Ok(code)
 }
 
 /// One frame split by light (`--light-groups`), each group with its light's tables.

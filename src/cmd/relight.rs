@@ -137,28 +137,34 @@ fn print_factors(record: &Path, parts: &[LightPart], factors: &[PartFactor]) {
 /// What a plain composite (no --light-parts, no --light-groups) says of the passes' light
 /// split, from the transmission pass's header: a warning when the passes are split by light
 /// groups (their record would relight the room; without it the light that came through the
-/// glazing keeps the render's glass); under --stats, a note when they are not split.
-pub fn note_unsplit(trans: &Path, max_pixels: u64, stats: bool) {
+/// glazing is scaled by no glass). Returns whether they are not split (`--stats` then says so,
+/// [`print_unsplit_note`]).
+pub fn warn_split(trans: &Path, max_pixels: u64) -> bool {
     let Ok(groups) = glassdb_pass::light_group_layers_of(trans, max_pixels) else {
-        return;
+        return false;
     };
-    if !groups.is_empty() {
-        let names: Vec<&str> = groups.iter().map(|g| g.group.as_str()).collect();
-        eprintln!(
-            "warning: {} is split by light ({}) but composited as one image: if these are light parts (glassdb \
-             blender's light split, rendered with the glazing clear to light), the light that came through the \
-             glazing is scaled by no glass: give --light-parts FILE (light_parts.####.json) to relight the room; \
-             if they are light groups of different spectra, give --light-groups",
-            trans.display(),
-            names.join(", ")
-        );
-    } else if stats {
-        outln!(
-            "light        not split by the light's path: a glass swap changes the glass pixels only; the light \
-             that came through the glazing (sun patches, sky light, what is seen through the glass) keeps the \
-             render's glass"
-        );
+    if groups.is_empty() {
+        return true;
     }
+    let names: Vec<&str> = groups.iter().map(|g| g.group.as_str()).collect();
+    eprintln!(
+        "warning: {} is split by light ({}) but composited as one image: if these are light parts (glassdb \
+         blender's light split, rendered with the glazing clear to light), the light that came through the \
+         glazing is scaled by no glass: give --light-parts FILE (light_parts.####.json) to relight the room; \
+         if they are light groups of different spectra, give --light-groups",
+        trans.display(),
+        names.join(", ")
+    );
+    false
+}
+
+/// `--stats`' line for passes without a light-path split: what a swap cannot change.
+pub fn print_unsplit_note() {
+    outln!(
+        "light        not split by the light's path: a glass swap changes the glass pixels only; the light \
+         that came through the glazing (sun patches, sky light, what is seen through the glass) keeps the \
+         render's glass"
+    );
 }
 
 /// `glassdb blender compose`'s line per frame relit by its light parts: each part's factors.

@@ -186,30 +186,40 @@ fn blender_run_frames(dir: &Path) -> anyhow::Result<Vec<ViewerFrame>> {
     }
     let record = glassdb_blender::RunRecord::load(dir)?;
     // A product change on the page is a glass swap: say what it cannot change (issue 28).
-    eprintln!(
-        "note: {}'s passes keep no light-path split: a product chosen on the page re-tints the glass pixels only; the light that came into the scene through the glazing stays that of the glasses the passes were rendered with",
-        dir.display()
-    );
+    if record.frames.iter().any(|f| f.light_parts.is_none()) {
+        eprintln!(
+            "note: {}'s passes keep no light-path split: a product chosen on the page re-tints the glass pixels only; the light that came into the scene through the glazing stays that of the glasses the passes were rendered with",
+            dir.display()
+        );
+    }
     if record.frames.is_empty() {
         bail!(
             "{}: the run records no frame",
             dir.join(glassdb_blender::job::RECORD_NAME).display()
         );
     }
-    Ok(record
+    record
         .frames
         .iter()
-        .map(|f| ViewerFrame {
-            label: f.frame.to_string(),
-            files: FrameFiles {
-                refl: f.refl.iter().map(|r| dir.join(r)).collect(),
-                groups: Vec::new(),
-                trans: dir.join(&f.trans),
-                mask: dir.join(&f.mask),
-            },
-            plane_sides: f.sides.iter().copied().enumerate().collect(),
+        .map(|f| {
+            Ok(ViewerFrame {
+                label: f.frame.to_string(),
+                files: FrameFiles {
+                    refl: f.refl.iter().map(|r| dir.join(r)).collect(),
+                    groups: Vec::new(),
+                    trans: dir.join(&f.trans),
+                    mask: dir.join(&f.mask),
+                },
+                plane_sides: f.sides.iter().copied().enumerate().collect(),
+                // the frame's light parts: a product change then relights the room too
+                light_parts: f
+                    .light_parts
+                    .as_ref()
+                    .map(|name| glassdb_compose::read_light_parts(&dir.join(name)))
+                    .transpose()?,
+            })
         })
-        .collect())
+        .collect()
 }
 
 /// The catalog the page builds units from: --catalog, else the bundled catalog where this

@@ -80,12 +80,13 @@ fn mask(id: u16) -> MaskImage {
 }
 
 fn parts_json(id: u16, extra: &[&str]) -> String {
+    // the record lists the sun first: a group name with underscores names the first layer
     let mut parts = vec![
-        serde_json::json!({"group": GROUPS[0], "source": {"kind": "other"}}),
         serde_json::json!({"group": GROUPS[1], "source": {"kind": "sun", "direction_to_sun": SUN},
             "through": {"plane": 0, "normal": [0.0, 0.0, 1.0], "id": id}}),
         serde_json::json!({"group": GROUPS[2], "source": {"kind": "sky"},
             "through": {"plane": 0, "normal": [0.0, 0.0, 1.0], "id": id}}),
+        serde_json::json!({"group": GROUPS[0], "source": {"kind": "other"}}),
     ];
     for g in extra {
         parts.push(serde_json::json!({"group": g, "source": {"kind": "other"}}));
@@ -209,10 +210,14 @@ fn light_parts_relight_every_pixel_by_the_glass_each_part_came_through() {
                 );
             }
         }
-        assert!(
-            !planes.names.iter().any(|n| n.contains("Combined_")),
-            "the parts' layers are not carried: {:?}",
-            planes.names
+        assert_eq!(
+            planes.names,
+            [
+                "ViewLayer.Combined.B",
+                "ViewLayer.Combined.G",
+                "ViewLayer.Combined.R"
+            ],
+            "the relit beauty alone: the parts' layers are not carried"
         );
     }
 }
@@ -236,7 +241,7 @@ fn light_parts_and_layers_must_match() {
         &["t.0001.exr", "no layer for light part \"lamp\""],
     );
     let fewer =
-        parts_json(g.id, &[]).replace(r#"{"group":"interior","source":{"kind":"other"}},"#, "");
+        parts_json(g.id, &[]).replace(r#",{"group":"interior","source":{"kind":"other"}}"#, "");
     assert!(!fewer.contains("interior"), "{fewer}");
     fails_naming(
         &mut run_with("fewer.json", fewer),
@@ -335,7 +340,8 @@ fn blender_compose_relights_frames_whose_record_names_their_light_parts() {
         .arg(dir.path()));
     assert!(out.status.success(), "{stderr}");
     assert!(
-        stdout.contains("frame 1: relit by 3 light part(s): interior ×(1.000, 1.000, 1.000)"),
+        stdout.contains("frame 1: relit by 3 light part(s): sun_p0 ×(")
+            && stdout.contains("interior ×(1.000, 1.000, 1.000)"),
         "{stdout}"
     );
     assert!(!stderr.contains("only its pixels change"), "{stderr}");
@@ -365,4 +371,104 @@ fn blender_compose_relights_frames_whose_record_names_their_light_parts() {
     assert!(out.status.success(), "{stderr}");
     assert!(!stdout.contains("relit by"), "{stdout}");
     assert!(stderr.contains("only its pixels change"), "{stderr}");
+}
+
+/// `glassdb view DIR` on a run whose record names light parts: a product chosen on the page
+/// rescales the room's light too, giving `compose --light-parts`'s pixels with that product
+/// (8-bit PNG, standard view, undithered), not the glass-pixels-only swap; a part's exposure
+/// slider scales its factor by 2^EV.
+#[test]
+fn a_product_chosen_in_the_viewer_relights_the_room_as_compose_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = glass();
+    write_blender_dir(dir.path(), &g, true);
+    // the darkest product of the table the page composites with
+    let reg = glassdb_registry::default_registry().unwrap();
+    let table = reg.table(ColourBasis::Space(RgbSpace::Srgb)).unwrap();
+    let (index, dark) = table
+        .glasses
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.t0[1].total_cmp(&b.1.t0[1]))
+        .unwrap();
+    assert!(dark.t0[1] < 0.5 * g.t0[1], "{} vs {}", dark.name, g.name);
+    let swapped = crate::viewer::swapped_registry(
+        &crate::util::repo_path("data/registry.json"),
+        dir.path(),
+        g.id,
+        &dark.name,
+    );
+    let png = |name: &str, relit: bool| -> Vec<[f64; 3]> {
+        let mut cmd = compose_in(dir.path(), "0001");
+        cmd.args(["--dither", "none", "--registry"]).arg(&swapped);
+        if relit {
+            cmd.args(["--light-parts", "lp.0001.json"]);
+        } else {
+            cmd.args(["--layer", "ViewLayer.Combined"]);
+        }
+        ok(cmd.arg("-o").arg(name));
+        let p = crate::util::read_png_planes(&dir.path().join(name));
+        (0..p.width * p.height)
+            .map(|i| [0, 1, 2].map(|c| p.channels[c][i]))
+            .collect()
+    };
+    let relit = png("relit.png", true);
+    let glass_only = png("glass_only.png", false);
+
+    let export = dir.path().join("export");
+    ok(crate::util::glassdb()
+        .arg("view")
+        .arg(dir.path())
+        .arg("--export")
+        .arg(&export));
+    let url = format!("file://{}", export.join("index.html").display());
+    let choose = format!(
+        "window.glassdb.choose({}, {index}); return Array.from(atob(window.glassdb.readPixels()), (c) => c.charCodeAt(0));",
+        g.id
+    );
+    let ev = "window.glassdb.setPartEv('interior', 1); return window.glassdb.partFactors();";
+    let out = crate::util::run_oracle(
+        "viewer_driver.py",
+        &[
+            "layout".as_ref(),
+            url.as_ref(),
+            "--run".as_ref(),
+            "return window.glassdb.partFactors();".as_ref(),
+            "--run".as_ref(),
+            choose.as_ref(),
+            "--run".as_ref(),
+            "return window.glassdb.partFactors();".as_ref(),
+            "--run".as_ref(),
+            ev.as_ref(),
+        ],
+    );
+    let report: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    let results = &report["results"];
+    let bytes: Vec<f64> = results[1]
+        .as_array()
+        .unwrap_or_else(|| panic!("{report}"))
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let canvas: Vec<[f64; 3]> = bytes.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect();
+    let worst = |a: &[[f64; 3]], b: &[[f64; 3]]| {
+        a.iter()
+            .zip(b)
+            .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+            .fold(0.0, f64::max)
+    };
+    assert!(worst(&canvas, &relit) <= 1.0, "{canvas:?}\n{relit:?}");
+    assert!(
+        worst(&canvas, &glass_only) >= 10.0,
+        "the room did not change"
+    );
+    // factors: the sky part's is t_dif of the product, before and after the choice
+    let sky = |r: &serde_json::Value| r[1]["A"][1].as_f64().unwrap();
+    assert!((sky(&results[0]) - g.t_dif()[1]).abs() < 1e-6, "{report}");
+    assert!(
+        (sky(&results[2]) - dark.t_dif()[1]).abs() < 1e-6,
+        "{report}"
+    );
+    let interior = results[3][2]["A"][0].as_f64().unwrap();
+    assert!((interior - 2.0).abs() < 1e-12, "{report}");
 }

@@ -80,7 +80,7 @@ fn spawn_viewer(cmd: &mut Command) -> Served {
 
 /// The registry `source` with `product`'s record under id `id` in every table: what the page
 /// composites after the swap, written independently of the viewer (JSON edited directly).
-fn swapped_registry(source: &Path, dir: &Path, id: u16, product: &str) -> PathBuf {
+pub(crate) fn swapped_registry(source: &Path, dir: &Path, id: u16, product: &str) -> PathBuf {
     let text = std::fs::read_to_string(source).unwrap();
     let mut reg: serde_json::Value = serde_json::from_str(&text).unwrap();
     for table in reg["tables"].as_array_mut().unwrap() {

@@ -195,7 +195,8 @@ pub(crate) fn add_group_composite(total: &mut [Vec<f32>; 3], add: &[Vec<f32>; 3]
 /// (they hold the light behind the glass, not the composite) and, with `keep_groups`, each
 /// group's composite written in their place (`layer.R`, `.G`, `.B`). The sum replaces the
 /// file's beauty layer: the one the group layers are split from (`ViewLayer.Combined` for
-/// `ViewLayer.Combined_sun`), else bare `R`, `G`, `B`, else it is added as bare `R`, `G`, `B`.
+/// `ViewLayer.Combined_sun`), else bare `R`, `G`, `B`, else it is added: as the Cycles groups'
+/// base layer when only the file's attributes are carried, else as bare `R`, `G`, `B`.
 pub(crate) fn carry_groups(
     frame: &mut glassdb_pass::CarriedFrame,
     groups: &[GroupPasses],
@@ -215,6 +216,7 @@ pub(crate) fn carry_groups(
             })
             .collect()
     };
+    let attributes_only = matches!(frame.exr, Some(ExrCarried::Attributes { .. }));
     let (mut file, part) = match frame.exr.take() {
         Some(ExrCarried::Whole { file, part, .. }) => (file, part),
         Some(ExrCarried::Attributes { image, part, .. }) => {
@@ -241,17 +243,34 @@ pub(crate) fn carry_groups(
                 .is_some_and(|rest| rest.starts_with('.'))
         })
     });
-    // the beauty: the layer the first group's is split from, else bare R, G, B
-    let split_from = group_layers
-        .first()
-        .and_then(|l| l.rsplit_once('_').map(|(base, _)| base.to_string()))
-        .unwrap_or_default();
+    // the beauty: the layer the first group's is split from (`ViewLayer.Combined` for
+    // `ViewLayer.Combined_sun_p0_id1`: the group's name, underscores and all, removed), else
+    // bare R, G, B
+    let first = groups.first();
+    let split_from = first
+        .and_then(|g| {
+            let layer = g.layers.trans.as_deref()?;
+            layer.strip_suffix(g.group.as_str())?.strip_suffix('_')
+        })
+        .unwrap_or_default()
+        .to_string();
+    // Nothing carried but the attributes: a Cycles beauty is named as the groups' base.
+    let cycles_base = attributes_only
+        && first
+            .and_then(|g| g.layers.trans.as_deref())
+            .and_then(glassdb_pass::light_group_of_layer)
+            .is_some_and(|(_, naming)| naming == glassdb_pass::GroupNaming::Cycles);
+    let added = if cycles_base {
+        split_from.clone()
+    } else {
+        String::new()
+    };
     let beauty = [split_from, String::new()]
         .into_iter()
         .map(|l| rgb_names(&l))
         .find(|names| names.iter().all(|n| channels.iter().any(|(c, _)| c == n)))
         .unwrap_or_else(|| {
-            let names = rgb_names("");
+            let names = rgb_names(&added);
             for name in &names {
                 channels.push((name.clone(), FlatSamples::F32(vec![0.0; n])));
             }

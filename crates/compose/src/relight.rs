@@ -299,9 +299,15 @@ pub fn compose_light_parts(
         record: record.to_string(),
         problem: p.0,
     })?;
-    let target = crate::check_job(job, settings)?;
+    let mut target = crate::check_job(job, settings)?;
     let names: Vec<&str> = parts.parts.iter().map(|p| p.group.as_str()).collect();
     let passes = part_passes(&job.inputs, &names, settings.decode.pass.max_pixels)?;
+    if target.carry.keep_channels
+        && !carries_more_than_parts(&job.inputs.trans, &passes, &settings.decode.pass)?
+    {
+        // Nothing to carry but the beauty the relit sum replaces: read the parts alone.
+        target.carry.keep_channels = false;
+    }
     let planes = job.inputs.refl.len();
     let budget = MemoryBudget::new(settings.decode.max_memory);
     let mut lights: Vec<(Option<&str>, Vec<&LightPart>)> = Vec::new();
@@ -375,6 +381,43 @@ pub fn compose_light_parts(
         .filter_map(|p| factors.iter().find(|f| f.group == p.group).cloned())
         .collect();
     Ok(RelitReport { frame, factors })
+}
+
+/// Whether the transmission file holds channels other than the parts' layers and the beauty
+/// they are split from (the layer named as the first part's without `_<group>`), from its
+/// header: only then are its other channels carried into the output.
+fn carries_more_than_parts(
+    trans: &Path,
+    passes: &[GroupPasses],
+    pass: &glassdb_pass::PassReadOptions,
+) -> Result<bool, ComposeError> {
+    let opts = glassdb_pass::PassReadOptions {
+        light_mix: Some(LightMix {
+            weights: passes.iter().map(|g| (g.group.clone(), [1.0; 3])).collect(),
+        }),
+        ..pass.clone()
+    };
+    let header = glassdb_pass::read_pass_header(trans, &opts)?;
+    let layers: Vec<&str> = passes
+        .iter()
+        .filter_map(|g| g.layers.trans.as_deref())
+        .collect();
+    let beauty = passes.first().and_then(|g| {
+        g.layers
+            .trans
+            .as_deref()?
+            .strip_suffix(g.group.as_str())?
+            .strip_suffix('_')
+    });
+    let in_layer = |name: &str, layer: &str| {
+        name.strip_prefix(layer)
+            .is_some_and(|rest| rest.starts_with('.'))
+    };
+    Ok(glassdb_image::all_channel_names(&header.parts)
+        .iter()
+        .any(|name| {
+            !layers.iter().any(|l| in_layer(name, l)) && !beauty.is_some_and(|b| in_layer(name, b))
+        }))
 }
 
 #[cfg(test)]

@@ -77,8 +77,10 @@
     return scene;
   }
 
-  function readFrame(info, passes, mask) {
-    return { info: { ids: info.ids, trans: info.trans, plane_sides: info.plane_sides }, passes, mask };
+  // `parts`: the light parts' passes, part after part (empty without a light-path split).
+  function readFrame(info, passes, mask, parts) {
+    return { info: { ids: info.ids, trans: info.trans, plane_sides: info.plane_sides, parts: info.parts || [] }, passes, mask,
+      parts: parts || new Uint16Array(0) };
   }
 
   // A unit the server built (POST api/unit): its product and its table.
@@ -94,7 +96,8 @@
     frame: async (i) => {
       if (!EXPORT.frames[i]) await loadScript(window.GLASSDB_EXPORT_FRAME_FILES[i]);
       const f = EXPORT.frames[i];
-      return readFrame(f.info, new Uint16Array(await packedBytes(f.passes, 2)), new Float32Array(await packedBytes(f.mask, 4)));
+      return readFrame(f.info, new Uint16Array(await packedBytes(f.passes, 2)), new Float32Array(await packedBytes(f.mask, 4)),
+        f.parts ? new Uint16Array(await packedBytes(f.parts, 2)) : undefined);
     },
   } : {
     scene: async () => readScene(await fetchOk('api/scene', 'json')),
@@ -110,7 +113,8 @@
       const info = await fetchOk('api/frame/' + i, 'json');
       const passes = await fetchOk('api/frame/' + i + '/passes');
       const mask = await fetchOk('api/frame/' + i + '/mask');
-      return readFrame(info, new Uint16Array(passes), new Float32Array(mask));
+      const parts = info.parts && info.parts.length ? new Uint16Array(await fetchOk('api/frame/' + i + '/parts')) : undefined;
+      return readFrame(info, new Uint16Array(passes), new Float32Array(mask), parts);
     },
   };
 
@@ -214,6 +218,13 @@ uniform vec3 uShaperOffset;
 uniform int uCubeN;
 uniform vec3 uCubeScale;
 uniform vec3 uCubeOffset;
+// The relit swap (docs/viewer.md): each light part's passes (transmission, then each plane's
+// reflection, part after part) and its factor per set: what the glass its light came through
+// passes, times its exposure.
+uniform highp sampler2DArray uParts;
+uniform int uPartCount;
+uniform vec3 uFactorA[16];
+uniform vec3 uFactorB[16];
 out vec4 outColor;
 const int W = ${lut.width};
 const int ROWS_CURVE = ${lut.rows_per_curve};
@@ -309,13 +320,27 @@ void main() {
   int y = uHeight - 1 - int(gl_FragCoord.y);
   vec4 tr = texelFetch(uTrans, ivec2(x, y), 0);
   vec4 m = texelFetch(uMask, ivec2(x, y), 0);
-  vec3 col = tr.rgb;
   int slot = int(m.r + 0.5) - 1;
   int plane = int(m.g + 0.5);
-  if (slot >= 0 && plane < uPlanes) {
+  bool glass = slot >= 0 && plane < uPlanes;
+  bool useB = uAB == 1 || (uAB == 2 && float(x) >= uSplitX);
+  vec3 rfParts = vec3(0.0);
+  if (uPartCount > 0) {
+    // Σ_p f_p·trans_p and Σ_p f_p·refl_p: the composite is linear in the passes.
+    vec3 trParts = vec3(0.0);
+    int per = 1 + uPlanes;
+    for (int p = 0; p < 16; p++) {
+      if (p >= uPartCount) break;
+      vec3 f = useB ? uFactorB[p] : uFactorA[p];
+      trParts += f * texelFetch(uParts, ivec3(x, y, p * per), 0).rgb;
+      if (glass) rfParts += f * texelFetch(uParts, ivec3(x, y, p * per + 1 + plane), 0).rgb;
+    }
+    tr = vec4(trParts, 1.0);
+  }
+  vec3 col = tr.rgb;
+  if (glass) {
     vec3 r;
     vec3 t;
-    bool useB = uAB == 1 || (uAB == 2 && float(x) >= uSplitX);
     if (useB) {
       lookup(uLutB, slot, uSide[plane], m.b, r, t);
     } else {
@@ -324,7 +349,7 @@ void main() {
     float k = m.a;
     t = 1.0 - k + k * t;
     r = r * k;
-    vec3 rf = texelFetch(uRefl, ivec3(x, y, plane), 0).rgb;
+    vec3 rf = uPartCount > 0 ? rfParts : texelFetch(uRefl, ivec3(x, y, plane), 0).rgb;
     col = tr.rgb * t + rf * r;
   }
   col *= uGain;
@@ -450,9 +475,12 @@ void main() {
       gl.bindTexture(gl.TEXTURE_2D, lutTex[set]);
       gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, lutLayout.width, lutLayout.rows_per_slot * slots.length);
     }
+    const partsTex = texture(gl, gl.TEXTURE_2D_ARRAY);
+    // Complete from the start (one texel) until a frame's light parts replace it.
+    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, 1, 1, 1, 0, gl.RGBA, gl.HALF_FLOAT, new Uint16Array(4));
     const units = [['uTrans', gl.TEXTURE_2D, transTex], ['uRefl', gl.TEXTURE_2D_ARRAY, reflTex],
       ['uMask', gl.TEXTURE_2D, maskTex], ['uLutA', gl.TEXTURE_2D, lutTex.A], ['uLutB', gl.TEXTURE_2D, lutTex.B],
-      ['uShaper', gl.TEXTURE_2D, shaperTex], ['uCube', gl.TEXTURE_3D, cubeTex]];
+      ['uShaper', gl.TEXTURE_2D, shaperTex], ['uCube', gl.TEXTURE_3D, cubeTex], ['uParts', gl.TEXTURE_2D_ARRAY, partsTex]];
     const unitOf = (name) => units.findIndex(([n]) => n === name);
     units.forEach(([name, target, tex], i) => {
       gl.activeTexture(gl.TEXTURE0 + i);
@@ -517,6 +545,8 @@ void main() {
       lastUnit: null,
       // The unit being put together on the page: panes {glass, flip} and gaps {gap_mm, gas}.
       unit: [],
+      // Exposure in stops per light part (light mixing), by group name.
+      partEv: {},
     };
     const applySpec = (set, spec) => {
       for (const [id, p] of parseChoices(products, slots, spec)) state.sets[set][slots.indexOf(id)] = p;
@@ -589,12 +619,80 @@ void main() {
       gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.FLOAT, data.mask);
       // The side of each plane the camera sees in this frame (it may change as the camera moves).
       gl.uniform1iv(u('uSide'), Int32Array.from({ length: 64 }, (_, k) => data.info.plane_sides[k] === 'back' ? 1 : 0));
+      if (data.info.parts.length > 16) throw new Error('frame ' + i + ': ' + data.info.parts.length + ' light parts; the page shows at most 16');
+      if (data.info.parts.length) {
+        gl.bindTexture(gl.TEXTURE_2D_ARRAY, partsTex);
+        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, W, H, data.info.parts.length * (1 + scene.planes), 0, gl.RGBA,
+          gl.HALF_FLOAT, data.parts);
+      }
       state.frame = i;
       state.data = data;
+      setFactors();
+      renderPartSliders();
       renderGlasses();
       draw();
       finish();
       state.lastFrameLoadMs = performance.now() - t0;
+    }
+
+    // ---- the relit swap: a factor per light part and set (docs/viewer.md, "Relit swap") ----
+
+    // t of product table `lut` seen from `side` at cos θ, as compose's GlassSideLut::at_cos.
+    function tAtCos(lut, side, cos) {
+      const row = (side * 2 + 1) * lutLayout.rows_per_curve * lutLayout.width * 4;
+      const xf = Math.min(1, Math.max(0, cos)) * lutLayout.fine_steps;
+      const k = Math.min(Math.floor(xf), lutLayout.fine_steps - 1), fr = xf - k;
+      const at = (e) => { const b = row + (lutLayout.fine_offset + e) * 4; return [lut[b], lut[b + 1], lut[b + 2]]; };
+      const lo = at(k), hi = at(k + 1);
+      return lo.map((v, c) => v + (hi[c] - v) * fr);
+    }
+
+    // Part `part`'s factor in set `set`: 1 through no glazing, t(θ_sun) or t_dif of the product
+    // chosen for its aperture's glass, times 2^(its exposure).
+    function partFactor(part, set) {
+      let f = [1, 1, 1];
+      if (part.kind !== 'unglazed') {
+        const slot = slots.indexOf(part.id);
+        const p = slot >= 0 ? state.sets[set][slot] : -1;
+        if (p < 0 || !products[p]) f = part.factor;
+        else if (part.kind === 'diffuse') f = products[p].t_dif;
+        else f = tAtCos(luts[p], part.side === 'back' ? 1 : 0, part.cos_theta);
+      }
+      const gain = Math.pow(2, state.partEv[part.group] || 0);
+      return f.map((v) => v * gain);
+    }
+
+    // The factors of the frame's parts for both sets, as the shader's uniforms.
+    function setFactors() {
+      const parts = state.data ? state.data.info.parts : [];
+      gl.uniform1i(u('uPartCount'), parts.length);
+      if (!parts.length) return;
+      for (const set of ['A', 'B']) {
+        const v = new Float32Array(16 * 3);
+        parts.forEach((part, i) => v.set(partFactor(part, set), 3 * i));
+        gl.uniform3fv(u(set === 'A' ? 'uFactorA' : 'uFactorB'), v);
+      }
+    }
+
+    // One exposure slider per light part (light mixing), beside the frame.
+    function renderPartSliders() {
+      const box = $('light-parts');
+      const parts = state.data ? state.data.info.parts : [];
+      box.parentElement.hidden = !parts.length;
+      box.replaceChildren(...parts.map((part) => {
+        const row = document.createElement('label');
+        row.className = 'light-part';
+        const through = part.kind === 'unglazed' ? '' : ' through id ' + part.id;
+        const input = document.createElement('input');
+        Object.assign(input, { type: 'range', min: -6, max: 6, step: 0.1, value: state.partEv[part.group] || 0 });
+        input.dataset.group = part.group;
+        const value = document.createElement('span');
+        const say = () => { value.textContent = Number(input.value).toFixed(1) + ' EV'; };
+        say();
+        input.oninput = () => { state.partEv[part.group] = Number(input.value); say(); setFactors(); draw(); };
+        row.append(part.group + ' (' + part.source + through + ') ', input, ' ', value);
+        return row;
+      }));
     }
 
     // Chooses product `p` for glass `id` in set `set` (default: the edited one) and draws.
@@ -605,6 +703,7 @@ void main() {
       if (slot < 0 || !luts[p]) throw new Error('no glass ' + id + ' or product ' + p);
       state.sets[set][slot] = p;
       uploadSlot(set, slot);
+      setFactors();
       draw();
       finish();
       state.lastSwapMs = performance.now() - t0;
@@ -977,6 +1076,10 @@ void main() {
       scene,
       choose: (id, product, set) => choose(id, typeof product === 'number' ? product : findProduct(products, product), set),
       setEv: (ev) => { state.ev = ev; draw(); },
+      // A light part's exposure in stops (its slider), by group name.
+      setPartEv: (group, ev) => { state.partEv[group] = ev; renderPartSliders(); setFactors(); draw(); },
+      // Each light part's factor per set (none: passes without a light-path split).
+      partFactors: () => (state.data ? state.data.info.parts : []).map((p) => ({ group: p.group, A: partFactor(p, 'A'), B: partFactor(p, 'B') })),
       setView: async (name) => { await setView(scene.views.findIndex((v) => v.name === name)); draw(); },
       setAB: (mode, split) => { state.ab = mode; if (split !== undefined) state.split = split; draw(); },
       // Where the split line stands (0–1 across the frame) while A | B is split, else null.

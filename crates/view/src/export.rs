@@ -248,10 +248,11 @@ pub fn write_export(
         staged.write_replacing_link(&dir.join(frame_file(i)), |w| {
             writeln!(
                 w,
-                "window.GLASSDB_EXPORT.frames[{i}] = {{\"info\": {}, \"passes\": \"{}\", \"mask\": \"{}\"}};",
+                "window.GLASSDB_EXPORT.frames[{i}] = {{\"info\": {}, \"passes\": \"{}\", \"mask\": \"{}\", \"parts\": \"{}\"}};",
                 json!(frame.info),
                 packed_base64(&frame.passes, 2)?,
-                packed_base64(&frame.mask, 4)?
+                packed_base64(&frame.mask, 4)?,
+                packed_base64(&frame.parts, 2)?
             )
         })?;
     }

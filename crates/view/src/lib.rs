@@ -16,6 +16,7 @@
 //!   default).
 //! - [`export`]: the self-contained folder that works from `file://`.
 //! - [`units`]: insulated units built on the page by the registry's stack engine.
+//! - [`relight`]: a frame's light parts, so that a product change rescales the room's light.
 
 #![warn(missing_docs)]
 
@@ -23,6 +24,7 @@ pub mod data;
 pub mod error;
 pub mod export;
 pub mod page;
+pub mod relight;
 pub mod scene;
 pub mod server;
 pub mod units;

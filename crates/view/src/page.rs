@@ -118,6 +118,9 @@ pub struct PageProduct {
     pub angle_model: String,
     /// Its build-up, when it is an insulated unit.
     pub unit: Option<PageUnit>,
+    /// Hemispherical transmittance per channel: the factor of sky light through it (the
+    /// relit swap, docs/compose.md "Relit swap").
+    pub t_dif: [f64; 3],
 }
 
 /// A unit's build-up as the picker shows it: its layers and gaps, outside first, and the
@@ -242,6 +245,7 @@ impl PageProduct {
             luminous: g.luminous,
             angle_model: g.angle_model.kind.clone(),
             unit: g.unit.as_ref().map(PageUnit::of),
+            t_dif: g.t_dif(),
         }
     }
 }
@@ -331,6 +335,10 @@ pub struct PageFrame {
     pub trans: String,
     /// The side each plane shows the camera in this frame.
     pub plane_sides: Vec<Side>,
+    /// The frame's light parts, in the order of its `parts` data (none: passes without a
+    /// light-path split).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub parts: Vec<crate::relight::PagePart>,
 }
 
 #[cfg(test)]

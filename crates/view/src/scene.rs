@@ -47,6 +47,9 @@ pub struct ViewerFrame {
     pub files: FrameFiles,
     /// Side of each plane that faces the camera; planes not listed show the front.
     pub plane_sides: BTreeMap<usize, Side>,
+    /// The frame's light parts, when its passes keep the light's path apart (a product change
+    /// then rescales the room's light too, [`crate::relight`]).
+    pub light_parts: Option<glassdb_compose::light_parts::LightParts>,
 }
 
 impl ViewerFrame {
@@ -62,6 +65,7 @@ impl ViewerFrame {
                 label: files.trans.display().to_string(),
                 files: files.clone(),
                 plane_sides: plane_sides.clone(),
+                light_parts: None,
             }]);
         }
         numbers
@@ -71,6 +75,7 @@ impl ViewerFrame {
                     label: n.to_string(),
                     files: files.for_frame(n)?,
                     plane_sides: plane_sides.clone(),
+                    light_parts: None,
                 })
             })
             .collect()
@@ -86,6 +91,9 @@ pub struct FrameData {
     pub passes: Vec<u8>,
     /// The mask ([`data::mask_bytes`]).
     pub mask: Vec<u8>,
+    /// The light parts' passes, part after part, each as [`FrameData::passes`] (empty without
+    /// light parts; [`crate::relight`]).
+    pub parts: Vec<u8>,
 }
 
 /// A product chosen for a glass id: (id, index of the product in [`Viewer::products`]).
@@ -159,8 +167,15 @@ impl Viewer {
         };
         let product_luts = product_tables(&products, &slots, first.lut);
         // Kept for the page's first request.
-        let first_data = Arc::new(frame_data(&first, first_frame, &slots));
+        let first_data = frame_data(&first, first_frame, &slots);
         drop(first);
+        let first_data = Arc::new(crate::relight::with_parts(
+            first_data,
+            first_frame,
+            &inputs.settings,
+            &luts,
+            &budget,
+        )?);
         let display_matrix = (space.space != RgbSpace::Srgb).then(|| {
             let m = glassdb_colour::rgb_to_rgb(space.space, RgbSpace::Srgb);
             (0..3)
@@ -304,8 +319,15 @@ impl Viewer {
                 first: self.mask_mode.name(),
             });
         }
-        let data = Arc::new(frame_data(&frame, viewer_frame, &self.slots));
+        let data = frame_data(&frame, viewer_frame, &self.slots);
         drop(frame);
+        let data = Arc::new(crate::relight::with_parts(
+            data,
+            viewer_frame,
+            &self.inputs.settings,
+            &self.luts,
+            &self.budget,
+        )?);
         *cache = Some((index, data.clone()));
         Ok(data)
     }
@@ -426,9 +448,11 @@ fn frame_data(
             plane_sides: (0..frame.refl.len())
                 .map(|k| source.plane_sides.get(&k).copied().unwrap_or(Side::Front))
                 .collect(),
+            parts: Vec::new(),
         },
         passes: data::pass_bytes(frame),
         mask: data::mask_bytes(frame, |id| slots.get(&id).copied()),
+        parts: Vec::new(),
     }
 }
 

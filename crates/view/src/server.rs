@@ -18,6 +18,7 @@
 //! | `GET /api/scene` | the scene JSON: size, planes, frames, colour, table layout, products |
 //! | `GET /api/frame/N` | frame N's JSON: glass pixels per id |
 //! | `GET /api/frame/N/passes`, `/api/frame/N/mask` | frame N's binary data ([`crate::data`]) |
+//! | `GET /api/frame/N/parts` | frame N's light parts' passes ([`crate::relight`]; empty without) |
 //! | `GET /api/product/N/lut` | product N's lookup table |
 //! | `GET /api/view/N` | `.cube` view N's tables ([`crate::data::view_bytes`]) |
 //! | `GET /api/luts` | every product's table, one after the other (the page's one request) |
@@ -275,6 +276,7 @@ impl ViewServer {
             [] => Reply::json(&json!(data.info)),
             ["passes"] => Reply::binary(Body::Frame(data, FramePart::Passes)),
             ["mask"] => Reply::binary(Body::Frame(data, FramePart::Mask)),
+            ["parts"] => Reply::binary(Body::Frame(data, FramePart::Parts)),
             _ => Reply::error(404, "no such resource"),
         }
     }
@@ -534,6 +536,7 @@ enum Body {
 enum FramePart {
     Passes,
     Mask,
+    Parts,
 }
 
 impl AsRef<[u8]> for Body {
@@ -545,6 +548,7 @@ impl AsRef<[u8]> for Body {
             Body::Shared(bytes, range) => bytes.get(range.clone()).unwrap_or_default(),
             Body::Frame(data, FramePart::Passes) => &data.passes,
             Body::Frame(data, FramePart::Mask) => &data.mask,
+            Body::Frame(data, FramePart::Parts) => &data.parts,
         }
     }
 }

@@ -1,0 +1,126 @@
+//! A frame's light parts on the page (issue 28, docs/viewer.md "Relit swap"): each part's
+//! passes, decoded and placed as `compose` decodes them, for the GPU, and what the page needs to
+//! compute each part's factor for any product chosen ([`PagePart`]): the part's source, the
+//! aperture's glass id and plane, and for the sun its cos θ and the face it enters. A product
+//! change then rescales the room's light with a factor per part (no decode, no upload of
+//! passes), and the page's per-part exposure sliders (light mixing, issue 29) are the same
+//! factors.
+
+use glassdb_compose::colour::RegistryLuts;
+use glassdb_compose::light_parts::{LightPart, LightSource};
+use glassdb_compose::memory::MemoryBudget;
+use glassdb_compose::{
+    ApertureGlass, ComposeError, DecodeSettings, DecodeTarget, FactorKind, decode_frame,
+    part_factors, part_passes,
+};
+use glassdb_side::Side;
+use serde::Serialize;
+
+use crate::ViewError;
+use crate::data;
+use crate::scene::{FrameData, ViewerFrame};
+
+/// One light part as the page computes its factor: `kind` `unglazed` (1), `sun` (t at
+/// `cos_theta` seen from `side`, from the chosen product's table) or `diffuse` (the chosen
+/// product's `t_dif`) of the product chosen for glass `id`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PagePart {
+    /// The part's light group.
+    pub group: String,
+    /// `sun`, `sky` or `other`.
+    pub source: &'static str,
+    /// `unglazed`, `sun` or `diffuse`.
+    pub kind: &'static str,
+    /// The aperture's glass id.
+    pub id: Option<u16>,
+    /// The aperture's plane.
+    pub plane: Option<usize>,
+    /// The sun's `|n·d|`.
+    pub cos_theta: Option<f64>,
+    /// The face the sunlight enters.
+    pub side: Option<Side>,
+    /// Its factor with the glass of the registry (the page's starting products).
+    pub factor: [f32; 3],
+}
+
+/// `data` with the light parts of `frame` (none: as it is): each part's passes decoded with its
+/// own layers ([`glassdb_compose::part_passes`] checks them against the record), one part at a
+/// time, and its [`PagePart`].
+pub fn with_parts(
+    mut data: FrameData,
+    frame: &ViewerFrame,
+    settings: &DecodeSettings,
+    luts: &RegistryLuts,
+    budget: &MemoryBudget,
+) -> Result<FrameData, ViewError> {
+    let Some(parts) = &frame.light_parts else {
+        return Ok(data);
+    };
+    let files = &frame.files;
+    parts.check().map_err(|p| ComposeError::LightPartsRecord {
+        record: format!("frame {}", frame.label),
+        problem: p.0,
+    })?;
+    let names: Vec<&str> = parts.parts.iter().map(|p| p.group.as_str()).collect();
+    let layers = part_passes(files, &names, settings.pass.max_pixels)?;
+    let mut bytes = Vec::with_capacity(data.passes.len() * parts.parts.len());
+    let mut page = Vec::new();
+    for group in &layers {
+        let mut one = settings.clone();
+        one.layers = group.layers.clone();
+        let decoded = decode_frame(files, &one, luts, budget, &DecodeTarget::display())?;
+        if page.is_empty() {
+            let basis = decoded.table.basis;
+            let t_dif = |id: u16| {
+                luts.table(basis)
+                    .and_then(|t| t.glass(id))
+                    .map(|g| g.t_dif())
+            };
+            let glass = ApertureGlass {
+                lut: decoded.lut,
+                t_dif: &t_dif,
+                registry: &settings.registry_label,
+            };
+            let refs: Vec<&LightPart> = parts.parts.iter().collect();
+            let factors = part_factors(&refs, files.refl.len(), &files.mask, &glass)?;
+            page = parts
+                .parts
+                .iter()
+                .zip(factors)
+                .map(|(part, f)| page_part(part, f.kind, f.factor))
+                .collect();
+        }
+        bytes.extend(data::pass_bytes(&decoded));
+    }
+    data.parts = bytes;
+    data.info.parts = page;
+    Ok(data)
+}
+
+fn page_part(part: &LightPart, kind: FactorKind, factor: [f32; 3]) -> PagePart {
+    let source = match part.source {
+        LightSource::Sun { .. } => "sun",
+        LightSource::Sky => "sky",
+        LightSource::Other => "other",
+    };
+    let (kind, id, plane, cos_theta, side) = match kind {
+        FactorKind::Unglazed => ("unglazed", None, None, None, None),
+        FactorKind::Sun {
+            id,
+            plane,
+            cos_theta,
+            side,
+        } => ("sun", Some(id), Some(plane), Some(cos_theta), Some(side)),
+        FactorKind::Diffuse { id, plane } => ("diffuse", Some(id), Some(plane), None, None),
+    };
+    PagePart {
+        group: part.group.clone(),
+        source,
+        kind,
+        id,
+        plane,
+        cos_theta,
+        side,
+        factor,
+    }
+}
