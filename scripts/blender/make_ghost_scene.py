@@ -28,6 +28,7 @@ Licence: same as the project, MIT OR Apache-2.0.
 
 import json
 import math
+import os
 import sys
 
 import bpy
@@ -157,7 +158,7 @@ scene.cycles.transparent_max_bounces = 16
 scene.view_settings.view_transform = "Standard"
 bpy.context.view_layer.update()
 
-bpy.ops.wm.save_as_mainfile(filepath=bpy.path.abspath(out))
+bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out))
 
 if "--facts" in opts:
     images = {}

@@ -292,30 +292,41 @@ impl FramesOfMasks<'_, '_> {
 }
 
 impl FramesOfMasks<'_, '_> {
-    /// Plane `k`'s mirror planes facing the camera (on its front when `front`), each with its
-    /// depth behind the face: one per pane group in the order the camera's rays meet them, at
-    /// most `--surfaces` of them; the face itself for glass of one group.
+    /// Plane `k`'s mirror planes facing the camera ([`mirror_planes`]).
     fn mirror_planes(&self, k: usize, front: bool) -> Vec<(glassdb_scene::Plane, f64)> {
-        let plane = self.planes[k];
-        let mut depths = self.plane_depths.get(k).cloned().unwrap_or_default();
-        if !front {
-            depths.reverse();
-        }
-        if depths.is_empty() {
-            depths.push(0.0);
-        }
-        depths.truncate(self.work.surfaces());
-        depths
-            .into_iter()
-            .map(|depth| {
-                let shifted = glassdb_scene::Plane {
-                    normal: plane.normal,
-                    d: plane.d + depth,
-                };
-                (if front { shifted } else { shifted.flipped() }, depth)
-            })
-            .collect()
+        let depths = self.plane_depths.get(k).map_or(&[][..], Vec::as_slice);
+        mirror_planes(&self.planes[k], depths, front, self.work.surfaces())
     }
+}
+
+/// The mirror planes of `plane` (its normal to the glass's front) facing a camera on its front
+/// (`front`) or back, each with its depth behind the face: one per pane group at
+/// `depths_outer_first`, in the order the camera's rays meet them (from the back the inner
+/// pane first), at most `surfaces` of them; the face itself for glass of one group.
+fn mirror_planes(
+    plane: &glassdb_scene::Plane,
+    depths_outer_first: &[f64],
+    front: bool,
+    surfaces: usize,
+) -> Vec<(glassdb_scene::Plane, f64)> {
+    let mut depths = depths_outer_first.to_vec();
+    if !front {
+        depths.reverse();
+    }
+    if depths.is_empty() {
+        depths.push(0.0);
+    }
+    depths.truncate(surfaces.max(1));
+    depths
+        .into_iter()
+        .map(|depth| {
+            let shifted = glassdb_scene::Plane {
+                normal: plane.normal,
+                d: plane.d + depth,
+            };
+            (if front { shifted } else { shifted.flipped() }, depth)
+        })
+        .collect()
 }
 
 /// A plane's pane-group depths from planes.json, outer group first (the file lists them in the
@@ -407,4 +418,44 @@ fn glass_of_materials(
         .iter()
         .filter_map(|m| matcher.first_match(m).map(|k| (m.clone(), mappings[k].id)))
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The face z = 0 (normal +z, outdoors) of a unit with groups 3 and 21 mm behind it.
+    #[test]
+    fn mirror_planes_follow_the_cameras_rays_into_the_unit() {
+        let face = glassdb_scene::Plane::from_equation([0.0, 0.0, 1.0, 0.0]).unwrap();
+        let depths = [0.003, 0.021];
+        let eq = |v: Vec<(glassdb_scene::Plane, f64)>| -> Vec<([f64; 4], f64)> {
+            v.into_iter().map(|(p, d)| (p.equation(), d)).collect()
+        };
+        // From outdoors: the outer pane first, each mid-plane below the face, facing +z.
+        assert_eq!(
+            eq(mirror_planes(&face, &depths, true, usize::MAX)),
+            [
+                ([0.0, 0.0, 1.0, 0.003], 0.003),
+                ([0.0, 0.0, 1.0, 0.021], 0.021)
+            ]
+        );
+        // From indoors: the inner pane first, facing −z (the camera on the positive side).
+        assert_eq!(
+            eq(mirror_planes(&face, &depths, false, usize::MAX)),
+            [
+                ([0.0, 0.0, -1.0, -0.021], 0.021),
+                ([0.0, 0.0, -1.0, -0.003], 0.003)
+            ]
+        );
+        // --surfaces 1: the first group only; glass of one group: the face.
+        assert_eq!(
+            eq(mirror_planes(&face, &depths, false, 1)),
+            [([0.0, 0.0, -1.0, -0.021], 0.021)]
+        );
+        assert_eq!(
+            eq(mirror_planes(&face, &[], true, usize::MAX)),
+            [([0.0, 0.0, 1.0, 0.0], 0.0)]
+        );
+    }
 }
