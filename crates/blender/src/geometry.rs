@@ -348,9 +348,10 @@ struct RunUnits {
 }
 
 impl RunUnits {
-    /// The units of `work`'s glass mappings in the registry's table. A unit that does not
-    /// record its groups' depths is refused unless one pass per plane is asked for
-    /// (`--surfaces 1`, mirrored about the face).
+    /// The units of `work`'s glass mappings in the registry's table. With one pass per plane
+    /// (`--surfaces 1`) every plane is mirrored about its face, as before pane groups (so a
+    /// plane may hold glasses of different build-ups); otherwise a unit that does not record
+    /// its groups' depths is refused.
     fn of(work: &Workspace<'_>, registry: &RegistryChoice) -> Result<RunUnits, BlenderError> {
         let table = registry.registry.default_table();
         let mut units = RunUnits {
@@ -368,8 +369,8 @@ impl RunUnits {
             };
             units.counts.insert(m.id, unit.groups.len());
             match unit.group_depths_m() {
+                _ if work.surfaces() == 1 => units.depths.push(Vec::new()),
                 Some(d) => units.depths.push(d),
-                None if work.surfaces() == 1 => units.depths.push(Vec::new()),
                 None => {
                     return Err(BlenderError::BadOption(format!(
                         "--glass {}={}: unit {} ({}) in {} does not record its pane groups' \
