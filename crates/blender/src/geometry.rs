@@ -373,10 +373,9 @@ impl RunUnits {
                 Some(d) => units.depths.push(d),
                 None => {
                     return Err(BlenderError::BadOption(format!(
-                        "--glass {}={}: unit {} ({}) in {} does not record its pane groups' \
+                        "glass {}={}: unit {} ({}) in {} does not record its pane groups' \
                          depths (every layer needs a thickness), so its deeper panes' \
-                         reflections cannot be placed; render one pass per plane with \
-                         --surfaces 1",
+                         reflections cannot be placed; render it with one pass per plane",
                         m.pattern, m.id, m.id, glass.name, registry.label
                     )));
                 }
