@@ -86,6 +86,11 @@ pub struct RenderArgs {
     /// them (a farm's render step, then its composite step).
     #[arg(long)]
     pub no_composite: bool,
+    /// N: render at most N of a unit's pane groups as reflection passes of their own (default:
+    /// all: each pane's reflection at its depth, the double image); `--surfaces 1` renders one
+    /// pass per plane, the deeper panes' reflectance added to it (faster, no double image).
+    #[arg(long, value_name = "N")]
+    pub surfaces: Option<std::num::NonZeroUsize>,
 }
 
 /// `--light-split`.
@@ -150,6 +155,37 @@ fn print_composites(dir: &std::path::Path, report: &ComposeReport) {
     crate::cmd::relight::print_blender_factors(&report.light_parts);
 }
 
+/// What the run did with units' pane groups (issue 27): the group passes rendered, and what
+/// `--surfaces` folded into a nearer group's pass.
+fn print_pane_groups(report: &glassdb_blender::RenderReport) {
+    let passes: usize = report.record.frames.iter().map(|f| f.groups.len()).sum();
+    if passes > 0 {
+        outln!(
+            "pane groups: {passes} reflection pass(es) of units' deeper panes, each mirrored about its pane's mid-plane (the double image)"
+        );
+    }
+    let folded: u64 = report
+        .compose
+        .frames
+        .iter()
+        .map(|(_, f)| f.folded_pixels)
+        .sum();
+    let Some(n) = report.record.surfaces else {
+        return;
+    };
+    // Composited: say it only where units' panes were folded; otherwise compose folds later.
+    if folded > 0 || report.compose.frames.is_empty() {
+        let pixels = if folded > 0 {
+            format!(" ({folded} glass pixels)")
+        } else {
+            String::new()
+        };
+        outln!(
+            "pane groups: --surfaces {n}: a unit's panes beyond the first {n} get no pass of their own; their reflectance is added to pane {n}'s pass{pixels}, so there is no double image there"
+        );
+    }
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     match args.command {
         BlenderCommand::Render(a) => run_render(a),
@@ -186,6 +222,7 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         mask_samples: a.mask_samples,
         light_split: a.light_split == LightSplit::On,
         composite: !a.no_composite,
+        surfaces: a.surfaces,
     };
     let spinner = Spinner::on_terminal("blender");
     let report = glassdb_blender::render(&request, &registry, &spinner)?;
@@ -213,6 +250,7 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
     for o in &report.record.overrides {
         outln!("passes: {o}");
     }
+    print_pane_groups(&report);
     if request.composite {
         print_composites(&a.out_dir, &report.compose);
     } else {

@@ -147,6 +147,10 @@ pub struct MaskArgs {
     /// JSON file, `####` replaced by the frame number as in -o (docs/scene.md, "Plane bounds").
     #[arg(long, value_name = "BOUNDS.json")]
     pub bounds: Option<PathBuf>,
+    /// Registry whose units give --bounds each deeper pane group's rectangle (default: the
+    /// bundled one; an id it lacks counts as one group).
+    #[arg(long, value_name = "FILE", requires = "bounds")]
+    pub registry: Option<PathBuf>,
     /// Plane grouping: largest angle between face normals, degrees.
     #[arg(long, default_value_t = 0.1)]
     pub angle_tolerance_deg: f64,
@@ -453,6 +457,7 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         format: checked.format,
         output: args.output.clone(),
         bounds: args.bounds.clone(),
+        pane_groups: mask_pane_groups(&args, &checked.mappings)?,
     };
     let summary = MaskSummary {
         args: &args,
@@ -464,6 +469,26 @@ pub fn run_mask(args: MaskArgs) -> anyhow::Result<ExitCode> {
         None => summary.single(&job, &spinner),
         Some(frames) => summary.frames(&job, frames, &spinner),
     }
+}
+
+/// Pane groups of each --glass id that is a unit in the registry, for --bounds' group
+/// rectangles (none without --bounds).
+fn mask_pane_groups(
+    args: &MaskArgs,
+    mappings: &[GlassMapping],
+) -> anyhow::Result<std::collections::BTreeMap<u16, usize>> {
+    if args.bounds.is_none() {
+        return Ok(Default::default());
+    }
+    let (registry, _) = super::compose::load_registry(args.registry.as_deref())?;
+    let table = registry.default_table();
+    Ok(mappings
+        .iter()
+        .filter_map(|m| {
+            let groups = table.glass(m.id)?.unit.as_ref()?.groups.len();
+            (groups > 1).then_some((m.id, groups))
+        })
+        .collect())
 }
 
 /// What `glassdb mask` prints of its scene and masks.

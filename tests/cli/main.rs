@@ -3,6 +3,7 @@
 
 mod architecture;
 mod blender;
+mod blender_ghosts;
 mod cameras;
 mod colour;
 mod compose;

@@ -15,7 +15,7 @@ use glassdb_scene::{
 use glassdb_side::Side;
 
 use crate::BlenderError;
-use crate::job::{ExportInfo, FrameRecord, PixelBounds, ScriptFrame, ScriptPlane};
+use crate::job::{ExportInfo, FrameRecord, GroupPassRecord, PixelBounds, ScriptFrame, ScriptPlane};
 use crate::pipeline::{RegistryChoice, Workspace, frame_name, moving_obj_name};
 use crate::thin_pane::ThinPane;
 
@@ -59,9 +59,11 @@ pub fn planes_and_masks(
     };
     let glass_materials = glass_of_materials(&info.materials, &work.mappings)?;
     let panes = thin_panes(&glass_materials, registry)?;
+    let units = RunUnits::of(work, registry)?;
     let mut frames = FramesOfMasks {
         work,
         planes: Vec::new(),
+        plane_depths: Vec::new(),
         tolerance: 0.0,
         apertures: Vec::new(),
         first_frame,
@@ -82,9 +84,15 @@ pub fn planes_and_masks(
             eye: Some(eye),
             tolerance: PlaneTolerance::default_for(&scene),
             out_dir: &group.planes_dir,
-            pane_groups: Vec::new(),
+            pane_groups: units.depths.clone(),
         })?;
         frames.planes = report.planes.planes();
+        frames.plane_depths = report
+            .planes
+            .planes
+            .iter()
+            .map(|p| outer_first(&p.groups))
+            .collect();
         frames.tolerance = report.planes.tolerance.distance;
         planes_found = planes_found.max(frames.planes.len());
         let source = PlaneSource::Given {
@@ -102,6 +110,7 @@ pub fn planes_and_masks(
             format: MaskFormat::Exr,
             output: dir.join("mask.####.exr"),
             bounds: None,
+            pane_groups: units.counts.clone(),
         };
         mask_frames(
             &job,
@@ -170,6 +179,9 @@ struct FramesOfMasks<'w, 'a> {
     work: &'w Workspace<'a>,
     /// The planes of the frames being added.
     planes: Vec<glassdb_scene::Plane>,
+    /// Each plane's pane-group depths behind its face, outer group first (empty: the glass is
+    /// not a unit, mirrored about the face).
+    plane_depths: Vec<Vec<f64>>,
     /// planes.json's distance tolerance.
     tolerance: f64,
     /// The apertures of the frames being added.
@@ -225,17 +237,40 @@ impl FramesOfMasks<'_, '_> {
             .collect();
         let mut sides = Vec::new();
         let mut script_planes = Vec::new();
+        let mut groups = Vec::new();
         for (k, plane) in self.planes.iter().enumerate() {
             let front = plane.signed_distance(mask.camera_origin) >= 0.0;
             sides.push(if front { Side::Front } else { Side::Back });
-            let facing = if front { *plane } else { plane.flipped() };
+            let mirrors = self.mirror_planes(k, front);
             if let Some(r) = rectangles[k] {
+                let (facing, depth) = mirrors[0];
                 script_planes.push(ScriptPlane {
                     index: k,
                     equation: facing.equation(),
-                    tolerance: self.tolerance,
+                    tolerance: self.tolerance + depth,
                     border: r.blender_border(width, height),
                     output: self.work.staging.join(&refl[k]),
+                });
+            }
+            let deeper = mirrors.iter().enumerate().skip(1).filter_map(|(g, m)| {
+                let b = mask.group_bounds.get(&(u16::try_from(k).ok()?, g))?;
+                Some((g, m, b))
+            });
+            for (g, &(facing, depth), b) in deeper {
+                let file = frame_name(&format!("refl_{k}_{g}"), frame);
+                script_planes.push(ScriptPlane {
+                    index: k,
+                    equation: facing.equation(),
+                    tolerance: self.tolerance + depth,
+                    border: b.blender_border(width, height),
+                    output: self.work.staging.join(&file),
+                });
+                groups.push(GroupPassRecord {
+                    plane: k,
+                    group: g,
+                    file,
+                    depth_m: depth,
+                    bounds: PixelBounds::from(b.window()),
                 });
             }
         }
@@ -257,9 +292,104 @@ impl FramesOfMasks<'_, '_> {
             bounds: windows.iter().map(|w| w.map(PixelBounds::from)).collect(),
             composite: frame_name("composite", frame),
             light_parts: None,
+            groups,
         });
         self.crops.push(windows);
         Ok(())
+    }
+}
+
+impl FramesOfMasks<'_, '_> {
+    /// Plane `k`'s mirror planes facing the camera ([`mirror_planes`]).
+    fn mirror_planes(&self, k: usize, front: bool) -> Vec<(glassdb_scene::Plane, f64)> {
+        let depths = self.plane_depths.get(k).map_or(&[][..], Vec::as_slice);
+        mirror_planes(&self.planes[k], depths, front, self.work.surfaces())
+    }
+}
+
+/// The mirror planes of `plane` (its normal to the glass's front) facing a camera on its front
+/// (`front`) or back, each with its depth behind the face: one per pane group at
+/// `depths_outer_first`, in the order the camera's rays meet them (from the back the inner
+/// pane first), at most `surfaces` of them; the face itself for glass of one group.
+fn mirror_planes(
+    plane: &glassdb_scene::Plane,
+    depths_outer_first: &[f64],
+    front: bool,
+    surfaces: usize,
+) -> Vec<(glassdb_scene::Plane, f64)> {
+    let mut depths = depths_outer_first.to_vec();
+    if !front {
+        depths.reverse();
+    }
+    if depths.is_empty() {
+        depths.push(0.0);
+    }
+    depths.truncate(surfaces.max(1));
+    depths
+        .into_iter()
+        .map(|depth| {
+            let shifted = glassdb_scene::Plane {
+                normal: plane.normal,
+                d: plane.d + depth,
+            };
+            (if front { shifted } else { shifted.flipped() }, depth)
+        })
+        .collect()
+}
+
+/// A plane's pane-group depths from planes.json, outer group first (the file lists them in the
+/// order its eye meets them).
+fn outer_first(groups: &[glassdb_scene::GroupEntry]) -> Vec<f64> {
+    let mut depths: Vec<f64> = groups.iter().map(|g| g.depth).collect();
+    depths.sort_by(f64::total_cmp);
+    depths
+}
+
+/// The registry's units among the run's glass (issue 27).
+struct RunUnits {
+    /// Per `--glass` mapping, its unit's pane-group depths behind surface #1 (metres, outer
+    /// first; empty for glass of one group), where `glassdb mirror` puts the mirror planes.
+    depths: Vec<Vec<f64>>,
+    /// Pane groups of each glass id that is a unit of two or more, for the masks' group
+    /// rectangles.
+    counts: std::collections::BTreeMap<u16, usize>,
+}
+
+impl RunUnits {
+    /// The units of `work`'s glass mappings in the registry's table. With one pass per plane
+    /// (`--surfaces 1`) every plane is mirrored about its face, as before pane groups (so a
+    /// plane may hold glasses of different build-ups); otherwise a unit that does not record
+    /// its groups' depths is refused.
+    fn of(work: &Workspace<'_>, registry: &RegistryChoice) -> Result<RunUnits, BlenderError> {
+        let table = registry.registry.default_table();
+        let mut units = RunUnits {
+            depths: Vec::new(),
+            counts: Default::default(),
+        };
+        for m in &work.mappings {
+            let unit = table
+                .glass(m.id)
+                .and_then(|g| g.unit.as_ref().map(|u| (g, u)))
+                .filter(|(_, u)| u.groups.len() > 1);
+            let Some((glass, unit)) = unit else {
+                units.depths.push(Vec::new());
+                continue;
+            };
+            units.counts.insert(m.id, unit.groups.len());
+            match unit.group_depths_m() {
+                _ if work.surfaces() == 1 => units.depths.push(Vec::new()),
+                Some(d) => units.depths.push(d),
+                None => {
+                    return Err(BlenderError::BadOption(format!(
+                        "glass {}={}: unit {} ({}) in {} does not record its pane groups' \
+                         depths (every layer needs a thickness), so its deeper panes' \
+                         reflections cannot be placed; render it with one pass per plane",
+                        m.pattern, m.id, m.id, glass.name, registry.label
+                    )));
+                }
+            }
+        }
+        Ok(units)
     }
 }
 
@@ -296,4 +426,44 @@ fn glass_of_materials(
         .iter()
         .filter_map(|m| matcher.first_match(m).map(|k| (m.clone(), mappings[k].id)))
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The face z = 0 (normal +z, outdoors) of a unit with groups 3 and 21 mm behind it.
+    #[test]
+    fn mirror_planes_follow_the_cameras_rays_into_the_unit() {
+        let face = glassdb_scene::Plane::from_equation([0.0, 0.0, 1.0, 0.0]).unwrap();
+        let depths = [0.003, 0.021];
+        let eq = |v: Vec<(glassdb_scene::Plane, f64)>| -> Vec<([f64; 4], f64)> {
+            v.into_iter().map(|(p, d)| (p.equation(), d)).collect()
+        };
+        // From outdoors: the outer pane first, each mid-plane below the face, facing +z.
+        assert_eq!(
+            eq(mirror_planes(&face, &depths, true, usize::MAX)),
+            [
+                ([0.0, 0.0, 1.0, 0.003], 0.003),
+                ([0.0, 0.0, 1.0, 0.021], 0.021)
+            ]
+        );
+        // From indoors: the inner pane first, facing −z (the camera on the positive side).
+        assert_eq!(
+            eq(mirror_planes(&face, &depths, false, usize::MAX)),
+            [
+                ([0.0, 0.0, -1.0, -0.021], 0.021),
+                ([0.0, 0.0, -1.0, -0.003], 0.003)
+            ]
+        );
+        // --surfaces 1: the first group only; glass of one group: the face.
+        assert_eq!(
+            eq(mirror_planes(&face, &depths, false, 1)),
+            [([0.0, 0.0, -1.0, -0.021], 0.021)]
+        );
+        assert_eq!(
+            eq(mirror_planes(&face, &[], true, usize::MAX)),
+            [([0.0, 0.0, 1.0, 0.0], 0.0)]
+        );
+    }
 }

@@ -139,6 +139,18 @@ pub struct PixelBounds {
     pub height: u32,
 }
 
+impl PixelBounds {
+    /// The rectangle as a window in the frame.
+    pub fn window(&self) -> PixelWindow {
+        PixelWindow {
+            x: self.x as i32,
+            y: self.y as i32,
+            width: self.width as usize,
+            height: self.height as usize,
+        }
+    }
+}
+
 impl From<PixelWindow> for PixelBounds {
     /// A window inside a frame (coordinates not negative, as a mask's plane rectangles are).
     fn from(w: PixelWindow) -> PixelBounds {
@@ -174,6 +186,26 @@ pub struct FrameRecord {
     /// when the passes keep the light's path apart.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub light_parts: Option<String>,
+    /// The reflection passes of units' deeper pane groups (issue 27): the scene mirrored about
+    /// each group's mid-plane, cropped to the glass of that group. Absent without units.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<GroupPassRecord>,
+}
+
+/// The reflection pass of pane group `group` (1 or more) of plane `plane` in one frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroupPassRecord {
+    /// The plane (its group 0 pass is `FrameRecord::refl[plane]`).
+    pub plane: usize,
+    /// The pane group, counted in the order the camera's rays meet the groups.
+    pub group: usize,
+    /// The pass, relative to the output folder (`refl_<plane>_<group>.####.exr`).
+    pub file: String,
+    /// Its mirror plane's depth behind the glass face (metres along −normal).
+    pub depth_m: f64,
+    /// The glass pixels it covers (`glassdb mask --bounds`' group rectangle).
+    pub bounds: PixelBounds,
 }
 
 /// `glassdb-blender.json`: what `glassdb blender render` made, for re-compositing.
@@ -204,6 +236,10 @@ pub struct RunRecord {
     /// recorded): what a swap to other glasses cannot change ([`crate::swap`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub lit_by: Vec<crate::swap::PassGlass>,
+    /// How many of a unit's pane groups got a reflection pass (`--surfaces N`; absent: all):
+    /// the deeper groups' reflectance is composited on the last one's pass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surfaces: Option<std::num::NonZeroUsize>,
 }
 
 impl RunRecord {
@@ -229,9 +265,23 @@ impl RunRecord {
                     f.frame
                 )));
             }
+            if let Some(g) = f
+                .groups
+                .iter()
+                .find(|g| g.plane >= f.refl.len() || g.group == 0)
+            {
+                return Err(bad(format!(
+                    "frame {}: pane group {} of plane {} is not a deeper group of one of its {} planes",
+                    f.frame,
+                    g.group,
+                    g.plane,
+                    f.refl.len()
+                )));
+            }
             let files = [&f.trans, &f.mask, &f.composite]
                 .into_iter()
                 .chain(&f.refl)
+                .chain(f.groups.iter().map(|g| &g.file))
                 .chain(&f.light_parts);
             if let Some(p) = files.into_iter().find(|p| !is_plain_name(p)) {
                 return Err(bad(format!(

@@ -160,6 +160,14 @@ pub(crate) fn place_split_passes(
                 window: *window,
             });
         }
+        // A unit's deeper pane groups (issue 27): split like every other reflection pass.
+        for g in &record.groups {
+            passes.push(SplitPass {
+                rendered: work.staging.join(&g.file),
+                target: work.dir.join(&g.file),
+                window: Some(g.bounds.window()),
+            });
+        }
         let lights = lights_path(&work.staging, script.frame);
         let parts = assemble_frame(script, &lights, &passes, size)?;
         let name = light_parts_name(script.frame);

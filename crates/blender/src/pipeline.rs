@@ -8,6 +8,7 @@
 //! glassdb places the crops), [`render_reference`] (optional) and [`compose_record`].
 
 use std::collections::BTreeMap;
+use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -77,6 +78,10 @@ pub struct RenderRequest {
     /// Composite every frame at the end (else the run stops at its passes, masks and record,
     /// for [`compose_dir`] to composite: a farm's render and composite steps).
     pub composite: bool,
+    /// How many of a unit's pane groups get a reflection pass of their own (`--surfaces N`;
+    /// `None`: all, issue 27's double image); the deeper groups' reflectance is composited on
+    /// the last one's pass (`Some(1)`: one pass per plane, no double image).
+    pub surfaces: Option<NonZeroUsize>,
 }
 
 /// The registry and how it is named in messages and outputs.
@@ -276,6 +281,11 @@ impl<'a> Workspace<'a> {
         })
     }
 
+    /// The most pane groups of a unit rendered as passes of their own (`--surfaces`).
+    pub(crate) fn surfaces(&self) -> usize {
+        self.request.surfaces.map_or(usize::MAX, NonZeroUsize::get)
+    }
+
     /// `WxH` of the request, if it sets one.
     fn resolution(&self) -> Option<String> {
         self.request.resolution.map(|(w, h)| format!("{w}x{h}"))
@@ -370,8 +380,22 @@ pub fn render_passes(work: &Workspace<'_>, masks: &mut Masks) -> Result<ScriptJo
                 None => write_unused_pass(&target, width, height)?,
             }
         }
+        place_group_passes(work, f, masks.size)?;
     }
     Ok(job)
+}
+
+/// Places the frame's pane-group passes (issue 27), each crop at its group's rectangle.
+fn place_group_passes(
+    work: &Workspace<'_>,
+    frame: &FrameRecord,
+    (width, height): (u32, u32),
+) -> Result<(), BlenderError> {
+    for g in &frame.groups {
+        let (from, to) = (work.staging.join(&g.file), work.dir.join(&g.file));
+        place_crop(&from, &to, g.bounds.window(), width, height)?;
+    }
+    Ok(())
 }
 
 /// Writes the run record `glassdb-blender.json` of `frames`, `size` pixels each.
@@ -394,6 +418,7 @@ fn write_record(
         overrides,
         frames,
         lit_by,
+        surfaces: request.surfaces,
     };
     let record_path = work.dir.join(RECORD_NAME);
     let text = serde_json::to_string_pretty(&record).map_err(|e| BlenderError::BadRecord {
@@ -487,9 +512,9 @@ pub fn compose_record(
         let settings = ComposeSettings {
             decode: DecodeSettings {
                 registry_label: registry.label.clone(),
-                // One reflection pass per plane is rendered: a unit's deeper pane groups are
-                // composited on it (issue 27's group passes are not rendered yet).
-                max_groups: std::num::NonZeroUsize::new(1),
+                // The run's `--surfaces`: a unit's groups beyond it are composited on the last
+                // group rendered.
+                max_groups: record.surfaces,
                 ..DecodeSettings::default()
             },
             plane_sides: f
@@ -503,7 +528,7 @@ pub fn compose_record(
         let job = ComposeJob {
             inputs: FrameFiles {
                 refl: f.refl.iter().map(|r| dir.join(r)).collect(),
-                groups: Vec::new(),
+                groups: group_pass_files(dir, f),
                 trans: dir.join(&f.trans),
                 mask: dir.join(&f.mask),
             },
@@ -525,6 +550,19 @@ pub fn compose_record(
         seconds: t.elapsed().as_secs_f64(),
         light_parts,
     })
+}
+
+/// The frame's pane-group passes as compose takes them.
+fn group_pass_files(dir: &Path, f: &FrameRecord) -> Vec<glassdb_compose::GroupPassFile> {
+    f.groups
+        .iter()
+        .map(|g| glassdb_compose::GroupPassFile {
+            plane: g.plane,
+            group: g.group,
+            path: dir.join(&g.file),
+            layer: None,
+        })
+        .collect()
 }
 
 /// `glassdb blender compose DIR`: the run's frames composited again with `registry`.

@@ -166,6 +166,7 @@ mod tests {
             overrides: Vec::new(),
             frames: Vec::new(),
             lit_by,
+            surfaces: None,
         }
     }
 

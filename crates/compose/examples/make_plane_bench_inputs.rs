@@ -2,9 +2,13 @@
 //! plus noise passes) with PLANES glass windows on a 6-column grid, one plane each, and the same
 //! glass on a single plane. Writes OUT_DIR/{trans.exr, refl.exr, mask_planes.png, mask_one.png}
 //! and prints each window as `K X Y WIDTH HEIGHT` (pixels, row 0 at the top), for cropping the
-//! reflection pass to each plane's glass.
+//! reflection pass to each plane's glass. The windows alternate between two glass ids, 2 and 6
+//! (monolithic) unless IDS gives others (`11,12`: the bundled double units, for
+//! `scripts/bench_ghosts.sh`); with IDS it also writes each window's reflection pass cropped to
+//! it, `crop_K.exr`, and a second one, `group_K.exr` (pane group 1's pass), their data windows
+//! at the window in the frame.
 //!
-//! `cargo run --release -p glassdb-compose --example make_plane_bench_inputs -- OUT_DIR WIDTH HEIGHT half|float COMPRESSION PLANES`
+//! `cargo run --release -p glassdb-compose --example make_plane_bench_inputs -- OUT_DIR WIDTH HEIGHT half|float COMPRESSION PLANES [IDS]`
 
 use std::path::PathBuf;
 
@@ -15,11 +19,18 @@ use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
-    if a.len() != 7 {
+    if !(7..=8).contains(&a.len()) {
         return Err(
-            "usage: make_plane_bench_inputs OUT_DIR WIDTH HEIGHT half|float COMPRESSION PLANES"
+            "usage: make_plane_bench_inputs OUT_DIR WIDTH HEIGHT half|float COMPRESSION PLANES [IDS]"
                 .into(),
         );
+    }
+    let ids: Vec<u16> = match a.get(7) {
+        Some(list) => list.split(',').map(str::parse).collect::<Result<_, _>>()?,
+        None => vec![2, 6],
+    };
+    if ids.is_empty() || ids.contains(&0) {
+        return Err("IDS: glass ids 1 or more, separated by commas".into());
     }
     let out = PathBuf::from(&a[1]);
     let (w, h): (usize, usize) = (a[2].parse()?, a[3].parse()?);
@@ -51,10 +62,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             (cy * 10 + 9) * h / (rows * 10),
         );
         println!("{k} {x0} {y0} {} {}", x1 - x0, y1 - y0);
+        if a.len() == 8 {
+            for (name, seed) in [("crop", bench_passes::REFL.0), ("group", 7 << 40)] {
+                let path = out.join(format!("{name}_{k}.exr"));
+                write_crop(&path, (w, h), (x0, y0, x1 - x0, y1 - y0), seed, ty)?;
+            }
+        }
         for y in y0..y1 {
             for x in x0..x1 {
                 let i = y * w + x;
-                id[i] = if k % 2 == 0 { 2 } else { 6 };
+                id[i] = ids[k % ids.len()];
                 cos[i] = (40 + x * 200 / w) as u8;
                 plane[i] = k as u16;
             }
@@ -74,5 +91,45 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &mask(vec![0; n]),
         MaskFormat::Png8,
     )?;
+    Ok(())
+}
+
+/// A reflection pass of the `frame` cropped to `(x, y, width, height)`: its data window there.
+fn write_crop(
+    path: &std::path::Path,
+    frame: (usize, usize),
+    (x, y, cw, ch): (usize, usize, usize, usize),
+    seed: u64,
+    ty: ExrDataType,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use exr::prelude::*;
+    let image = bench_passes::pass_image(cw, ch, seed, bench_passes::REFL.1);
+    let samples = |v: &[f32]| match ty {
+        ExrDataType::Half => FlatSamples::F16(v.iter().map(|&s| f16::from_f32(s)).collect()),
+        _ => FlatSamples::F32(v.to_vec()),
+    };
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = ["R", "G", "B"]
+        .iter()
+        .zip(&image.rgb)
+        .map(|(name, v)| AnyChannel::new(*name, samples(v)))
+        .collect();
+    let layer = Layer::new(
+        (cw, ch),
+        LayerAttributes {
+            layer_position: Vec2(x as i32, y as i32),
+            ..LayerAttributes::default()
+        },
+        Encoding {
+            compression: Compression::ZIP16,
+            ..Encoding::default()
+        },
+        AnyChannels::sort(list),
+    );
+    Image::new(
+        ImageAttributes::new(IntegerBounds::from_dimensions(frame)),
+        layer,
+    )
+    .write()
+    .to_file(path)?;
     Ok(())
 }

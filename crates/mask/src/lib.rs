@@ -288,6 +288,29 @@ impl MaskImage {
         self.plane_bounds_of(|_, _, _, _| true)
     }
 
+    /// Each deeper pane group's screen rectangle, by `(plane, group)` for groups 1 and on
+    /// (issue 27): the smallest window holding the glass pixels of that plane whose glass has
+    /// more than `group` pane groups (`groups_of(id)`: 1 for a monolithic glass), i.e. where
+    /// that group's reflection pass is composited. Group 0's rectangle is the plane's own
+    /// ([`MaskImage::plane_bounds`]).
+    pub fn group_bounds(
+        &self,
+        groups_of: impl Fn(u16) -> usize + Sync,
+    ) -> BTreeMap<(u16, usize), PlaneBounds> {
+        let most = self
+            .id_pixel_counts()
+            .keys()
+            .map(|&id| groups_of(id))
+            .max()
+            .unwrap_or(1);
+        let mut out = BTreeMap::new();
+        for group in 1..most {
+            let bounds = self.plane_bounds_of(|_, _, id, _| groups_of(id) > group);
+            out.extend(bounds.into_iter().map(|(plane, b)| ((plane, group), b)));
+        }
+        out
+    }
+
     /// [`MaskImage::plane_bounds`] of the glass pixels `(x, y, id, plane)` that `select` keeps
     /// (e.g. those outside their plane's pass). Rows are scanned in parallel.
     pub fn plane_bounds_of(

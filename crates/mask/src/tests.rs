@@ -524,6 +524,28 @@ fn plane_bounds_are_the_glass_rectangles_per_plane() {
     assert_eq!((b[&2].x_max, b[&2].y_max), (2, 0));
 }
 
+#[test]
+fn group_bounds_hold_the_glass_of_units_with_that_group() {
+    // packed8 with id 7 a unit of three pane groups, id 3 of two, id 200 monolithic.
+    let groups = |id: u16| match id {
+        7 => 3,
+        3 => 2,
+        _ => 1,
+    };
+    let b = packed8().group_bounds(groups);
+    let keys: Vec<_> = b.keys().copied().collect();
+    // Plane 0 holds ids 7 (1,0) and 3 (2,1); plane 1 id 7 (0,1); plane 2 only the monolith.
+    assert_eq!(keys, vec![(0, 1), (0, 2), (1, 1), (1, 2)]);
+    let g = |k| {
+        let p: PlaneBounds = b[&k];
+        (p.x_min, p.y_min, p.x_max, p.y_max, p.glass_pixels)
+    };
+    assert_eq!(g((0, 1)), (1, 0, 2, 1, 2));
+    assert_eq!(g((0, 2)), (1, 0, 1, 0, 1), "only id 7 has a third group");
+    assert_eq!(g((1, 2)), (0, 1, 0, 1, 1));
+    assert!(packed8().group_bounds(|_| 1).is_empty());
+}
+
 /// Blender's own edge rule, `int(fraction · size)` with the fraction stored as float32
 /// (DNA's `rctf border`) and multiplied in float32 (render_init_from_main).
 fn blender_edge(fraction: f64, size: u32) -> i64 {

@@ -2,9 +2,10 @@
 //! bounds"): each plane's screen rectangle in one frame, so that a renderer renders that plane's
 //! reflection pass over just that region (Blender's render border, an EXR data window).
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
-use glassdb_mask::MaskImage;
+use glassdb_mask::{MaskImage, PlaneBounds};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SceneError;
@@ -47,6 +48,26 @@ pub struct PlaneBoundsEntry {
     /// float32 truncation `int(fraction · size)` gives exactly the data window
     /// (`glassdb_mask::PlaneBounds::blender_border`).
     pub blender_border: BlenderBorder,
+    /// The rectangles of the plane's deeper pane groups (issue 27), group 1 and on: where
+    /// each group's reflection pass is composited, the glass pixels of the plane whose glass
+    /// is a unit with that group (docs/scene.md, "Units"). Absent without units.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<GroupBoundsEntry>,
+}
+
+/// One deeper pane group's rectangle on a plane.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroupBoundsEntry {
+    /// The pane group, 1 or more, in the order the camera's rays meet the groups (compose's
+    /// `refl_<plane>_<group>`).
+    pub group: usize,
+    /// `[x_min, y_min, x_max, y_max]` as [`PlaneBoundsEntry::data_window`].
+    pub data_window: [i32; 4],
+    /// Glass pixels of the plane whose glass has this group.
+    pub glass_pixels: u64,
+    /// The same rectangle as Blender's render border.
+    pub blender_border: BlenderBorder,
 }
 
 /// A render border as Blender stores it: fractions in [0, 1], y up.
@@ -63,25 +84,31 @@ pub struct BlenderBorder {
     pub max_y: f64,
 }
 
+impl BlenderBorder {
+    /// `b`'s border in a `width × height` frame (`PlaneBounds::blender_border`).
+    fn of(b: &PlaneBounds, width: u32, height: u32) -> BlenderBorder {
+        let [min_x, max_x, min_y, max_y] = b.blender_border(width, height);
+        BlenderBorder {
+            min_x,
+            max_x,
+            min_y,
+            max_y,
+        }
+    }
+}
+
 impl PlaneBoundsFile {
     /// The rectangles of `mask` (a whole frame at the origin, as `glassdb mask` writes it).
     pub fn from_mask(mask: &MaskImage, frame: Option<u32>, mask_name: &str) -> PlaneBoundsFile {
         let planes = mask
             .plane_bounds()
             .into_iter()
-            .map(|(plane, b)| {
-                let [min_x, max_x, min_y, max_y] = b.blender_border(mask.width, mask.height);
-                PlaneBoundsEntry {
-                    plane,
-                    data_window: [b.x_min, b.y_min, b.x_max, b.y_max],
-                    glass_pixels: b.glass_pixels,
-                    blender_border: BlenderBorder {
-                        min_x,
-                        max_x,
-                        min_y,
-                        max_y,
-                    },
-                }
+            .map(|(plane, b)| PlaneBoundsEntry {
+                plane,
+                data_window: [b.x_min, b.y_min, b.x_max, b.y_max],
+                glass_pixels: b.glass_pixels,
+                blender_border: BlenderBorder::of(&b, mask.width, mask.height),
+                groups: Vec::new(),
             })
             .collect();
         PlaneBoundsFile {
@@ -92,6 +119,23 @@ impl PlaneBoundsFile {
             height: mask.height,
             planes,
         }
+    }
+
+    /// The file with each plane's deeper pane groups' rectangles (`MaskImage::group_bounds`,
+    /// by `(plane, group)`).
+    pub fn with_groups(mut self, groups: &BTreeMap<(u16, usize), PlaneBounds>) -> PlaneBoundsFile {
+        for p in &mut self.planes {
+            p.groups = groups
+                .range((p.plane, 1)..=(p.plane, usize::MAX))
+                .map(|(&(_, group), b)| GroupBoundsEntry {
+                    group,
+                    data_window: [b.x_min, b.y_min, b.x_max, b.y_max],
+                    glass_pixels: b.glass_pixels,
+                    blender_border: BlenderBorder::of(b, self.width, self.height),
+                })
+                .collect();
+        }
+        self
     }
 
     /// Writes the file atomically (pretty JSON).
@@ -119,8 +163,15 @@ impl PlaneBoundsFile {
                 glassdb_io::quoted(&file.format)
             )));
         }
-        for p in &file.planes {
-            let [x0, y0, x1, y1] = p.data_window;
+        let windows = file.planes.iter().flat_map(|p| {
+            std::iter::once((p.plane, None, p.data_window)).chain(
+                p.groups
+                    .iter()
+                    .map(|g| (p.plane, Some(g.group), g.data_window)),
+            )
+        });
+        for (plane, group, data_window) in windows {
+            let [x0, y0, x1, y1] = data_window;
             if x0 < 0
                 || y0 < 0
                 || x1 < x0
@@ -128,9 +179,10 @@ impl PlaneBoundsFile {
                 || x1 as u32 >= file.width
                 || y1 as u32 >= file.height
             {
+                let group = group.map_or_else(String::new, |g| format!(", pane group {g}"));
                 return Err(bad(format!(
-                    "plane {}: data_window {:?} is not inside the {}x{} frame",
-                    p.plane, p.data_window, file.width, file.height
+                    "plane {plane}{group}: data_window {data_window:?} is not inside the {}x{} frame",
+                    file.width, file.height
                 )));
             }
         }

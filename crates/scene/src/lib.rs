@@ -21,7 +21,9 @@ pub mod triangulate;
 pub mod virtual_scene;
 pub mod warning;
 
-pub use bounds_file::{BlenderBorder, PLANE_BOUNDS_FORMAT, PlaneBoundsEntry, PlaneBoundsFile};
+pub use bounds_file::{
+    BlenderBorder, GroupBoundsEntry, PLANE_BOUNDS_FORMAT, PlaneBoundsEntry, PlaneBoundsFile,
+};
 pub use camera::{CAMERA_FILE, Camera, CameraSource, CameraSpec, SensorFit, ViewPlane};
 pub use error::SceneError;
 pub use mask::{

@@ -109,6 +109,9 @@ pub struct MaskJob<'a> {
     pub output: PathBuf,
     /// Each frame's plane rectangles, `####` replaced as in `output`.
     pub bounds: Option<PathBuf>,
+    /// Pane groups of each glass id that is a unit of two or more (issue 27); an id not
+    /// listed has one. Gives each deeper group's rectangle ([`FrameMask::group_bounds`]).
+    pub pane_groups: BTreeMap<u16, usize>,
 }
 
 /// What one written mask holds.
@@ -126,6 +129,9 @@ pub struct FrameMask {
     pub id_pixels: BTreeMap<u16, u64>,
     /// Each plane's glass rectangle in the frame.
     pub plane_bounds: BTreeMap<u16, PlaneBounds>,
+    /// Each deeper pane group's rectangle by `(plane, group)`, groups 1 and on
+    /// (`MaskImage::group_bounds` with [`MaskJob::pane_groups`]).
+    pub group_bounds: BTreeMap<(u16, usize), PlaneBounds>,
     /// Where the frame's camera is (which side of each plane it sees).
     pub camera_origin: [f64; 3],
 }
@@ -165,8 +171,11 @@ pub fn mask_frame(
     progress.stage(write_stage);
     let mask = to_mask_image(raster, encoding);
     glassdb_mask::write_mask(&output, &mask, job.format)?;
+    let group_bounds = mask.group_bounds(|id| job.pane_groups.get(&id).copied().unwrap_or(1));
     if let Some(bounds) = &bounds {
-        PlaneBoundsFile::from_mask(&mask, frame, &output.to_string_lossy()).write(bounds)?;
+        PlaneBoundsFile::from_mask(&mask, frame, &output.to_string_lossy())
+            .with_groups(&group_bounds)
+            .write(bounds)?;
     }
     Ok(FrameMask {
         width: mask.width,
@@ -174,6 +183,7 @@ pub fn mask_frame(
         drawn,
         id_pixels: mask.id_pixel_counts(),
         plane_bounds: mask.plane_bounds(),
+        group_bounds,
         camera_origin: camera.origin,
         output,
     })
