@@ -212,4 +212,5 @@ def main():
               swap["wall_s"], swap["max_rss_kb"] / 1024))
 
 
-main()
+if __name__ == "__main__":
+    main()

@@ -74,6 +74,10 @@ pub struct RenderArgs {
     /// as DIR/reference.####.exr, for validation.
     #[arg(long)]
     pub reference: bool,
+    /// Leave the lamps out of the reflection passes (each pass sees them as the scene's
+    /// camera visibility says), as before they were shown there as the glass reflects them.
+    #[arg(long)]
+    pub no_lamps_in_reflections: bool,
     /// Stop after the passes, masks and run record: `glassdb blender compose DIR` composites
     /// them (a farm's render step, then its composite step).
     #[arg(long)]
@@ -167,6 +171,7 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         seed: a.seed,
         threads: a.threads,
         reference: a.reference,
+        lamps_in_reflections: !a.no_lamps_in_reflections,
         mask_samples: a.mask_samples,
         composite: !a.no_composite,
     };

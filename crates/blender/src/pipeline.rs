@@ -70,6 +70,10 @@ pub struct RenderRequest {
     /// Also render the Cycles reference (the glass as a thin pane seen by the camera) as
     /// `reference.####.exr`.
     pub reference: bool,
+    /// Show the lamps (point, spot, area, sun) in the reflection passes as the real glass
+    /// reflects them (docs/blender.md "Lamps in reflections"); off: each pass sees the lamps as
+    /// the scene's camera visibility says, as before.
+    pub lamps_in_reflections: bool,
     /// Composite every frame at the end (else the run stops at its passes, masks and record,
     /// for [`compose_dir`] to composite: a farm's render and composite steps).
     pub composite: bool,
@@ -331,6 +335,7 @@ pub fn render_passes(work: &Workspace<'_>, masks: &Masks) -> Result<ScriptJob, B
         seed: request.seed,
         threads: request.threads,
         reference: false,
+        lamps_in_reflections: request.lamps_in_reflections,
         glass: masks.panes.clone(),
         frames: masks.script_frames.clone(),
     };
