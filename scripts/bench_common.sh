@@ -43,3 +43,15 @@ max_abs_diff() {
 
 # A ÷ B to two decimals.
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", a / b }'; }
+
+# Runs "$@" (in $WORK, from make_work_dir); prints "SECONDS MAX_RSS_MIB" from GNU time's verbose report.
+measure() {
+    /usr/bin/time -v -o "$WORK/time" "$@" >/dev/null 2>"$WORK/stderr" || {
+        cat "$WORK/stderr" "$WORK/time" >&2
+        return 1
+    }
+    awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, t, ":"); s = 0; for (i = 1; i <= n; i++) s = s * 60 + t[i] }
+                /Maximum resident set size/ { kb = $2 }
+                END { printf "%.3f %.0f\n", s, kb / 1024 }' "$WORK/time"
+}
+median() { sort -n | awk '{ v[NR] = $0 } END { print v[int((NR + 1) / 2)] }'; }

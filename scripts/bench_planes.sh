@@ -26,18 +26,6 @@ build_compose_and_examples make_plane_bench_inputs oiiotool_colormaps
 make_work_dir glassdb-planes
 eval "$("$EXAMPLES/oiiotool_colormaps" 6)"
 
-# Runs "$@"; prints "SECONDS MAX_RSS_MIB" from GNU time's verbose report.
-measure() {
-    /usr/bin/time -v -o "$WORK/time" "$@" >/dev/null 2>"$WORK/stderr" || {
-        cat "$WORK/stderr" "$WORK/time" >&2
-        return 1
-    }
-    awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, t, ":"); s = 0; for (i = 1; i <= n; i++) s = s * 60 + t[i] }
-                /Maximum resident set size/ { kb = $2 }
-                END { printf "%.3f %.0f\n", s, kb / 1024 }' "$WORK/time"
-}
-median() { sort -n | awk '{ v[NR] = $0 } END { print v[int((NR + 1) / 2)] }'; }
-
 echo "machine: $(machine_and_peer), threads $THREADS, $PLANES planes, ZIP, medians of $REPEATS paired runs; load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 markdown_header size samples case "compose (s)" "compose RSS (MiB)" "oiiotool (s)" \
     "oiiotool RSS (MiB)" speed-up "max abs diff to oiiotool"
