@@ -44,7 +44,7 @@ max_abs_diff() {
 # A ÷ B to two decimals.
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", a / b }'; }
 
-# Runs "$@" (in a folder WORK); prints "SECONDS MAX_RSS_MIB" from GNU time's verbose report.
+# Runs "$@" (in $WORK, from make_work_dir); prints "SECONDS MAX_RSS_MIB" from GNU time's verbose report.
 measure() {
     /usr/bin/time -v -o "$WORK/time" "$@" >/dev/null 2>"$WORK/stderr" || {
         cat "$WORK/stderr" "$WORK/time" >&2

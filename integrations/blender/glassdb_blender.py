@@ -32,7 +32,9 @@ How the passes are made:
 - Reflection pass of plane n·x + d = 0: a copy of the camera with matrix R @ matrix_world (R the
   reflection about the plane, determinant −1); every other material mixes in a Transparent BSDF
   where Is Camera Ray and the shading point lies on the far side of the plane from the real
-  camera; a render border of the plane's screen rectangle, cropped.
+  camera; a render border of the plane's screen rectangle, cropped. Lamps (which camera rays
+  do not see by default) are made visible to camera rays in it when a glossy ray of the real
+  glass could see them from the camera's side of the plane, so that the glass reflects them.
 
 Licence: same as the project, MIT OR Apache-2.0.
 """
@@ -450,6 +452,48 @@ def reflection_matrix(plane):
     return Matrix(rows)
 
 
+class ReflectedLamp:
+    """A lamp of the scene and its own camera visibility, which the passes change and restore."""
+
+    def __init__(self, ob):
+        self.ob = ob
+        self.visible_camera = ob.visible_camera
+        data = ob.data
+        cyc = getattr(data, "cycles", None)
+        # What a glossy ray of the real glass can see: Cycles finds a lamp from a glossy bounce
+        # only when the lamp is visible to glossy rays and takes part in MIS (and a portal
+        # emits nothing).
+        self.seen_by_glossy = (ob.visible_glossy
+                               and getattr(cyc, "use_multiple_importance_sampling", True)
+                               and not getattr(cyc, "is_portal", False))
+
+
+def reflected_lamps(scene):
+    """The scene's lamp objects (point, spot, area, sun), with their camera visibility."""
+    return [ReflectedLamp(ob) for ob in scene.objects if ob.type == "LIGHT"]
+
+
+def show_lamps_in_reflection(lamps, plane):
+    """Lamps in the reflection pass of `plane` ((a, b, c, d), real camera on the positive
+    side) as the real glass shows them: a mirror-camera ray is the real glass's reflected ray,
+    so every lamp a glossy ray could meet on the camera's side of the plane (a sun always, as
+    a disc of its angle) is made visible to camera rays, and lamps on the far side, which the
+    mirror does not show, are hidden from them. With plane None (the transmission pass and
+    the reference) each lamp gets back the scene's own camera visibility."""
+    for lamp in lamps:
+        if plane is None:
+            lamp.ob.visible_camera = lamp.visible_camera
+            continue
+        if not lamp.seen_by_glossy:
+            lamp.ob.visible_camera = False
+        elif lamp.ob.data.type == "SUN":
+            lamp.ob.visible_camera = True
+        else:
+            a, b, c, d = plane
+            x, y, z = lamp.ob.matrix_world.translation
+            lamp.ob.visible_camera = a * x + b * y + c * z + d > 0.0
+
+
 def honest_passes(scene):
     """Cycles' denoiser and motion blur off, whatever the scene says: the passes must carry
     Cycles' own noise (the composite's and the reference's error are compared with it; and
@@ -498,6 +542,7 @@ def render(opts):
                 clips.append(nodes)
     split = LightSplit.of_job(scene, job)
     real = scene.camera
+    lamps = reflected_lamps(scene) if job.get("lamps_in_reflections", True) else []
     mirror_data = None
     mirror = None
     r = scene.render
@@ -506,6 +551,7 @@ def render(opts):
         scene.camera = real
         r.use_border = False
         set_clip(clips, glass_clips, None)
+        show_lamps_in_reflection(lamps, None)
         if split is not None:
             split.start_frame(scene, frame)
         render_pass(scene, frame["trans"], split)
@@ -521,6 +567,7 @@ def render(opts):
             mirror.matrix_world = reflection_matrix(plane["equation"]) @ m_real
             scene.camera = mirror
             set_clip(clips, glass_clips, plane["equation"], plane["tolerance"])
+            show_lamps_in_reflection(lamps, plane["equation"])
             x0, x1, y0, y1 = plane["border"]
             r.use_border = True
             r.use_crop_to_border = True
@@ -529,6 +576,7 @@ def render(opts):
             render_pass(scene, plane["output"], split)
         scene.camera = real
         r.use_border = False
+        show_lamps_in_reflection(lamps, None)
     print("glassdb_blender: rendered %d frames" % len(job["frames"]))
 
 

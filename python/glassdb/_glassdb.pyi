@@ -87,10 +87,12 @@ def compose(
     sides: Mapping[int, Literal["front", "back"]] | None = None,
     unknown: Literal["error", "passthrough"] = "error",
     light_groups: Sequence[str] | str | None = None,
+    surfaces: int | None = None,
 ) -> _F32Image:
     """The composite, bit for bit as `compose` writes it to a float EXR; with `light_groups`
     (`trans` and each `refl` then dicts {group: array}), the sum of the groups' composites,
-    bit for bit the beauty `compose --light-groups` writes."""
+    bit for bit the beauty `compose --light-groups` writes. A unit (an insulated glass) in the
+    mask is refused (no pane-group passes from arrays) unless `surfaces=1`."""
 
 def read_passes(path: _Path, layer: str | None = None) -> list[Pass]:
     """The passes of a file as `compose` reads them."""

@@ -399,8 +399,10 @@ fn group_arrays<'py>(
 /// one); `planes` a planes.json giving each plane's side, `sides` {plane: "front"|"back"} over
 /// it; `space` the passes' linear RGB space (default: untagged, linear Rec.709), which chooses
 /// the registry's table; `unknown` "error" or "passthrough" for ids the registry lacks.
-/// There are no pane-group passes: a unit's plane pass takes every pane group's share (as
-/// `compose --surfaces 1`).
+/// `surfaces` (`compose --surfaces N`): the pane groups of a unit given their own reflection
+/// pass; arrays carry no pane-group passes, so a unit (an insulated glass id of the registry)
+/// in the mask is refused, naming its plane and first missing group, unless `surfaces=1`
+/// composites its plane's pass with every pane group's share (no double image).
 /// `light_groups` (a list of names, or "sun,warm"): the passes split by light, as
 /// `compose --light-groups`: `trans` a dict {group: array}, `refl` one such dict or a list, one
 /// per plane; each group composited with the table of the registry's light of its name and the
@@ -409,7 +411,7 @@ fn group_arrays<'py>(
 /// Returns a new float32 (H, W, C) array; the GIL is released while it composites.
 #[pyfunction]
 #[pyo3(signature = (trans, refl, mask, registry=None, planes=None, space=None, sides=None,
-    unknown="error", light_groups=None))]
+    unknown="error", light_groups=None, surfaces=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn compose<'py>(
     py: Python<'py>,
@@ -422,6 +424,7 @@ pub fn compose<'py>(
     sides: Option<BTreeMap<usize, String>>,
     unknown: &str,
     light_groups: Option<&Bound<'py, PyAny>>,
+    surfaces: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let names = light_groups.map(|g| group_names(py, g)).transpose()?;
     let registry: &PyRegistry = match &registry {
@@ -504,6 +507,12 @@ pub fn compose<'py>(
     settings.decode.unknown = unknown;
     settings.decode.outside = OutsidePolicy::Error;
     settings.decode.registry_label = registry.label.clone();
+    settings.decode.max_groups = surfaces
+        .map(|n| {
+            std::num::NonZeroUsize::new(n)
+                .ok_or_else(|| invalid(py, "surfaces: at least 1 (the unit's front group)".into()))
+        })
+        .transpose()?;
     let passes = refl_samples.first().map_or(0, Vec::len);
     settings.plane_sides = plane_sides(py, planes, sides, passes)?;
     let labels = MemoryLabels {

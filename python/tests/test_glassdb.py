@@ -25,7 +25,7 @@ ATRIUM = ROOT / "fixtures" / "atrium"
 B34 = ROOT / "fixtures" / "blender" / "masks" / "b34"
 GLAZING = ROOT / "fixtures" / "glazing"
 sys.path.insert(0, str(ROOT / "python_oracle"))
-from exr_oracle import read_png  # noqa: E402  (the oracles' PNG reader, not glassdb's)
+from exr_oracle import read_png, write_png_rgb8  # noqa: E402  (the oracles' PNG codec, not glassdb's)
 
 
 def run(tool, *args):
@@ -100,6 +100,34 @@ def test_compose_atrium_float_mask_and_own_registry_bit_for_bit(tmp_path):
     trans, refl = atrium_passes()
     got = glassdb.compose(trans, refl, mask, registry=glassdb.Registry.load(registry), planes=PLANES)
     assert_bits_equal(got, want)
+
+
+def test_compose_refuses_a_unit_without_its_pane_group_passes_unless_surfaces_1(tmp_path):
+    # The atrium's glass as id 11 of the bundled registry (double clear: a unit of two pane
+    # groups). Arrays carry no pane-group passes: like `compose` without --refl-group, the
+    # unit is refused, naming its plane and group, unless surfaces=1 folds its deeper group
+    # into the plane's pass, as `compose --surfaces 1` does.
+    mask = np.ascontiguousarray(read_png(str(ATRIUM / "mask.png"))[..., :3].astype(np.uint8))
+    mask[..., 1] = np.where(mask[..., 1] > 0, 11, 0).astype(np.uint8)
+    unit_mask = tmp_path / "unit_mask.png"
+    write_png_rgb8(str(unit_mask), mask)
+    trans, refl = atrium_passes()
+    refl_args = [a for p in ATRIUM_REFL for a in ("--refl", p)]
+    done = subprocess.run(
+        [str(BIN / "compose"), *map(str, refl_args), "--trans", str(ATRIUM / "trans.exr"),
+         "--mask", str(unit_mask), "--planes", str(PLANES), "-o", str(tmp_path / "out.exr")],
+        capture_output=True, text=True,
+    )
+    assert done.returncode != 0
+    with pytest.raises(glassdb.InvalidInput) as e:
+        glassdb.compose(trans, refl, mask, planes=PLANES)
+    assert "pane group 1" in str(e.value) and "glass 11" in str(e.value), str(e.value)
+    assert done.stderr.splitlines()[0].startswith("error: mask ") and "pane group 1" in done.stderr
+    want = compose_cli(tmp_path, *refl_args, "--trans", ATRIUM / "trans.exr", "--mask", unit_mask,
+                       "--planes", PLANES, "--surfaces", "1")
+    assert_bits_equal(glassdb.compose(trans, refl, mask, planes=PLANES, surfaces=1), want)
+    with pytest.raises(glassdb.InvalidInput):
+        glassdb.compose(trans, refl, mask, planes=PLANES, surfaces=0)
 
 
 def test_compose_multi_plane_file_bit_for_bit(tmp_path):

@@ -15,6 +15,12 @@
   through two windows (`Glass_clear` in the plane y = 3, `Tinted_bronze` in the plane x = 3)
   by the sun and a blue world; frame 1 looks into the room from inside, frame 2 at the daylit
   room from outside through both windows.
+- `lamps` (docs/blender.md "Lamps in reflections"; the test in tests/cli/blender.rs): 64 × 48,
+  32 samples, one frame: a dusk facade, one `Glass_film` pane (pass index 10, a reflective
+  bronze film) in the plane y = 1 seen from the street, with what it reflects made of lamps:
+  a warm area lamp on the camera's side facing the glass, a low orange sun (8°) behind the
+  camera whose glint falls on the pane, and inside the room a bulb (a point lamp the camera
+  sees, `visible_camera`) that the glass's reflection must not show; a dim dusk world.
 
 Every coordinate is a multiple of 1/8 (exact in float32 and in text). With `--index DIR` the
 saved scene is also rendered once per frame with 1 sample through each pixel centre
@@ -47,7 +53,9 @@ MATERIALS = {
     "Plaster": ((0.70, 0.68, 0.64), 0.9, 0),
     "Glass_clear": ((1.0, 1.0, 1.0), 0.0, 1),
     "Tinted_bronze": ((0.55, 0.40, 0.25), 0.0, 5),
+    "Glass_film": ((0.60, 0.45, 0.35), 0.0, 10),
 }
+GLASS_MATERIALS = ("Glass_clear", "Tinted_bronze", "Glass_film")
 
 
 def box(x0, y0, z0, x1, y1, z1):
@@ -144,6 +152,48 @@ def relit():
     return objects, cameras, (160, 120), 64, (50.0, 0.0, 135.0)
 
 
+def lamps():
+    objects = [
+        ("Ground", "Floor", quad((-8.0, -8.0, 0.0), (8.0, -8.0, 0.0), (8.0, 8.0, 0.0), (-8.0, 8.0, 0.0))),
+        ("BackWall", "Wall", quad((-6.0, 4.0, 0.0), (6.0, 4.0, 0.0), (6.0, 4.0, 3.0), (-6.0, 4.0, 3.0))),
+        ("Box_out", "Box_green", box(0.25, 2.25, 0.0, 1.0, 3.0, 1.0)),
+        ("Box_in", "Box_red", box(-2.0, -2.5, 0.0, -1.25, -1.75, 0.75)),
+        ("Pane_film", "Glass_film", quad((-1.5, 1.0, 0.25), (1.5, 1.0, 0.25), (1.5, 1.0, 2.0), (-1.5, 1.0, 2.0))),
+    ]
+    cameras = {1: ((0.0, -4.5, 1.0), (0.0, 1.0, 1.125))}
+    return objects, cameras, (64, 48), 32, (0.0, 0.0, 0.0)
+
+
+def add_lamps(scene):
+    """The `lamps` scene's lights: the sun low behind the camera (its glint on the pane at
+    (-0.5, 1, 1.6), where the camera ray towards it reflects), a warm area lamp facing the glass
+    on the camera's side (its image at about (0.52, 1, 1.52)), a bulb inside the room."""
+    from mathutils import Vector
+    sun = scene.objects["Sun"]
+    sun.data.angle = math.radians(8.0)
+    sun.data.energy = 2.0
+    sun.data.color = (1.0, 0.55, 0.3)
+    # A sun light shines along its local -Z: +Z points at the sun, the mirror image across
+    # y = 1 of the camera's ray (-0.5, 5.5, 0.6) to the glint.
+    sun.rotation_euler = Vector((-0.5, -5.5, 0.6)).to_track_quat("Z", "Y").to_euler()
+    area = bpy.data.lights.new("Area", "AREA")
+    area.size = 0.75
+    area.energy = 30.0
+    area.color = (1.0, 0.8, 0.6)
+    ob = bpy.data.objects.new("Area", area)
+    ob.location = (0.75, -1.5, 1.75)
+    ob.rotation_euler = (math.radians(90.0), 0.0, 0.0)  # emits along +y, at the glass
+    scene.collection.objects.link(ob)
+    bulb = bpy.data.lights.new("Bulb", "POINT")
+    bulb.shadow_soft_size = 0.125
+    bulb.energy = 10.0
+    ob = bpy.data.objects.new("Bulb", bulb)
+    ob.location = (-0.75, 2.5, 1.25)
+    ob.visible_camera = True
+    scene.collection.objects.link(ob)
+    scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.07, 0.12, 1.0)
+
+
 def material(name):
     rgb, rough, index = MATERIALS[name]
     mat = bpy.data.materials.new(name)
@@ -159,13 +209,13 @@ def material(name):
     bsdf = nt.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = rgb + (1.0,)
     bsdf.inputs["Roughness"].default_value = rough
-    if name in ("Glass_clear", "Tinted_bronze"):
+    if name in GLASS_MATERIALS:
         bsdf.inputs["Transmission" if "Transmission" in bsdf.inputs else "Transmission Weight"].default_value = 1.0
     return mat
 
 
 def build(kind):
-    objects, cameras, (w, h), samples, sun_rot = {"tiny": tiny, "example": example, "relit": relit}[kind]()
+    objects, cameras, (w, h), samples, sun_rot = {"tiny": tiny, "example": example, "relit": relit, "lamps": lamps}[kind]()
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     mats = {}
@@ -209,6 +259,8 @@ def build(kind):
     scene.cycles.use_denoising = False
     scene.cycles.seed = 0
     scene.view_settings.view_transform = "Standard"
+    if kind == "lamps":
+        add_lamps(scene)
     return objects, cameras
 
 
@@ -236,7 +288,7 @@ def main():
     bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out))
     if "--facts" in opts:
         facts = {"panes": {name: {"material": m, "corners": verts}
-                           for name, m, (verts, _f) in objects if m in ("Glass_clear", "Tinted_bronze")},
+                           for name, m, (verts, _f) in objects if m in GLASS_MATERIALS},
                  "frames": sorted(cameras),
                  "cameras": {str(f): {"eye": e, "target": t} for f, (e, t) in cameras.items()}}
         with open(opts["--facts"], "w") as fh:

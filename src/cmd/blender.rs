@@ -82,6 +82,10 @@ pub struct RenderArgs {
     /// lit through the render's glass (a swap leaves the room lit by it).
     #[arg(long, value_enum, default_value_t = LightSplit::On)]
     pub light_split: LightSplit,
+    /// Leave the lamps out of the reflection passes (each pass sees them as the scene's
+    /// camera visibility says), as before they were shown there as the glass reflects them.
+    #[arg(long)]
+    pub no_lamps_in_reflections: bool,
     /// Stop after the passes, masks and run record: `glassdb blender compose DIR` composites
     /// them (a farm's render step, then its composite step).
     #[arg(long)]
@@ -219,6 +223,7 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         seed: a.seed,
         threads: a.threads,
         reference: a.reference,
+        lamps_in_reflections: !a.no_lamps_in_reflections,
         mask_samples: a.mask_samples,
         light_split: a.light_split == LightSplit::On,
         composite: !a.no_composite,

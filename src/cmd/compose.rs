@@ -17,7 +17,9 @@ use glassdb_compose::{
 use glassdb_encode::{ExrDataType, OutputOptions, parse_exr_compression};
 use glassdb_pass::PngBits;
 use glassdb_registry::{ColourBasis, Registry};
-use glassdb_sequence::{FrameDone, FrameOutcome, FramesReport, SequenceOptions, SequenceProgress};
+use glassdb_sequence::{
+    FrameDone, FrameOutcome, FrameTables, FramesReport, SequenceOptions, SequenceProgress,
+};
 
 use crate::cmd::inputs::FrameInputArgs;
 use crate::cmd::progress::Spinner;
@@ -389,7 +391,7 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     });
     let code = match &args.inputs.frames {
         None => run_frame(&args, &job, &settings, &luts),
-        Some(spec) => run_sequence(&args, spec, &job, &settings, &luts),
+        Some(spec) => run_sequence(&args, spec, &job, &settings, FrameTables::One(&luts)),
     }?;
     // after the output: a closed standard output must not stop it being written
     if args.stats && unsplit {
@@ -398,17 +400,22 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
     Ok(code)
 }
 
-/// One frame split by light (`--light-groups`), each group with its light's tables.
+/// A frame split by light (`--light-groups`), each group with its light's tables; with
+/// `--frames`, every frame of the patterns so.
 fn run_light_groups(
     args: &Args,
     job: &ComposeJob,
     settings: &ComposeSettings,
 ) -> anyhow::Result<ExitCode> {
-    if args.inputs.frames.is_some() {
-        bail!("--light-groups: one frame at a time (without --frames) for now");
-    }
     let (registry, label) = load_registry(args.registry.as_deref())?;
     let groups = glassdb_compose::LightGroup::from_registry(&registry, &args.light_groups, &label)?;
+    if let Some(spec) = &args.inputs.frames {
+        let tables = FrameTables::LightGroups {
+            groups: &groups,
+            keep_groups: args.keep_groups,
+        };
+        return run_sequence(args, spec, job, settings, tables);
+    }
     let spinner = Spinner::on_terminal("compose");
     let report =
         glassdb_compose::compose_light_groups(job, settings, &groups, args.keep_groups, &spinner)?;
@@ -488,7 +495,7 @@ fn run_sequence(
     spec: &str,
     job: &ComposeJob,
     settings: &ComposeSettings,
-    luts: &RegistryLuts,
+    tables: FrameTables<'_>,
 ) -> anyhow::Result<ExitCode> {
     let frames = glassdb_io::parse_frame_list(spec)?;
     let bar = frames_bar(frames.len());
@@ -517,7 +524,7 @@ fn run_sequence(
         .clone()
         .map(|path| glassdb_io::on_stop(report_on_stop(path, progress.clone())));
     let outcomes = glassdb_sequence::compose_sequence(
-        job, &frames, settings, luts, options, &progress, &on_done,
+        job, &frames, settings, tables, options, &progress, &on_done,
     )?;
     if let Some(b) = &bar {
         b.finish_and_clear();
@@ -525,7 +532,7 @@ fn run_sequence(
     if let Some(report) = &args.report {
         FramesReport::from_outcomes(&outcomes).write(report)?;
     }
-    report_sequence(args, &outcomes, frames.len(), luts, settings)
+    report_sequence(args, &outcomes, frames.len(), tables, settings)
 }
 
 /// Writes the frames report of a sequence stopped by a signal (the exit code's).
@@ -559,7 +566,7 @@ fn report_sequence(
     args: &Args,
     outcomes: &[FrameOutcome],
     requested: usize,
-    luts: &RegistryLuts,
+    tables: FrameTables<'_>,
     settings: &ComposeSettings,
 ) -> anyhow::Result<ExitCode> {
     let failed: Vec<u32> = outcomes
@@ -572,7 +579,7 @@ fn report_sequence(
         .iter()
         .filter(|o| matches!(o.result, Ok(FrameDone::Skipped)))
         .count();
-    if args.stats {
+    if let (true, Some(luts)) = (args.stats, tables.report_luts()) {
         for o in outcomes {
             if let Some(r) = o.report() {
                 outln!("--- frame {}", o.frame);

@@ -500,3 +500,85 @@ fn light_groups_refuse_what_does_not_match() {
     crate::util::fails_naming(&mut cmd, &["out.png", "EXR"]);
     assert!(!out.exists() && !png.exists());
 }
+
+/// `compose --light-groups … --frames` composites each frame of the `#` patterns as a
+/// single-frame `--light-groups` run of that frame's files would, bit for bit; a frame whose
+/// passes lack a group fails alone, naming its frame and file, and the others are written.
+#[test]
+fn light_groups_composite_a_sequence_frame_by_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let catalog = write_catalog(dir.path());
+    let registry = dir.path().join("lights.json");
+    ok(&mut registry_build(
+        &catalog,
+        &registry,
+        &["--light", "sun=D65", "--light", "warm=A"],
+    ));
+    let seq = dir.path().join("seq");
+    std::fs::create_dir(&seq).unwrap();
+    // frame 2 swaps the two passes (both 8 × 6, both split into sun and warm), so that each
+    // frame's own files are seen to be read; frame 3's transmission pass has no group layers
+    for (frame, trans, refl) in [
+        (1, group_fixture("trans.exr"), group_fixture("refl.exr")),
+        (2, group_fixture("refl.exr"), group_fixture("trans.exr")),
+        (
+            3,
+            repo_path("fixtures/example/trans.exr"),
+            group_fixture("refl.exr"),
+        ),
+    ] {
+        std::fs::copy(trans, seq.join(format!("trans.{frame:04}.exr"))).unwrap();
+        std::fs::copy(refl, seq.join(format!("refl.{frame:04}.exr"))).unwrap();
+    }
+    let run = |trans: &Path, refl: &Path, out: &Path, extra: &[&str]| {
+        let mut cmd = crate::util::compose();
+        cmd.arg("--registry")
+            .arg(&registry)
+            .arg("--trans")
+            .arg(trans)
+            .arg("--refl")
+            .arg(refl)
+            .arg("--mask")
+            .arg(group_fixture("mask.png"))
+            .args(["--light-groups", "sun,warm", "--keep-groups"])
+            .args(["--data-type", "float", "-o"])
+            .arg(out)
+            .args(extra);
+        cmd
+    };
+    let stderr = crate::util::fails_naming(
+        &mut run(
+            &seq.join("trans.####.exr"),
+            &seq.join("refl.####.exr"),
+            &seq.join("out.####.exr"),
+            &["--frames", "1-3"],
+        ),
+        &["frame 3", "trans.0003.exr", "sun"],
+    );
+    assert!(!seq.join("out.0003.exr").exists(), "{stderr}");
+    for frame in [1, 2] {
+        let single = dir.path().join(format!("single.{frame}.exr"));
+        let name = |stem: &str| seq.join(format!("{stem}.{frame:04}.exr"));
+        ok(&mut run(&name("trans"), &name("refl"), &single, &[]));
+        let (got, want) = (
+            crate::util::read_exr_planes(&name("out")),
+            crate::util::read_exr_planes(&single),
+        );
+        assert_eq!(got.names, want.names, "frame {frame}");
+        assert!(
+            got.names.iter().any(|n| n == "ViewLayer.Combined_warm.R"),
+            "frame {frame}: {:?}",
+            got.names
+        );
+        assert!(
+            got.channels == want.channels,
+            "frame {frame}: samples differ"
+        );
+    }
+    let first = crate::util::read_exr_planes(&seq.join("out.0001.exr"));
+    let second = crate::util::read_exr_planes(&seq.join("out.0002.exr"));
+    assert!(
+        first.channels != second.channels,
+        "frames 1 and 2 read the same files"
+    );
+}

@@ -28,6 +28,9 @@ pub struct ScriptJob {
     pub threads: Option<u32>,
     /// Camera rays see the glass too (the Cycles reference render), instead of through it.
     pub reference: bool,
+    /// Lamps on the camera's side of a plane are visible to the camera rays of its reflection
+    /// pass, those on the far side hidden ([`crate::RenderRequest::lamps_in_reflections`]).
+    pub lamps_in_reflections: bool,
     /// The glass as thin panes.
     pub glass: Vec<ThinPane>,
     /// The frames to render.

@@ -75,6 +75,10 @@ pub struct RenderRequest {
     /// source and one render per aperture, so that a swap relights the room; `false` renders
     /// each pass once, lit through the render's glass (a swap then leaves the room as lit).
     pub light_split: bool,
+    /// Show the lamps (point, spot, area, sun) in the reflection passes as the real glass
+    /// reflects them (docs/blender.md "Lamps in reflections"); off: each pass sees the lamps as
+    /// the scene's camera visibility says, as before.
+    pub lamps_in_reflections: bool,
     /// Composite every frame at the end (else the run stops at its passes, masks and record,
     /// for [`compose_dir`] to composite: a farm's render and composite steps).
     pub composite: bool,
@@ -357,6 +361,7 @@ pub fn render_passes(work: &Workspace<'_>, masks: &mut Masks) -> Result<ScriptJo
         seed: request.seed,
         threads: request.threads,
         reference: false,
+        lamps_in_reflections: request.lamps_in_reflections,
         glass: masks.panes.clone(),
         frames: masks.script_frames.clone(),
         light_split: request.light_split,

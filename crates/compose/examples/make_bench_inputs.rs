@@ -10,7 +10,7 @@ use std::path::PathBuf;
 mod bench_passes;
 
 use glassdb_encode::{ExrDataType, parse_exr_compression};
-use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
+use glassdb_mask::{MaskFormat, write_mask};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
@@ -26,26 +26,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let compression = parse_exr_compression(&a[5])?;
     std::fs::create_dir_all(&out)?;
-    let n = (w * h) as usize;
     bench_passes::write_passes(&out, w as usize, h as usize, ty, compression)?;
-
-    let mut id = vec![0u16; n];
-    let mut cos = vec![0u8; n];
-    for i in 0..n {
-        let (x, y) = (i % w as usize, i / w as usize);
-        if (y * 4 / h as usize).is_multiple_of(2) {
-            id[i] = if x < w as usize / 2 { 2 } else { 6 };
-            cos[i] = (40 + x * 200 / w as usize) as u8;
-        }
-    }
-    let mask = MaskImage {
-        width: w,
-        height: h,
-        id,
-        cos_theta: CosTheta::Quantized8(cos),
-        plane: vec![0; n],
-        coverage: None,
-    };
+    let mask = bench_passes::half_glass_mask(w, h);
     write_mask(&out.join("mask.png"), &mask, MaskFormat::Png8)?;
     println!(
         "wrote {}/{{trans.exr, refl.exr, mask.png}} ({w}×{h}, {}, {})",

@@ -64,6 +64,28 @@ pub struct DecodedGroupPass {
     pub window: PixelWindow,
 }
 
+/// A frame's mask decoded once for several composites of the frame (its light groups, each
+/// group's passes decoded in turn): decoding a 4K mask costs more than copying it.
+pub(crate) type MaskOnce = std::sync::OnceLock<PlacedMask>;
+
+/// The frame's mask: a copy of the one `once` holds, else read from its file (and, with
+/// `once`, kept there for the next composite of the frame).
+fn read_mask(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    once: Option<&MaskOnce>,
+) -> Result<PlacedMask, ComposeError> {
+    if let Some(mask) = once.and_then(|o| o.get()) {
+        return Ok(mask.clone());
+    }
+    let mask = glassdb_mask::read_placed_mask(&files.mask, &settings.mask)?;
+    if let Some(once) = once {
+        // Only this frame's composites share `once`, one at a time: it was empty.
+        let _ = once.set(mask.clone());
+    }
+    Ok(mask)
+}
+
 /// The decoded inputs of one image, as read.
 struct DecodedInputs {
     trans: Pass,
@@ -74,12 +96,15 @@ struct DecodedInputs {
 
 /// The decode phase of a frame its header phase planned: decodes the inputs, places them in
 /// the transmission pass's frame and checks ids, planes and glass outside cropped passes (as
-/// `settings` says). `carry` says what the transmission file carries over.
+/// `settings` says). `carry` says what the transmission file carries over; with `mask_once`
+/// the mask is decoded by the first frame that asks and copied for the others (the light
+/// groups of one frame, composited in turn).
 pub(crate) fn decode_planned<'a>(
     files: &FrameFiles,
     settings: &DecodeSettings,
     plan: FramePlan<'a>,
     carry: Carry,
+    mask_once: Option<&MaskOnce>,
 ) -> Result<DecodedFrame<'a>, ComposeError> {
     let FramePlan {
         reads,
@@ -91,7 +116,7 @@ pub(crate) fn decode_planned<'a>(
         memory,
         reservation,
     } = plan;
-    let inputs = decode_inputs(files, settings, &reads, &display, carry)?;
+    let inputs = decode_inputs(files, settings, &reads, &display, carry, mask_once)?;
     let mut placed = place_inputs(files, inputs)?;
     let id_counts = placed.mask.id_pixel_counts();
     let planes = files.refl.len();
@@ -159,6 +184,7 @@ fn decode_inputs(
     reads: &InputReads,
     display: &PixelWindow,
     carry: Carry,
+    mask_once: Option<&MaskOnce>,
 ) -> Result<DecodedInputs, ComposeError> {
     let read_trans = || -> Result<(Pass, CarriedFrame), ComposeError> {
         Ok(glassdb_pass::read_transmission(
@@ -168,7 +194,7 @@ fn decode_inputs(
         )?)
     };
     let mask_then_refl = || -> Result<(PlacedMask, Vec<Pass>), ComposeError> {
-        let mask = glassdb_mask::read_placed_mask(&files.mask, &settings.mask)?;
+        let mask = read_mask(files, settings, mask_once)?;
         let at = in_frame(mask.windows, !mask.has_coordinates, display).data;
         let rows = mask
             .image

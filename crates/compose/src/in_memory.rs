@@ -57,8 +57,10 @@ pub struct MemoryComposite {
 /// files: the registry table for the passes' space (`luts`), ids and planes checked as
 /// `settings.decode` says (unknown ids, a plane without a reflection pass), each plane with its
 /// side from `settings.plane_sides`, then the kernel in place. The reflection passes hold the
-/// whole frame, so no glass lies outside them. There are no pane-group passes: a unit's plane
-/// pass takes every pane group's share (as `compose --surfaces 1`).
+/// whole frame, so no glass lies outside them. There are no pane-group passes: a unit (glass
+/// of more than one pane group) is refused as `compose` refuses one without its group passes
+/// ([`crate::ComposeError::GroupWithoutPass`]), unless `settings.decode.max_groups` is 1
+/// (`--surfaces 1`: its plane's pass takes every pane group's share).
 pub fn compose_in_memory(
     frame: MemoryFrame,
     settings: &ComposeSettings,
@@ -155,6 +157,18 @@ fn compose_planes(
         &id_counts,
     )?;
     let whole = PixelWindow::at_origin(mask.width as usize, mask.height as usize);
+    // There are no pane-group passes in memory: a unit is refused as `compose` refuses one
+    // without its --refl-group passes, unless `max_groups` (`--surfaces 1`) folds its deeper
+    // groups into the plane's pass.
+    let files = crate::FrameFiles {
+        refl: (0..refl.len())
+            .map(|k| format!("refl[{k}]").into())
+            .collect(),
+        groups: Vec::new(),
+        trans: labels.trans.clone().into(),
+        mask: labels.mask.clone().into(),
+    };
+    crate::pane_groups::check_group_passes(&files, &settings.decode, lut, mask, &[], &[], &whole)?;
     let counts = composite::run_kernel(
         &mut trans,
         refl.iter().map(|p| (p, whole)),

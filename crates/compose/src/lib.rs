@@ -59,7 +59,9 @@ pub use in_memory::{
     MemoryComposite, MemoryFrame, MemoryGroup, MemoryLabels, compose_in_memory,
     compose_light_groups_in_memory, interleave, planes_from_interleaved,
 };
-pub use light_groups::{GroupPasses, LightGroup, compose_light_groups, group_passes};
+pub use light_groups::{
+    GroupPasses, LightGroup, compose_light_groups, compose_light_groups_within, group_passes,
+};
 use memory::{MemoryBudget, MemoryEstimate};
 pub use plan::DecodeTarget;
 pub use relight::{
@@ -386,7 +388,7 @@ pub fn compose_frame_within(
 ) -> Result<FrameReport, ComposeError> {
     let target = check_job(job, settings)?;
     let (composited, timings) =
-        decode_and_composite(job, settings, &target, luts, budget, progress)?;
+        decode_and_composite(job, settings, &target, luts, budget, None, progress)?;
     write_composited(job, settings, composited, timings, progress)
 }
 
@@ -398,13 +400,15 @@ fn decode_and_composite(
     target: &DecodeTarget,
     luts: &RegistryLuts,
     budget: &MemoryBudget,
+    mask_once: Option<&decode::MaskOnce>,
     progress: &dyn glassdb_io::Progress,
 ) -> Result<(Composited, StageTimings), ComposeError> {
     let [decode_stage, composite_stage, _] = FRAME_STAGES;
     progress.stage(decode_stage);
     let t0 = Instant::now();
     let plan = plan::plan_frame(&job.inputs, &settings.decode, luts, budget, target)?;
-    let frame = decode::decode_planned(&job.inputs, &settings.decode, plan, target.carry)?;
+    let frame =
+        decode::decode_planned(&job.inputs, &settings.decode, plan, target.carry, mask_once)?;
     let decode = t0.elapsed();
 
     progress.stage(composite_stage);
@@ -464,7 +468,7 @@ pub fn decode_frame<'a>(
     target: &DecodeTarget,
 ) -> Result<DecodedFrame<'a>, ComposeError> {
     let plan = plan::plan_frame(files, settings, luts, budget, target)?;
-    decode::decode_planned(files, settings, plan, target.carry)
+    decode::decode_planned(files, settings, plan, target.carry, None)
 }
 
 /// Refuses a job before any pixel is read: no reflection pass, an output that cannot be

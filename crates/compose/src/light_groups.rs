@@ -14,7 +14,7 @@ use std::path::Path;
 
 use glassdb_encode::OutputFormat;
 use glassdb_image::{ExactExr, ExactPart, FlatSamples};
-use glassdb_pass::{ExrCarried, light_group_layers_of};
+use glassdb_pass::{CarriedFrame, Carry, ExrCarried, light_group_layers_of};
 use glassdb_registry::Registry;
 
 use crate::colour::RegistryLuts;
@@ -132,7 +132,7 @@ pub fn group_passes(
 
 /// Composites a frame split into light groups: each group's passes ([`group_passes`])
 /// composited with its own light's tables, in turn (one group's passes decoded at a time, the
-/// frame's memory limit held per group), and the sum written as the output's beauty. With
+/// frame's memory limit held per group; the mask decoded once), and the sum written as the output's beauty. With
 /// `keep_groups` (EXR output only) each group's composite is also written, as a layer of the
 /// transmission pass's name for that group (`ViewLayer.Combined_sun.R`, …), so that a
 /// compositor can still balance the lights. The report is the first group's, with the output
@@ -144,6 +144,20 @@ pub fn compose_light_groups(
     keep_groups: bool,
     progress: &dyn glassdb_io::Progress,
 ) -> Result<FrameReport, ComposeError> {
+    let budget = MemoryBudget::new(settings.decode.max_memory);
+    compose_light_groups_within(job, settings, groups, keep_groups, &budget, progress)
+}
+
+/// [`compose_light_groups`] holding each group's memory from `budget`, which the frames of a
+/// sequence share (`glassdb_sequence`), as [`crate::compose_frame_within`].
+pub fn compose_light_groups_within(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    groups: &[LightGroup],
+    keep_groups: bool,
+    budget: &MemoryBudget,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<FrameReport, ComposeError> {
     let names: Vec<&str> = groups.iter().map(|g| g.name.as_str()).collect();
     if keep_groups && glassdb_encode::output_format(&job.output)? != OutputFormat::Exr {
         return Err(ComposeError::KeepGroupsNotExr {
@@ -152,15 +166,34 @@ pub fn compose_light_groups(
     }
     let target = crate::check_job(job, settings)?;
     let passes = group_passes(&job.inputs, &names, settings.decode.pass.max_pixels)?;
-    let budget = MemoryBudget::new(settings.decode.max_memory);
     let mut sum: Option<Composited> = None;
     let mut kept: Vec<(String, [Vec<f32>; 3])> = Vec::new();
     let mut timings = crate::StageTimings::default();
-    for (group, group_passes) in groups.iter().zip(&passes) {
+    // One mask for every group: decoded with the first group's passes, copied for the others.
+    let mask_once = crate::decode::MaskOnce::new();
+    let mask_once = (groups.len() > 1).then_some(&mask_once);
+    // What the output carries comes with the first group's transmission pass; the others
+    // decode their layer alone.
+    let rest = crate::DecodeTarget {
+        carry: Carry::NONE,
+        ..target.clone()
+    };
+    let group_layers: Vec<String> = passes
+        .iter()
+        .filter_map(|g| g.layers.trans.clone())
+        .collect();
+    for (k, (group, group_passes)) in groups.iter().zip(&passes).enumerate() {
         let mut one = settings.clone();
         one.decode.layers = group_passes.layers.clone();
-        let (composited, t) =
-            crate::decode_and_composite(job, &one, &target, &group.luts, &budget, progress)?;
+        let (composited, t) = crate::decode_and_composite(
+            job,
+            &one,
+            if k == 0 { &target } else { &rest },
+            &group.luts,
+            budget,
+            mask_once,
+            progress,
+        )?;
         timings.decode += t.decode;
         timings.compose += t.compose;
         if keep_groups {
@@ -168,7 +201,13 @@ pub fn compose_light_groups(
             kept.push((layer, composited.image.trans.image.rgb.clone()));
         }
         match &mut sum {
-            None => sum = Some(composited),
+            None => {
+                // the group layers hold the light behind the glass, not the composite: not
+                // carried to the output, and not held while the other groups composite
+                let mut first = composited;
+                drop_group_layers(&mut first.image.frame, &group_layers);
+                sum = Some(first);
+            }
             Some(total) => add_group_composite(
                 &mut total.image.trans.image.rgb,
                 &composited.image.trans.image.rgb,
@@ -191,17 +230,35 @@ pub(crate) fn add_group_composite(total: &mut [Vec<f32>; 3], add: &[Vec<f32>; 3]
     }
 }
 
-/// What the output carries beside the beauty (the sum): the passes' group layers are dropped
-/// (they hold the light behind the glass, not the composite) and, with `keep_groups`, each
+/// Drops the group layers `group_layers` (`ViewLayer.Combined_sun`, …) from what `frame`
+/// carries over.
+fn drop_group_layers(frame: &mut CarriedFrame, group_layers: &[String]) {
+    if let Some(ExrCarried::Whole { file, part, .. }) = &mut frame.exr {
+        file.parts[*part].channels.retain(|(name, _)| {
+            !group_layers.iter().any(|l| {
+                name.strip_prefix(l.as_str())
+                    .is_some_and(|rest| rest.starts_with('.'))
+            })
+        });
+    }
+}
+
+/// What the output carries beside the beauty (the sum): the layers of `groups` in the
+/// transmission pass are dropped ([`drop_group_layers`]) and, with `keep_groups`, each
 /// group's composite written in their place (`layer.R`, `.G`, `.B`). The sum replaces the
 /// file's beauty layer: the one the group layers are split from (`ViewLayer.Combined` for
 /// `ViewLayer.Combined_sun`), else bare `R`, `G`, `B`, else it is added: as the Cycles groups'
 /// base layer when only the file's attributes are carried, else as bare `R`, `G`, `B`.
 pub(crate) fn carry_groups(
-    frame: &mut glassdb_pass::CarriedFrame,
+    frame: &mut CarriedFrame,
     groups: &[GroupPasses],
     kept: Vec<(String, [Vec<f32>; 3])>,
 ) {
+    let group_layers: Vec<String> = groups
+        .iter()
+        .filter_map(|g| g.layers.trans.clone())
+        .collect();
+    drop_group_layers(frame, &group_layers);
     let window = frame.windows.data;
     let n = window.pixel_count() as usize;
     let rgb_names = |layer: &str| -> Vec<String> {
@@ -232,17 +289,7 @@ pub(crate) fn carry_groups(
         }
         None => return,
     };
-    let group_layers: Vec<String> = groups
-        .iter()
-        .filter_map(|g| g.layers.trans.clone())
-        .collect();
     let channels = &mut file.parts[part].channels;
-    channels.retain(|(name, _)| {
-        !group_layers.iter().any(|l| {
-            name.strip_prefix(l.as_str())
-                .is_some_and(|rest| rest.starts_with('.'))
-        })
-    });
     // the beauty: the layer the first group's is split from (`ViewLayer.Combined` for
     // `ViewLayer.Combined_sun_p0_id1`: the group's name, underscores and all, removed), else
     // bare R, G, B

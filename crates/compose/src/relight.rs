@@ -11,7 +11,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use glassdb_pass::LightMix;
+use glassdb_pass::{Carry, LightMix};
 use glassdb_registry::Registry;
 use glassdb_side::Side;
 
@@ -321,7 +321,10 @@ pub fn compose_light_parts(
     let mut sum: Option<Composited> = None;
     let mut timings = StageTimings::default();
     let [decode_stage, composite_stage, _] = FRAME_STAGES;
-    for (_, members) in &lights {
+    // One mask for every light: decoded with the first light's passes, copied for the others.
+    let mask_once = crate::decode::MaskOnce::new();
+    let mask_once = (lights.len() > 1).then_some(&mask_once);
+    for (k, (_, members)) in lights.iter().enumerate() {
         let luts = tables.get(members[0])?;
         let mut one = settings.clone();
         one.decode.layers = InputLayers::default();
@@ -354,7 +357,10 @@ pub fn compose_light_parts(
             r.light_mix = Some(mix.clone());
         }
         factors.extend(these);
-        let frame = crate::decode::decode_planned(&job.inputs, &one.decode, plan, target.carry)?;
+        // what the output carries comes with the first light's transmission pass
+        let carry = if k == 0 { target.carry } else { Carry::NONE };
+        let frame =
+            crate::decode::decode_planned(&job.inputs, &one.decode, plan, carry, mask_once)?;
         timings.decode += t0.elapsed();
         progress.stage(composite_stage);
         let t1 = Instant::now();

@@ -18,7 +18,8 @@ use std::time::{Duration, Instant};
 use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::memory::MemoryBudget;
 use glassdb_compose::{
-    ComposeError, ComposeJob, ComposeSettings, FrameReport, compose_frame_within,
+    ComposeError, ComposeJob, ComposeSettings, FrameReport, LightGroup, compose_frame_within,
+    compose_light_groups_within,
 };
 use glassdb_io::ErrorKind;
 
@@ -162,6 +163,32 @@ pub fn output_is_complete(path: &Path, max_pixels: u64) -> Result<(), SequenceEr
     Ok(())
 }
 
+/// What each frame of a sequence composites.
+#[derive(Debug, Clone, Copy)]
+pub enum FrameTables<'a> {
+    /// The frame's beauty, with one set of tables.
+    One(&'a RegistryLuts),
+    /// The frame split into light groups, each with its light's tables, as
+    /// [`glassdb_compose::compose_light_groups`] composites one frame (`compose --light-groups`).
+    LightGroups {
+        /// The groups, in the order summed.
+        groups: &'a [LightGroup],
+        /// Also write each group's composite as a layer.
+        keep_groups: bool,
+    },
+}
+
+impl FrameTables<'_> {
+    /// The tables a frame's report is of: the one set, or the first group's (whose report a
+    /// light-group frame returns).
+    pub fn report_luts(&self) -> Option<&RegistryLuts> {
+        match self {
+            FrameTables::One(luts) => Some(luts),
+            FrameTables::LightGroups { groups, .. } => groups.first().map(|g| &g.luts),
+        }
+    }
+}
+
 /// Frames composed at once.
 pub const FRAMES_IN_FLIGHT: usize = 2;
 
@@ -169,12 +196,13 @@ pub const FRAMES_IN_FLIGHT: usize = 2;
 /// completion order). Returns the outcomes in frame order. The frames in flight share
 /// `settings.max_memory`: a frame whose estimate does not fit beside the other's waits for it
 /// (so two large frames run one after the other), and a frame over the whole limit fails.
-/// `progress` (made for `pattern` and `frames`) follows the frames as they start and end.
+/// `progress` (made for `pattern` and `frames`) follows the frames as they start and end;
+/// `tables` says what each frame composites (its beauty, or its light groups).
 pub fn compose_sequence(
     pattern: &ComposeJob,
     frames: &[u32],
     settings: &ComposeSettings,
-    luts: &RegistryLuts,
+    tables: FrameTables<'_>,
     options: SequenceOptions,
     progress: &SequenceProgress,
     on_done: &(dyn Fn(&FrameOutcome) + Sync),
@@ -198,7 +226,7 @@ pub fn compose_sequence(
                     progress.start(frame, job.as_ref().ok());
                     let (job, result) = match job {
                         Ok(job) => {
-                            let result = compose_or_skip(&job, settings, luts, &budget, options);
+                            let result = compose_or_skip(&job, settings, tables, &budget, options);
                             (Some(job), result)
                         }
                         Err(e) => (None, Err(e.into())),
@@ -227,7 +255,7 @@ pub fn compose_sequence(
 fn compose_or_skip(
     job: &ComposeJob,
     settings: &ComposeSettings,
-    luts: &RegistryLuts,
+    tables: FrameTables<'_>,
     budget: &MemoryBudget,
     options: SequenceOptions,
 ) -> Result<FrameDone, SequenceError> {
@@ -243,7 +271,14 @@ fn compose_or_skip(
             }
         }
     }
-    let report = compose_frame_within(job, settings, luts, budget, &glassdb_io::NoProgress)?;
+    let none = &glassdb_io::NoProgress;
+    let report = match tables {
+        FrameTables::One(luts) => compose_frame_within(job, settings, luts, budget, none)?,
+        FrameTables::LightGroups {
+            groups,
+            keep_groups,
+        } => compose_light_groups_within(job, settings, groups, keep_groups, budget, none)?,
+    };
     Ok(FrameDone::Composed {
         report: Box::new(report),
         replaced,

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use glassdb_encode::{ExrDataType, OutputOptions, write_output};
+use glassdb_mask::{CosTheta, MaskImage};
 use glassdb_pass::{CarriedFrame, LinearImage, PassSource, PngBits};
 
 /// A deterministic hash of `i` in [0, 1).
@@ -16,8 +17,9 @@ fn noise(i: u64) -> f32 {
     (x >> 40) as f32 / (1u64 << 24) as f32
 }
 
-/// A `w × h` pass: a gradient of `base` plus render-like noise from `seed`.
-pub fn pass_image(w: usize, h: usize, seed: u64, base: [f32; 3]) -> LinearImage {
+/// R, G, B planes of `w × h`: a gradient of `base` plus noise seeded by `seed`.
+#[allow(dead_code)] // not every generator writes these passes
+pub fn gradient_planes(w: usize, h: usize, seed: u64, base: [f32; 3]) -> [Vec<f32>; 3] {
     let n = w * h;
     let mut rgb = [vec![0f32; n], vec![0f32; n], vec![0f32; n]];
     for (c, plane) in rgb.iter_mut().enumerate() {
@@ -27,18 +29,26 @@ pub fn pass_image(w: usize, h: usize, seed: u64, base: [f32; 3]) -> LinearImage 
                 + 0.05 * noise(seed + (i * 3 + c) as u64);
         }
     }
+    rgb
+}
+
+/// A `w × h` pass: a gradient of `base` plus render-like noise from `seed`.
+#[allow(dead_code)] // not every generator writes these passes
+pub fn pass_image(w: usize, h: usize, seed: u64, base: [f32; 3]) -> LinearImage {
     LinearImage {
         width: w as u32,
         height: h as u32,
-        rgb,
+        rgb: gradient_planes(w, h, seed, base),
         alpha: None,
     }
 }
 
 /// The seed and base colour of the reflection pass.
+#[allow(dead_code)] // not every generator writes these passes
 pub const REFL: (u64, [f32; 3]) = (1 << 40, [0.9, 1.0, 1.2]);
 
 /// Writes `out/trans.exr` and `out/refl.exr`, `w × h`, in `ty` with `compression`.
+#[allow(dead_code)] // not every generator writes these passes
 pub fn write_passes(
     out: &Path,
     w: usize,
@@ -60,4 +70,28 @@ pub fn write_passes(
     let refl = pass_image(w, h, REFL.0, REFL.1);
     write_output(&out.join("refl.exr"), refl, frame(), &src, &opts)?;
     Ok(())
+}
+
+/// The benchmarks' mask, `w × h`: every other quarter of the rows glass (ids 2 and 6 of the
+/// bundled catalog, left and right halves), cos θ varying across the frame, 8-bit.
+#[allow(dead_code)] // not every generator writes this mask
+pub fn half_glass_mask(w: u32, h: u32) -> MaskImage {
+    let n = (w * h) as usize;
+    let mut id = vec![0u16; n];
+    let mut cos = vec![0u8; n];
+    for i in 0..n {
+        let (x, y) = (i % w as usize, i / w as usize);
+        if (y * 4 / h as usize).is_multiple_of(2) {
+            id[i] = if x < w as usize / 2 { 2 } else { 6 };
+            cos[i] = (40 + x * 200 / w as usize) as u8;
+        }
+    }
+    MaskImage {
+        width: w,
+        height: h,
+        id,
+        cos_theta: CosTheta::Quantized8(cos),
+        plane: vec![0; n],
+        coverage: None,
+    }
 }
