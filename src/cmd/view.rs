@@ -98,12 +98,6 @@ pub fn run(mut args: Args) -> anyhow::Result<ExitCode> {
             "nothing to view: give a `glassdb blender render` output folder, or the passes and the mask (--trans, --refl, --mask)"
         ),
     };
-    // The page composites one reflection pass per plane: a unit's deeper pane groups are shown
-    // on it (their reflectance added to it), as `compose --surfaces 1` does.
-    let settings = DecodeSettings {
-        max_groups: std::num::NonZeroUsize::new(1),
-        ..settings
-    };
     let viewer = Viewer::open(ViewerInputs {
         frames,
         settings,

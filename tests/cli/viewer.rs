@@ -809,6 +809,83 @@ fn a_multi_part_reflection_file_gives_composes_pixels() {
     assert!(db >= 50.0, "page from planes.exr vs compose: {db:.1} dB");
 }
 
+/// The unit the ghost test puts on the atrium's glass 5 (plane 1): two pane groups.
+const GHOST_UNIT: &str = "Double clear: clear 6 | 12.7 air | clear 6";
+
+/// Units and their ghosts (issue 27): with a pass for plane 1's pane group 1 (here the
+/// transmission pass, a picture unlike the plane's own reflection), a product change on the
+/// page between the monolithic glass and a double unit shows the inner pane's reflection: the
+/// page matches `compose --refl-group` within 1 code value, in set A and in set B, and differs
+/// from the one-pass (`--surfaces 1`) composite on the unit's pixels.
+#[test]
+fn a_unit_swapped_in_shows_its_ghost_as_compose_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = |f: &str| repo_path("fixtures/atrium").join(f);
+    let registry = swapped_registry(&repo_path("data/registry.json"), d, SWAP_ID, GHOST_UNIT);
+    let group = format!("1.1={}", a("trans.exr").display());
+    let composed = |extra: &[&str], name: &str| {
+        let out = d.join(name);
+        let mut cmd = glassdb();
+        cmd.arg("compose");
+        atrium_inputs(&mut cmd)
+            .args(["--dither", "none", "--registry"])
+            .arg(&registry)
+            .args(extra)
+            .arg("-o")
+            .arg(&out);
+        ok(&mut cmd);
+        png_pixels(&out)
+    };
+    let want = composed(&["--refl-group", &group], "ghost.png");
+    let folded = composed(&["--surfaces", "1"], "folded.png");
+    let bundled = compose_png(d, None, "bundled.png");
+
+    let served = serve(&["--refl-group".as_ref(), group.as_ref()]);
+    let max_diff = |a: &[[f64; 3]], b: &[[f64; 3]]| {
+        a.iter()
+            .zip(b)
+            .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+            .fold(0.0f64, f64::max)
+    };
+    // Set A: the unit swapped in through the page's controls.
+    let swap = format!("{SWAP_ID}:{GHOST_UNIT}");
+    let (got, report) = canvas(&served.url, &[swap], &d.join("a.rgba"));
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    assert_eq!(report["products"]["A"]["5"], GHOST_UNIT, "{report}");
+    let diff = max_diff(&got, &want);
+    assert!(
+        diff <= 1.0,
+        "page (set A) vs compose --refl-group: {diff} code values"
+    );
+    // The ghost is there: the one-pass composite differs on the unit's pixels.
+    let ghost_pixels = got
+        .iter()
+        .zip(&folded)
+        .filter(|(p, q)| (0..3).any(|c| (p[c] - q[c]).abs() > 2.0))
+        .count();
+    assert!(
+        ghost_pixels > 500,
+        "only {ghost_pixels} pixels differ from --surfaces 1"
+    );
+    // Set B holds the unit, set A the bundled monolithic glass: B shows the ghost, A not.
+    let ab = format!("{}?glassB=5:{}&ab=B", served.url, "Double clear");
+    let (got, report) = canvas(&ab, &[], &d.join("b.rgba"));
+    assert_eq!(report["products"]["B"]["5"], GHOST_UNIT, "{report}");
+    let diff = max_diff(&got, &want);
+    assert!(
+        diff <= 1.0,
+        "page (set B) vs compose --refl-group: {diff} code values"
+    );
+    let plain = format!("{}?glassB=5:{}&ab=A", served.url, "Double clear");
+    let (got, _) = canvas(&plain, &[], &d.join("plain.rgba"));
+    let diff = max_diff(&got, &bundled);
+    assert!(
+        diff <= 1.0,
+        "page (set A, no unit) vs compose: {diff} code values"
+    );
+}
+
 /// A `.cube` view (a 1D shaper over 0–4, then a 3D table mixing channels), written here.
 fn write_cube(path: &Path) {
     let mut text =
@@ -1267,7 +1344,7 @@ fn unit_requests_are_checked_and_only_the_page_may_send_them() {
     let (code, body) = post_reply(u, "/api/unit", good);
     assert_eq!(code, 200, "{body:.300}");
     let built: serde_json::Value = serde_json::from_str(&body).unwrap();
-    assert_eq!(built["format"], "glassdb-viewer-page/2");
+    assert_eq!(built["format"], "glassdb-viewer-page/3");
     assert_eq!(
         built["product"]["unit"]["elements"][1]["gas"], "argon",
         "{body:.600}"

@@ -67,7 +67,7 @@
 
   // The page's data (crates/view/src/page.rs), from the server or from an export: read here
   // only, so that every field the page uses comes through one place that knows its version.
-  const PAGE_FORMAT = 'glassdb-viewer-page/2';
+  const PAGE_FORMAT = 'glassdb-viewer-page/3';
 
   function readScene(scene) {
     if (!scene || scene.format !== PAGE_FORMAT) {
@@ -78,8 +78,11 @@
   }
 
   // `parts`: the light parts' passes, part after part (empty without a light-path split).
+  // `passes`: the transmission, each plane's reflection, then each pane group's (`groups`:
+  // {plane, group}, in that order; `groups_folded`: why a frame's groups are not apart).
   function readFrame(info, passes, mask, parts) {
-    return { info: { ids: info.ids, trans: info.trans, plane_sides: info.plane_sides, parts: info.parts || [] }, passes, mask,
+    return { info: { ids: info.ids, trans: info.trans, plane_sides: info.plane_sides, parts: info.parts || [],
+      groups: info.groups || [], groupsFolded: info.groups_folded || null }, passes, mask,
       parts: parts || new Uint16Array(0) };
   }
 
@@ -202,6 +205,9 @@ uniform int uHeight;
 uniform int uMode;      // 0: 8-bit code, 1: cos, 2: normal incidence
 uniform int uPlanes;
 uniform int uSide[64];  // 0 front, 1 back, per plane
+// Per plane: the uRefl layer of its pane groups 1 and 2 (-1: none; the group's share then
+// goes to the deepest nearer group's pass, as compose folds it).
+uniform ivec2 uGroupLayer[64];
 uniform float uGain;    // 2^ev
 uniform bool uConvert;
 uniform mat3 uDisplay;  // passes' space to linear Rec.709
@@ -232,6 +238,7 @@ const int ROWS_SLOT = ${lut.rows_per_slot};
 const int FINE = ${lut.fine_offset};
 const int STEPS = ${lut.fine_steps};
 const int NORMAL = ${lut.normal_offset};
+const int GROUPS = ${lut.groups};
 
 // a + f·(b − a), as compose's lerp (not GLSL's mix, whose rounding may differ).
 vec3 mix3(vec3 a, vec3 b, float f) {
@@ -262,6 +269,25 @@ void lookup(sampler2D lut, int slot, int side, float c, out vec3 r, out vec3 t) 
     r = entry(lut, rRow, NORMAL);
     t = entry(lut, tRow, NORMAL);
   }
+}
+
+// Pane group g's share of r (compose's ShareSideLut), as lookup reads r.
+vec3 share(sampler2D lut, int slot, int side, int g, float c) {
+  int row = slot * ROWS_SLOT + (4 + side * GROUPS + g) * ROWS_CURVE;
+  if (uMode == 0) return entry(lut, row, int(c + 0.5));
+  if (uMode == 1) {
+    float x = clamp(c, 0.0, 1.0) * float(STEPS);
+    int i = min(int(x), STEPS - 1);
+    float f = x - float(i);
+    vec3 a = entry(lut, row, FINE + i);
+    return a + (entry(lut, row, FINE + i + 1) - a) * f;
+  }
+  return entry(lut, row, NORMAL);
+}
+
+// The glass's pane groups (the front r curve's normal-incidence alpha).
+int groupCount(sampler2D lut, int slot) {
+  return int(texelFetch(lut, ivec2(NORMAL % W, slot * ROWS_SLOT + NORMAL / W), 0).a + 0.5);
 }
 
 vec3 srgb(vec3 c) {
@@ -350,7 +376,24 @@ void main() {
     t = 1.0 - k + k * t;
     r = r * k;
     vec3 rf = uPartCount > 0 ? rfParts : texelFetch(uRefl, ivec3(x, y, plane), 0).rgb;
-    col = tr.rgb * t + rf * r;
+    int n = useB ? groupCount(uLutB, slot) : groupCount(uLutA, slot);
+    ivec2 gls = uGroupLayer[plane];
+    if (n > 1 && (gls.x >= 0 || gls.y >= 0)) {
+      // A unit: Σ_g refl_g · r_g (docs/viewer.md, "Units and their ghosts").
+      vec3 sum = vec3(0.0);
+      int layer = -1;
+      for (int g = 0; g < GROUPS; g++) {
+        if (g >= n) break;
+        int own = g == 1 ? gls.x : (g == 2 ? gls.y : -1);
+        if (own >= 0) layer = own;
+        vec3 s = useB ? share(uLutB, slot, uSide[plane], g, m.b) : share(uLutA, slot, uSide[plane], g, m.b);
+        vec3 pass = layer >= 0 ? texelFetch(uRefl, ivec3(x, y, layer), 0).rgb : rf;
+        sum += pass * (s * k);
+      }
+      col = tr.rgb * t + sum;
+    } else {
+      col = tr.rgb * t + rf * r;
+    }
   }
   col *= uGain;
   if (uConvert && uView == 0) col = uDisplay * col;
@@ -466,7 +509,7 @@ void main() {
     gl.texImage3D(gl.TEXTURE_3D, 0, gl.RGB32F, 1, 1, 1, 0, gl.RGB, gl.FLOAT, new Float32Array(3));
     gl.bindTexture(gl.TEXTURE_2D, shaperTex);
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, 1, 1, 0, gl.RGB, gl.FLOAT, new Float32Array(3));
-    gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, gl.RGBA16F, W, H, scene.planes);
+    // The reflection layers (the planes', then the pane groups') are sized per frame.
     gl.bindTexture(gl.TEXTURE_2D, transTex);
     gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA16F, W, H);
     gl.bindTexture(gl.TEXTURE_2D, maskTex);
@@ -612,9 +655,17 @@ void main() {
       const data = await source.frame(i);
       gl.bindTexture(gl.TEXTURE_2D, transTex);
       gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.HALF_FLOAT, data.passes.subarray(0, W * H * 4));
+      const groups = data.info.groups;
       gl.bindTexture(gl.TEXTURE_2D_ARRAY, reflTex);
-      gl.texSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, 0, W, H, scene.planes, gl.RGBA, gl.HALF_FLOAT,
+      gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, W, H, scene.planes + groups.length, 0, gl.RGBA, gl.HALF_FLOAT,
         data.passes.subarray(W * H * 4));
+      // Each plane's pane groups 1 and 2 (deeper ones: their shares are in group 2's).
+      const layers = new Int32Array(64 * 2).fill(-1);
+      groups.forEach((g, j) => {
+        if (g.plane < 64 && g.group >= 1 && g.group <= 2) layers[g.plane * 2 + g.group - 1] = scene.planes + j;
+      });
+      gl.uniform2iv(u('uGroupLayer'), layers);
+      if (data.info.groupsFolded) status('frame ' + i + ': ' + data.info.groupsFolded, false);
       gl.bindTexture(gl.TEXTURE_2D, maskTex);
       gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.FLOAT, data.mask);
       // The side of each plane the camera sees in this frame (it may change as the camera moves).

@@ -2,18 +2,24 @@
 //!
 //! - passes: half floats, RGBA per pixel: the transmission pass (its alpha, or 1), then each
 //!   reflection pass placed in the frame (0 where it holds no pixels: the kernel's "no
-//!   reflection" there);
+//!   reflection" there), then each pane group's pass the frame composites apart
+//!   ([`group_pass_bytes`], in the order of `PageFrame::groups`), placed the same way;
 //! - mask: `f32` RGBA per pixel: glass slot + 1 (0: no glass), plane, cos θ (the 8-bit code
 //!   for an 8-bit mask; cos θ for 16-bit and float masks, NaN as 1 as the kernel reads it; 1
 //!   for a binary mask), coverage (1 without);
 //! - a product's table: `f32` RGBA texels (RGB, 0), [`LUT_ROWS_PER_CURVE`] rows of
 //!   [`LUT_WIDTH`] per curve, curves in the order front r, front t, back r, back t; each curve
 //!   holds the 256 8-bit entries, then the [`FINE_STEPS`] + 1 fine entries, then normal
-//!   incidence.
+//!   incidence. Then the pane groups' shares of r (issue 27, `glassdb_compose::shares`): front
+//!   groups 0..[`PAGE_GROUPS`], then back groups, in the order the rays meet them, the shares
+//!   of groups deeper than the last folded into it; zeros for a glass of one group. The front
+//!   r curve's normal-incidence texel holds the glass's number of pane groups in its alpha
+//!   (at most [`PAGE_GROUPS`]; 1 for a glass of one group).
 
 use glassdb_colour::CubeLut;
 use glassdb_compose::DecodedFrame;
 use glassdb_compose::lut::{FINE_STEPS, GlassSideLut, RtTriple};
+use glassdb_compose::shares::GroupShares;
 use glassdb_mask::{CosCode, CosTheta};
 
 /// Texels per row of the lookup-table texture (WebGL2 guarantees 2048).
@@ -22,8 +28,13 @@ pub const LUT_WIDTH: usize = 1024;
 pub const LUT_TEXELS_PER_CURVE: usize = 256 + FINE_STEPS + 1 + 1;
 /// Rows of one curve.
 pub const LUT_ROWS_PER_CURVE: usize = LUT_TEXELS_PER_CURVE.div_ceil(LUT_WIDTH);
-/// Rows of one glass slot (front r, front t, back r, back t).
-pub const LUT_ROWS_PER_SLOT: usize = 4 * LUT_ROWS_PER_CURVE;
+/// Most pane groups of a unit the page composites with a pass each: the shares of deeper
+/// groups go to the last one's (a quadruple unit shows three reflections).
+pub const PAGE_GROUPS: usize = 3;
+/// Curves of one glass slot: front r, front t, back r, back t, then the groups' shares.
+pub const LUT_CURVES_PER_SLOT: usize = 4 + 2 * PAGE_GROUPS;
+/// Rows of one glass slot.
+pub const LUT_ROWS_PER_SLOT: usize = LUT_CURVES_PER_SLOT * LUT_ROWS_PER_CURVE;
 /// Offset of the fine table in a curve.
 pub const LUT_FINE_OFFSET: usize = 256;
 /// Offset of the normal-incidence entry in a curve.
@@ -62,11 +73,12 @@ impl MaskMode {
     }
 }
 
-/// A product's table for one glass: both sides (front, back), r and t, in the texture layout
-/// ([`LUT_BYTES`] bytes).
-pub fn lut_bytes(sides: [&GlassSideLut; 2]) -> Vec<u8> {
+/// A product's table for one glass: both sides (front, back), r and t, and its pane groups'
+/// shares (`None` or empty: a glass of one group), in the texture layout ([`LUT_BYTES`]
+/// bytes).
+pub fn lut_bytes(sides: [&GlassSideLut; 2], shares: Option<&GroupShares>) -> Vec<u8> {
     let curve_len = LUT_ROWS_PER_CURVE * LUT_WIDTH * 4;
-    let mut texels = vec![0f32; 4 * curve_len];
+    let mut texels = vec![0f32; LUT_CURVES_PER_SLOT * curve_len];
     let picks: [fn(&RtTriple) -> [f32; 3]; 2] = [|e| e.r, |e| e.t];
     let mut k = 0;
     for side in sides {
@@ -83,7 +95,64 @@ pub fn lut_bytes(sides: [&GlassSideLut; 2]) -> Vec<u8> {
             k += 1;
         }
     }
+    let groups = shares.map_or(0, |s| s[0].len());
+    if let Some(shares) = shares.filter(|_| groups > 1) {
+        for (side, tables) in shares.iter().enumerate() {
+            for (g, share) in tables.iter().enumerate() {
+                let k = 4 + side * PAGE_GROUPS + g.min(PAGE_GROUPS - 1);
+                let curve = &mut texels[k * curve_len..(k + 1) * curve_len];
+                let entries = share
+                    .q8
+                    .iter()
+                    .chain(share.fine.iter())
+                    .chain(std::iter::once(&share.normal));
+                for (texel, e) in curve.chunks_exact_mut(4).zip(entries) {
+                    (0..3).for_each(|c| texel[c] += e[c]);
+                }
+            }
+        }
+    }
+    texels[LUT_NORMAL_OFFSET * 4 + 3] = groups.clamp(1, PAGE_GROUPS) as f32;
     f32_bytes(&texels)
+}
+
+/// The pane groups' passes of a decoded frame, each placed in the frame as
+/// [`pass_bytes`] places the planes' (see the module docs).
+pub fn group_pass_bytes(frame: &DecodedFrame<'_>) -> Vec<u8> {
+    let trans = &frame.trans.image;
+    let (w, h) = (trans.width as usize, trans.height as usize);
+    let mut out: Vec<u8> = Vec::with_capacity(w * h * 8 * frame.groups.len());
+    for g in &frame.groups {
+        placed_pass(
+            &mut out,
+            &g.pass.image.rgb,
+            |x, y| g.window.index_of(x, y),
+            w,
+            h,
+        );
+    }
+    out
+}
+
+/// `rgb` placed in a `w`×`h` frame (`index_of`: its sample of a frame pixel) as half-float
+/// RGBA (0 where it has none, alpha 1).
+fn placed_pass(
+    out: &mut Vec<u8>,
+    rgb: &[Vec<f32>; 3],
+    index_of: impl Fn(i64, i64) -> Option<usize>,
+    w: usize,
+    h: usize,
+) {
+    let mut push = |v: f32| out.extend_from_slice(&half::f16::from_f32(v).to_le_bytes());
+    for y in 0..h {
+        for x in 0..w {
+            match index_of(x as i64, y as i64) {
+                Some(j) => (0..3).for_each(|c| push(rgb[c][j])),
+                None => (0..3).for_each(|_| push(0.0)),
+            }
+            push(1.0);
+        }
+    }
 }
 
 /// The passes of a decoded frame as half-float RGBA planes (see the module docs).
@@ -100,16 +169,13 @@ pub fn pass_bytes(frame: &DecodedFrame<'_>) -> Vec<u8> {
         push(trans.alpha.as_ref().map_or(1.0, |a| a[i]));
     }
     for (pass, window) in frame.refl.iter().zip(&frame.refl_windows) {
-        let rgb = &pass.image.rgb;
-        for y in 0..h {
-            for x in 0..w {
-                match window.index_of(x as i64, y as i64) {
-                    Some(j) => (0..3).for_each(|c| push(rgb[c][j])),
-                    None => (0..3).for_each(|_| push(0.0)),
-                }
-                push(1.0);
-            }
-        }
+        placed_pass(
+            &mut out,
+            &pass.image.rgb,
+            |x, y| window.index_of(x, y),
+            w,
+            h,
+        );
     }
     out
 }
@@ -172,7 +238,7 @@ mod tests {
             lut.side(1, glassdb_registry::Side::Front).unwrap(),
             lut.side(1, glassdb_registry::Side::Back).unwrap(),
         ];
-        let bytes = lut_bytes(sides);
+        let bytes = lut_bytes(sides, lut.group_shares(1));
         let texel = |curve: usize, e: usize, c: usize| {
             let at = ((curve * LUT_ROWS_PER_CURVE * LUT_WIDTH) + e) * 4 + c;
             f32::from_le_bytes(bytes[at * 4..at * 4 + 4].try_into().unwrap())
@@ -184,7 +250,7 @@ mod tests {
             sides[0].fine[4000].r[2]
         );
         assert_eq!(texel(2, LUT_NORMAL_OFFSET, 0), g.r0_back[0] as f32);
-        assert_eq!(bytes.len(), 4 * LUT_ROWS_PER_CURVE * LUT_WIDTH * 16);
+        assert_eq!(bytes.len(), 10 * LUT_ROWS_PER_CURVE * LUT_WIDTH * 16);
         assert_eq!(bytes.len(), LUT_BYTES);
     }
 }

@@ -13,7 +13,7 @@ use serde::Serialize;
 use crate::data;
 
 /// Value of [`PageScene::format`]; `viewer.js` refuses anything else.
-pub const PAGE_FORMAT: &str = "glassdb-viewer-page/2";
+pub const PAGE_FORMAT: &str = "glassdb-viewer-page/3";
 
 /// The scene the page starts from: the frames, their colour, the candidate products and the
 /// layout of their tables.
@@ -75,8 +75,10 @@ pub struct LutLayout {
     pub width: usize,
     /// Rows of one curve.
     pub rows_per_curve: usize,
-    /// Rows of one glass slot (four curves).
+    /// Rows of one glass slot (four curves, then the pane groups' shares).
     pub rows_per_slot: usize,
+    /// Pane groups per side whose shares a slot holds (curves 4.. front, then back).
+    pub groups: usize,
     /// Offset of the fine table in a curve.
     pub fine_offset: usize,
     /// Steps of the fine table.
@@ -91,6 +93,7 @@ impl LutLayout {
         width: data::LUT_WIDTH,
         rows_per_curve: data::LUT_ROWS_PER_CURVE,
         rows_per_slot: data::LUT_ROWS_PER_SLOT,
+        groups: data::PAGE_GROUPS,
         fine_offset: data::LUT_FINE_OFFSET,
         fine_steps: glassdb_compose::lut::FINE_STEPS,
         normal_offset: data::LUT_NORMAL_OFFSET,
@@ -121,6 +124,9 @@ pub struct PageProduct {
     /// Hemispherical transmittance per channel: the factor of sky light through it (the
     /// relit swap, docs/compose.md "Relit swap").
     pub t_dif: [f64; 3],
+    /// Its pane groups (1: a monolithic glass; a unit's reflection is one per group: its
+    /// ghosts).
+    pub pane_groups: usize,
 }
 
 /// A unit's build-up as the picker shows it: its layers and gaps, outside first, and the
@@ -246,6 +252,7 @@ impl PageProduct {
             angle_model: g.angle_model.kind.clone(),
             unit: g.unit.as_ref().map(PageUnit::of),
             t_dif: g.t_dif(),
+            pane_groups: g.unit.as_ref().map_or(1, |u| u.groups.len().max(1)),
         }
     }
 }
@@ -339,6 +346,22 @@ pub struct PageFrame {
     /// light-path split).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub parts: Vec<crate::relight::PagePart>,
+    /// The pane groups' passes composited apart, in the order of their layers after the
+    /// planes' (issue 27: a unit's ghosts).
+    pub groups: Vec<PageGroupPass>,
+    /// Why the frame's pane-group passes are not composited apart (the units' deeper groups
+    /// then reflect on their plane's pass, as `compose --surfaces 1`), if they are not.
+    pub groups_folded: Option<&'static str>,
+}
+
+/// A pane group's pass in a frame's data: its plane and group (1 or more, in the order the
+/// rays meet the groups from the plane's side).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct PageGroupPass {
+    /// The plane.
+    pub plane: usize,
+    /// The pane group.
+    pub group: usize,
 }
 
 #[cfg(test)]

@@ -18,7 +18,9 @@ use glassdb_stack::Gas;
 
 use crate::ViewError;
 use crate::data::{self, MaskMode};
-use crate::page::{LutLayout, PAGE_FORMAT, PageDisplayView, PageFrame, PageProduct, PageScene};
+use crate::page::{
+    LutLayout, PAGE_FORMAT, PageDisplayView, PageFrame, PageGroupPass, PageProduct, PageScene,
+};
 use crate::units::{BuiltUnit, UnitWorkshop};
 
 /// The viewer's inputs: the frames' files and sides, how to read them, and the registry whose
@@ -137,7 +139,7 @@ impl Viewer {
         let first_files = &first_frame.files;
         let first = decode_frame(
             first_files,
-            &inputs.settings,
+            &frame_settings(&inputs.settings, first_frame),
             &luts,
             &budget,
             &DecodeTarget::display(),
@@ -305,7 +307,7 @@ impl Viewer {
         let files = &viewer_frame.files;
         let frame = decode_frame(
             files,
-            &self.inputs.settings,
+            &frame_settings(&self.inputs.settings, viewer_frame),
             &self.luts,
             &self.budget,
             &DecodeTarget::display(),
@@ -436,11 +438,40 @@ fn find_product_in(candidates: &[&GlassRecord], name: &str) -> Result<usize, Vie
 }
 
 /// A decoded frame as the page uploads it; `slots` gives each mask id's glass slot.
+/// How `frame` is decoded: as `settings` say, with its units' deeper pane groups folded onto
+/// their plane's pass (`compose --surfaces 1`) where it has no pane-group passes (a render
+/// with `--surfaces 1`) or light parts ([`groups_folded`]).
+fn frame_settings(settings: &DecodeSettings, frame: &ViewerFrame) -> DecodeSettings {
+    let fold = frame.files.groups.is_empty() || groups_folded(frame).is_some();
+    DecodeSettings {
+        max_groups: if fold {
+            std::num::NonZeroUsize::new(1)
+        } else {
+            settings.max_groups
+        },
+        ..settings.clone()
+    }
+}
+
+/// Why `frame`'s pane-group passes are not composited apart on the page, if they are not: the
+/// relit swap's light parts carry the planes' passes only.
+fn groups_folded(frame: &ViewerFrame) -> Option<&'static str> {
+    (frame.light_parts.is_some() && !frame.files.groups.is_empty()).then_some(
+        "the frame's passes are split by the light's path: the units' deeper pane groups \
+         reflect on their plane's pass (as compose --surfaces 1)",
+    )
+}
+
 fn frame_data(
     frame: &DecodedFrame<'_>,
     source: &ViewerFrame,
     slots: &HashMap<u16, usize>,
 ) -> FrameData {
+    let folded = groups_folded(source);
+    let mut passes = data::pass_bytes(frame);
+    if folded.is_none() {
+        passes.extend(data::group_pass_bytes(frame));
+    }
     FrameData {
         info: PageFrame {
             ids: frame.id_counts.clone(),
@@ -449,8 +480,20 @@ fn frame_data(
                 .map(|k| source.plane_sides.get(&k).copied().unwrap_or(Side::Front))
                 .collect(),
             parts: Vec::new(),
+            groups: match folded {
+                Some(_) => Vec::new(),
+                None => frame
+                    .groups
+                    .iter()
+                    .map(|g| PageGroupPass {
+                        plane: g.plane,
+                        group: g.group,
+                    })
+                    .collect(),
+            },
+            groups_folded: folded,
         },
-        passes: data::pass_bytes(frame),
+        passes,
         mask: data::mask_bytes(frame, |id| slots.get(&id).copied()),
         parts: Vec::new(),
     }
@@ -477,10 +520,10 @@ fn product_tables(
     lut: &GlassLut,
 ) -> Arc<[u8]> {
     let table_of = |lut: &GlassLut, id: u16| {
-        Some(data::lut_bytes([
-            lut.side(id, Side::Front)?,
-            lut.side(id, Side::Back)?,
-        ]))
+        Some(data::lut_bytes(
+            [lut.side(id, Side::Front)?, lut.side(id, Side::Back)?],
+            lut.group_shares(id),
+        ))
     };
     let mut bytes = Vec::with_capacity(products.len() * data::LUT_BYTES);
     for (i, g) in products.iter().enumerate() {
@@ -522,10 +565,13 @@ mod tests {
     /// from the compositor's table.
     fn own_table(g: &GlassRecord) -> Vec<u8> {
         let lut = GlassLut::from_records(&[(g.id, g)]);
-        data::lut_bytes([
-            lut.side(g.id, Side::Front).unwrap(),
-            lut.side(g.id, Side::Back).unwrap(),
-        ])
+        data::lut_bytes(
+            [
+                lut.side(g.id, Side::Front).unwrap(),
+                lut.side(g.id, Side::Back).unwrap(),
+            ],
+            lut.group_shares(g.id),
+        )
     }
 
     #[test]

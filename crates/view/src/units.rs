@@ -87,7 +87,7 @@ impl UnitWorkshop {
         let record = registry.default_table().glasses[0].clone();
         let lut = GlassLut::from_records(&[(1, &record)]);
         let table = match (lut.side(1, Side::Front), lut.side(1, Side::Back)) {
-            (Some(front), Some(back)) => data::lut_bytes([front, back]),
+            (Some(front), Some(back)) => data::lut_bytes([front, back], lut.group_shares(1)),
             _ => unreachable!("the table of id 1 holds id 1"),
         };
         Ok(BuiltUnit { record, lut: table })
@@ -248,10 +248,13 @@ mod tests {
         );
         assert_eq!(built.lut.len(), data::LUT_BYTES);
         let lut = GlassLut::from_records(&[(1, twelve)]);
-        let want = data::lut_bytes([
-            lut.side(1, Side::Front).unwrap(),
-            lut.side(1, Side::Back).unwrap(),
-        ]);
+        let want = data::lut_bytes(
+            [
+                lut.side(1, Side::Front).unwrap(),
+                lut.side(1, Side::Back).unwrap(),
+            ],
+            lut.group_shares(1),
+        );
         assert!(
             built.lut == want,
             "the table differs from the catalog unit's"
