@@ -200,7 +200,17 @@ fn blender_run_frames(dir: &Path) -> anyhow::Result<Vec<ViewerFrame>> {
                 label: f.frame.to_string(),
                 files: FrameFiles {
                     refl: f.refl.iter().map(|r| dir.join(r)).collect(),
-                    groups: Vec::new(),
+                    // units' deeper pane groups: the page composites each with its share
+                    groups: f
+                        .groups
+                        .iter()
+                        .map(|g| glassdb_compose::GroupPassFile {
+                            plane: g.plane,
+                            group: g.group,
+                            path: dir.join(&g.file),
+                            layer: None,
+                        })
+                        .collect(),
                     trans: dir.join(&f.trans),
                     mask: dir.join(&f.mask),
                 },
