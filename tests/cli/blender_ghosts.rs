@@ -48,8 +48,16 @@ fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
+/// Channel `name` of the beauty: bare, or of `ViewLayer.Combined` in a pass split by the
+/// light's path (docs/blender.md, "Light parts").
 fn channel<'a>(p: &'a Planes, name: &str) -> &'a [f64] {
-    let k = p.names.iter().position(|n| n == name).unwrap();
+    let split = format!("ViewLayer.Combined.{name}");
+    let k = p
+        .names
+        .iter()
+        .position(|n| n == name)
+        .or_else(|| p.names.iter().position(|n| *n == split))
+        .unwrap_or_else(|| panic!("no channel {name} or {split} in {:?}", p.names));
     &p.channels[k]
 }
 

@@ -1166,6 +1166,10 @@ fn a_blender_run_folder_opens_directly() {
         cmd.arg("--side")
             .arg(format!("{k}={}", f["sides"][k].as_str().unwrap()));
     }
+    // a run split by the light's path is composited with its light parts, as the viewer does
+    if let Some(parts) = f["light_parts"].as_str() {
+        cmd.arg("--light-parts").arg(run.join(parts));
+    }
     ok(cmd.args(["--dither", "none", "-o"]).arg(&out));
     let want = png_pixels(&out);
 
