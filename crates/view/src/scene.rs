@@ -169,7 +169,7 @@ impl Viewer {
         };
         let product_luts = product_tables(&products, &slots, first.lut);
         // Kept for the page's first request.
-        let first_data = frame_data(&first, first_frame, &slots);
+        let first_data = frame_data(&first, first_frame, &slots, &inputs.settings);
         drop(first);
         let first_data = Arc::new(crate::relight::with_parts(
             first_data,
@@ -321,7 +321,7 @@ impl Viewer {
                 first: self.mask_mode.name(),
             });
         }
-        let data = frame_data(&frame, viewer_frame, &self.slots);
+        let data = frame_data(&frame, viewer_frame, &self.slots, &self.inputs.settings);
         drop(frame);
         let data = Arc::new(crate::relight::with_parts(
             data,
@@ -466,8 +466,12 @@ fn frame_data(
     frame: &DecodedFrame<'_>,
     source: &ViewerFrame,
     slots: &HashMap<u16, usize>,
+    settings: &DecodeSettings,
 ) -> FrameData {
-    let folded = groups_folded(source);
+    let folded = groups_folded(source).or_else(|| {
+        (settings.max_groups == std::num::NonZeroUsize::new(1) && !frame.groups.is_empty())
+            .then_some("--surfaces 1: the units' deeper pane groups reflect on their plane's pass")
+    });
     let mut passes = data::pass_bytes(frame);
     if folded.is_none() {
         passes.extend(data::group_pass_bytes(frame));
