@@ -458,7 +458,7 @@ fn frame_settings(settings: &DecodeSettings, frame: &ViewerFrame) -> DecodeSetti
 fn groups_folded(frame: &ViewerFrame) -> Option<&'static str> {
     (frame.light_parts.is_some() && !frame.files.groups.is_empty()).then_some(
         "the frame's passes are split by the light's path: the units' deeper pane groups \
-         reflect on their plane's pass (as compose --surfaces 1)",
+         reflect on their plane's pass (one surface per plane)",
     )
 }
 
@@ -470,7 +470,7 @@ fn frame_data(
 ) -> FrameData {
     let folded = groups_folded(source).or_else(|| {
         (settings.max_groups == std::num::NonZeroUsize::new(1) && !frame.groups.is_empty())
-            .then_some("--surfaces 1: the units' deeper pane groups reflect on their plane's pass")
+            .then_some("one surface per plane: the units' deeper pane groups reflect on their plane's pass")
     });
     let mut passes = data::pass_bytes(frame);
     if folded.is_none() {
