@@ -201,16 +201,7 @@ fn blender_run_frames(dir: &Path) -> anyhow::Result<Vec<ViewerFrame>> {
                 files: FrameFiles {
                     refl: f.refl.iter().map(|r| dir.join(r)).collect(),
                     // units' deeper pane groups: the page composites each with its share
-                    groups: f
-                        .groups
-                        .iter()
-                        .map(|g| glassdb_compose::GroupPassFile {
-                            plane: g.plane,
-                            group: g.group,
-                            path: dir.join(&g.file),
-                            layer: None,
-                        })
-                        .collect(),
+                    groups: f.group_pass_files(dir),
                     trans: dir.join(&f.trans),
                     mask: dir.join(&f.mask),
                 },

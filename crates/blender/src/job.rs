@@ -195,6 +195,21 @@ pub struct FrameRecord {
     pub groups: Vec<GroupPassRecord>,
 }
 
+impl FrameRecord {
+    /// The frame's pane-group passes as compose takes them, in the run folder `dir`.
+    pub fn group_pass_files(&self, dir: &Path) -> Vec<glassdb_compose::GroupPassFile> {
+        self.groups
+            .iter()
+            .map(|g| glassdb_compose::GroupPassFile {
+                plane: g.plane,
+                group: g.group,
+                path: dir.join(&g.file),
+                layer: None,
+            })
+            .collect()
+    }
+}
+
 /// The reflection pass of pane group `group` (1 or more) of plane `plane` in one frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -533,7 +533,7 @@ pub fn compose_record(
         let job = ComposeJob {
             inputs: FrameFiles {
                 refl: f.refl.iter().map(|r| dir.join(r)).collect(),
-                groups: group_pass_files(dir, f),
+                groups: f.group_pass_files(dir),
                 trans: dir.join(&f.trans),
                 mask: dir.join(&f.mask),
             },
@@ -555,19 +555,6 @@ pub fn compose_record(
         seconds: t.elapsed().as_secs_f64(),
         light_parts,
     })
-}
-
-/// The frame's pane-group passes as compose takes them.
-fn group_pass_files(dir: &Path, f: &FrameRecord) -> Vec<glassdb_compose::GroupPassFile> {
-    f.groups
-        .iter()
-        .map(|g| glassdb_compose::GroupPassFile {
-            plane: g.plane,
-            group: g.group,
-            path: dir.join(&g.file),
-            layer: None,
-        })
-        .collect()
 }
 
 /// `glassdb blender compose DIR`: the run's frames composited again with `registry`.
