@@ -431,6 +431,22 @@ proptest! {
     }
 }
 
+/// A frame that sees one plane of several (every glass pixel on plane 0) still says which
+/// plane its pixels are on: once its EXR mask had no plane channel, and compose refused it
+/// beside the scene's other planes' passes.
+#[test]
+fn an_exr_mask_on_plane_0_alone_still_stores_its_planes() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = packed8();
+    m.plane = vec![0; m.pixel_count()];
+    let p = dir.path().join("m.exr");
+    write_mask(&p, &m, MaskFormat::Exr).unwrap();
+    assert!(read_mask_header(&p, &opts()).unwrap().stores_planes);
+    let placed = read_placed_mask(&p, &opts()).unwrap();
+    assert!(placed.stores_planes);
+    assert_eq!(placed.image.plane, m.plane);
+}
+
 #[test]
 fn the_header_says_where_the_mask_lies_and_what_reading_it_costs_without_decoding() {
     let dir = tempfile::tempdir().unwrap();

@@ -168,7 +168,10 @@ fn binary_png(mask: &MaskImage, at: &PixelErrors<'_>) -> Result<Vec<u8>, MaskErr
     encode_png_grey(at.path, mask.width, mask.height, &grey)
 }
 
-/// Float EXR channels `id`, `cos_theta`, and `plane` / `coverage` where the mask has them.
+/// Float EXR channels `id`, `cos_theta`, `plane`, and `coverage` where the mask has it. The
+/// plane channel is written even when every pixel is on plane 0: a frame that sees one plane
+/// of several still says so, and compose refuses several reflection passes beside a mask that
+/// does not say which plane each pixel is on.
 fn exr_channels(mask: &MaskImage, path: &Path) -> Result<Vec<u8>, MaskError> {
     let n = mask.pixel_count();
     let id: Vec<f32> = mask.id.iter().map(|&v| f32::from(v)).collect();
@@ -176,10 +179,8 @@ fn exr_channels(mask: &MaskImage, path: &Path) -> Result<Vec<u8>, MaskError> {
         CosTheta::Float(c) => c.clone(),
         _ => (0..n).map(|i| mask.cos_theta_at(i) as f32).collect(),
     };
-    let mut channels = vec![("id", id), ("cos_theta", cos)];
-    if mask.plane.iter().any(|&p| p != 0) {
-        channels.push(("plane", mask.plane.iter().map(|&p| f32::from(p)).collect()));
-    }
+    let plane: Vec<f32> = mask.plane.iter().map(|&p| f32::from(p)).collect();
+    let mut channels = vec![("id", id), ("cos_theta", cos), ("plane", plane)];
     if let Some(c) = &mask.coverage {
         channels.push(("coverage", c.clone()));
     }
