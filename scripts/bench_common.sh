@@ -54,4 +54,8 @@ measure() {
                 /Maximum resident set size/ { kb = $2 }
                 END { printf "%.3f %.0f\n", s, kb / 1024 }' "$WORK/time"
 }
-median() { sort -n | awk '{ v[NR] = $0 } END { print v[int((NR + 1) / 2)] }'; }
+# The median of the numbers on standard input, one a line (an even count: the mean of the middle two).
+median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
+
+# The median of field $2 (1: seconds, 2: MiB) of the lines "$1" that `measure` printed, one a run.
+median_field() { printf '%s' "$1" | awk 'NF' | cut -d' ' -f"$2" | median; }

@@ -46,7 +46,7 @@ for size in $SIZES; do
         runs[double]+="$(measure "$COMPOSE" "${crops[@]}" "${groups[@]}" --trans "$d/trans.exr" --mask "$d/units/mask_planes.png" --compression zip -o "$d/c_double.exr")"$'\n'
         runs[s1]+="$(measure "$COMPOSE" "${crops[@]}" --surfaces 1 --trans "$d/trans.exr" --mask "$d/units/mask_planes.png" --compression zip -o "$d/c_s1.exr")"$'\n'
     done
-    med() { printf '%s' "${runs[$1]}" | awk 'NF' | cut -d' ' -f"$2" | median; }
+    med() { median_field "${runs[$1]}" "$2"; }
     t1=$(med one 1) m1=$(med one 2)
     for case in one double s1; do
         label=$([ "$case" = one ] && echo "monolithic (one group)" || { [ "$case" = double ] && echo "double units, ghosts" || echo "double units, --surfaces 1"; })

@@ -50,7 +50,7 @@ for g in $GROUPS_LIST; do
         done
         singles+="$total $peak"$'\n'
     done
-    med() { printf '%s' "$1" | awk 'NF' | cut -d' ' -f"$2" | median; }
+    med() { median_field "$1" "$2"; }
     ts=$(med "$together" 1) tm=$(med "$together" 2) ss=$(med "$singles" 1) sm=$(med "$singles" 2)
     echo "| $g | $ts | $tm | $ss | $sm | $(ratio "$ts" "$ss")× | $(ratio "$tm" "$sm")× |"
 done

@@ -62,7 +62,7 @@ for size in $SIZES; do
             runs[o_full]+="$(measure oiiotool --threads "$THREADS" "$d/mask_planes.png" "${composite[@]}" "${oiio_full[@]}" --mul --swap --colormap "$T_KNOTS" "$d/trans.exr" --mul --add -d "$type" --compression zip -o "$d/o_full.exr")"$'\n'
             runs[o_crop]+="$(measure oiiotool --threads "$THREADS" "$d/mask_planes.png" "${composite[@]}" "${oiio_crop[@]}" --mul --swap --colormap "$T_KNOTS" "$d/trans.exr" --mul --add -d "$type" --compression zip -o "$d/o_crop.exr")"$'\n'
         done
-        med() { printf '%s' "${runs[$1]}" | awk 'NF' | cut -d' ' -f"$2" | median; }
+        med() { median_field "${runs[$1]}" "$2"; }
         row() { # LABEL COMPOSE_KEY OIIO_KEY COMPOSE_OUT OIIO_OUT
             local cs cr os or
             cs=$(med "$2" 1) cr=$(med "$2" 2) os=$(med "$3" 1) or=$(med "$3" 2)

@@ -9,6 +9,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 width=${1:-1920} height=${2:-1080} pairs=${3:-7}
+# shellcheck source=scripts/bench_common.sh
+. scripts/bench_common.sh
 python=${GLASSDB_PYTHON:-.venv/bin/python}
 cargo build --release --quiet --bin glassdb
 glassdb=${CARGO_TARGET_DIR:-target}/release/glassdb
@@ -23,7 +25,6 @@ seconds() {
     end=$(date +%s%N)
     awk -v s="$start" -v e="$end" 'BEGIN { printf "%.4f\n", (e - s) / 1e9 }'
 }
-median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
 echo "$(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), ${width}x${height}, $pairs pairs"
 echo
