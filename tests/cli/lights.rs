@@ -77,6 +77,20 @@ fn light_args(lights: &[(&str, &str)]) -> Vec<String> {
         .collect()
 }
 
+/// `glassdb registry build CATALOG -o DIR/NAME --light …` with `lights`: the registry's path.
+fn registry_with_lights(
+    catalog: &Path,
+    dir: &Path,
+    name: &str,
+    lights: &[(&str, &str)],
+) -> PathBuf {
+    let out = dir.join(name);
+    let args = light_args(lights);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(&mut registry_build(catalog, &out, &args));
+    out
+}
+
 /// The registry's table under `light` in `space`.
 fn table<'a>(registry: &'a Value, light: &str, space: &str) -> &'a Value {
     registry["tables"]
@@ -377,11 +391,7 @@ fn light_groups_composite_is_the_sum_of_each_group_with_its_table() {
     let dir = tempfile::tempdir().unwrap();
     let catalog = write_catalog(dir.path());
     let build = |name: &str, lights: &[(&str, &str)]| {
-        let out = dir.path().join(name);
-        let args = light_args(lights);
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        ok(&mut registry_build(&catalog, &out, &args));
-        out
+        registry_with_lights(&catalog, dir.path(), name, lights)
     };
     let both = build("both.json", &[("sun", "D65"), ("warm", "A")]);
     let out = dir.path().join("groups.exr");
@@ -458,19 +468,8 @@ fn light_groups_composite_is_the_sum_of_each_group_with_its_table() {
 fn light_groups_refuse_what_does_not_match() {
     let dir = tempfile::tempdir().unwrap();
     let catalog = write_catalog(dir.path());
-    let registry = dir.path().join("lights.json");
-    ok(&mut registry_build(
-        &catalog,
-        &registry,
-        &[
-            "--light",
-            "sun=D65",
-            "--light",
-            "warm=A",
-            "--light",
-            "lamp=LED-B1",
-        ],
-    ));
+    let lights = [("sun", "D65"), ("warm", "A"), ("lamp", "LED-B1")];
+    let registry = registry_with_lights(&catalog, dir.path(), "lights.json", &lights);
     let out = dir.path().join("out.exr");
     // the warm group has no table given
     crate::util::fails_naming(
@@ -483,12 +482,7 @@ fn light_groups_refuse_what_does_not_match() {
         &["trans.exr", "lamp", "sun, warm"],
     );
     // a registry without the warm light
-    let sun_only = dir.path().join("sun.json");
-    ok(&mut registry_build(
-        &catalog,
-        &sun_only,
-        &["--light", "sun=D65"],
-    ));
+    let sun_only = registry_with_lights(&catalog, dir.path(), "sun.json", &[("sun", "D65")]);
     crate::util::fails_naming(
         &mut compose_groups(&sun_only, &out, &["--light-groups", "sun,warm"]),
         &["sun.json", "warm", "sun (D65)"],
@@ -508,12 +502,8 @@ fn light_groups_refuse_what_does_not_match() {
 fn light_groups_composite_a_sequence_frame_by_frame() {
     let dir = tempfile::tempdir().unwrap();
     let catalog = write_catalog(dir.path());
-    let registry = dir.path().join("lights.json");
-    ok(&mut registry_build(
-        &catalog,
-        &registry,
-        &["--light", "sun=D65", "--light", "warm=A"],
-    ));
+    let lights = [("sun", "D65"), ("warm", "A")];
+    let registry = registry_with_lights(&catalog, dir.path(), "lights.json", &lights);
     let seq = dir.path().join("seq");
     std::fs::create_dir(&seq).unwrap();
     // frame 2 swaps the two passes (both 8 × 6, both split into sun and warm), so that each
