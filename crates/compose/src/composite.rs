@@ -9,6 +9,7 @@ use glassdb_mask::MaskImage;
 use glassdb_side::Side;
 
 use crate::colour::{ChosenTable, PassSpace};
+use crate::decode::MaskOnce;
 use crate::kernel::{self, KernelCounts, KernelInput, OutsidePass, PlacedGroupRefl, PlacedRefl};
 use crate::lut::GlassLut;
 use crate::memory::MemoryEstimate;
@@ -75,10 +76,12 @@ pub(crate) fn run_kernel<'a>(
 
 /// The composite phase: every reflection pass placed in the frame with its plane's side, the
 /// kernel run in place on the transmission pass, and the decoded passes freed beside the
-/// encoder.
+/// encoder; the mask is handed back to `mask_once` where given (the next composite of the
+/// frame takes it), else freed with them.
 pub(crate) fn composite(
     mut frame: DecodedFrame<'_>,
     settings: &ComposeSettings,
+    mask_once: Option<&MaskOnce>,
 ) -> Result<Composited, ComposeError> {
     let refl = frame
         .refl
@@ -111,7 +114,14 @@ pub(crate) fn composite(
     // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;
     // another thread does it while the encoder keeps both cores busy.
     // Where no thread can be started, the closure, and so the passes, are dropped here.
-    let (refl, groups, mask) = (frame.refl, frame.groups, frame.mask);
+    let (refl, groups) = (frame.refl, frame.groups);
+    let mask = match mask_once {
+        Some(once) => {
+            once.give_back(frame.mask, frame.trans.windows);
+            None
+        }
+        None => Some(frame.mask),
+    };
     let _ = std::thread::Builder::new()
         .name("glassdb-free".into())
         .spawn(move || drop((refl, groups, mask)));

@@ -65,23 +65,51 @@ pub struct DecodedGroupPass {
 }
 
 /// A frame's mask decoded once for several composites of the frame (its light groups, each
-/// group's passes decoded in turn): decoding a 4K mask costs more than copying it.
-pub(crate) type MaskOnce = std::sync::OnceLock<PlacedMask>;
+/// group's passes decoded in turn): the first composite reads it from its file, and each hands
+/// it back, placed in the frame, for the next (decoding a 4K mask costs more than keeping it,
+/// and keeping a copy beside the one in use would hold it twice).
+#[derive(Default)]
+pub(crate) struct MaskOnce {
+    /// The mask between two composites.
+    mask: std::sync::Mutex<Option<PlacedMask>>,
+    /// Whether its file stores a plane per pixel, as read the first time.
+    stores_planes: std::sync::OnceLock<bool>,
+}
 
-/// The frame's mask: a copy of the one `once` holds, else read from its file (and, with
-/// `once`, kept there for the next composite of the frame).
+impl MaskOnce {
+    /// Hands `mask` back, placed in the frame `windows` (the transmission pass's), for the
+    /// next composite of the frame.
+    pub(crate) fn give_back(&self, mask: MaskImage, windows: ImageWindows) {
+        let placed = PlacedMask {
+            image: mask,
+            windows,
+            stores_planes: self.stores_planes.get().copied().unwrap_or(true),
+            has_coordinates: true,
+        };
+        if let Ok(mut slot) = self.mask.lock() {
+            *slot = Some(placed);
+        }
+    }
+
+    /// The mask handed back, if any.
+    fn take(&self) -> Option<PlacedMask> {
+        self.mask.lock().ok().and_then(|mut slot| slot.take())
+    }
+}
+
+/// The frame's mask: the one `once` holds (handed back by the previous composite of the
+/// frame), else read from its file.
 fn read_mask(
     files: &FrameFiles,
     settings: &DecodeSettings,
     once: Option<&MaskOnce>,
 ) -> Result<PlacedMask, ComposeError> {
-    if let Some(mask) = once.and_then(|o| o.get()) {
-        return Ok(mask.clone());
+    if let Some(mask) = once.and_then(MaskOnce::take) {
+        return Ok(mask);
     }
     let mask = glassdb_mask::read_placed_mask(&files.mask, &settings.mask)?;
     if let Some(once) = once {
-        // Only this frame's composites share `once`, one at a time: it was empty.
-        let _ = once.set(mask.clone());
+        let _ = once.stores_planes.set(mask.stores_planes);
     }
     Ok(mask)
 }

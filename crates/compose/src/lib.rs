@@ -387,33 +387,47 @@ pub fn compose_frame_within(
     progress: &dyn glassdb_io::Progress,
 ) -> Result<FrameReport, ComposeError> {
     let target = check_job(job, settings)?;
+    let read = SharedRead {
+        carry: target.carry,
+        mask: None,
+    };
     let (composited, timings) =
-        decode_and_composite(job, settings, &target, luts, budget, None, progress)?;
+        decode_and_composite(job, settings, &target, luts, budget, read, progress)?;
     write_composited(job, settings, composited, timings, progress)
 }
 
+/// How one of several composites of a frame (its light groups) reads what they share.
+#[derive(Clone, Copy)]
+struct SharedRead<'a> {
+    /// What the transmission file carries over in this read: the target's, or nothing where
+    /// the output's channels are read once the composites are summed.
+    carry: Carry,
+    /// The frame's mask, decoded once for all of them.
+    mask: Option<&'a decode::MaskOnce>,
+}
+
 /// The header, decode and composite phases of a checked job, timed, telling `progress` as
-/// each begins.
+/// each begins; `target` is what the frame's memory is estimated for, `read` what this
+/// composite reads of what the frame's composites share.
 fn decode_and_composite(
     job: &ComposeJob,
     settings: &ComposeSettings,
     target: &DecodeTarget,
     luts: &RegistryLuts,
     budget: &MemoryBudget,
-    mask_once: Option<&decode::MaskOnce>,
+    read: SharedRead<'_>,
     progress: &dyn glassdb_io::Progress,
 ) -> Result<(Composited, StageTimings), ComposeError> {
     let [decode_stage, composite_stage, _] = FRAME_STAGES;
     progress.stage(decode_stage);
     let t0 = Instant::now();
     let plan = plan::plan_frame(&job.inputs, &settings.decode, luts, budget, target)?;
-    let frame =
-        decode::decode_planned(&job.inputs, &settings.decode, plan, target.carry, mask_once)?;
+    let frame = decode::decode_planned(&job.inputs, &settings.decode, plan, read.carry, read.mask)?;
     let decode = t0.elapsed();
 
     progress.stage(composite_stage);
     let t1 = Instant::now();
-    let composited = composite::composite(frame, settings)?;
+    let composited = composite::composite(frame, settings, read.mask)?;
     let compose = t1.elapsed();
     let timings = StageTimings {
         decode,

@@ -132,7 +132,9 @@ pub fn group_passes(
 
 /// Composites a frame split into light groups: each group's passes ([`group_passes`])
 /// composited with its own light's tables, in turn (one group's passes decoded at a time, the
-/// frame's memory limit held per group; the mask decoded once), and the sum written as the output's beauty. With
+/// frame's memory limit held per group; the mask decoded once), and the sum written as the
+/// output's beauty, with the transmission file's other channels read after the groups (less
+/// their layers: [`read_carried_after_groups`]). With
 /// `keep_groups` (EXR output only) each group's composite is also written, as a layer of the
 /// transmission pass's name for that group (`ViewLayer.Combined_sun.R`, …), so that a
 /// compositor can still balance the lights. The report is the first group's, with the output
@@ -169,29 +171,35 @@ pub fn compose_light_groups_within(
     let mut sum: Option<Composited> = None;
     let mut kept: Vec<(String, [Vec<f32>; 3])> = Vec::new();
     let mut timings = crate::StageTimings::default();
-    // One mask for every group: decoded with the first group's passes, copied for the others.
-    let mask_once = crate::decode::MaskOnce::new();
-    let mask_once = (groups.len() > 1).then_some(&mask_once);
-    // What the output carries comes with the first group's transmission pass; the others
-    // decode their layer alone.
+    // One mask for every group: decoded with the first group's passes, handed on to the others.
+    let mask_slot = crate::decode::MaskOnce::default();
+    let mask = (groups.len() > 1).then_some(&mask_slot);
+    // What the output carries of the transmission file's other channels is read once the
+    // groups are summed, without the group layers; each group decodes its own layer alone.
+    let carry_after = target.carry.keep_channels;
+    // the frame's memory is estimated with what its output carries by its first composite
     let rest = crate::DecodeTarget {
         carry: Carry::NONE,
         ..target.clone()
     };
-    let group_layers: Vec<String> = passes
-        .iter()
-        .filter_map(|g| g.layers.trans.clone())
-        .collect();
     for (k, (group, group_passes)) in groups.iter().zip(&passes).enumerate() {
         let mut one = settings.clone();
         one.decode.layers = group_passes.layers.clone();
+        let read = crate::SharedRead {
+            carry: if k == 0 && !carry_after {
+                target.carry
+            } else {
+                Carry::NONE
+            },
+            mask,
+        };
         let (composited, t) = crate::decode_and_composite(
             job,
             &one,
             if k == 0 { &target } else { &rest },
             &group.luts,
             budget,
-            mask_once,
+            read,
             progress,
         )?;
         timings.decode += t.decode;
@@ -200,23 +208,65 @@ pub fn compose_light_groups_within(
             let layer = group_passes.layers.trans.clone().unwrap_or_default();
             kept.push((layer, composited.image.trans.image.rgb.clone()));
         }
-        match &mut sum {
-            None => {
-                // the group layers hold the light behind the glass, not the composite: not
-                // carried to the output, and not held while the other groups composite
-                let mut first = composited;
-                drop_group_layers(&mut first.image.frame, &group_layers);
-                sum = Some(first);
-            }
-            Some(total) => add_group_composite(
-                &mut total.image.trans.image.rgb,
-                &composited.image.trans.image.rgb,
-            ),
-        }
+        add_to_sum(&mut sum, composited);
     }
+    drop(mask_slot);
     let mut total = sum.ok_or_else(|| ComposeError::LightGroupList("none named".into()))?;
+    if carry_after && let Some(first) = passes.first() {
+        let mut opts = settings.decode.pass.clone();
+        opts.layer = first.layers.trans.clone();
+        total.image.frame = read_carried_after_groups(&job.inputs, &opts, target.carry, &passes)?;
+    }
     carry_groups(&mut total.image.frame, &passes, kept);
     crate::write_composited(job, settings, total, timings, progress)
+}
+
+/// What the output of a frame split by light carries from its transmission file (`opts` reads
+/// the first group's layer) as `carry` says, read once the groups' composites are summed so
+/// that it is never held beside a group's passes: its attributes and other channels, less the
+/// layers of `groups` (the sum replaces them), which are never decoded.
+pub(crate) fn read_carried_after_groups(
+    files: &FrameFiles,
+    opts: &glassdb_pass::PassReadOptions,
+    carry: Carry,
+    groups: &[GroupPasses],
+) -> Result<CarriedFrame, ComposeError> {
+    let layers = group_layers(groups);
+    Ok(glassdb_pass::read_carried(
+        &files.trans,
+        opts,
+        carry,
+        &|name| in_layers(name, &layers),
+    )?)
+}
+
+/// The transmission pass's layers of `groups` (`ViewLayer.Combined_sun`, …).
+fn group_layers(groups: &[GroupPasses]) -> Vec<String> {
+    groups
+        .iter()
+        .filter_map(|g| g.layers.trans.clone())
+        .collect()
+}
+
+/// Whether the channel `name` is in one of `layers` (`ViewLayer.Combined_sun.R` is in
+/// `ViewLayer.Combined_sun`).
+fn in_layers(name: &str, layers: &[String]) -> bool {
+    layers.iter().any(|l| {
+        name.strip_prefix(l.as_str())
+            .is_some_and(|rest| rest.starts_with('.'))
+    })
+}
+
+/// Adds a composite of the frame to the sum of those before it (the first is the sum, with what
+/// its output carries).
+pub(crate) fn add_to_sum(sum: &mut Option<Composited>, composited: Composited) {
+    match sum {
+        None => *sum = Some(composited),
+        Some(total) => add_group_composite(
+            &mut total.image.trans.image.rgb,
+            &composited.image.trans.image.rgb,
+        ),
+    }
 }
 
 /// `total += add`, plane by plane, in f32: the sum of the groups' composites, the next group
@@ -234,12 +284,9 @@ pub(crate) fn add_group_composite(total: &mut [Vec<f32>; 3], add: &[Vec<f32>; 3]
 /// carries over.
 fn drop_group_layers(frame: &mut CarriedFrame, group_layers: &[String]) {
     if let Some(ExrCarried::Whole { file, part, .. }) = &mut frame.exr {
-        file.parts[*part].channels.retain(|(name, _)| {
-            !group_layers.iter().any(|l| {
-                name.strip_prefix(l.as_str())
-                    .is_some_and(|rest| rest.starts_with('.'))
-            })
-        });
+        file.parts[*part]
+            .channels
+            .retain(|(name, _)| !in_layers(name, group_layers));
     }
 }
 
@@ -254,11 +301,7 @@ pub(crate) fn carry_groups(
     groups: &[GroupPasses],
     kept: Vec<(String, [Vec<f32>; 3])>,
 ) {
-    let group_layers: Vec<String> = groups
-        .iter()
-        .filter_map(|g| g.layers.trans.clone())
-        .collect();
-    drop_group_layers(frame, &group_layers);
+    drop_group_layers(frame, &group_layers(groups));
     let window = frame.windows.data;
     let n = window.pixel_count() as usize;
     let rgb_names = |layer: &str| -> Vec<String> {

@@ -17,7 +17,9 @@ use glassdb_side::Side;
 
 use crate::colour::RegistryLuts;
 use crate::composite::Composited;
-use crate::light_groups::{GroupPasses, add_group_composite, carry_groups, group_passes};
+use crate::light_groups::{
+    GroupPasses, add_to_sum, carry_groups, group_passes, read_carried_after_groups,
+};
 use crate::light_parts::{LightPart, LightParts, LightSource};
 use crate::lut::{FINE_STEPS, GlassLut};
 use crate::memory::MemoryBudget;
@@ -317,13 +319,15 @@ pub fn compose_light_parts(
             None => lights.push((part.light.as_deref(), vec![part])),
         }
     }
+    let carry_after = target.carry.keep_channels;
+    let mut first_trans = None;
     let mut factors: Vec<PartFactor> = Vec::with_capacity(parts.parts.len());
     let mut sum: Option<Composited> = None;
     let mut timings = StageTimings::default();
     let [decode_stage, composite_stage, _] = FRAME_STAGES;
-    // One mask for every light: decoded with the first light's passes, copied for the others.
-    let mask_once = crate::decode::MaskOnce::new();
-    let mask_once = (lights.len() > 1).then_some(&mask_once);
+    // One mask for every light: decoded with the first light's passes, handed on to the others.
+    let mask_slot = crate::decode::MaskOnce::default();
+    let mask_once = (lights.len() > 1).then_some(&mask_slot);
     for (k, (_, members)) in lights.iter().enumerate() {
         let luts = tables.get(members[0])?;
         let mut one = settings.clone();
@@ -357,27 +361,33 @@ pub fn compose_light_parts(
             r.light_mix = Some(mix.clone());
         }
         factors.extend(these);
-        // what the output carries comes with the first light's transmission pass
-        let carry = if k == 0 { target.carry } else { Carry::NONE };
+        // what the output carries of the transmission file's other channels is read once the
+        // lights are summed; each light decodes its parts alone
+        if k == 0 && carry_after {
+            first_trans = Some(plan.reads.trans.clone());
+        }
+        let carry = if k == 0 && !carry_after {
+            target.carry
+        } else {
+            Carry::NONE
+        };
         let frame =
             crate::decode::decode_planned(&job.inputs, &one.decode, plan, carry, mask_once)?;
         timings.decode += t0.elapsed();
         progress.stage(composite_stage);
         let t1 = Instant::now();
-        let composited = crate::composite::composite(frame, &one)?;
+        let composited = crate::composite::composite(frame, &one, mask_once)?;
         timings.compose += t1.elapsed();
-        match &mut sum {
-            None => sum = Some(composited),
-            Some(total) => add_group_composite(
-                &mut total.image.trans.image.rgb,
-                &composited.image.trans.image.rgb,
-            ),
-        }
+        add_to_sum(&mut sum, composited);
     }
+    drop(mask_slot);
     let mut total = sum.ok_or_else(|| ComposeError::LightPartsRecord {
         record: record.to_string(),
         problem: "no parts".into(),
     })?;
+    if let Some(opts) = first_trans {
+        total.image.frame = read_carried_after_groups(&job.inputs, &opts, target.carry, &passes)?;
+    }
     carry_groups(&mut total.image.frame, &passes, Vec::new());
     let frame = crate::write_composited(job, settings, total, timings, progress)?;
     // the record's order

@@ -1,12 +1,13 @@
 //! The block decoding under glassdb-image's EXR reader: a part's blocks decompressed in
 //! parallel (rayon, one task per band of rows) straight into the output buffers, each band's
-//! rows checked to be fully covered, and every sample type converted to `f32`.
+//! rows checked to be fully covered, every sample type converted to `f32` or kept as stored.
 
 use std::sync::Mutex;
 
 use exr::block::UncompressedBlock;
 use exr::block::chunk::Chunk;
 use exr::meta::header::Header;
+use exr::prelude::FlatSamples;
 use rayon::prelude::*;
 
 use crate::exr_header::{ExrPart, ExrSampleType};
@@ -38,9 +39,19 @@ impl BandLayout {
     }
 }
 
+/// How the decoded samples are kept: converted to `f32`, or in the channel's own type (half,
+/// float, uint), exactly as stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Samples {
+    /// Every channel as `f32` (`FlatSamples::F32`).
+    AsF32,
+    /// Each channel in its stored type.
+    AsStored,
+}
+
 /// Decompresses the blocks `chunks` yields in parallel, each straight into the output buffers
-/// of its band (one buffer per selected channel), checking that each band's rows are fully
-/// covered.
+/// of its band (one buffer per selected channel, of the type `samples` says), checking that
+/// each band's rows are fully covered.
 pub(crate) fn decode_bands(
     meta: &exr::meta::MetaData,
     header: &Header,
@@ -48,7 +59,8 @@ pub(crate) fn decode_bands(
     channels: &[usize],
     chunks: impl Iterator<Item = exr::error::Result<Chunk>> + Send,
     layout: &BandLayout,
-) -> Result<Vec<Vec<f32>>, ImageError> {
+    samples: Samples,
+) -> Result<Vec<FlatSamples>, ImageError> {
     let BandLayout {
         width,
         height,
@@ -65,9 +77,19 @@ pub(crate) fn decode_bands(
     }
     let sample_types: Vec<ExrSampleType> = info.channels.iter().map(|c| c.sample_type).collect();
 
-    let mut outputs: Vec<Vec<f32>> = channels
+    let len = width * layout.decoded_rows();
+    let mut outputs: Vec<FlatSamples> = channels
         .iter()
-        .map(|_| vec![0f32; width * layout.decoded_rows()])
+        .map(|&c| {
+            let stored = sample_types.get(c).copied().unwrap_or(ExrSampleType::Float);
+            match (samples, stored) {
+                (Samples::AsStored, ExrSampleType::Half) => {
+                    FlatSamples::F16(vec![half::f16::ZERO; len])
+                }
+                (Samples::AsStored, ExrSampleType::Uint) => FlatSamples::U32(vec![0; len]),
+                _ => FlatSamples::F32(vec![0.0; len]),
+            }
+        })
         .collect();
     let mut band_slices: Vec<BandTarget<'_>> = (first_band..end_band)
         .map(|_| BandTarget {
@@ -75,11 +97,14 @@ pub(crate) fn decode_bands(
             written: 0,
         })
         .collect();
+    let rows = width * band_height;
     for buffer in outputs.iter_mut() {
-        for (band, slice) in band_slices
-            .iter_mut()
-            .zip(buffer.chunks_mut(width * band_height))
-        {
+        let bands: Box<dyn Iterator<Item = SliceMut<'_>>> = match buffer {
+            FlatSamples::F16(b) => Box::new(b.chunks_mut(rows).map(SliceMut::F16)),
+            FlatSamples::F32(b) => Box::new(b.chunks_mut(rows).map(SliceMut::F32)),
+            FlatSamples::U32(b) => Box::new(b.chunks_mut(rows).map(SliceMut::U32)),
+        };
+        for (band, slice) in band_slices.iter_mut().zip(bands) {
             band.slices.push(slice);
         }
     }
@@ -136,8 +161,27 @@ pub(crate) fn decode_bands(
 
 /// One band's slice of every output buffer, and the samples written into them so far.
 struct BandTarget<'a> {
-    slices: Vec<&'a mut [f32]>,
+    slices: Vec<SliceMut<'a>>,
     written: usize,
+}
+
+/// A band's part of one output buffer, of the buffer's sample type.
+enum SliceMut<'a> {
+    F16(&'a mut [half::f16]),
+    F32(&'a mut [f32]),
+    U32(&'a mut [u32]),
+}
+
+impl SliceMut<'_> {
+    /// Its `start..start + n` samples, of the same type; `None` out of range.
+    fn range(&mut self, start: usize, n: usize) -> Option<SliceMut<'_>> {
+        let end = start.checked_add(n)?;
+        Some(match self {
+            SliceMut::F16(s) => SliceMut::F16(s.get_mut(start..end)?),
+            SliceMut::F32(s) => SliceMut::F32(s.get_mut(start..end)?),
+            SliceMut::U32(s) => SliceMut::U32(s.get_mut(start..end)?),
+        })
+    }
 }
 
 /// The blocks of a chunk reader, with a panic in the reader on a corrupt file turned into an
@@ -167,7 +211,7 @@ fn scatter_block(
     header: &Header,
     target: &[Option<usize>],
     sample_types: &[ExrSampleType],
-    slices: &mut [&mut [f32]],
+    slices: &mut [SliceMut<'_>],
     y0: usize,
     rows: usize,
     width: usize,
@@ -187,7 +231,7 @@ fn scatter_block(
         let start = (y - y0) * width + x;
         let dst = slices
             .get_mut(k)
-            .and_then(|s| s.get_mut(start..start + n))
+            .and_then(|s| s.range(start, n))
             .ok_or_else(|| incomplete("block line out of range".into()))?;
         let ty = sample_types
             .get(loc.channel)
@@ -199,31 +243,50 @@ fn scatter_block(
     Ok(written)
 }
 
-/// Native-endian sample bytes to `f32`.
-fn convert_samples(bytes: &[u8], ty: ExrSampleType, dst: &mut [f32]) -> Result<(), ImageError> {
+/// Native-endian sample bytes into `dst`: converted to `f32`, or copied into a buffer of their
+/// own type.
+fn convert_samples(bytes: &[u8], ty: ExrSampleType, dst: SliceMut<'_>) -> Result<(), ImageError> {
     let size = match ty {
         ExrSampleType::Half => 2,
         ExrSampleType::Float | ExrSampleType::Uint => 4,
     };
-    if bytes.len() != dst.len() * size {
+    let len = match &dst {
+        SliceMut::F16(d) => d.len(),
+        SliceMut::F32(d) => d.len(),
+        SliceMut::U32(d) => d.len(),
+    };
+    if bytes.len() != len * size {
         return Err(incomplete("a block line has the wrong byte length".into()));
     }
-    match ty {
-        ExrSampleType::Float => {
+    let four = |c: &[u8]| [c[0], c[1], c[2], c[3]];
+    let two = |c: &[u8]| u16::from_ne_bytes([c[0], c[1]]);
+    match (ty, dst) {
+        (ExrSampleType::Float, SliceMut::F32(dst)) => {
             for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(4)) {
-                *d = f32::from_ne_bytes([c[0], c[1], c[2], c[3]]);
+                *d = f32::from_ne_bytes(four(c));
             }
         }
-        ExrSampleType::Uint => {
+        (ExrSampleType::Uint, SliceMut::F32(dst)) => {
             for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(4)) {
-                *d = u32::from_ne_bytes([c[0], c[1], c[2], c[3]]) as f32;
+                *d = u32::from_ne_bytes(four(c)) as f32;
             }
         }
-        ExrSampleType::Half => {
+        (ExrSampleType::Uint, SliceMut::U32(dst)) => {
+            for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(4)) {
+                *d = u32::from_ne_bytes(four(c));
+            }
+        }
+        (ExrSampleType::Half, SliceMut::F32(dst)) => {
             for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(2)) {
-                *d = half::f16::from_bits(u16::from_ne_bytes([c[0], c[1]])).to_f32();
+                *d = half::f16::from_bits(two(c)).to_f32();
             }
         }
+        (ExrSampleType::Half, SliceMut::F16(dst)) => {
+            for (d, c) in dst.iter_mut().zip(bytes.chunks_exact(2)) {
+                *d = half::f16::from_bits(two(c));
+            }
+        }
+        _ => return Err(incomplete("a channel's samples changed type".into())),
     }
     Ok(())
 }

@@ -13,7 +13,7 @@ use exr::meta::BlockDescription;
 use exr::meta::header::{ImageAttributes, LayerAttributes};
 use exr::prelude::{FlatSamples, ReadChannels, ReadLayers};
 
-use crate::exr_bands::{BandLayout, decode_bands};
+use crate::exr_bands::{BandLayout, Samples, decode_bands};
 use crate::exr_header::{ExrPart, ParsedHeaders, parsed_headers, read_exr_headers};
 use crate::guard::catch_codec_panic;
 use crate::{Codec, ImageError, PixelWindow};
@@ -86,13 +86,7 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
         .get(part)
         .ok_or_else(|| unsupported(format!("part {part}")))?
         .clone();
-    let band_height = match header.blocks {
-        BlockDescription::ScanLines => header.compression.scan_lines_per_block(),
-        BlockDescription::Tiles(t) => t.tile_size.height(),
-    };
-    if band_height == 0 {
-        return Err(unsupported("tile height 0".into()));
-    }
+    let band_height = band_height(&header)?;
     let band_count = info.height.div_ceil(band_height);
     // The bands (block rows) holding the rows asked for, relative to the data window.
     let (first_band, end_band) = match rows {
@@ -130,7 +124,21 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
     let mut unique: Vec<usize> = channels.to_vec();
     unique.sort_unstable();
     unique.dedup();
-    let mut decoded = decode_bands(meta, &header, &info, &unique, chunks, &layout)?;
+    let mut decoded = decode_bands(
+        meta,
+        &header,
+        &info,
+        &unique,
+        chunks,
+        &layout,
+        Samples::AsF32,
+    )?
+    .into_iter()
+    .map(|samples| match samples {
+        FlatSamples::F32(v) => Ok(v),
+        _ => Err(incomplete("a channel was not decoded as f32".into())),
+    })
+    .collect::<Result<Vec<_>, _>>()?;
     let outputs = channels
         .iter()
         .enumerate()
@@ -145,6 +153,18 @@ pub fn read_exr_channel_rows_from<R: Read + Seek + Send>(
         })
         .collect();
     Ok((info, outputs))
+}
+
+/// The rows of one band: a scan-line block's, or a tile's height.
+fn band_height(header: &exr::meta::header::Header) -> Result<usize, ImageError> {
+    let rows = match header.blocks {
+        BlockDescription::ScanLines => header.compression.scan_lines_per_block(),
+        BlockDescription::Tiles(t) => t.tile_size.height(),
+    };
+    if rows == 0 {
+        return Err(unsupported("tile height 0".into()));
+    }
+    Ok(rows)
 }
 
 /// The blocks of part `part` whose band (block row, level 0) is in `bands`, read one at a time
@@ -284,32 +304,7 @@ pub struct ExactExr {
 /// deep parts and subsampled channels are refused from the headers, before any pixel is decoded.
 pub fn read_exr_exact(bytes: &[u8], max_pixels: u64) -> Result<ExactExr, ImageError> {
     let parts = read_exr_headers(bytes)?;
-    let total: u64 = parts
-        .iter()
-        .map(|p| p.data_window.pixel_count())
-        .fold(0, u64::saturating_add);
-    if total > max_pixels {
-        let largest = parts
-            .iter()
-            .map(|p| p.data_window)
-            .max_by_key(|w| w.pixel_count());
-        return Err(ImageError::TooLarge {
-            width: largest.map_or(0, |w| w.width as u64),
-            height: largest.map_or(0, |w| w.height as u64),
-            max_pixels,
-        });
-    }
-    for part in &parts {
-        if part.deep {
-            return Err(unsupported("deep EXR data".into()));
-        }
-        if let Some(c) = part.channels.iter().find(|c| c.sampling != (1, 1)) {
-            return Err(unsupported(format!(
-                "subsampled channel {} ({}×{})",
-                c.name, c.sampling.0, c.sampling.1
-            )));
-        }
-    }
+    check_exact_readable(&parts, max_pixels)?;
     let image = guarded(|| {
         exr::prelude::read()
             .no_deep_data()
@@ -341,6 +336,106 @@ pub fn read_exr_exact(bytes: &[u8], max_pixels: u64) -> Result<ExactExr, ImageEr
             })
             .collect(),
     })
+}
+
+/// [`read_exr_exact`] of only the channels `keep` accepts (by their full names), from a
+/// seekable reader (a file) whose headers the caller has read (`parts`): each part's blocks are
+/// read as they are decoded (in parallel, as [`read_exr_channel_rows_from`] reads a pass's),
+/// never the whole file at once, and only the channels kept are held, in their stored types.
+/// A part none of whose channels is kept is returned without channels. The same checks as
+/// [`read_exr_exact`], from the headers.
+pub fn read_exr_exact_keeping<R: Read + Seek + Send>(
+    mut source: R,
+    parts: &[ExrPart],
+    max_pixels: u64,
+    keep: &dyn Fn(&str) -> bool,
+) -> Result<ExactExr, ImageError> {
+    check_exact_readable(parts, max_pixels)?;
+    let io_err = |e| ImageError::ExrDecode(exr::error::Error::Io(e));
+    source.seek(SeekFrom::Start(0)).map_err(io_err)?;
+    let parsed = parsed_headers(&mut source)?;
+    let meta = &parsed.meta;
+    let header_of = |p: usize| {
+        meta.headers
+            .get(p)
+            .ok_or_else(|| unsupported(format!("part {p}")))
+    };
+    let attributes = header_of(0)?.shared_attributes.clone();
+    let mut exact = Vec::with_capacity(parts.len());
+    for (p, info) in parts.iter().enumerate() {
+        let header = header_of(p)?;
+        let kept: Vec<usize> = (0..info.channels.len())
+            .filter(|&c| keep(&info.channels[c].name))
+            .collect();
+        let samples = if kept.is_empty() {
+            Vec::new()
+        } else {
+            let band_height = band_height(header)?;
+            let band_count = info.height.div_ceil(band_height);
+            let chunks = part_chunks(&mut source, &parsed, p, 0..band_count)?;
+            let layout = BandLayout {
+                width: info.width,
+                height: info.height,
+                band_height,
+                first_band: 0,
+                end_band: band_count,
+            };
+            decode_bands(
+                meta,
+                header,
+                info,
+                &kept,
+                chunks,
+                &layout,
+                Samples::AsStored,
+            )?
+        };
+        exact.push(ExactPart {
+            attributes: header.own_attributes.clone(),
+            data_window: info.data_window,
+            channels: kept
+                .iter()
+                .map(|&c| info.channels[c].name.clone())
+                .zip(samples)
+                .collect(),
+        });
+    }
+    Ok(ExactExr {
+        attributes,
+        parts: exact,
+    })
+}
+
+/// What [`read_exr_exact`] refuses from the headers: more than `max_pixels` in all parts, deep
+/// data, subsampled channels.
+fn check_exact_readable(parts: &[ExrPart], max_pixels: u64) -> Result<(), ImageError> {
+    let total: u64 = parts
+        .iter()
+        .map(|p| p.data_window.pixel_count())
+        .fold(0, u64::saturating_add);
+    if total > max_pixels {
+        let largest = parts
+            .iter()
+            .map(|p| p.data_window)
+            .max_by_key(|w| w.pixel_count());
+        return Err(ImageError::TooLarge {
+            width: largest.map_or(0, |w| w.width as u64),
+            height: largest.map_or(0, |w| w.height as u64),
+            max_pixels,
+        });
+    }
+    for part in parts {
+        if part.deep {
+            return Err(unsupported("deep EXR data".into()));
+        }
+        if let Some(c) = part.channels.iter().find(|c| c.sampling != (1, 1)) {
+            return Err(unsupported(format!(
+                "subsampled channel {} ({}×{})",
+                c.name, c.sampling.0, c.sampling.1
+            )));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

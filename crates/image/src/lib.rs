@@ -39,7 +39,7 @@ pub use exr_layers::{
 };
 pub use exr_read::{
     ExactExr, ExactPart, check_exr_readable, read_exr_attributes, read_exr_channel_rows,
-    read_exr_channel_rows_from, read_exr_channels, read_exr_exact,
+    read_exr_channel_rows_from, read_exr_channels, read_exr_exact, read_exr_exact_keeping,
 };
 pub use exr_write::{
     ClampedSample, ExrImageOut, ExrPartOut, ExrPlane, ExrStorage, ExrWriteOptions, ExrWriteReport,

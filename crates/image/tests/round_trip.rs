@@ -140,3 +140,90 @@ fn unknown_bytes_are_unsupported_and_show_their_start() {
     assert_eq!(err.kind(), ImageErrorKind::Unsupported);
     assert!(err.to_string().contains("47, 49, 46"), "{err}");
 }
+
+/// Two parts of half, float and uint channels, one in scan lines (ZIP) at an offset data
+/// window, one in tiles (PIZ) smaller than its part: `read_exr_exact_keeping` returns what
+/// `read_exr_exact` returns less the channels it leaves out, in the stored types.
+#[test]
+fn exr_exact_read_of_some_channels_is_the_whole_read_without_the_others() {
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image,
+        ImageAttributes, IntegerBounds, Layer, LayerAttributes, LineOrder, SmallVec, Vec2,
+        WritableImage,
+    };
+    let ramp =
+        |n: usize, k: usize| -> Vec<f32> { (0..n).map(|i| (i * 7 + k) as f32 / 64.0).collect() };
+    let half = |v: Vec<f32>| FlatSamples::F16(v.into_iter().map(half::f16::from_f32).collect());
+    let channels = |n: usize| -> AnyChannels<FlatSamples> {
+        let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = [
+            AnyChannel::new("ViewLayer.Combined.R", half(ramp(n, 1))),
+            AnyChannel::new("ViewLayer.Combined.G", FlatSamples::F32(ramp(n, 2))),
+            AnyChannel::new("ViewLayer.Combined_sun.R", half(ramp(n, 3))),
+            AnyChannel::new("ViewLayer.Combined_sun.G", FlatSamples::F32(ramp(n, 4))),
+            AnyChannel::new("ViewLayer.Depth.Z", FlatSamples::F32(ramp(n, 5))),
+            AnyChannel::new("id", FlatSamples::U32((0..n as u32).collect())),
+        ]
+        .into_iter()
+        .collect();
+        AnyChannels::sort(list)
+    };
+    let layer = |name: &str, (w, h): (usize, usize), at: (i32, i32), blocks, compression| {
+        let mut attributes = LayerAttributes::named(name);
+        attributes.layer_position = Vec2(at.0, at.1);
+        let encoding = Encoding {
+            compression,
+            blocks,
+            line_order: LineOrder::Increasing,
+        };
+        Layer::new((w, h), attributes, encoding, channels(w * h))
+    };
+    let layers: SmallVec<[_; 2]> = [
+        layer(
+            "lines",
+            (37, 45),
+            (3, -2),
+            Blocks::ScanLines,
+            Compression::ZIP16,
+        ),
+        layer(
+            "tiles",
+            (21, 13),
+            (0, 0),
+            Blocks::Tiles(Vec2(8, 8)),
+            Compression::PIZ,
+        ),
+    ]
+    .into_iter()
+    .collect();
+    let image = Image::from_layers(
+        ImageAttributes::new(IntegerBounds::from_dimensions((40, 44))),
+        layers,
+    );
+    let mut bytes = Vec::new();
+    image.write().to_buffered(Cursor::new(&mut bytes)).unwrap();
+
+    let whole = glassdb_image::read_exr_exact(&bytes, u64::MAX).unwrap();
+    let parts = glassdb_image::read_exr_headers(&bytes).unwrap();
+    let keeps: [&dyn Fn(&str) -> bool; 4] = [
+        &|_| true,
+        &|n| !n.starts_with("ViewLayer.Combined_sun."),
+        &|n| n == "id",
+        &|_| false,
+    ];
+    for (k, keep) in keeps.iter().enumerate() {
+        let got =
+            glassdb_image::read_exr_exact_keeping(Cursor::new(&bytes), &parts, u64::MAX, keep)
+                .unwrap();
+        let mut want = whole.clone();
+        for part in &mut want.parts {
+            part.channels.retain(|(name, _)| keep(name));
+        }
+        assert_eq!(got, want, "filter {k}");
+    }
+    // The limits are read_exr_exact's, from the headers.
+    let small = glassdb_image::read_exr_exact_keeping(Cursor::new(&bytes), &parts, 100, &|_| true);
+    assert!(
+        matches!(small, Err(ImageError::TooLarge { .. })),
+        "{small:?}"
+    );
+}

@@ -105,7 +105,14 @@ impl CarriedFrame {
         };
         let parts = glassdb_image::read_exr_headers(bytes).map_err(|s| decode_err(path, s))?;
         if !carries_whole_file(&parts, channel_names, carry) {
-            return Self::with_attributes(pass, &parts, bytes, path, carry.keep_channels);
+            return Self::with_attributes(
+                pass.windows,
+                (*part, channel_names),
+                &parts,
+                bytes,
+                path,
+                carry.keep_channels,
+            );
         }
         let file = glassdb_image::read_exr_exact(bytes, max_pixels).map_err(|source| {
             PassError::KeepChannels {
@@ -124,39 +131,26 @@ impl CarriedFrame {
         })
     }
 
-    /// The frame of an EXR transmission pass (`parts`, the file's headers) of which only the
-    /// attributes are carried over, read from `header` (the file from its start: only its
-    /// headers are read).
+    /// The frame (`windows`) of an EXR transmission pass (`parts`, the file's headers; its
+    /// layer in part `part`, channels `channel_names`) of which only the attributes are carried
+    /// over, read from `header` (the file from its start: only its headers are read).
     fn with_attributes(
-        pass: &Pass,
+        windows: ImageWindows,
+        (part, channel_names): (usize, &[String]),
         parts: &[ExrPart],
         header: impl std::io::Read,
         path: &Path,
         keep_channels: bool,
     ) -> Result<CarriedFrame, PassError> {
-        let (part, channel_names) = match &pass.source {
-            PassSource::Exr {
-                part,
-                channel_names,
-                ..
-            } => (*part, channel_names),
-            PassSource::Png { .. } => {
-                return Ok(CarriedFrame {
-                    windows: pass.windows,
-                    exr: None,
-                    tag_space: None,
-                });
-            }
-        };
         let (image, part) =
             glassdb_image::read_exr_attributes(header, part).map_err(|s| decode_err(path, s))?;
         Ok(CarriedFrame {
-            windows: pass.windows,
+            windows,
             exr: Some(ExrCarried::Attributes {
                 image: Box::new(image),
                 part: Box::new(part),
                 names: (keep_channels && only_the_layer(parts, channel_names))
-                    .then(|| channel_names.clone()),
+                    .then(|| channel_names.to_vec()),
             }),
             tag_space: None,
         })
@@ -191,13 +185,25 @@ pub fn read_transmission(
                 )
             })?;
             rewind(&mut file, path)?;
-            let frame = CarriedFrame::with_attributes(
-                &pass,
-                &headers.parts,
-                file,
-                path,
-                carry.keep_channels,
-            )?;
+            let frame = match &pass.source {
+                PassSource::Exr {
+                    part,
+                    channel_names,
+                    ..
+                } => CarriedFrame::with_attributes(
+                    pass.windows,
+                    (*part, channel_names),
+                    &headers.parts,
+                    file,
+                    path,
+                    carry.keep_channels,
+                )?,
+                PassSource::Png { .. } => CarriedFrame {
+                    windows: pass.windows,
+                    exr: None,
+                    tag_space: None,
+                },
+            };
             return Ok((pass, frame));
         }
     }
@@ -206,6 +212,61 @@ pub fn read_transmission(
     let pass = read_pass_bytes(&bytes, path, opts)?;
     let frame = CarriedFrame::of_transmission(&pass, &bytes, path, carry, opts.max_pixels)?;
     Ok((pass, frame))
+}
+
+/// What an output carries over from the transmission file `path` whose pass (the layer
+/// `opts` chooses) was read before: as [`read_transmission`] carries it with `carry`, less
+/// the channels `leave_out` names (by their full names: a light-split frame's group layers,
+/// which the output replaces by their sum), never held. The file is read by seeking, one block
+/// per decoding thread at a time, not whole.
+pub fn read_carried(
+    path: &Path,
+    opts: &PassReadOptions,
+    carry: Carry,
+    leave_out: &dyn Fn(&str) -> bool,
+) -> Result<CarriedFrame, PassError> {
+    let (mut file, header, _) = open_seekable(path, opts.max_pixels)?;
+    let headers = match header {
+        ImageHeader::Png(png) => return Ok(CarriedFrame::whole(png.width, png.height)),
+        ImageHeader::Exr(headers) => headers,
+    };
+    let (chosen, _) = read_layer(&headers.parts, opts, path)?;
+    let info = headers.parts.get(chosen.part).ok_or_else(|| {
+        decode_err(
+            path,
+            glassdb_image::ImageError::Unsupported {
+                feature: format!("part {}", chosen.part),
+            },
+        )
+    })?;
+    let names = channel_names(info, &layer_channels(&chosen));
+    let windows = info.windows();
+    if !carries_whole_file(&headers.parts, &names, carry) {
+        return CarriedFrame::with_attributes(
+            windows,
+            (chosen.part, &names),
+            &headers.parts,
+            file,
+            path,
+            carry.keep_channels,
+        );
+    }
+    let keep = |name: &str| !leave_out(name);
+    let file =
+        glassdb_image::read_exr_exact_keeping(&mut file, &headers.parts, opts.max_pixels, &keep)
+            .map_err(|source| PassError::KeepChannels {
+                path: path.to_path_buf(),
+                source,
+            })?;
+    Ok(CarriedFrame {
+        windows,
+        exr: Some(ExrCarried::Whole {
+            file,
+            part: chosen.part,
+            channel_names: names,
+        }),
+        tag_space: None,
+    })
 }
 
 /// Whether the output carries every part and channel of the transmission file (`parts`, its

@@ -17,7 +17,9 @@ pub mod groups;
 pub mod pixels;
 pub mod read;
 
-pub use carry::{CarriedFrame, Carry, ExrCarried, carries_whole_file, read_transmission};
+pub use carry::{
+    CarriedFrame, Carry, ExrCarried, carries_whole_file, read_carried, read_transmission,
+};
 pub use error::PassError;
 pub use groups::{GroupLayer, GroupNaming, light_group_layers_of, light_group_of_layer};
 pub use pixels::{EncodedImage, EncodedSamples, InputTransfer, LinearImage, PngBits};
