@@ -91,6 +91,17 @@ fn registry_with_lights(
     out
 }
 
+/// The test catalog's registry with the fixture's two lights, sun (D65) and warm (A), in `dir`.
+fn sun_and_warm_registry(dir: &Path) -> PathBuf {
+    let catalog = write_catalog(dir);
+    registry_with_lights(
+        &catalog,
+        dir,
+        "lights.json",
+        &[("sun", "D65"), ("warm", "A")],
+    )
+}
+
 /// The registry's table under `light` in `space`.
 fn table<'a>(registry: &'a Value, light: &str, space: &str) -> &'a Value {
     registry["tables"]
@@ -362,11 +373,16 @@ fn layer_rgb(path: &Path, layer: &str) -> [Vec<f64>; 3] {
 
 /// `compose` of the fixture's passes with `registry`, no output yet.
 fn compose_fixture(registry: &Path) -> std::process::Command {
+    compose_fixture_with(registry, &group_fixture("trans.exr"))
+}
+
+/// [`compose_fixture`] with the transmission pass `trans`.
+fn compose_fixture_with(registry: &Path, trans: &Path) -> std::process::Command {
     let mut cmd = crate::util::compose();
     cmd.arg("--registry")
         .arg(registry)
         .arg("--trans")
-        .arg(group_fixture("trans.exr"))
+        .arg(trans)
         .arg("--refl")
         .arg(group_fixture("refl.exr"))
         .arg("--mask")
@@ -501,9 +517,7 @@ fn light_groups_refuse_what_does_not_match() {
 #[test]
 fn light_groups_composite_a_sequence_frame_by_frame() {
     let dir = tempfile::tempdir().unwrap();
-    let catalog = write_catalog(dir.path());
-    let lights = [("sun", "D65"), ("warm", "A")];
-    let registry = registry_with_lights(&catalog, dir.path(), "lights.json", &lights);
+    let registry = sun_and_warm_registry(dir.path());
     let seq = dir.path().join("seq");
     std::fs::create_dir(&seq).unwrap();
     // frame 2 swaps the two passes (both 8 × 6, both split into sun and warm), so that each
@@ -571,4 +585,57 @@ fn light_groups_composite_a_sequence_frame_by_frame() {
         first.channels != second.channels,
         "frames 1 and 2 read the same files"
     );
+}
+
+/// A light-split frame's transmission file's other channels (a float depth, a uint object
+/// index) reach the output exactly as stored, and its group layers do not (read once the groups
+/// are summed, without the group layers); the beauty is the one composited without them.
+#[test]
+fn light_groups_carry_the_transmission_files_other_channels_exactly() {
+    use exr::prelude::{AnyChannel, AnyChannels, FlatSamples, WritableImage};
+    let dir = tempfile::tempdir().unwrap();
+    let registry = sun_and_warm_registry(dir.path());
+    let mut image =
+        exr::prelude::read_all_flat_layers_from_file(group_fixture("trans.exr")).unwrap();
+    let layer = &mut image.layer_data[0];
+    let n = layer.size.area();
+    let depth: Vec<f32> = (0..n).map(|i| 0.25 + i as f32 / 8.0).collect();
+    let index: Vec<u32> = (0..n as u32).map(|i| 7 * i + 1).collect();
+    let mut list = layer.channel_data.list.clone();
+    list.push(AnyChannel::new(
+        "ViewLayer.Depth.Z",
+        FlatSamples::F32(depth.clone()),
+    ));
+    list.push(AnyChannel::new(
+        "ViewLayer.IndexOB.X",
+        FlatSamples::U32(index.clone()),
+    ));
+    layer.channel_data = AnyChannels::sort(list);
+    let trans = dir.path().join("trans.exr");
+    image.write().to_file(&trans).unwrap();
+
+    let composite = |trans: &Path, out: &Path| {
+        let mut cmd = compose_fixture_with(&registry, trans);
+        ok(cmd.args(["--light-groups", "sun,warm", "-o"]).arg(out));
+        crate::util::read_exr_planes(out)
+    };
+    let with = composite(&trans, &dir.path().join("with.exr"));
+    let without = composite(&group_fixture("trans.exr"), &dir.path().join("without.exr"));
+    let channel = |p: &crate::util::Planes, name: &str| -> Vec<f64> {
+        let k = p.names.iter().position(|n| n == name);
+        p.channels[k.unwrap_or_else(|| panic!("no {name} in {:?}", p.names))].clone()
+    };
+    let as_f64 = |v: &[f32]| v.iter().map(|&x| f64::from(x)).collect::<Vec<_>>();
+    assert_eq!(channel(&with, "ViewLayer.Depth.Z"), as_f64(&depth));
+    let index: Vec<f64> = index.iter().map(|&i| f64::from(i)).collect();
+    assert_eq!(channel(&with, "ViewLayer.IndexOB.X"), index);
+    assert!(
+        !with.names.iter().any(|n| n.contains("Combined_")),
+        "{:?}",
+        with.names
+    );
+    for c in ["R", "G", "B", "A"] {
+        let name = format!("ViewLayer.Combined.{c}");
+        assert_eq!(channel(&with, &name), channel(&without, &name), "{name}");
+    }
 }

@@ -156,7 +156,7 @@ pub fn group_passes(
 /// composited with its own light's tables, in turn (one group's passes decoded at a time, the
 /// frame's memory limit held per group; the mask decoded once), and the sum written as the
 /// output's beauty, with the transmission file's other channels read after the groups (less
-/// their layers: [`read_carried_after_groups`]). With
+/// their layers, never decoded). With
 /// `keep_groups` (EXR output only) each group's composite is also written, as a layer of the
 /// transmission pass's name for that group (`ViewLayer.Combined_sun.R`, …), so that a
 /// compositor can still balance the lights. The report is the first group's, with the output
