@@ -67,7 +67,7 @@
 
   // The page's data (crates/view/src/page.rs), from the server or from an export: read here
   // only, so that every field the page uses comes through one place that knows its version.
-  const PAGE_FORMAT = 'glassdb-viewer-page/3';
+  const PAGE_FORMAT = 'glassdb-viewer-page/4';
 
   function readScene(scene) {
     if (!scene || scene.format !== PAGE_FORMAT) {
@@ -77,7 +77,8 @@
     return scene;
   }
 
-  // `parts`: the light parts' passes, part after part (empty without a light-path split).
+  // `parts`: the light parts' passes, part after part, each laid out as `passes` (empty without
+  // a light-path split).
   // `passes`: the transmission, each plane's reflection, then each pane group's (`groups`:
   // {plane, group}, in that order; `groups_folded`: why a frame's groups are not apart).
   function readFrame(info, passes, mask, parts) {
@@ -208,6 +209,7 @@ uniform int uSide[64];  // 0 front, 1 back, per plane
 // Per plane: the uRefl layer of its pane groups 1 and 2 (-1: none; the group's share then
 // goes to the deepest nearer group's pass, as compose folds it).
 uniform ivec2 uGroupLayer[64];
+uniform int uGroups;    // the frame's pane-group passes (uRefl layers after the planes')
 uniform float uGain;    // 2^ev
 uniform bool uConvert;
 uniform mat3 uDisplay;  // passes' space to linear Rec.709
@@ -224,9 +226,9 @@ uniform vec3 uShaperOffset;
 uniform int uCubeN;
 uniform vec3 uCubeScale;
 uniform vec3 uCubeOffset;
-// The relit swap (docs/viewer.md): each light part's passes (transmission, then each plane's
-// reflection, part after part) and its factor per set: what the glass its light came through
-// passes, times its exposure.
+// The relit swap (docs/viewer.md): each light part's passes (transmission, each plane's
+// reflection, then each pane group's, part after part) and its factor per set: what the glass
+// its light came through passes, times its exposure.
 uniform highp sampler2DArray uParts;
 uniform int uPartCount;
 uniform vec3 uFactorA[16];
@@ -344,26 +346,60 @@ vec3 cubeView(vec3 v) {
 void main() {
   int x = int(gl_FragCoord.x);
   int y = uHeight - 1 - int(gl_FragCoord.y);
-  vec4 tr = texelFetch(uTrans, ivec2(x, y), 0);
   vec4 m = texelFetch(uMask, ivec2(x, y), 0);
   int slot = int(m.r + 0.5) - 1;
   int plane = int(m.g + 0.5);
   bool glass = slot >= 0 && plane < uPlanes;
   bool useB = uAB == 1 || (uAB == 2 && float(x) >= uSplitX);
-  vec3 rfParts = vec3(0.0);
+  // A unit on a plane with pane-group passes reflects once per group (docs/viewer.md, "Units
+  // and their ghosts"): the uRefl layer of each of its groups' reflections, a group without a
+  // pass of its own taking the deepest nearer group's (as compose folds it).
+  int n = 1;
+  ivec3 layer = ivec3(plane);
+  if (glass) {
+    n = useB ? groupCount(uLutB, slot) : groupCount(uLutA, slot);
+    ivec2 gls = uGroupLayer[plane];
+    if (n > 1 && (gls.x >= 0 || gls.y >= 0)) {
+      layer.y = gls.x >= 0 ? gls.x : layer.x;
+      layer.z = gls.y >= 0 ? gls.y : layer.y;
+    } else {
+      n = 1;
+    }
+  }
+  bool ghosts = n > 1;
+  // The transmission and each group's reflection: the passes, or with light parts
+  // Σ_p f_p·pass_p (the composite is linear in the passes).
+  vec3 tr = vec3(0.0);
+  float alpha = 1.0;
+  vec3 rf0 = vec3(0.0);
+  vec3 rf1 = vec3(0.0);
+  vec3 rf2 = vec3(0.0);
   if (uPartCount > 0) {
-    // Σ_p f_p·trans_p and Σ_p f_p·refl_p: the composite is linear in the passes.
-    vec3 trParts = vec3(0.0);
-    int per = 1 + uPlanes;
+    int per = 1 + uPlanes + uGroups;
     for (int p = 0; p < 16; p++) {
       if (p >= uPartCount) break;
       vec3 f = useB ? uFactorB[p] : uFactorA[p];
-      trParts += f * texelFetch(uParts, ivec3(x, y, p * per), 0).rgb;
-      if (glass) rfParts += f * texelFetch(uParts, ivec3(x, y, p * per + 1 + plane), 0).rgb;
+      int base = p * per + 1;
+      tr += f * texelFetch(uParts, ivec3(x, y, base - 1), 0).rgb;
+      if (glass) {
+        rf0 += f * texelFetch(uParts, ivec3(x, y, base + layer.x), 0).rgb;
+        if (ghosts && layer.y != layer.x) rf1 += f * texelFetch(uParts, ivec3(x, y, base + layer.y), 0).rgb;
+        if (n > 2 && layer.z != layer.y) rf2 += f * texelFetch(uParts, ivec3(x, y, base + layer.z), 0).rgb;
+      }
     }
-    tr = vec4(trParts, 1.0);
+  } else {
+    vec4 t4 = texelFetch(uTrans, ivec2(x, y), 0);
+    tr = t4.rgb;
+    alpha = t4.a;
+    if (glass) {
+      rf0 = texelFetch(uRefl, ivec3(x, y, layer.x), 0).rgb;
+      if (ghosts && layer.y != layer.x) rf1 = texelFetch(uRefl, ivec3(x, y, layer.y), 0).rgb;
+      if (n > 2 && layer.z != layer.y) rf2 = texelFetch(uRefl, ivec3(x, y, layer.z), 0).rgb;
+    }
   }
-  vec3 col = tr.rgb;
+  if (layer.y == layer.x) rf1 = rf0;
+  if (layer.z == layer.y) rf2 = rf1;
+  vec3 col = tr;
   if (glass) {
     vec3 r;
     vec3 t;
@@ -374,30 +410,23 @@ void main() {
     }
     float k = m.a;
     t = 1.0 - k + k * t;
-    r = r * k;
-    vec3 rf = uPartCount > 0 ? rfParts : texelFetch(uRefl, ivec3(x, y, plane), 0).rgb;
-    int n = useB ? groupCount(uLutB, slot) : groupCount(uLutA, slot);
-    ivec2 gls = uGroupLayer[plane];
-    if (n > 1 && (gls.x >= 0 || gls.y >= 0)) {
-      // A unit: Σ_g refl_g · r_g (docs/viewer.md, "Units and their ghosts").
+    if (ghosts) {
+      // Σ_g refl_g · r_g, in compose's order.
       vec3 sum = vec3(0.0);
-      int layer = -1;
       for (int g = 0; g < GROUPS; g++) {
         if (g >= n) break;
-        int own = g == 1 ? gls.x : (g == 2 ? gls.y : -1);
-        if (own >= 0) layer = own;
         vec3 s = useB ? share(uLutB, slot, uSide[plane], g, m.b) : share(uLutA, slot, uSide[plane], g, m.b);
-        vec3 pass = layer >= 0 ? texelFetch(uRefl, ivec3(x, y, layer), 0).rgb : rf;
+        vec3 pass = g == 0 ? rf0 : (g == 1 ? rf1 : rf2);
         sum += pass * (s * k);
       }
-      col = tr.rgb * t + sum;
+      col = tr * t + sum;
     } else {
-      col = tr.rgb * t + rf * r;
+      col = tr * t + rf0 * (r * k);
     }
   }
   col *= uGain;
   if (uConvert && uView == 0) col = uDisplay * col;
-  if (tr.a > 0.0) col /= tr.a;
+  if (alpha > 0.0) col /= alpha;
   if (uView == 0) {
     outColor = vec4(srgb(col), 1.0);
   } else {
@@ -665,6 +694,7 @@ void main() {
         if (g.plane < 64 && g.group >= 1 && g.group <= 2) layers[g.plane * 2 + g.group - 1] = scene.planes + j;
       });
       gl.uniform2iv(u('uGroupLayer'), layers);
+      gl.uniform1i(u('uGroups'), groups.length);
       if (data.info.groupsFolded) status('frame ' + i + ': ' + data.info.groupsFolded, false);
       gl.bindTexture(gl.TEXTURE_2D, maskTex);
       gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.FLOAT, data.mask);
@@ -672,9 +702,15 @@ void main() {
       gl.uniform1iv(u('uSide'), Int32Array.from({ length: 64 }, (_, k) => data.info.plane_sides[k] === 'back' ? 1 : 0));
       if (data.info.parts.length > 16) throw new Error('frame ' + i + ': ' + data.info.parts.length + ' light parts; the page shows at most 16');
       if (data.info.parts.length) {
+        // Per part: its transmission, each plane's reflection, each pane group's.
+        const depth = data.info.parts.length * (1 + scene.planes + groups.length);
+        const most = gl.getParameter(gl.MAX_ARRAY_TEXTURE_LAYERS);
+        if (depth > most) {
+          throw new Error('frame ' + i + ': ' + data.info.parts.length + ' light parts × ' + (1 + scene.planes + groups.length)
+            + ' passes are ' + depth + ' texture layers; this browser holds ' + most);
+        }
         gl.bindTexture(gl.TEXTURE_2D_ARRAY, partsTex);
-        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, W, H, data.info.parts.length * (1 + scene.planes), 0, gl.RGBA,
-          gl.HALF_FLOAT, data.parts);
+        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, W, H, depth, 0, gl.RGBA, gl.HALF_FLOAT, data.parts);
       }
       state.frame = i;
       state.data = data;
