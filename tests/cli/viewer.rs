@@ -1520,7 +1520,7 @@ fn unit_requests_are_checked_and_only_the_page_may_send_them() {
     let (code, body) = post_reply(u, "/api/unit", good);
     assert_eq!(code, 200, "{body:.300}");
     let built: serde_json::Value = serde_json::from_str(&body).unwrap();
-    assert_eq!(built["format"], "glassdb-viewer-page/3");
+    assert_eq!(built["format"], "glassdb-viewer-page/4");
     assert_eq!(
         built["product"]["unit"]["elements"][1]["gas"], "argon",
         "{body:.600}"

@@ -77,14 +77,14 @@
     return scene;
   }
 
-  // `parts`: the light parts' passes, part after part, each laid out as `passes` (empty without
-  // a light-path split).
+  // `parts`: the light parts' passes, part after part, packed (data.rs, part_bytes; empty
+  // without a light-path split).
   // `passes`: the transmission, each plane's reflection, then each pane group's (`groups`:
   // {plane, group}, in that order; `groups_folded`: why a frame's groups are not apart).
   function readFrame(info, passes, mask, parts) {
     return { info: { ids: info.ids, trans: info.trans, plane_sides: info.plane_sides, parts: info.parts || [],
       groups: info.groups || [], groupsFolded: info.groups_folded || null }, passes, mask,
-      parts: parts || new Uint16Array(0) };
+      parts: parts || new Uint32Array(0) };
   }
 
   // A unit the server built (POST api/unit): its product and its table.
@@ -101,7 +101,7 @@
       if (!EXPORT.frames[i]) await loadScript(window.GLASSDB_EXPORT_FRAME_FILES[i]);
       const f = EXPORT.frames[i];
       return readFrame(f.info, new Uint16Array(await packedBytes(f.passes, 2)), new Float32Array(await packedBytes(f.mask, 4)),
-        f.parts ? new Uint16Array(await packedBytes(f.parts, 2)) : undefined);
+        f.parts ? new Uint32Array(await packedBytes(f.parts, 4)) : undefined);
     },
   } : {
     scene: async () => readScene(await fetchOk('api/scene', 'json')),
@@ -117,7 +117,7 @@
       const info = await fetchOk('api/frame/' + i, 'json');
       const passes = await fetchOk('api/frame/' + i + '/passes');
       const mask = await fetchOk('api/frame/' + i + '/mask');
-      const parts = info.parts && info.parts.length ? new Uint16Array(await fetchOk('api/frame/' + i + '/parts')) : undefined;
+      const parts = info.parts && info.parts.length ? new Uint32Array(await fetchOk('api/frame/' + i + '/parts')) : undefined;
       return readFrame(info, new Uint16Array(passes), new Float32Array(mask), parts);
     },
   };
@@ -209,7 +209,6 @@ uniform int uSide[64];  // 0 front, 1 back, per plane
 // Per plane: the uRefl layer of its pane groups 1 and 2 (-1: none; the group's share then
 // goes to the deepest nearer group's pass, as compose folds it).
 uniform ivec2 uGroupLayer[64];
-uniform int uGroups;    // the frame's pane-group passes (uRefl layers after the planes')
 uniform float uGain;    // 2^ev
 uniform bool uConvert;
 uniform mat3 uDisplay;  // passes' space to linear Rec.709
@@ -226,10 +225,12 @@ uniform vec3 uShaperOffset;
 uniform int uCubeN;
 uniform vec3 uCubeScale;
 uniform vec3 uCubeOffset;
-// The relit swap (docs/viewer.md): each light part's passes (transmission, each plane's
-// reflection, then each pane group's, part after part) and its factor per set: what the glass
-// its light came through passes, times its exposure.
-uniform highp sampler2DArray uParts;
+// The relit swap (docs/viewer.md): each light part's passes, part after part, packed as
+// halves (crates/view/src/data.rs, part_bytes: the transmission and the pixel's plane's
+// reflection in one texel, its pane groups' in a second), and its factor per set: what the
+// glass its light came through passes, times its exposure.
+uniform highp usampler2DArray uParts;
+uniform int uPartLayers; // layers per part: 1, or 2 with pane-group passes
 uniform int uPartCount;
 uniform vec3 uFactorA[16];
 uniform vec3 uFactorB[16];
@@ -356,15 +357,11 @@ void main() {
   // pass of its own taking the deepest nearer group's (as compose folds it).
   int n = 1;
   ivec3 layer = ivec3(plane);
-  if (glass) {
+  ivec2 gls = glass ? uGroupLayer[plane] : ivec2(-1);
+  if (gls.x >= 0 || gls.y >= 0) {
     n = useB ? groupCount(uLutB, slot) : groupCount(uLutA, slot);
-    ivec2 gls = uGroupLayer[plane];
-    if (n > 1 && (gls.x >= 0 || gls.y >= 0)) {
-      layer.y = gls.x >= 0 ? gls.x : layer.x;
-      layer.z = gls.y >= 0 ? gls.y : layer.y;
-    } else {
-      n = 1;
-    }
+    layer.y = gls.x >= 0 ? gls.x : layer.x;
+    layer.z = gls.y >= 0 ? gls.y : layer.y;
   }
   bool ghosts = n > 1;
   // The transmission and each group's reflection: the passes, or with light parts
@@ -375,16 +372,21 @@ void main() {
   vec3 rf1 = vec3(0.0);
   vec3 rf2 = vec3(0.0);
   if (uPartCount > 0) {
-    int per = 1 + uPlanes + uGroups;
     for (int p = 0; p < 16; p++) {
       if (p >= uPartCount) break;
       vec3 f = useB ? uFactorB[p] : uFactorA[p];
-      int base = p * per + 1;
-      tr += f * texelFetch(uParts, ivec3(x, y, base - 1), 0).rgb;
+      uvec4 a = texelFetch(uParts, ivec3(x, y, p * uPartLayers), 0);
+      vec2 a0 = unpackHalf2x16(a.x);
+      vec2 a1 = unpackHalf2x16(a.y);
+      tr += f * vec3(a0, a1.x);
       if (glass) {
-        rf0 += f * texelFetch(uParts, ivec3(x, y, base + layer.x), 0).rgb;
-        if (ghosts && layer.y != layer.x) rf1 += f * texelFetch(uParts, ivec3(x, y, base + layer.y), 0).rgb;
-        if (n > 2 && layer.z != layer.y) rf2 += f * texelFetch(uParts, ivec3(x, y, base + layer.z), 0).rgb;
+        rf0 += f * vec3(a1.y, unpackHalf2x16(a.z));
+        if (ghosts) {
+          uvec4 b = texelFetch(uParts, ivec3(x, y, p * uPartLayers + 1), 0);
+          vec2 b1 = unpackHalf2x16(b.y);
+          if (layer.y != layer.x) rf1 += f * vec3(unpackHalf2x16(b.x), b1.x);
+          if (n > 2 && layer.z != layer.y) rf2 += f * vec3(b1.y, unpackHalf2x16(b.z));
+        }
       }
     }
   } else {
@@ -549,7 +551,7 @@ void main() {
     }
     const partsTex = texture(gl, gl.TEXTURE_2D_ARRAY);
     // Complete from the start (one texel) until a frame's light parts replace it.
-    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, 1, 1, 1, 0, gl.RGBA, gl.HALF_FLOAT, new Uint16Array(4));
+    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, 1, 1, 1, 0, gl.RGBA_INTEGER, gl.UNSIGNED_INT, new Uint32Array(4));
     const units = [['uTrans', gl.TEXTURE_2D, transTex], ['uRefl', gl.TEXTURE_2D_ARRAY, reflTex],
       ['uMask', gl.TEXTURE_2D, maskTex], ['uLutA', gl.TEXTURE_2D, lutTex.A], ['uLutB', gl.TEXTURE_2D, lutTex.B],
       ['uShaper', gl.TEXTURE_2D, shaperTex], ['uCube', gl.TEXTURE_3D, cubeTex], ['uParts', gl.TEXTURE_2D_ARRAY, partsTex]];
@@ -694,7 +696,6 @@ void main() {
         if (g.plane < 64 && g.group >= 1 && g.group <= 2) layers[g.plane * 2 + g.group - 1] = scene.planes + j;
       });
       gl.uniform2iv(u('uGroupLayer'), layers);
-      gl.uniform1i(u('uGroups'), groups.length);
       if (data.info.groupsFolded) status('frame ' + i + ': ' + data.info.groupsFolded, false);
       gl.bindTexture(gl.TEXTURE_2D, maskTex);
       gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.FLOAT, data.mask);
@@ -702,15 +703,12 @@ void main() {
       gl.uniform1iv(u('uSide'), Int32Array.from({ length: 64 }, (_, k) => data.info.plane_sides[k] === 'back' ? 1 : 0));
       if (data.info.parts.length > 16) throw new Error('frame ' + i + ': ' + data.info.parts.length + ' light parts; the page shows at most 16');
       if (data.info.parts.length) {
-        // Per part: its transmission, each plane's reflection, each pane group's.
-        const depth = data.info.parts.length * (1 + scene.planes + groups.length);
-        const most = gl.getParameter(gl.MAX_ARRAY_TEXTURE_LAYERS);
-        if (depth > most) {
-          throw new Error('frame ' + i + ': ' + data.info.parts.length + ' light parts × ' + (1 + scene.planes + groups.length)
-            + ' passes are ' + depth + ' texture layers; this browser holds ' + most);
-        }
+        // Per part: its transmission and each pixel's plane's reflection, then its pane groups'.
+        const per = groups.length ? 2 : 1;
+        gl.uniform1i(u('uPartLayers'), per);
         gl.bindTexture(gl.TEXTURE_2D_ARRAY, partsTex);
-        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, W, H, depth, 0, gl.RGBA, gl.HALF_FLOAT, data.parts);
+        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, W, H, data.info.parts.length * per, 0, gl.RGBA_INTEGER,
+          gl.UNSIGNED_INT, data.parts);
       }
       state.frame = i;
       state.data = data;

@@ -48,8 +48,8 @@ pub struct PagePart {
 /// (each pass read as that part's layer, [`LightMix`] of one part, as
 /// [`glassdb_compose::compose_light_parts`] reads them; [`glassdb_compose::part_passes`] checks
 /// them against the record), one part at a time, and its [`PagePart`]. A part's passes are the
-/// transmission, each plane's reflection, then each pane group's that `data` composites apart
-/// (`PageFrame::groups`), laid out as `data`'s passes.
+/// transmission, each pixel's plane's reflection and, where `data` composites pane groups apart
+/// (`PageFrame::groups`), its groups' ([`data::part_bytes`]).
 pub fn with_parts(
     mut data: FrameData,
     frame: &ViewerFrame,
@@ -76,7 +76,7 @@ pub fn with_parts(
         },
         ..frame.files.clone()
     };
-    let mut bytes = Vec::with_capacity(data.passes.len() * parts.parts.len());
+    let mut bytes = Vec::new();
     let mut page = Vec::new();
     for name in names {
         let mut one = settings.clone();
@@ -106,10 +106,7 @@ pub fn with_parts(
                 .map(|(part, f)| page_part(part, f.kind, f.factor))
                 .collect();
         }
-        bytes.extend(data::pass_bytes(&decoded));
-        if groups_apart {
-            bytes.extend(data::group_pass_bytes(&decoded));
-        }
+        bytes.extend(data::part_bytes(&decoded, groups_apart));
     }
     data.parts = bytes;
     data.info.parts = page;
