@@ -93,8 +93,8 @@ pub struct FrameData {
     pub passes: Vec<u8>,
     /// The mask ([`data::mask_bytes`]).
     pub mask: Vec<u8>,
-    /// The light parts' passes, part after part, each as [`FrameData::passes`] (empty without
-    /// light parts; [`crate::relight`]).
+    /// The light parts' passes, part after part, each packed by [`data::part_bytes`] (empty
+    /// without light parts; [`crate::relight`]).
     pub parts: Vec<u8>,
 }
 
