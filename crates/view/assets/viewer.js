@@ -190,7 +190,10 @@ void main() {
   gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
 }`;
 
-  function fragmentSource(lut) {
+  // `relit`: with the light parts' loop (a frame with light parts); without it, the plain
+  // shader, which SwiftShader runs faster even though the loop's uniform branch is not taken
+  // (docs/performance.md, "Relit swap").
+  function fragmentSource(lut, relit) {
     return `#version 300 es
 precision highp float;
 precision highp int;
@@ -371,7 +374,7 @@ void main() {
   vec3 rf0 = vec3(0.0);
   vec3 rf1 = vec3(0.0);
   vec3 rf2 = vec3(0.0);
-  if (uPartCount > 0) {
+  if (${relit ? 'uPartCount > 0' : 'false'}) {
     for (int p = 0; p < 16; p++) {
       if (p >= uPartCount) break;
       vec3 f = useB ? uFactorB[p] : uFactorA[p];
@@ -519,14 +522,28 @@ void main() {
     const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false, alpha: false });
     if (!gl) throw new Error('this browser has no WebGL2');
     if (scene.planes > 64) throw new Error('the page handles at most 64 planes');
-    const program = gl.createProgram();
-    gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX));
-    gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragmentSource(lutLayout)));
-    gl.linkProgram(program);
-    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
-    gl.useProgram(program);
+    // Two programs: the plain shader, and the relit one for frames with light parts; every
+    // uniform is set on both (`uni`), and a draw uses the frame's.
+    const programs = [false, true].map((relit) => {
+      const program = gl.createProgram();
+      gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX));
+      gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragmentSource(lutLayout, relit)));
+      gl.linkProgram(program);
+      if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
+      return program;
+    });
     gl.bindVertexArray(gl.createVertexArray());
-    const u = (name) => gl.getUniformLocation(program, name);
+    const locations = programs.map(() => new Map());
+    function uni(fn, name, ...args) {
+      programs.forEach((program, k) => {
+        if (!locations[k].has(name)) locations[k].set(name, gl.getUniformLocation(program, name));
+        const at = locations[k].get(name);
+        if (at !== null) {
+          gl.useProgram(program);
+          gl[fn](at, ...args);
+        }
+      });
+    }
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
 
     const transTex = texture(gl, gl.TEXTURE_2D);
@@ -559,7 +576,7 @@ void main() {
     units.forEach(([name, target, tex], i) => {
       gl.activeTexture(gl.TEXTURE0 + i);
       gl.bindTexture(target, tex);
-      gl.uniform1i(u(name), i);
+      uni('uniform1i', name, i);
     });
     // Texture units: one per sampler, then an idle one that uploads bind to.
     gl.activeTexture(gl.TEXTURE0 + units.length);
@@ -568,36 +585,36 @@ void main() {
     async function setView(i) {
       if (i >= 0 && !viewTables[i]) viewTables[i] = await source.view(i);
       const v = scene.views[i];
-      gl.uniform1i(u('uView'), v ? 1 : 0);
+      uni('uniform1i', 'uView', v ? 1 : 0);
       if (v) {
         const data = viewTables[i];
         const shaperFloats = v.shaper ? v.shaper.rows * lutLayout.width * 3 : 0;
-        gl.uniform1i(u('uHasShaper'), v.shaper ? 1 : 0);
-        gl.uniform1i(u('uHasCube'), v.cube ? 1 : 0);
+        uni('uniform1i', 'uHasShaper', v.shaper ? 1 : 0);
+        uni('uniform1i', 'uHasCube', v.cube ? 1 : 0);
         if (v.shaper) {
           gl.activeTexture(gl.TEXTURE0 + unitOf('uShaper'));
           gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, lutLayout.width, v.shaper.rows, 0, gl.RGB, gl.FLOAT, data.subarray(0, shaperFloats));
-          gl.uniform1i(u('uShaperLen'), v.shaper.len);
-          gl.uniform3fv(u('uShaperScale'), v.shaper.scale);
-          gl.uniform3fv(u('uShaperOffset'), v.shaper.offset);
+          uni('uniform1i', 'uShaperLen', v.shaper.len);
+          uni('uniform3fv', 'uShaperScale', v.shaper.scale);
+          uni('uniform3fv', 'uShaperOffset', v.shaper.offset);
         }
         if (v.cube) {
           const n = v.cube.n;
           gl.activeTexture(gl.TEXTURE0 + unitOf('uCube'));
           gl.texImage3D(gl.TEXTURE_3D, 0, gl.RGB32F, n, n, n, 0, gl.RGB, gl.FLOAT, data.subarray(shaperFloats, shaperFloats + n * n * n * 3));
-          gl.uniform1i(u('uCubeN'), n);
-          gl.uniform3fv(u('uCubeScale'), v.cube.scale);
-          gl.uniform3fv(u('uCubeOffset'), v.cube.offset);
+          uni('uniform1i', 'uCubeN', n);
+          uni('uniform3fv', 'uCubeScale', v.cube.scale);
+          uni('uniform3fv', 'uCubeOffset', v.cube.offset);
         }
         gl.activeTexture(gl.TEXTURE0 + units.length);
       }
       state.view = i;
     }
-    gl.uniform1i(u('uHeight'), H);
-    gl.uniform1i(u('uMode'), { code8: 0, cos: 1, normal: 2 }[scene.mask_mode]);
-    gl.uniform1i(u('uPlanes'), scene.planes);
-    gl.uniform1i(u('uConvert'), scene.display_matrix ? 1 : 0);
-    gl.uniformMatrix3fv(u('uDisplay'), true, scene.display_matrix || [1, 0, 0, 0, 1, 0, 0, 0, 1]);
+    uni('uniform1i', 'uHeight', H);
+    uni('uniform1i', 'uMode', { code8: 0, cos: 1, normal: 2 }[scene.mask_mode]);
+    uni('uniform1i', 'uPlanes', scene.planes);
+    uni('uniform1i', 'uConvert', scene.display_matrix ? 1 : 0);
+    uni('uniformMatrix3fv', 'uDisplay', true, scene.display_matrix || [1, 0, 0, 0, 1, 0, 0, 0, 1]);
 
     // Every product's table, on the CPU (a swap then uploads one slot's rows and nothing else).
     const luts = await source.luts(products.length);
@@ -642,10 +659,11 @@ void main() {
     }
 
     function draw() {
-      gl.uniform1f(u('uGain'), Math.pow(2, state.ev));
-      gl.uniform1i(u('uAB'), { A: 0, B: 1, split: 2 }[state.ab] ?? 0);
-      gl.uniform1f(u('uSplitX'), state.split * W);
+      uni('uniform1f', 'uGain', Math.pow(2, state.ev));
+      uni('uniform1i', 'uAB', { A: 0, B: 1, split: 2 }[state.ab] ?? 0);
+      uni('uniform1f', 'uSplitX', state.split * W);
       gl.viewport(0, 0, W, H);
+      gl.useProgram(programs[state.data && state.data.info.parts.length ? 1 : 0]);
       gl.drawArrays(gl.TRIANGLES, 0, 3);
       placeSplitLine();
       state.drawn += 1;
@@ -695,17 +713,17 @@ void main() {
       groups.forEach((g, j) => {
         if (g.plane < 64 && g.group >= 1 && g.group <= 2) layers[g.plane * 2 + g.group - 1] = scene.planes + j;
       });
-      gl.uniform2iv(u('uGroupLayer'), layers);
+      uni('uniform2iv', 'uGroupLayer', layers);
       if (data.info.groupsFolded) status('frame ' + i + ': ' + data.info.groupsFolded, false);
       gl.bindTexture(gl.TEXTURE_2D, maskTex);
       gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.FLOAT, data.mask);
       // The side of each plane the camera sees in this frame (it may change as the camera moves).
-      gl.uniform1iv(u('uSide'), Int32Array.from({ length: 64 }, (_, k) => data.info.plane_sides[k] === 'back' ? 1 : 0));
+      uni('uniform1iv', 'uSide', Int32Array.from({ length: 64 }, (_, k) => data.info.plane_sides[k] === 'back' ? 1 : 0));
       if (data.info.parts.length > 16) throw new Error('frame ' + i + ': ' + data.info.parts.length + ' light parts; the page shows at most 16');
       if (data.info.parts.length) {
         // Per part: its transmission and each pixel's plane's reflection, then its pane groups'.
         const per = groups.length ? 2 : 1;
-        gl.uniform1i(u('uPartLayers'), per);
+        uni('uniform1i', 'uPartLayers', per);
         gl.bindTexture(gl.TEXTURE_2D_ARRAY, partsTex);
         gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, W, H, data.info.parts.length * per, 0, gl.RGBA_INTEGER,
           gl.UNSIGNED_INT, data.parts);
@@ -750,12 +768,12 @@ void main() {
     // The factors of the frame's parts for both sets, as the shader's uniforms.
     function setFactors() {
       const parts = state.data ? state.data.info.parts : [];
-      gl.uniform1i(u('uPartCount'), parts.length);
+      uni('uniform1i', 'uPartCount', parts.length);
       if (!parts.length) return;
       for (const set of ['A', 'B']) {
         const v = new Float32Array(16 * 3);
         parts.forEach((part, i) => v.set(partFactor(part, set), 3 * i));
-        gl.uniform3fv(u(set === 'A' ? 'uFactorA' : 'uFactorB'), v);
+        uni('uniform3fv', set === 'A' ? 'uFactorA' : 'uFactorB', v);
       }
     }
 
