@@ -235,9 +235,12 @@ def build():
              mats["Oak"] if k == 0 else mats["Concrete"])
         quad("Ceiling_%d" % k, [(inner, inner, g1), (inner, -0.05, g1), (-0.05, -0.05, g1),
                                 (-0.05, inner, g1)], mats["Plaster"])
-        # The back walls of each storey, 7 m in.
+        # The back walls of each storey, 7 m in, the whole length of each facade, and the
+        # walls that close each wing at its far end: every ray through the glass meets a room.
         box("Back_A%d" % k, (-LENGTH, -7.2, z_floor), (-0.05, -7.0, g1), mats["Plaster"])
-        box("Back_B%d" % k, (-7.2, -7.0, z_floor), (-7.0, -0.05, g1), mats["Teal" if k else "Plaster"])
+        box("Back_B%d" % k, (-7.2, -LENGTH, z_floor), (-7.0, -0.05, g1), mats["Teal" if k else "Plaster"])
+        box("End_A%d" % k, (-LENGTH - 0.2, -7.2, z_floor), (-LENGTH, 0.0, g1), mats["Plaster"])
+        box("End_B%d" % k, (-7.2, -LENGTH - 0.2, z_floor), (0.0, -LENGTH, g1), mats["Plaster"])
         for i, (x, y) in enumerate(((-3.0, -3.0), (-3.0, -6.0), (-6.0, -3.0), (-9.0, -3.0), (-3.0, -9.0))):
             box("Column_in_%d%d" % (k, i), (x - 0.2, y - 0.2, z_floor), (x + 0.2, y + 0.2, g1), mats["Concrete"])
         # The room's light: one large area lamp under each ceiling (Blender 3.4 samples one
