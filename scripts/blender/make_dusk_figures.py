@@ -11,8 +11,9 @@ difference between the two over the glass, as a heat map and its distribution.
 may be given as `A.exr+B.exr`, summed, e.g. groups composited one by one, and `FILE:LAYER`
 picks a layer).
 
-Writes `dusk_facade.png` (left: per-group tables, right: one D65 table; the `standard` view,
-sRGB transfer, clipped, as compose writes PNG), `dusk_delta_e.png` (ΔE00 per glass pixel, 0
+Writes `dusk_facade.png` (left: per-group tables, right: one D65 table; each resampled to 2/3
+of its size by area in linear light, then the `standard` view, sRGB transfer, clipped, as
+compose writes PNG), `dusk_delta_e.png` (ΔE00 over the glass, at 2/3 of the size too, 0
 black through purple and orange to 4 and more pale yellow, a scale bar at the bottom in steps
 of 1; the frame outside the glass dimmed grey), and prints (and with --json writes) ΔE00's
 median, 95th percentile, maximum and mean over the glass pixels of full coverage, per glass id
@@ -82,6 +83,24 @@ def standard_view(linear):
     return np.round(enc * 255).astype(np.uint8)
 
 
+def two_thirds(img):
+    """Area resampling to 2/3 of the size in each direction (linear light): every 3 × 3 block
+    of pixels becomes 2 × 2, each output pixel the area-weighted mean of the 1.5 × 1.5 input
+    pixels it covers. Odd rows or columns left over at the edges are cut."""
+    h, w = (img.shape[0] // 3) * 3, (img.shape[1] // 3) * 3
+    img = img[:h, :w]
+
+    def axis(a, k):
+        a = np.moveaxis(a, k, 0)
+        a0, a1, a2 = a[0::3], a[1::3], a[2::3]
+        out = np.empty((2 * a0.shape[0],) + a0.shape[1:])
+        out[0::2] = (2 * a0 + a1) / 3
+        out[1::2] = (a1 + 2 * a2) / 3
+        return np.moveaxis(out, 0, k)
+
+    return axis(axis(img, 0), 1)
+
+
 def lab(linear):
     xyz = linear @ REC709_TO_XYZ.T
     return colour.XYZ_to_Lab(xyz, D65_XY)
@@ -134,13 +153,20 @@ def main():
     report["outside the glass (max)"] = round(float(np.abs(per_group - one_table)[~(ids > 0)].max()), 6)
 
     out = Path(args.out_dir)
-    gap = np.full((per_group.shape[0], 8, 3), 255, dtype=np.uint8)
+    small = [two_thirds(per_group), two_thirds(one_table)]
+    gap = np.full((small[0].shape[0], 6, 3), 255, dtype=np.uint8)
     write_png_rgb8(str(out / "dusk_facade.png"),
-                   np.concatenate([standard_view(per_group), gap, standard_view(one_table)], axis=1))
+                   np.concatenate([standard_view(small[0]), gap, standard_view(small[1])], axis=1))
 
-    grey = standard_view(0.25 * (per_group @ REC709_TO_XYZ[1])[..., None].repeat(3, axis=-1))
-    img = np.where(glass[..., None], heat(de), grey)
-    h, w = de.shape
+    # At 2/3 of the size too: ΔE00 averaged by area, a pixel shown as glass where most of
+    # the pixels it covers are.
+    grey = standard_view(0.25 * (two_thirds(per_group) @ REC709_TO_XYZ[1])[..., None].repeat(3, axis=-1))
+    shown = two_thirds(glass.astype(np.float64)[..., None])[..., 0] >= 0.5
+    de_small = two_thirds(np.where(glass, de, 0.0)[..., None])[..., 0]
+    weight = two_thirds(glass.astype(np.float64)[..., None])[..., 0]
+    de_small = np.where(weight > 0, de_small / np.maximum(weight, 1e-12), 0.0)
+    img = np.where(shown[..., None], heat(de_small), grey)
+    h, w = de_small.shape
     bar_h = max(12, h // 30)
     ramp = np.linspace(0.0, SCALE_MAX, w)[None, :].repeat(bar_h, axis=0)
     bar = heat(ramp)

@@ -5,7 +5,11 @@ without changing a pixel that compose reads:
 - every pass (trans, refl_K, refl_K_G of frame 1) keeps only its light-group layers
   `<prefix>Combined_<group>.R/G/B` (the beauty `Combined` is their sum and compose does not
   read it with --light-groups; alpha is dropped), as half floats, ZIP, with its data window
-  (a reflection pass stays cropped where the run cropped it) and display window;
+  (a reflection pass stays cropped where the run cropped it) and display window; in a
+  reflection pass of plane K, the pixels that are not glass of plane K in the mask (mullions,
+  spandrels, the other facade inside its rectangle) are zeroed, since compose reads a
+  reflection pass on its plane's glass pixels only (the composite is the same, bit for bit, and
+  zeros compress);
 - the mask keeps its channels (id, cos_theta, plane, coverage) as half floats (ids and planes
   exact; cos θ within 2.5e-4, the half spacing below 1 halved; an eighth of the float file);
 - planes.json is copied (compose reads each plane's side from it), its `source` made the
@@ -44,7 +48,7 @@ def fail(message):
 def read(path):
     with OpenEXR.File(path, separate_channels=True) as f:
         header = dict(f.header())
-        channels = {name: ch.pixels for name, ch in f.channels().items()}
+        channels = {name: np.array(ch.pixels) for name, ch in f.channels().items()}
     return header, channels
 
 
@@ -94,6 +98,18 @@ def one_group(path, group):
     return header, kept
 
 
+def zero_off_plane(kept, header, plane, ids, planes):
+    """Zeroes the samples of a reflection pass of `plane` where the mask has no glass of that
+    plane (the pass's data window placed in the mask's frame)."""
+    x0, y0, x1, y1 = window(header)
+    (dx0, dy0), _ = header["displayWindow"]
+    rows = slice(y0 - int(dy0), y1 - int(dy0) + 1)
+    cols = slice(x0 - int(dx0), x1 - int(dx0) + 1)
+    off = (ids[rows, cols] == 0) | (planes[rows, cols] != plane)
+    for name in kept:
+        kept[name] = np.where(off, np.float16(0.0), kept[name])
+
+
 def frame_of(run):
     with open(os.path.join(run, "glassdb-blender.json")) as fh:
         return json.load(fh)["frames"][0]
@@ -138,6 +154,9 @@ def main(argv):
             fail("%s's passes or windows differ from %s's" % (run, first))
         if open(os.path.join(run, other["mask"]), "rb").read() != mask_bytes:
             fail("%s's mask differs from %s's" % (run, first))
+    mask_header, mask = read(os.path.join(first, frame["mask"]))
+    ids, planes = np.asarray(mask["id"]), np.asarray(mask["plane"])
+    plane_of = {dst: int(dst.split("_")[1].split(".")[0]) for _, dst in pass_files(frame) if dst.startswith("refl_")}
     total, groups_seen = 0, None
     for src, dst in pass_files(frame):
         if runs[0][0] is None:
@@ -151,6 +170,8 @@ def main(argv):
                 elif window(header_k) != window(header):
                     fail("%s/%s's data window differs from %s's" % (run, src, first))
                 kept.update(layer)
+        if dst in plane_of:
+            zero_off_plane(kept, header, plane_of[dst], ids, planes)
         if groups_seen is None:
             groups_seen = groups
         elif groups != groups_seen:
@@ -158,7 +179,7 @@ def main(argv):
         size = write(os.path.join(out, dst), header, kept)
         total += size
         print("%s <- %s: %d bytes" % (dst, src, size))
-    header, channels = read(os.path.join(first, frame["mask"]))
+    header, channels = mask_header, mask
     channels = {k: np.ascontiguousarray(v, dtype=np.float16) for k, v in channels.items()}
     ids = np.rint(channels["id"].astype(np.float64))
     if np.any(ids != channels["id"]) or np.any(ids > 2048):
