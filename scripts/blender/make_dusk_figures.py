@@ -28,13 +28,14 @@ Licence: same as the project, MIT OR Apache-2.0.
 
 import argparse
 import json
-import struct
 import sys
-import zlib
 from pathlib import Path
 
 import numpy as np
 import OpenEXR
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python_oracle"))
+from exr_oracle import write_png_rgb8  # noqa: E402
 
 import colour  # noqa: E402
 
@@ -74,35 +75,6 @@ def rgb(spec):
             sys.exit("%s has no RGB (bare or ViewLayer.Combined): %s" % (path, sorted(chans)))
         total = img if total is None else total + img
     return total
-
-
-def write_png_rgb8(path, rgb):
-    """An 8-bit RGB PNG with every row Paeth-filtered (PNG filter type 4), zlib level 9: a
-    rendered picture's noise compresses to about two thirds of the unfiltered size."""
-    height, width, _ = rgb.shape
-    x = rgb.reshape(height, width * 3).astype(np.int16)
-    a = np.zeros_like(x)
-    a[:, 3:] = x[:, :-3]
-    b = np.zeros_like(x)
-    b[1:] = x[:-1]
-    c = np.zeros_like(x)
-    c[1:, 3:] = x[:-1, :-3]
-    p = a + b - c
-    pa, pb, pc = np.abs(p - a), np.abs(p - b), np.abs(p - c)
-    pred = np.where((pa <= pb) & (pa <= pc), a, np.where(pb <= pc, b, c))
-    raw = np.empty((height, 1 + width * 3), dtype=np.uint8)
-    raw[:, 0] = 4
-    raw[:, 1:] = ((x - pred) % 256).astype(np.uint8)
-
-    def chunk(kind, body):
-        return (struct.pack(">I", len(body)) + kind + body
-                + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF))
-
-    png = (b"\x89PNG\r\n\x1a\n"
-           + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
-           + chunk(b"IDAT", zlib.compress(raw.tobytes(), 9))
-           + chunk(b"IEND", b""))
-    Path(path).write_bytes(png)
 
 
 def standard_view(linear):
@@ -183,8 +155,8 @@ def main():
     out = Path(args.out_dir)
     small = [two_thirds(per_group), two_thirds(one_table)]
     gap = np.full((small[0].shape[0], 6, 3), 255, dtype=np.uint8)
-    write_png_rgb8(str(out / "dusk_facade.png"),
-                   np.concatenate([standard_view(small[0]), gap, standard_view(small[1])], axis=1))
+    side_by_side = np.concatenate([standard_view(small[0]), gap, standard_view(small[1])], axis=1)
+    write_png_rgb8(str(out / "dusk_facade.png"), side_by_side, paeth=True)
 
     # At 2/3 of the size too: ΔE00 averaged by area, a pixel shown as glass where most of
     # the pixels it covers are.
@@ -201,7 +173,7 @@ def main():
     for k in range(int(SCALE_MAX) + 1):   # white ticks at every whole ΔE00
         x = min(w - 1, int(round(k / SCALE_MAX * (w - 1))))
         bar[: bar_h // 2, max(0, x - 1): x + 1] = 255
-    write_png_rgb8(str(out / "dusk_delta_e.png"), np.concatenate([img, bar], axis=0))
+    write_png_rgb8(str(out / "dusk_delta_e.png"), np.concatenate([img, bar], axis=0), paeth=True)
 
     text = json.dumps(report, indent=1)
     print(text)
