@@ -15,6 +15,7 @@ mod passes;
 pub mod pipeline;
 pub mod program;
 pub mod relit;
+pub mod scene_lights;
 pub mod swap;
 pub mod thin_pane;
 
