@@ -220,14 +220,14 @@ pub(crate) struct SplitPass {
 }
 
 /// A state's render: each group's R, G, B and the beauty's alpha.
-struct StateImage {
-    window: PixelWindow,
-    groups: Vec<[Vec<f32>; 3]>,
-    alpha: Vec<f32>,
+pub(crate) struct StateImage {
+    pub(crate) window: PixelWindow,
+    pub(crate) groups: Vec<[Vec<f32>; 3]>,
+    pub(crate) alpha: Vec<f32>,
 }
 
 /// Reads state `state` of `pass` with the light groups `groups`.
-fn read_state(pass: &Path, groups: &[String]) -> Result<StateImage, BlenderError> {
+pub(crate) fn read_state(pass: &Path, groups: &[String]) -> Result<StateImage, BlenderError> {
     let bad = |message: String| BlenderError::BadRender {
         path: pass.to_path_buf(),
         message,
@@ -389,10 +389,10 @@ fn parts_record(
 }
 
 /// A pass's parts (in the record's order) and alpha over `window`.
-struct Assembled {
-    window: PixelWindow,
-    parts: Vec<[Vec<f32>; 3]>,
-    alpha: Vec<f32>,
+pub(crate) struct Assembled {
+    pub(crate) window: PixelWindow,
+    pub(crate) parts: Vec<[Vec<f32>; 3]>,
+    pub(crate) alpha: Vec<f32>,
 }
 
 /// The parts of one pass: state 0's group for the unglazed part, state k's minus state 0's for
@@ -454,7 +454,7 @@ fn unused_pass(names: &[&str]) -> Assembled {
 }
 
 /// Writes `image` to `to` (atomically): a layer per part and the beauty, their sum.
-fn write_pass(
+pub(crate) fn write_pass(
     to: &Path,
     image: Assembled,
     names: &[&str],

@@ -205,7 +205,7 @@ pub fn render(
         progress.stage("render reference");
         let t = Instant::now();
         let cpu = children_cpu_seconds();
-        render_reference(&work, &record, job)?;
+        render_reference(&work, &record, job, registry)?;
         reference_s = t.elapsed().as_secs_f64();
         reference_cpu_s = cpu_since(cpu);
     }
@@ -468,12 +468,24 @@ fn write_record(
 }
 
 /// The Cycles reference: the same shader seen by the camera, no passes
-/// (`reference.####.exr`); `job` is the passes' job, whose settings it keeps.
+/// (`reference.####.exr`); `job` is the passes' job, whose settings it keeps. With the scene's
+/// light groups and a registry of several lights, one render per group with the glass of its
+/// light (`crate::reference_lights`).
 pub fn render_reference(
     work: &Workspace<'_>,
     record: &RunRecord,
     job: ScriptJob,
+    registry: &RegistryChoice,
 ) -> Result<(), BlenderError> {
+    let by_light = crate::reference_lights::panes_by_light(record, &job.glass, registry)?;
+    if !by_light.is_empty() {
+        let jobs = crate::reference_lights::jobs(&work.staging, record, &job, &by_light);
+        for (k, job) in jobs.iter().enumerate() {
+            let path = work.staging.join(format!("reference_job_{k}.json"));
+            run_job(work, &path, "reference", job)?;
+        }
+        return crate::reference_lights::assemble(&work.staging, &work.dir, record, &by_light);
+    }
     let job = ScriptJob {
         reference: true,
         frames: record
