@@ -557,4 +557,51 @@ mod tests {
         assert_eq!(record.parts[5].through.unwrap().id, 5);
         assert_eq!(record.parts[3].through, None);
     }
+
+    /// With the scene's light groups each source names its group, and its parts carry it as
+    /// their light; the kind, not the name, says what the source is.
+    #[test]
+    fn parts_of_scene_group_sources_carry_their_light() {
+        let source = |group: &str, kind, light: &str| ScriptSource {
+            group: group.into(),
+            kind,
+            light: Some(light.into()),
+        };
+        let lights = FrameLights {
+            suns: vec![SunLamp {
+                group: "sun0_sun".into(),
+                direction_to_sun: [0.0, 0.0, 1.0],
+            }],
+            sources: vec![
+                source("sun0_sun", SourceKind::Sun, "sun"),
+                source("sky_sun", SourceKind::Sky, "sun"),
+                source("other_warm", SourceKind::Other, "warm"),
+            ],
+        };
+        let aperture = ScriptAperture {
+            plane: 0,
+            id: 1,
+            equation: [0.0, 1.0, 0.0, -2.0],
+            tolerance: 1e-3,
+            materials: vec!["Glass".into()],
+        };
+        let record = parts_record(&lights, &[0, 2], &[aperture]).unwrap();
+        let said: Vec<(&str, Option<&str>, LightSource)> = record
+            .parts
+            .iter()
+            .map(|p| (p.group.as_str(), p.light.as_deref(), p.source))
+            .collect();
+        let sun = LightSource::Sun {
+            direction_to_sun: [0.0, 0.0, 1.0],
+        };
+        assert_eq!(
+            said,
+            [
+                ("sun0_sun", Some("sun"), sun),
+                ("sun0_sun_p0_id1", Some("sun"), sun),
+                ("other_warm", Some("warm"), LightSource::Other),
+                ("other_warm_p0_id1", Some("warm"), LightSource::Other),
+            ]
+        );
+    }
 }
