@@ -131,6 +131,104 @@ fn a_unit_composites_each_pane_groups_pass_with_its_share() {
     );
 }
 
+/// `compose --light-groups` reads each light group's own layer of the units' pane-group passes
+/// (issue 29 with issue 27): the composite is the sum of each group composited from files that
+/// hold its layers only, and the pane-group pass weighs in with each group's value.
+#[test]
+fn light_groups_read_each_groups_layer_of_the_pane_group_passes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let registry = d.join("lights.json");
+    ok(&mut crate::util::registry_build(
+        &crate::util::repo_path("data/catalog.toml"),
+        &registry,
+        &["--light", "sun=D65", "--light", "warm=A"],
+    ));
+    let (sun, warm) = ("ViewLayer.Combined_sun.", "ViewLayer.Combined_warm.");
+    // (file, sun's value, warm's value): the group pass's light differs from the plane pass's
+    let rendered = [
+        ("trans", 0.5, 0.125),
+        ("refl_0", 1.0, 0.5),
+        ("refl_0_1", 0.25, 2.0),
+    ];
+    let files = |name: &str, passes: &[(&str, f32, f32)], layers: &[(&str, usize)]| {
+        passes
+            .iter()
+            .map(|(pass, s, w)| {
+                let p = d.join(format!("{pass}_{name}.exr"));
+                let values: Vec<(&str, f32)> = layers
+                    .iter()
+                    .map(|&(prefix, k)| (prefix, if k == 0 { *s } else { *w }))
+                    .collect();
+                write_layers(&p, &values);
+                p
+            })
+            .collect::<Vec<PathBuf>>()
+    };
+    let compose_groups = |inputs: &[PathBuf], groups: &str, out: &Path| {
+        let mut c = compose();
+        c.arg("--registry").arg(&registry);
+        c.arg("--trans")
+            .arg(&inputs[0])
+            .arg("--refl")
+            .arg(&inputs[1]);
+        c.arg("--refl-group")
+            .arg(format!("0.1={}", inputs[2].display()));
+        c.arg("--mask").arg(unit_mask(d));
+        c.args(["--light-groups", groups, "--data-type", "float", "-o"])
+            .arg(out);
+        ok(&mut c);
+        beauty_g(out)
+    };
+    let both = compose_groups(
+        &files("both", &rendered, &[(sun, 0), (warm, 1)]),
+        "sun,warm",
+        &d.join("both.exr"),
+    );
+    let alone: Vec<[f64; 2]> = [("sun", sun, 0), ("warm", warm, 1)]
+        .iter()
+        .map(|&(group, prefix, k)| {
+            compose_groups(
+                &files(group, &rendered, &[(prefix, k)]),
+                group,
+                &d.join(format!("{group}.exr")),
+            )
+        })
+        .collect();
+    for px in 0..2 {
+        let sum = alone[0][px] + alone[1][px];
+        assert!(
+            (both[px] - sum).abs() <= 1e-6 * sum.abs().max(1.0),
+            "pixel {px}: the groups' composite {}, the sum of each alone {sum}",
+            both[px]
+        );
+    }
+    // without the warm light in the deeper pane's pass the glass pixel loses that ghost
+    let no_warm_ghost = [rendered[0], rendered[1], ("refl_0_1", 0.25, 0.0)];
+    let without = compose_groups(
+        &files("no_ghost", &no_warm_ghost, &[(sun, 0), (warm, 1)]),
+        "sun,warm",
+        &d.join("no_ghost.exr"),
+    );
+    assert!(
+        both[0] - without[0] > 1e-2,
+        "glass pixel: {} without the warm ghost, {} with it",
+        without[0],
+        both[0]
+    );
+    assert!((both[1] - without[1]).abs() <= 1e-6, "no glass: unchanged");
+}
+
+/// The G samples of a light-groups composite's beauty (`ViewLayer.Combined.G`, else `G`).
+fn beauty_g(out: &Path) -> [f64; 2] {
+    let p = read_exr_planes(out);
+    let k = ["ViewLayer.Combined.G", "G"]
+        .iter()
+        .find_map(|name| p.names.iter().position(|n| n == name))
+        .unwrap_or_else(|| panic!("{}: no beauty G in {:?}", out.display(), p.names));
+    [p.channels[k][0], p.channels[k][1]]
+}
+
 /// The bundled registry's depths (m) of unit `id`'s pane groups, outside first.
 fn registry_depths(id: u64) -> Vec<f64> {
     let reg: serde_json::Value = serde_json::from_str(

@@ -64,16 +64,32 @@ impl LightGroup {
     }
 }
 
-/// One group's layers in a frame's passes: the transmission pass's and each reflection pass's.
+/// One group's layers in a frame's passes: the transmission pass's, each reflection pass's and
+/// each of the units' pane-group passes'.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct GroupPasses {
     /// The group.
     pub group: String,
     /// The layer of each input the group is read from.
     pub layers: InputLayers,
+    /// The layer of each pane-group pass (`FrameFiles::groups`, in order).
+    pub pane_groups: Vec<String>,
 }
 
-/// Each group's layers in `files`' passes, from their headers alone, in the order of `groups`:
+impl GroupPasses {
+    /// `job` reading this group's layer of each pane-group pass (the transmission and plane
+    /// passes' layers are the decode settings' [`InputLayers`]).
+    pub fn pane_group_job(&self, job: &ComposeJob) -> ComposeJob {
+        let mut one = job.clone();
+        for (file, layer) in one.inputs.groups.iter_mut().zip(&self.pane_groups) {
+            file.layer = Some(layer.clone());
+        }
+        one
+    }
+}
+
+/// Each group's layers in `files`' passes (the units' pane-group passes too), from their
+/// headers alone, in the order of `groups`:
 /// every group must have a layer in every pass ([`ComposeError::GroupWithoutLayer`]), and
 /// every group layer of a pass must be one of `groups` ([`ComposeError::GroupWithoutTable`]),
 /// so that no light is lost or composited twice. `max_pixels` bounds each header read.
@@ -117,6 +133,11 @@ pub fn group_passes(
         .iter()
         .map(|p| layers_of(p))
         .collect::<Result<_, _>>()?;
+    let pane_groups: Vec<Vec<String>> = files
+        .groups
+        .iter()
+        .map(|g| layers_of(&g.path))
+        .collect::<Result<_, _>>()?;
     Ok(groups
         .iter()
         .enumerate()
@@ -126,6 +147,7 @@ pub fn group_passes(
                 trans: Some(trans[g].clone()),
                 refl: refl.iter().map(|r| Some(r[g].clone())).collect(),
             },
+            pane_groups: pane_groups.iter().map(|p| p[g].clone()).collect(),
         })
         .collect())
 }
@@ -186,7 +208,7 @@ pub fn compose_light_groups_within(
         let mut one = settings.clone();
         one.decode.layers = group_passes.layers.clone();
         let (composited, t) = crate::decode_and_composite(
-            job,
+            &group_passes.pane_group_job(job),
             &one,
             if k == 0 { &target } else { &rest },
             &group.luts,

