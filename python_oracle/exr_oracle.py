@@ -343,11 +343,35 @@ def read_png(path):
     return samples.reshape(height, width, channels)
 
 
-def write_png_rgb8(path, rgb):
-    """An 8-bit RGB PNG, no filters, no colour chunks (masks are data)."""
+def _paeth_rows(rgb):
+    """The rows of an 8-bit RGB image Paeth-filtered (PNG filter type 4), each led by its
+    filter byte."""
     height, width, _ = rgb.shape
-    raw = np.zeros((height, 1 + width * 3), dtype=np.uint8)
-    raw[:, 1:] = rgb.reshape(height, width * 3)
+    x = rgb.reshape(height, width * 3).astype(np.int16)
+    a = np.zeros_like(x)
+    a[:, 3:] = x[:, :-3]
+    b = np.zeros_like(x)
+    b[1:] = x[:-1]
+    c = np.zeros_like(x)
+    c[1:, 3:] = x[:-1, :-3]
+    p = a + b - c
+    pa, pb, pc = np.abs(p - a), np.abs(p - b), np.abs(p - c)
+    pred = np.where((pa <= pb) & (pa <= pc), a, np.where(pb <= pc, b, c))
+    raw = np.empty((height, 1 + width * 3), dtype=np.uint8)
+    raw[:, 0] = 4
+    raw[:, 1:] = ((x - pred) % 256).astype(np.uint8)
+    return raw
+
+
+def write_png_rgb8(path, rgb, paeth=False):
+    """An 8-bit RGB PNG, no colour chunks (masks are data); rows unfiltered, or with `paeth`
+    Paeth-filtered and compressed harder (a rendered picture's noise to about two thirds)."""
+    height, width, _ = rgb.shape
+    if paeth:
+        raw = _paeth_rows(rgb)
+    else:
+        raw = np.zeros((height, 1 + width * 3), dtype=np.uint8)
+        raw[:, 1:] = rgb.reshape(height, width * 3)
 
     def chunk(kind, body):
         return (struct.pack(">I", len(body)) + kind + body
@@ -355,7 +379,7 @@ def write_png_rgb8(path, rgb):
 
     png = (b"\x89PNG\r\n\x1a\n"
            + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
-           + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
+           + chunk(b"IDAT", zlib.compress(raw.tobytes(), 9 if paeth else 6))
            + chunk(b"IEND", b""))
     with open(path, "wb") as f:
         f.write(png)

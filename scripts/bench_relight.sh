@@ -55,7 +55,10 @@ if [ "${VIEWER:-1}" != 0 ]; then
         for side in today relit; do
             "$glassdb" view "$work/p$parts/$side" --port 0 >"$work/url" 2>/dev/null &
             server=$!
-            for _ in $(seq 100); do [ -s "$work/url" ] && break; sleep 0.1; done
+            # the server decodes the frame and its parts before it prints its URL (seconds
+            # on a loaded machine)
+            for _ in $(seq 600); do [ -s "$work/url" ] && break; sleep 0.1; done
+            [ -s "$work/url" ] || { echo "glassdb view $work/p$parts/$side printed no URL in 60 s" >&2; exit 1; }
             url=$(head -1 "$work/url" | sed 's/^serving //')
             echo "== viewer, $parts light parts, $side"
             "$python" python_oracle/viewer_driver.py bench "$url" --id 1 --products "$products" \

@@ -220,6 +220,8 @@ def export(opts):
         "objects": list(all_objects),
         # Frames whose geometry differs from the first frame's: their OBJ and what moved.
         "moving": moving,
+        # The scene's own light groups (issue 29): glassdb asks each one's spectrum.
+        "light_groups": scene_light_groups(scene),
     }
     with open(os.path.join(out, "export.json"), "w") as fh:
         json.dump(info, fh, indent=1)
@@ -227,6 +229,97 @@ def export(opts):
     print("glassdb_blender: exported %d objects, %d frames" % (len(objects), len(frames)))
     for f, m in moving.items():
         print("glassdb_blender: frame %s: %s moved (%s)" % (f, ", ".join(m["objects"]), m["obj"]))
+
+
+LIGHT_PROPERTY = "glassdb_light"
+
+
+def emits(ob):
+    """Whether a rendered object gives light: a lamp of non-zero power, or a mesh whose
+    material has an Emission shader or a Principled BSDF with emission (a fair guess: a
+    material that emits through another node is not seen)."""
+    if ob.type == "LIGHT":
+        return ob.data.energy > 0.0
+    for slot in getattr(ob, "material_slots", []):
+        mat = slot.material
+        if mat is None or not mat.use_nodes or mat.node_tree is None:
+            continue
+        for node in mat.node_tree.nodes:
+            if node.bl_idname == "ShaderNodeEmission":
+                strength = node.inputs["Strength"]
+                if strength.is_linked or strength.default_value > 0.0:
+                    return True
+            elif node.bl_idname == "ShaderNodeBsdfPrincipled":
+                strength = node.inputs.get("Emission Strength")
+                colour = node.inputs.get("Emission") or node.inputs.get("Emission Color")
+                if strength is None or colour is None:
+                    continue
+                bright = colour.is_linked or any(c > 0.0 for c in colour.default_value[:3])
+                if bright and (strength.is_linked or strength.default_value > 0.0):
+                    return True
+    return False
+
+
+def world_emits(world):
+    """Whether the world gives light: any Background node not set to zero strength or black."""
+    if world is None:
+        return False
+    if not world.use_nodes or world.node_tree is None:
+        return any(c > 0.0 for c in world.color)
+    for node in world.node_tree.nodes:
+        if node.bl_idname == "ShaderNodeBackground":
+            strength, colour = node.inputs["Strength"], node.inputs["Color"]
+            if (strength.is_linked or strength.default_value > 0.0) and (
+                    colour.is_linked or any(c > 0.0 for c in colour.default_value[:3])):
+                return True
+    return False
+
+
+def light_property(holder):
+    """A `glassdb_light` custom property (an illuminant's name, or an SPD CSV's path: absolute
+    or `//` relative to the .blend file), or None."""
+    value = holder.get(LIGHT_PROPERTY) if holder is not None else None
+    if value is None:
+        return None
+    value = str(value).strip()
+    return bpy.path.abspath(value) if value.startswith("//") else value
+
+
+def scene_light_groups(scene):
+    """The scene's own Cycles light groups (the view layer's order first): the groups its
+    rendered objects and its world name, the emitters in none, and the `glassdb_light`
+    properties of each group's objects, lamps and world (crates/blender/src/scene_lights.rs
+    reads this)."""
+    vl = bpy.context.view_layer
+    order = [lg.name for lg in vl.lightgroups]
+    used, ungrouped, properties = set(), [], []
+    for ob in scene.objects:
+        if ob.hide_render:
+            continue
+        group = ob.lightgroup
+        what = "lamp %s" % ob.name if ob.type == "LIGHT" else "object %s" % ob.name
+        if group:
+            used.add(group)
+            for holder in (ob, ob.data if ob.type == "LIGHT" else None):
+                value = light_property(holder)
+                if value:
+                    properties.append({"group": group, "holder": what, "value": value})
+        elif ob.type in MESH_TYPES or ob.type == "LIGHT":
+            if emits(ob):
+                ungrouped.append(what if ob.type == "LIGHT" else what + " (emissive material)")
+    world = scene.world
+    if world is not None:
+        if world.lightgroup:
+            used.add(world.lightgroup)
+            value = light_property(world)
+            if value:
+                properties.append({"group": world.lightgroup, "holder": "world %s" % world.name,
+                                   "value": value})
+        elif world_emits(world):
+            ungrouped.append("world %s" % world.name)
+    groups = [g for g in order if g in used] + sorted(used - set(order))
+    return {"groups": groups, "ungrouped": ungrouped if groups else [],
+            "properties": properties}
 
 
 def output_node(nt):
@@ -637,31 +730,67 @@ def add_light_opening(mat):
     return {"dot": dot, "add": add, "near": near, "enable": enable}
 
 
-def source_light_groups(scene):
-    """Cycles light groups by source: each sun lamp (`sun`, or `sun0`, `sun1`, ... for
-    several), the world (`sky`) and every other emitter (`other`), written as the layers
-    `ViewLayer.Combined_<group>` of multilayer EXRs. A scene's own light groups are replaced.
-    Returns the sun lamps with their groups, and the groups."""
+def set_light_groups(scene, names):
+    """The view layer's light groups become `names` (written as the layers
+    `ViewLayer.Combined_<group>` of multilayer EXRs)."""
     vl = bpy.context.view_layer
     scene.render.use_single_layer = True
-    suns = [ob for ob in scene.objects
-            if ob.type == "LIGHT" and ob.data.type == "SUN" and not ob.hide_render]
-    suns = [(ob, "sun" if len(suns) == 1 else "sun%d" % k) for k, ob in enumerate(suns)]
-    names = [n for _, n in suns] + ["sky", "other"]
-    for lg in list(vl.lightgroups):
-        if lg.name not in names:
-            print("glassdb_blender: light group %s replaced by the light split" % lg.name)
-            vl.lightgroups.remove(lg)
+    # Blender 3.4's collection has no remove(): the operator removes the active group.
+    k = 0
+    while k < len(vl.lightgroups):
+        if vl.lightgroups[k].name in names:
+            k += 1
+            continue
+        vl.active_lightgroup_index = k
+        bpy.ops.scene.view_layer_remove_lightgroup()
     for name in names:
         if name not in vl.lightgroups:
             vl.lightgroups.add(name=name)
+    scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+
+
+def source_light_groups(scene, scene_groups=()):
+    """Cycles light groups by source: each sun lamp (`sun`, or `sun0`, `sun1`, ... for
+    several), the world (`sky`) and every other emitter (`other`). With the scene's own light
+    groups `scene_groups` (issue 29) each source is split by them too: `<source>_<group>`
+    (`sun_sun`, `sky_sun`, `other_warm`), and its light is that group's; without them the
+    scene's groups are replaced. Returns the sun lamps with their groups, and the sources
+    (group, kind, scene group) in order."""
+    suns = [ob for ob in scene.objects
+            if ob.type == "LIGHT" and ob.data.type == "SUN" and not ob.hide_render]
+    suns = [(ob, "sun" if len(suns) == 1 else "sun%d" % k) for k, ob in enumerate(suns)]
+    if scene_groups:
+        # The scene's groups, read before they are replaced; ungrouped objects emit nothing
+        # (glassdb refused the scene otherwise) and stay in no group.
+        own = {ob.name: ob.lightgroup for ob in scene.objects}
+        world_group = scene.world.lightgroup if scene.world is not None else ""
+        suns = [(ob, "%s_%s" % (n, own[ob.name])) for ob, n in suns if own[ob.name]]
+        sources = [(n, "sun", own[ob.name]) for ob, n in suns]
+        for g in scene_groups:
+            if g == world_group:
+                sources.append(("sky_%s" % g, "sky", g))
+            sources.append(("other_%s" % g, "other", g))
+    else:
+        own, world_group = {}, ""
+        sources = [(n, "sun", None) for _, n in suns] + [("sky", "sky", None),
+                                                         ("other", "other", None)]
+    names = [n for n, _, _ in sources]
+    for lg in bpy.context.view_layer.lightgroups:
+        if lg.name not in names and not scene_groups:
+            print("glassdb_blender: light group %s replaced by the light split" % lg.name)
+    set_light_groups(scene, names)
     by_sun = {ob.name: n for ob, n in suns}
     for ob in scene.objects:
-        ob.lightgroup = by_sun.get(ob.name, "other")
+        if ob.name in by_sun:
+            ob.lightgroup = by_sun[ob.name]
+        elif scene_groups:
+            ob.lightgroup = "other_%s" % own[ob.name] if own.get(ob.name) else ""
+        else:
+            ob.lightgroup = "other"
     if scene.world is not None:
-        scene.world.lightgroup = "sky"
-    scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
-    return suns, names
+        scene.world.lightgroup = ("sky_%s" % world_group if world_group else "") \
+            if scene_groups else "sky"
+    return suns, sources
 
 
 class LightSplit:
@@ -676,14 +805,18 @@ class LightSplit:
         for g in job["glass"]:
             self.openings[g["material"]] = add_light_opening(bpy.data.materials[g["material"]])
         self.apertures = []
-        self.suns, self.groups = source_light_groups(scene)
+        self.suns, self.sources = source_light_groups(scene, job.get("scene_groups", []))
 
     @staticmethod
     def of_job(scene, job):
         """The job's light split, or None; a reference job with `light_groups` gets the
-        sources' light groups only (the validation's error by source)."""
+        sources' light groups only (the validation's error by source); a job with the scene's
+        light groups and no split renders a layer per scene group."""
+        scene_groups = job.get("scene_groups", [])
         if job.get("light_groups"):
-            source_light_groups(scene)
+            source_light_groups(scene, scene_groups)
+        elif scene_groups and not job.get("light_split"):
+            set_light_groups(scene, scene_groups)
         return LightSplit(scene, job) if job.get("light_split") else None
 
     def start_frame(self, scene, frame):
@@ -697,8 +830,9 @@ class LightSplit:
             # A sun lamp shines along its local -Z: +Z is towards the sun.
             d = ob.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))
             suns.append({"group": name, "direction_to_sun": list(d.normalized())})
+        sources = [{"group": n, "kind": kind, "light": light} for n, kind, light in self.sources]
         with open(frame["lights"], "w") as fh:
-            json.dump({"suns": suns, "groups": self.groups, "sky": scene.world is not None}, fh)
+            json.dump({"suns": suns, "sources": sources, "sky": scene.world is not None}, fh)
 
     def set_state(self, state):
         """0: every glazing opaque to light rays; k: aperture k - 1 clear, the others opaque."""
@@ -731,6 +865,10 @@ class GlassdbSettings(bpy.types.PropertyGroup):
                                        description="Registry JSON; empty: the bundled one")
     samples: bpy.props.IntProperty(name="Samples", default=0, min=0,
                                    description="0: the scene's Cycles samples")
+    lights: bpy.props.StringProperty(
+        name="Lights", default="",
+        description="Each light group's spectrum, GROUP=ILLUMINANT separated by spaces "
+                    "(e.g. sun=D65 warm=A); empty: the glassdb_light properties")
 
 
 def addon_command(context):
@@ -747,6 +885,8 @@ def addon_command(context):
         cmd += ["--registry", bpy.path.abspath(s.registry)]
     if s.samples:
         cmd += ["--samples", str(s.samples)]
+    for light in s.lights.split():
+        cmd += ["--light", light]
     return cmd
 
 
@@ -780,7 +920,7 @@ class GLASSDB_PT_panel(bpy.types.Panel):
     def draw(self, context):
         s = context.scene.glassdb
         col = self.layout.column()
-        for prop in ("binary", "glass", "frames", "out_dir", "registry", "samples"):
+        for prop in ("binary", "glass", "frames", "out_dir", "registry", "samples", "lights"):
             col.prop(s, prop)
         col.operator(GLASSDB_OT_render.bl_idname)
 

@@ -21,7 +21,7 @@ pub struct Args {
 pub enum BlenderCommand {
     /// Render a .blend file's passes with Blender (headless) and composite every frame into
     /// DIR/composite.####.exr.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Composite an existing `glassdb blender render` output again (other glasses), without
     /// Blender.
     Compose(ComposeArgs),
@@ -95,6 +95,13 @@ pub struct RenderArgs {
     /// pass per plane, the deeper panes' reflectance added to it (faster, no double image).
     #[arg(long, value_name = "N")]
     pub surfaces: Option<std::num::NonZeroUsize>,
+    /// The spectrum of one of the scene's Cycles light groups, `GROUP=ILLUMINANT` (a CIE
+    /// illuminant as `registry build --light` takes it, or an SPD CSV file); repeatable. Every
+    /// group needs one, or a `glassdb_light` custom property on one of its lamps or its world;
+    /// each group is composited with the registry's table of its light. A scene without light
+    /// groups is one light.
+    #[arg(long = "light", value_name = "GROUP=ILLUMINANT")]
+    pub lights: Vec<String>,
 }
 
 /// `--light-split`.
@@ -156,6 +163,20 @@ fn print_composites(dir: &std::path::Path, report: &ComposeReport) {
     for w in &report.swap {
         eprintln!("warning: {w}");
     }
+    if let Some(note) = &report.lights.one_table {
+        outln!("lights: {note}");
+    } else if !report.lights.groups.is_empty() {
+        outln!(
+            "lights: each light group composited with its registry light's tables ({})",
+            report
+                .lights
+                .groups
+                .iter()
+                .map(|(g, l)| format!("{g} -> {}", l.as_deref().unwrap_or("the default light")))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     crate::cmd::relight::print_blender_factors(&report.light_parts);
 }
 
@@ -192,7 +213,7 @@ fn print_pane_groups(report: &glassdb_blender::RenderReport) {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     match args.command {
-        BlenderCommand::Render(a) => run_render(a),
+        BlenderCommand::Render(a) => run_render(*a),
         BlenderCommand::Compose(a) => {
             let registry = registry_choice(&a.registry)?;
             let report = glassdb_blender::compose_dir(&a.dir, &registry)?;
@@ -228,6 +249,12 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         light_split: a.light_split == LightSplit::On,
         composite: !a.no_composite,
         surfaces: a.surfaces,
+        lights: a
+            .lights
+            .iter()
+            .map(|l| glassdb_registry::NamedLight::parse(l))
+            .collect::<Result<_, _>>()
+            .context("--light")?,
     };
     let spinner = Spinner::on_terminal("blender");
     let report = glassdb_blender::render(&request, &registry, &spinner)?;
@@ -250,6 +277,17 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
         outln!(
             "passes: light split: {renders} Blender renders ({unsplit} with --light-split off, \
              whose swaps leave the room lit by the rendered glass)"
+        );
+    }
+    if !report.record.lights.is_empty() {
+        outln!(
+            "lights: the scene's light groups {}{}",
+            glassdb_blender::scene_lights::describe_lights(&report.record.lights),
+            if report.record.group_layers {
+                "; every pass holds a ViewLayer.Combined_<group> layer per group"
+            } else {
+                "; each light-split source split by them"
+            }
         );
     }
     for o in &report.record.overrides {

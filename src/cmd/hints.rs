@@ -375,6 +375,24 @@ fn blender_hint(e: &glassdb_blender::BlenderError) -> Option<String> {
         B::TimedOut { .. } => {
             "raise --timeout-s, or render less: --samples, --resolution, --frames".into()
         }
+        B::LightGroupWithoutSpectrum { group, .. } => {
+            format!("give --light {group}=ILLUMINANT (e.g. D65 for daylight, A for tungsten)")
+        }
+        B::UnknownLightGroup { .. } => {
+            "--light takes the scene's own Cycles light groups (Object/World > Shading > Light \
+             Group); a scene without groups is one light and takes no --light"
+                .into()
+        }
+        B::RegistryLacksLight { group, .. } | B::LightMismatch { group, .. } => format!(
+            "build the registry with that light (glassdb registry build … --light \
+             {group}=ILLUMINANT), or give a registry of one light to composite every group with \
+             its table"
+        ),
+        B::UngroupedEmitters { .. } => {
+            "set each emitter's Light Group (Object Properties > Shading), or clear every \
+             group to render the scene as one light"
+                .into()
+        }
         B::UnknownGlass { .. } => {
             "give a registry with that id (--registry), or map the material to another id with \
              --glass"

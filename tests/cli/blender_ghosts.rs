@@ -12,7 +12,7 @@ use std::process::Command;
 use crate::util::{Planes, compose, glassdb, ok, read_exr_planes, repo_path};
 
 /// `make_ghost_scene.py --panes PANES` saved in `dir`, with its facts.
-fn ghost_scene(dir: &Path, panes: &str) -> (PathBuf, serde_json::Value) {
+pub(crate) fn ghost_scene(dir: &Path, panes: &str) -> (PathBuf, serde_json::Value) {
     let blend = dir.join(format!("{panes}.blend"));
     let facts = dir.join(format!("{panes}.json"));
     let made = Command::new("blender")
@@ -34,7 +34,9 @@ fn ghost_scene(dir: &Path, panes: &str) -> (PathBuf, serde_json::Value) {
     (blend, facts)
 }
 
-fn render(blend: &Path, glass: &str, out: &Path, extra: &[&str]) -> String {
+/// `glassdb blender render BLEND --glass GLASS --out-dir OUT` (seed 0, 2 threads) with `extra`;
+/// its stdout.
+pub(crate) fn render(blend: &Path, glass: &str, out: &Path, extra: &[&str]) -> String {
     ok(glassdb()
         .args(["blender", "render"])
         .arg(blend)
@@ -50,7 +52,7 @@ fn json(path: &Path) -> serde_json::Value {
 
 /// Channel `name` of the beauty: bare, or of `ViewLayer.Combined` in a pass split by the
 /// light's path (docs/blender.md, "Light parts").
-fn channel<'a>(p: &'a Planes, name: &str) -> &'a [f64] {
+pub(crate) fn channel<'a>(p: &'a Planes, name: &str) -> &'a [f64] {
     let split = format!("ViewLayer.Combined.{name}");
     let k = p
         .names

@@ -5,7 +5,7 @@
 use crate::util::{compose, fails, glassdb, ok, repo_path, repo_root};
 
 /// The first two lines of the README's first `sh` block, comments cut.
-fn readme_commands() -> (String, String) {
+pub(crate) fn readme_commands() -> (String, String) {
     let readme = std::fs::read_to_string(repo_path("README.md")).unwrap();
     let block = readme
         .split("```sh\n")

@@ -7,6 +7,7 @@ mod blender_ghosts;
 mod cameras;
 mod colour;
 mod compose;
+mod dusk;
 mod farm;
 mod first_contact;
 mod fit;

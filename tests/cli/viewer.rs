@@ -886,6 +886,178 @@ fn a_unit_swapped_in_shows_its_ghost_as_compose_does() {
     );
 }
 
+/// 8-bit codes of the linear RGB in `exr` (its beauty), as the page's standard view writes
+/// them (sRGB transfer, clipped, rounded): what the canvas shows of a composite at 0 EV.
+fn srgb_codes(exr: &Path) -> Vec<[f64; 3]> {
+    let p = crate::util::read_exr_planes(exr);
+    let rgb = ["R", "G", "B"].map(|c| crate::blender_ghosts::channel(&p, c));
+    let encode = |v: f64| {
+        let v = v.clamp(0.0, 1.0);
+        let e = if v <= 0.0031308 {
+            v * 12.92
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (e * 255.0).round()
+    };
+    (0..p.width * p.height)
+        .map(|i| [0, 1, 2].map(|c| encode(rgb[c][i])))
+        .collect()
+}
+
+/// `glassdb blender compose RUN` (with `registry`, else the bundled one): its composite of the
+/// first frame as 8-bit codes ([`srgb_codes`]).
+fn blender_composed(run: &Path, registry: Option<&Path>) -> Vec<[f64; 3]> {
+    let mut cmd = glassdb();
+    cmd.args(["blender", "compose"]).arg(run);
+    if let Some(r) = registry {
+        cmd.arg("--registry").arg(r);
+    }
+    ok(&mut cmd);
+    srgb_codes(&run.join("composite.0001.exr"))
+}
+
+/// Pixels where `a` and `b` differ by more than `codes` in some channel.
+fn pixels_apart(a: &[[f64; 3]], b: &[[f64; 3]], codes: f64) -> usize {
+    assert_eq!(a.len(), b.len(), "image sizes differ");
+    a.iter()
+        .zip(b)
+        .filter(|(p, q)| (0..3).any(|c| (p[c] - q[c]).abs() > codes))
+        .count()
+}
+
+/// The canvas's RGB, as a `layout` snippet returns it.
+const READ_CANVAS: &str =
+    "return Array.from(atob(window.glassdb.readPixels()), (c) => c.charCodeAt(0));";
+
+fn canvas_of(result: &serde_json::Value) -> Vec<[f64; 3]> {
+    let bytes: Vec<f64> = result
+        .as_array()
+        .unwrap_or_else(|| panic!("no canvas: {result}"))
+        .iter()
+        .map(num)
+        .collect();
+    bytes.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect()
+}
+
+/// A `glassdb blender render` run of the ghost scene's unit window with glass `unit` (the
+/// light split on, the default) opened with `glassdb view RUN`: the page shows the units'
+/// ghosts with the light parts, equal within 1 code value to `glassdb blender compose RUN`,
+/// for the rendered product and after a product change on the page to `other` (compose with a
+/// registry holding `other` under the unit's id); both differ from the one-pass composite
+/// (`--surfaces 1`) on more than `min_ghost` pixels. Returns the page's frame description.
+fn relit_ghosts_match_blender_compose(
+    unit: u16,
+    other: &str,
+    min_ghost: usize,
+) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (blend, _) = crate::blender_ghosts::ghost_scene(d, "unit");
+    let run = d.join("run");
+    crate::blender_ghosts::render(
+        &blend,
+        &format!("Unit={unit}"),
+        &run,
+        &["--samples", "8", "--resolution", "64x48"],
+    );
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("glassdb-blender.json")).unwrap())
+            .unwrap();
+    let frame = &record["frames"][0];
+    let parts = frame["light_parts"]
+        .as_str()
+        .unwrap_or_else(|| panic!("{record}"));
+    assert!(
+        frame["groups"].as_array().is_some_and(|g| !g.is_empty()),
+        "{record}"
+    );
+
+    let want = blender_composed(&run, None);
+    let registry = swapped_registry(&repo_path("data/registry.json"), d, unit, other);
+    let want_other = blender_composed(&run, Some(&registry));
+    // The ghosts are there: one pass per plane (the deeper groups folded) looks otherwise.
+    let folded = d.join("folded.exr");
+    let mut cmd = glassdb();
+    cmd.arg("compose")
+        .arg("--trans")
+        .arg(run.join(frame["trans"].as_str().unwrap()))
+        .arg("--refl")
+        .arg(run.join(frame["refl"][0].as_str().unwrap()))
+        .arg("--mask")
+        .arg(run.join(frame["mask"].as_str().unwrap()))
+        .arg("--light-parts")
+        .arg(run.join(parts))
+        .args(["--surfaces", "1", "-o"])
+        .arg(&folded);
+    ok(&mut cmd);
+    let folded = srgb_codes(&folded);
+    let ghost = pixels_apart(&want, &folded, 2.0);
+    eprintln!("Unit={unit}: {ghost} pixels of blender compose apart from --surfaces 1");
+    assert!(ghost >= min_ghost, "only {ghost} pixels show a ghost");
+
+    let mut cmd = glassdb();
+    cmd.arg("view").arg(&run);
+    let served = spawn_viewer(&mut cmd);
+    let choose = format!("window.glassdb.choose({unit}, {other:?}); {READ_CANVAS}");
+    let report = layout(
+        &served.url,
+        &[
+            READ_CANVAS,
+            &choose,
+            "return [window.glassdb.products().A, document.getElementById('status').textContent];",
+            "return (await fetch('api/frame/0')).json();",
+        ],
+        None,
+    );
+    let results = &report["results"];
+    assert_eq!(results[2][0][unit.to_string()], other, "{}", results[2]);
+    let status = results[2][1].as_str().unwrap();
+    assert!(!status.contains("one surface per plane"), "{status}");
+    for (got, want, what) in [
+        (canvas_of(&results[0]), &want, "the rendered product"),
+        (canvas_of(&results[1]), &want_other, other),
+    ] {
+        let apart = pixels_apart(&got, want, 1.0);
+        assert_eq!(
+            apart, 0,
+            "page vs glassdb blender compose, {what}: {apart} pixels apart"
+        );
+        let from_folded = pixels_apart(&got, &folded, 2.0);
+        assert!(
+            from_folded >= min_ghost,
+            "{what}: {from_folded} pixels apart from --surfaces 1"
+        );
+    }
+    results[3].clone()
+}
+
+/// Issue 27 with issue 28's light split (the default of `glassdb blender render`): a run of a
+/// double unit opened with `glassdb view RUN` shows the inner pane's reflection, relit, as
+/// `glassdb blender compose RUN` does, and after a change to another double unit.
+#[test]
+fn a_relit_double_unit_run_shows_its_ghost_as_blender_compose_does() {
+    let frame = relit_ghosts_match_blender_compose(11, CATALOG_UNIT, 40);
+    assert_eq!(
+        frame["groups"],
+        serde_json::json!([{"plane": 0, "group": 1}]),
+        "{frame}"
+    );
+    assert_eq!(frame["parts"].as_array().map(Vec::len), Some(4), "{frame}");
+}
+
+/// The same with a triple unit (two ghosts, each pane group's pass relit), then a double unit
+/// chosen on the page (the deepest pass unused).
+#[test]
+fn a_relit_triple_unit_run_shows_both_ghosts_as_blender_compose_does() {
+    let frame = relit_ghosts_match_blender_compose(13, GHOST_UNIT, 40);
+    assert_eq!(
+        frame["groups"],
+        serde_json::json!([{"plane": 0, "group": 1}, {"plane": 0, "group": 2}]),
+        "{frame}"
+    );
+}
+
 /// A `.cube` view (a 1D shaper over 0–4, then a 3D table mixing channels), written here.
 fn write_cube(path: &Path) {
     let mut text =
@@ -1348,7 +1520,7 @@ fn unit_requests_are_checked_and_only_the_page_may_send_them() {
     let (code, body) = post_reply(u, "/api/unit", good);
     assert_eq!(code, 200, "{body:.300}");
     let built: serde_json::Value = serde_json::from_str(&body).unwrap();
-    assert_eq!(built["format"], "glassdb-viewer-page/3");
+    assert_eq!(built["format"], "glassdb-viewer-page/4");
     assert_eq!(
         built["product"]["unit"]["elements"][1]["gas"], "argon",
         "{body:.600}"

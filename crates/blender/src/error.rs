@@ -150,6 +150,96 @@ pub enum BlenderError {
         /// The registry's name.
         registry: String,
     },
+    /// A light named twice in the render's lights.
+    #[error("light group `{group}` is given a spectrum twice")]
+    LightTwice {
+        /// The group.
+        group: String,
+    },
+    /// A light given for a group the scene does not have.
+    #[error("{blend} has no light group `{group}` ({})", list_groups(groups))]
+    UnknownLightGroup {
+        /// The group asked for.
+        group: String,
+        /// The scene.
+        blend: PathBuf,
+        /// The scene's groups.
+        groups: Vec<String>,
+    },
+    /// A scene light group whose spectrum nothing says.
+    #[error(
+        "light group `{group}` of {blend} has no spectrum: say its illuminant (GROUP=ILLUMINANT) or set a glassdb_light property on one of its lamps or its world"
+    )]
+    LightGroupWithoutSpectrum {
+        /// The group.
+        group: String,
+        /// The scene.
+        blend: PathBuf,
+    },
+    /// Emitters in no light group of a scene that has groups: their light would be lost.
+    #[error(
+        "{blend} has light groups ({}), but these emitters are in none: {}; put each in a group",
+        groups.join(", "), emitters.join(", ")
+    )]
+    UngroupedEmitters {
+        /// The scene.
+        blend: PathBuf,
+        /// The emitters (`lamp Desk`, `world World`).
+        emitters: Vec<String>,
+        /// The scene's groups.
+        groups: Vec<String>,
+    },
+    /// A `glassdb_light` property that is no illuminant.
+    #[error("the glassdb_light property of {holder} ({value:?}) is no illuminant")]
+    BadLightProperty {
+        /// Its holder.
+        holder: String,
+        /// Its value.
+        value: String,
+        /// Why.
+        source: Box<glassdb_spectral::SpectralError>,
+    },
+    /// Two `glassdb_light` properties of one group that name different spectra.
+    #[error("light group `{group}`: its glassdb_light properties disagree ({first}; {second})")]
+    LightPropertiesDisagree {
+        /// The group.
+        group: String,
+        /// One property.
+        first: String,
+        /// Another.
+        second: String,
+    },
+    /// A run's light group whose light the registry (of several lights) lacks.
+    #[error(
+        "light group `{group}` ({illuminant}) has no table in {registry} (its lights: {})",
+        lights.join(", ")
+    )]
+    RegistryLacksLight {
+        /// The group.
+        group: String,
+        /// The group's illuminant.
+        illuminant: String,
+        /// The registry.
+        registry: String,
+        /// The registry's lights, described.
+        lights: Vec<String>,
+    },
+    /// A registry light of a group's name but another spectrum.
+    #[error(
+        "light group `{group}` was rendered as {rendered} ({record}), but {registry}'s light `{group}` is {table}"
+    )]
+    LightMismatch {
+        /// The group.
+        group: String,
+        /// Its illuminant in the run record.
+        rendered: String,
+        /// The run record.
+        record: PathBuf,
+        /// The registry.
+        registry: String,
+        /// The registry's light of that name, described.
+        table: String,
+    },
     /// A frame list or option that cannot be used.
     #[error("{0}")]
     BadOption(String),
@@ -174,6 +264,15 @@ pub enum BlenderError {
     /// A registry could not be read.
     #[error(transparent)]
     Registry(#[from] glassdb_registry::RegistryError),
+}
+
+/// A scene's light groups in a message.
+fn list_groups(groups: &[String]) -> String {
+    if groups.is_empty() {
+        "it has no light groups: the whole scene is one light".into()
+    } else {
+        format!("its light groups: {}", groups.join(", "))
+    }
 }
 
 impl BlenderError {

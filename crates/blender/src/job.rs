@@ -43,6 +43,11 @@ pub struct ScriptJob {
     /// its layers `ViewLayer.Combined_<group>` say each source's light).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub light_groups: bool,
+    /// The scene's own light groups (issue 29, [`crate::scene_lights`]): with the split, each
+    /// source is split by them too; without it, every pass gets a `Combined_<group>` layer
+    /// per group. Empty: the scene is one light.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub scene_groups: Vec<String>,
 }
 
 /// One frame of a [`ScriptJob`].
@@ -98,6 +103,9 @@ pub struct ExportInfo {
     /// The scene has motion blur on, which the passes turn off.
     #[serde(default)]
     pub motion_blur: bool,
+    /// The scene's own light groups, their emitters and `glassdb_light` properties.
+    #[serde(default)]
+    pub light_groups: crate::scene_lights::SceneLightGroups,
 }
 
 /// A frame whose objects are not where they are in the first frame.
@@ -258,6 +266,15 @@ pub struct RunRecord {
     /// the deeper groups' reflectance is composited on the last one's pass.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surfaces: Option<std::num::NonZeroUsize>,
+    /// The scene's light groups and each one's spectrum (issue 29); absent: the scene is one
+    /// light, composited with the registry's default tables.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lights: Vec<crate::scene_lights::SceneLight>,
+    /// Every pass holds a `ViewLayer.Combined_<group>` layer per light group of
+    /// [`RunRecord::lights`] (the render without the light split); with the split the groups
+    /// are in each frame's light parts instead.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub group_layers: bool,
 }
 
 impl RunRecord {

@@ -14,7 +14,9 @@ pub mod light_split;
 mod passes;
 pub mod pipeline;
 pub mod program;
+mod reference_lights;
 pub mod relit;
+pub mod scene_lights;
 pub mod swap;
 pub mod thin_pane;
 

@@ -109,8 +109,37 @@ pub(crate) fn lights_path(staging: &Path, frame: u32) -> PathBuf {
 struct FrameLights {
     /// Each sun lamp: its group and the direction towards it.
     suns: Vec<SunLamp>,
-    /// Every light group rendered, in order.
-    groups: Vec<String>,
+    /// Every light group rendered, in order: a source, split by the scene's light groups.
+    sources: Vec<ScriptSource>,
+}
+
+impl FrameLights {
+    /// The sources' light groups, in order.
+    fn groups(&self) -> Vec<String> {
+        self.sources.iter().map(|s| s.group.clone()).collect()
+    }
+}
+
+/// One light group of a light-split render: a source of one scene light group.
+#[derive(Debug, Clone, Deserialize)]
+struct ScriptSource {
+    /// The Cycles light group rendered (`sun`, `sky`, `other`; with scene groups
+    /// `<source>_<scene group>`: `other_warm`, `sun0_sun`).
+    group: String,
+    /// What emits it.
+    kind: SourceKind,
+    /// The scene light group it belongs to (`None`: a scene without groups).
+    #[serde(default)]
+    light: Option<String>,
+}
+
+/// The kind of a [`ScriptSource`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum SourceKind {
+    Sun,
+    Sky,
+    Other,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -191,14 +220,14 @@ pub(crate) struct SplitPass {
 }
 
 /// A state's render: each group's R, G, B and the beauty's alpha.
-struct StateImage {
-    window: PixelWindow,
-    groups: Vec<[Vec<f32>; 3]>,
-    alpha: Vec<f32>,
+pub(crate) struct StateImage {
+    pub(crate) window: PixelWindow,
+    pub(crate) groups: Vec<[Vec<f32>; 3]>,
+    pub(crate) alpha: Vec<f32>,
 }
 
 /// Reads state `state` of `pass` with the light groups `groups`.
-fn read_state(pass: &Path, groups: &[String]) -> Result<StateImage, BlenderError> {
+pub(crate) fn read_state(pass: &Path, groups: &[String]) -> Result<StateImage, BlenderError> {
     let bad = |message: String| BlenderError::BadRender {
         path: pass.to_path_buf(),
         message,
@@ -281,22 +310,23 @@ pub(crate) fn assemble_frame(
         path: lights.to_path_buf(),
         message: e.to_string(),
     })?;
+    let groups = lights.groups();
     // First the sources that carry light anywhere, so that every pass has the same layers.
-    let mut lit = vec![false; lights.groups.len()];
+    let mut lit = vec![false; groups.len()];
     for pass in passes.iter().filter(|p| p.window.is_some()) {
         for s in 0..states {
-            let image = read_state(&split_path(&pass.rendered, s), &lights.groups)?;
+            let image = read_state(&split_path(&pass.rendered, s), &groups)?;
             for (g, rgb) in image.groups.iter().enumerate() {
                 lit[g] |= rgb.iter().flatten().any(|&v| v != 0.0);
             }
         }
     }
-    let kept: Vec<usize> = (0..lights.groups.len()).filter(|&g| lit[g]).collect();
+    let kept: Vec<usize> = (0..groups.len()).filter(|&g| lit[g]).collect();
     let record = parts_record(&lights, &kept, &frame.apertures)?;
     let names: Vec<&str> = record.parts.iter().map(|p| p.group.as_str()).collect();
     for pass in passes {
         let image = match pass.window {
-            Some(window) => assembled_pass(pass, window, &lights.groups, &kept, states)?,
+            Some(window) => assembled_pass(pass, window, &groups, &kept, states)?,
             None => unused_pass(&names),
         };
         write_pass(&pass.target, image, &names, (width, height))?;
@@ -312,15 +342,16 @@ fn parts_record(
 ) -> Result<LightParts, BlenderError> {
     let mut parts = Vec::new();
     for &g in kept {
-        let group = &lights.groups[g];
-        let source = match group.as_str() {
-            "sky" => LightSource::Sky,
-            "other" => LightSource::Other,
-            sun => LightSource::Sun {
+        let script = &lights.sources[g];
+        let group = &script.group;
+        let source = match script.kind {
+            SourceKind::Sky => LightSource::Sky,
+            SourceKind::Other => LightSource::Other,
+            SourceKind::Sun => LightSource::Sun {
                 direction_to_sun: lights
                     .suns
                     .iter()
-                    .find(|s| s.group == sun)
+                    .find(|s| &s.group == group)
                     .map(|s| s.direction_to_sun)
                     .unwrap_or([0.0, 0.0, 1.0]),
             },
@@ -329,7 +360,7 @@ fn parts_record(
             group: group.clone(),
             source,
             through: None,
-            light: None,
+            light: script.light.clone(),
         });
         for a in apertures {
             parts.push(LightPart {
@@ -340,7 +371,7 @@ fn parts_record(
                     normal: [a.equation[0], a.equation[1], a.equation[2]],
                     id: u32::from(a.id),
                 }),
-                light: None,
+                light: script.light.clone(),
             });
         }
     }
@@ -358,10 +389,10 @@ fn parts_record(
 }
 
 /// A pass's parts (in the record's order) and alpha over `window`.
-struct Assembled {
-    window: PixelWindow,
-    parts: Vec<[Vec<f32>; 3]>,
-    alpha: Vec<f32>,
+pub(crate) struct Assembled {
+    pub(crate) window: PixelWindow,
+    pub(crate) parts: Vec<[Vec<f32>; 3]>,
+    pub(crate) alpha: Vec<f32>,
 }
 
 /// The parts of one pass: state 0's group for the unglazed part, state k's minus state 0's for
@@ -423,7 +454,7 @@ fn unused_pass(names: &[&str]) -> Assembled {
 }
 
 /// Writes `image` to `to` (atomically): a layer per part and the beauty, their sum.
-fn write_pass(
+pub(crate) fn write_pass(
     to: &Path,
     image: Assembled,
     names: &[&str],
@@ -484,7 +515,18 @@ mod tests {
                 group: "sun".into(),
                 direction_to_sun: [0.0, -0.6, 0.8],
             }],
-            groups: vec!["sun".into(), "sky".into(), "other".into()],
+            sources: [
+                ("sun", SourceKind::Sun),
+                ("sky", SourceKind::Sky),
+                ("other", SourceKind::Other),
+            ]
+            .into_iter()
+            .map(|(group, kind)| ScriptSource {
+                group: group.into(),
+                kind,
+                light: None,
+            })
+            .collect(),
         };
         let aperture = |plane, id| ScriptAperture {
             plane,
@@ -514,5 +556,52 @@ mod tests {
         );
         assert_eq!(record.parts[5].through.unwrap().id, 5);
         assert_eq!(record.parts[3].through, None);
+    }
+
+    /// With the scene's light groups each source names its group, and its parts carry it as
+    /// their light; the kind, not the name, says what the source is.
+    #[test]
+    fn parts_of_scene_group_sources_carry_their_light() {
+        let source = |group: &str, kind, light: &str| ScriptSource {
+            group: group.into(),
+            kind,
+            light: Some(light.into()),
+        };
+        let lights = FrameLights {
+            suns: vec![SunLamp {
+                group: "sun0_sun".into(),
+                direction_to_sun: [0.0, 0.0, 1.0],
+            }],
+            sources: vec![
+                source("sun0_sun", SourceKind::Sun, "sun"),
+                source("sky_sun", SourceKind::Sky, "sun"),
+                source("other_warm", SourceKind::Other, "warm"),
+            ],
+        };
+        let aperture = ScriptAperture {
+            plane: 0,
+            id: 1,
+            equation: [0.0, 1.0, 0.0, -2.0],
+            tolerance: 1e-3,
+            materials: vec!["Glass".into()],
+        };
+        let record = parts_record(&lights, &[0, 2], &[aperture]).unwrap();
+        let said: Vec<(&str, Option<&str>, LightSource)> = record
+            .parts
+            .iter()
+            .map(|p| (p.group.as_str(), p.light.as_deref(), p.source))
+            .collect();
+        let sun = LightSource::Sun {
+            direction_to_sun: [0.0, 0.0, 1.0],
+        };
+        assert_eq!(
+            said,
+            [
+                ("sun0_sun", Some("sun"), sun),
+                ("sun0_sun_p0_id1", Some("sun"), sun),
+                ("other_warm", Some("warm"), LightSource::Other),
+                ("other_warm_p0_id1", Some("warm"), LightSource::Other),
+            ]
+        );
     }
 }

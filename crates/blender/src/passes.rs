@@ -91,12 +91,30 @@ pub(crate) fn write_exr(to: &Path, image: ExrImageOut) -> Result<(), BlenderErro
 }
 
 /// The pass of a plane without glass in a frame (the compositor wants one per plane and never
-/// reads its pixels): one black pixel at the frame's corner.
-pub(crate) fn write_unused_pass(to: &Path, width: u32, height: u32) -> Result<(), BlenderError> {
-    let planes = ["A", "B", "G", "R"]
+/// reads its pixels): one black pixel at the frame's corner, with a layer per light group of
+/// `groups` (the passes of a scene with light groups, [`crate::scene_lights`]).
+pub(crate) fn write_unused_pass(
+    to: &Path,
+    width: u32,
+    height: u32,
+    groups: &[String],
+) -> Result<(), BlenderError> {
+    // Blender's multilayer names when the passes have group layers.
+    let beauty = if groups.is_empty() {
+        ""
+    } else {
+        "ViewLayer.Combined."
+    };
+    let mut planes: Vec<ExrPlane> = ["A", "B", "G", "R"]
         .iter()
-        .map(|c| ExrPlane::new(c, vec![0.0]))
+        .map(|c| ExrPlane::new(&format!("{beauty}{c}"), vec![0.0]))
         .collect();
+    for g in groups {
+        for c in ["R", "G", "B"] {
+            let layer = crate::light_split::group_layer(g);
+            planes.push(ExrPlane::new(&format!("{layer}.{c}"), vec![0.0]));
+        }
+    }
     let display = PixelWindow::at_origin(width as usize, height as usize);
     write_exr(
         to,

@@ -16,7 +16,7 @@ use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::{ComposeJob, ComposeSettings, DecodeSettings, FrameFiles, FrameReport};
 use glassdb_io::Progress;
 use glassdb_mask::GlassMapping;
-use glassdb_registry::Registry;
+use glassdb_registry::{NamedLight, Registry};
 use glassdb_scene::{CosMode, RasterOptions};
 
 use crate::BlenderError;
@@ -26,6 +26,7 @@ use crate::job::{
 };
 use crate::passes::{place_crop, rename, write_unused_pass};
 use crate::program::{Blender, BlenderRun, check_blend_file, children_cpu_seconds};
+use crate::scene_lights::SceneLight;
 
 /// The Blender-side script, embedded so that the binary needs nothing else.
 pub const SCRIPT: &str = include_str!("../../../integrations/blender/glassdb_blender.py");
@@ -86,6 +87,9 @@ pub struct RenderRequest {
     /// `None`: all, issue 27's double image); the deeper groups' reflectance is composited on
     /// the last one's pass (`Some(1)`: one pass per plane, no double image).
     pub surfaces: Option<NonZeroUsize>,
+    /// The spectrum of each of the scene's light groups (`GROUP=ILLUMINANT`, issue 29,
+    /// [`crate::scene_lights`]); a group not named here takes its `glassdb_light` property.
+    pub lights: Vec<NamedLight>,
 }
 
 /// The registry and how it is named in messages and outputs.
@@ -142,6 +146,9 @@ pub struct ComposeReport {
     /// The factors of each frame composited with its light parts (the relit swap,
     /// [`crate::relit`]), by frame.
     pub light_parts: Vec<(u32, Vec<glassdb_compose::PartFactor>)>,
+    /// The registry light that composited each of the scene's light groups, and whether the
+    /// registry's one light composited them all ([`crate::scene_lights::light_tables`]).
+    pub lights: crate::scene_lights::LightTables,
 }
 
 /// Pattern names of the frame's files.
@@ -161,6 +168,15 @@ pub fn render(
     let t = Instant::now();
     let info = export_scene(&work)?;
     let export_s = t.elapsed().as_secs_f64();
+    let lights = crate::scene_lights::resolve_scene_lights(
+        &info.light_groups,
+        &request.lights,
+        &request.blend,
+    )?;
+    if request.composite {
+        // A registry that cannot composite the groups is refused before anything renders.
+        crate::scene_lights::light_tables(&lights, registry, &work.dir.join(RECORD_NAME))?;
+    }
 
     progress.stage("planes and masks");
     let t = Instant::now();
@@ -171,18 +187,25 @@ pub fn render(
     progress.stage("render passes");
     let t = Instant::now();
     let cpu = children_cpu_seconds();
-    let job = render_passes(&work, &mut masks)?;
+    let job = render_passes(&work, &mut masks, &lights)?;
     let render_s = t.elapsed().as_secs_f64();
     let render_cpu_s = cpu_since(cpu);
     let lit_by = crate::swap::pass_glasses(masks.glass_materials.iter().map(|m| m.1), registry);
-    let record = write_record(&work, masks.frames, masks.size, info.overrides(), lit_by)?;
+    let record = write_record(
+        &work,
+        masks.frames,
+        masks.size,
+        info.overrides(),
+        lit_by,
+        lights,
+    )?;
 
     let (mut reference_s, mut reference_cpu_s) = (0.0, None);
     if request.reference {
         progress.stage("render reference");
         let t = Instant::now();
         let cpu = children_cpu_seconds();
-        render_reference(&work, &record, job)?;
+        render_reference(&work, &record, job, registry)?;
         reference_s = t.elapsed().as_secs_f64();
         reference_cpu_s = cpu_since(cpu);
     }
@@ -196,6 +219,7 @@ pub fn render(
             swap: Vec::new(),
             seconds: 0.0,
             light_parts: Vec::new(),
+            lights: crate::scene_lights::LightTables::default(),
         }
     };
     std::fs::remove_dir_all(&work.staging).map_err(BlenderError::io("remove", &work.staging))?;
@@ -352,8 +376,13 @@ pub(crate) fn moving_obj_name(frame: u32) -> String {
 /// with glass; glassdb moves them into the output folder, each crop placed at its pixel
 /// rectangle (a plane without glass gets a one-pixel pass); with the light split, each pass
 /// is assembled from its light-split renders and each frame gets its light parts
-/// ([`crate::light_split`]). Returns the job it rendered.
-pub fn render_passes(work: &Workspace<'_>, masks: &mut Masks) -> Result<ScriptJob, BlenderError> {
+/// ([`crate::light_split`]); the scene's light groups `lights` split the sources further, or,
+/// without the split, give every pass a layer per group. Returns the job it rendered.
+pub fn render_passes(
+    work: &Workspace<'_>,
+    masks: &mut Masks,
+    lights: &[SceneLight],
+) -> Result<ScriptJob, BlenderError> {
     let request = work.request;
     let mut job = ScriptJob {
         resolution: work.resolution(),
@@ -366,6 +395,7 @@ pub fn render_passes(work: &Workspace<'_>, masks: &mut Masks) -> Result<ScriptJo
         frames: masks.script_frames.clone(),
         light_split: request.light_split,
         light_groups: false,
+        scene_groups: lights.iter().map(|l| l.group.clone()).collect(),
     };
     if request.light_split {
         crate::light_split::prepare_job(&work.staging, &mut job);
@@ -382,7 +412,7 @@ pub fn render_passes(work: &Workspace<'_>, masks: &mut Masks) -> Result<ScriptJo
             let target = work.dir.join(refl);
             match window {
                 Some(w) => place_crop(&work.staging.join(refl), &target, *w, width, height)?,
-                None => write_unused_pass(&target, width, height)?,
+                None => write_unused_pass(&target, width, height, &job.scene_groups)?,
             }
         }
         place_group_passes(work, f, masks.size)?;
@@ -410,6 +440,7 @@ fn write_record(
     (width, height): (u32, u32),
     overrides: Vec<String>,
     lit_by: Vec<crate::swap::PassGlass>,
+    lights: Vec<SceneLight>,
 ) -> Result<RunRecord, BlenderError> {
     let request = work.request;
     let record = RunRecord {
@@ -424,6 +455,8 @@ fn write_record(
         frames,
         lit_by,
         surfaces: request.surfaces,
+        group_layers: !request.light_split && !lights.is_empty(),
+        lights,
     };
     let record_path = work.dir.join(RECORD_NAME);
     let text = serde_json::to_string_pretty(&record).map_err(|e| BlenderError::BadRecord {
@@ -435,12 +468,24 @@ fn write_record(
 }
 
 /// The Cycles reference: the same shader seen by the camera, no passes
-/// (`reference.####.exr`); `job` is the passes' job, whose settings it keeps.
+/// (`reference.####.exr`); `job` is the passes' job, whose settings it keeps. With the scene's
+/// light groups and a registry of several lights, one render per group with the glass of its
+/// light (`crate::reference_lights`).
 pub fn render_reference(
     work: &Workspace<'_>,
     record: &RunRecord,
     job: ScriptJob,
+    registry: &RegistryChoice,
 ) -> Result<(), BlenderError> {
+    let by_light = crate::reference_lights::panes_by_light(record, &job.glass, registry)?;
+    if !by_light.is_empty() {
+        let jobs = crate::reference_lights::jobs(&work.staging, record, &job, &by_light);
+        for (k, job) in jobs.iter().enumerate() {
+            let path = work.staging.join(format!("reference_job_{k}.json"));
+            run_job(work, &path, "reference", job)?;
+        }
+        return crate::reference_lights::assemble(&work.staging, &work.dir, record, &by_light);
+    }
     let job = ScriptJob {
         reference: true,
         frames: record
@@ -511,6 +556,13 @@ pub fn compose_record(
     let t = Instant::now();
     let luts = RegistryLuts::new(&registry.registry);
     let tables = glassdb_compose::PartTables::new(&registry.registry, &registry.label);
+    let lights =
+        crate::scene_lights::light_tables(&record.lights, registry, &dir.join(RECORD_NAME))?;
+    let groups = if record.group_layers {
+        crate::scene_lights::compose_groups(&lights, &registry.registry)
+    } else {
+        Vec::new()
+    };
     let mut frames = Vec::new();
     let mut light_parts = Vec::new();
     for f in &record.frames {
@@ -541,10 +593,19 @@ pub fn compose_record(
         };
         let report = match &f.light_parts {
             Some(name) => {
-                let relit = crate::relit::compose_frame_parts(dir, name, &job, &settings, &tables)?;
+                let relit = crate::relit::compose_frame_parts(
+                    dir, name, &job, &settings, &tables, &lights,
+                )?;
                 light_parts.push((f.frame, relit.factors));
                 relit.frame
             }
+            None if !groups.is_empty() => glassdb_compose::compose_light_groups(
+                &job,
+                &settings,
+                &groups,
+                false,
+                &glassdb_io::NoProgress,
+            )?,
             None => glassdb_compose::compose_frame(&job, &settings, &luts)?,
         };
         frames.push((f.frame, report));
@@ -554,6 +615,7 @@ pub fn compose_record(
         swap: crate::relit::swap_warnings_relit(record, registry),
         seconds: t.elapsed().as_secs_f64(),
         light_parts,
+        lights,
     })
 }
 

@@ -167,6 +167,8 @@ mod tests {
             frames: Vec::new(),
             lit_by,
             surfaces: None,
+            lights: Vec::new(),
+            group_layers: false,
         }
     }
 

@@ -67,7 +67,7 @@
 
   // The page's data (crates/view/src/page.rs), from the server or from an export: read here
   // only, so that every field the page uses comes through one place that knows its version.
-  const PAGE_FORMAT = 'glassdb-viewer-page/3';
+  const PAGE_FORMAT = 'glassdb-viewer-page/4';
 
   function readScene(scene) {
     if (!scene || scene.format !== PAGE_FORMAT) {
@@ -77,13 +77,14 @@
     return scene;
   }
 
-  // `parts`: the light parts' passes, part after part (empty without a light-path split).
+  // `parts`: the light parts' passes, part after part, packed (data.rs, part_bytes; empty
+  // without a light-path split).
   // `passes`: the transmission, each plane's reflection, then each pane group's (`groups`:
   // {plane, group}, in that order; `groups_folded`: why a frame's groups are not apart).
   function readFrame(info, passes, mask, parts) {
     return { info: { ids: info.ids, trans: info.trans, plane_sides: info.plane_sides, parts: info.parts || [],
       groups: info.groups || [], groupsFolded: info.groups_folded || null }, passes, mask,
-      parts: parts || new Uint16Array(0) };
+      parts: parts || new Uint32Array(0) };
   }
 
   // A unit the server built (POST api/unit): its product and its table.
@@ -100,7 +101,7 @@
       if (!EXPORT.frames[i]) await loadScript(window.GLASSDB_EXPORT_FRAME_FILES[i]);
       const f = EXPORT.frames[i];
       return readFrame(f.info, new Uint16Array(await packedBytes(f.passes, 2)), new Float32Array(await packedBytes(f.mask, 4)),
-        f.parts ? new Uint16Array(await packedBytes(f.parts, 2)) : undefined);
+        f.parts ? new Uint32Array(await packedBytes(f.parts, 4)) : undefined);
     },
   } : {
     scene: async () => readScene(await fetchOk('api/scene', 'json')),
@@ -116,7 +117,7 @@
       const info = await fetchOk('api/frame/' + i, 'json');
       const passes = await fetchOk('api/frame/' + i + '/passes');
       const mask = await fetchOk('api/frame/' + i + '/mask');
-      const parts = info.parts && info.parts.length ? new Uint16Array(await fetchOk('api/frame/' + i + '/parts')) : undefined;
+      const parts = info.parts && info.parts.length ? new Uint32Array(await fetchOk('api/frame/' + i + '/parts')) : undefined;
       return readFrame(info, new Uint16Array(passes), new Float32Array(mask), parts);
     },
   };
@@ -189,7 +190,10 @@ void main() {
   gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
 }`;
 
-  function fragmentSource(lut) {
+  // `relit`: with the light parts' loop (a frame with light parts); without it, the plain
+  // shader, which SwiftShader runs faster even though the loop's uniform branch is not taken
+  // (docs/performance.md, "Relit swap").
+  function fragmentSource(lut, relit) {
     return `#version 300 es
 precision highp float;
 precision highp int;
@@ -224,10 +228,12 @@ uniform vec3 uShaperOffset;
 uniform int uCubeN;
 uniform vec3 uCubeScale;
 uniform vec3 uCubeOffset;
-// The relit swap (docs/viewer.md): each light part's passes (transmission, then each plane's
-// reflection, part after part) and its factor per set: what the glass its light came through
-// passes, times its exposure.
-uniform highp sampler2DArray uParts;
+// The relit swap (docs/viewer.md): each light part's passes, part after part, packed as
+// halves (crates/view/src/data.rs, part_bytes: the transmission and the pixel's plane's
+// reflection in one texel, its pane groups' in a second), and its factor per set: what the
+// glass its light came through passes, times its exposure.
+uniform highp usampler2DArray uParts;
+uniform int uPartLayers; // layers per part: 1, or 2 with pane-group passes
 uniform int uPartCount;
 uniform vec3 uFactorA[16];
 uniform vec3 uFactorB[16];
@@ -344,26 +350,61 @@ vec3 cubeView(vec3 v) {
 void main() {
   int x = int(gl_FragCoord.x);
   int y = uHeight - 1 - int(gl_FragCoord.y);
-  vec4 tr = texelFetch(uTrans, ivec2(x, y), 0);
   vec4 m = texelFetch(uMask, ivec2(x, y), 0);
   int slot = int(m.r + 0.5) - 1;
   int plane = int(m.g + 0.5);
   bool glass = slot >= 0 && plane < uPlanes;
   bool useB = uAB == 1 || (uAB == 2 && float(x) >= uSplitX);
-  vec3 rfParts = vec3(0.0);
-  if (uPartCount > 0) {
-    // Σ_p f_p·trans_p and Σ_p f_p·refl_p: the composite is linear in the passes.
-    vec3 trParts = vec3(0.0);
-    int per = 1 + uPlanes;
+  // A unit on a plane with pane-group passes reflects once per group (docs/viewer.md, "Units
+  // and their ghosts"): the uRefl layer of each of its groups' reflections, a group without a
+  // pass of its own taking the deepest nearer group's (as compose folds it).
+  int n = 1;
+  ivec3 layer = ivec3(plane);
+  ivec2 gls = glass ? uGroupLayer[plane] : ivec2(-1);
+  if (gls.x >= 0 || gls.y >= 0) {
+    n = useB ? groupCount(uLutB, slot) : groupCount(uLutA, slot);
+    layer.y = gls.x >= 0 ? gls.x : layer.x;
+    layer.z = gls.y >= 0 ? gls.y : layer.y;
+  }
+  bool ghosts = n > 1;
+  // The transmission and each group's reflection: the passes, or with light parts
+  // Σ_p f_p·pass_p (the composite is linear in the passes).
+  vec3 tr = vec3(0.0);
+  float alpha = 1.0;
+  vec3 rf0 = vec3(0.0);
+  vec3 rf1 = vec3(0.0);
+  vec3 rf2 = vec3(0.0);
+  if (${relit ? 'uPartCount > 0' : 'false'}) {
     for (int p = 0; p < 16; p++) {
       if (p >= uPartCount) break;
       vec3 f = useB ? uFactorB[p] : uFactorA[p];
-      trParts += f * texelFetch(uParts, ivec3(x, y, p * per), 0).rgb;
-      if (glass) rfParts += f * texelFetch(uParts, ivec3(x, y, p * per + 1 + plane), 0).rgb;
+      uvec4 a = texelFetch(uParts, ivec3(x, y, p * uPartLayers), 0);
+      vec2 a0 = unpackHalf2x16(a.x);
+      vec2 a1 = unpackHalf2x16(a.y);
+      tr += f * vec3(a0, a1.x);
+      if (glass) {
+        rf0 += f * vec3(a1.y, unpackHalf2x16(a.z));
+        if (ghosts) {
+          uvec4 b = texelFetch(uParts, ivec3(x, y, p * uPartLayers + 1), 0);
+          vec2 b1 = unpackHalf2x16(b.y);
+          if (layer.y != layer.x) rf1 += f * vec3(unpackHalf2x16(b.x), b1.x);
+          if (n > 2 && layer.z != layer.y) rf2 += f * vec3(b1.y, unpackHalf2x16(b.z));
+        }
+      }
     }
-    tr = vec4(trParts, 1.0);
+  } else {
+    vec4 t4 = texelFetch(uTrans, ivec2(x, y), 0);
+    tr = t4.rgb;
+    alpha = t4.a;
+    if (glass) {
+      rf0 = texelFetch(uRefl, ivec3(x, y, layer.x), 0).rgb;
+      if (ghosts && layer.y != layer.x) rf1 = texelFetch(uRefl, ivec3(x, y, layer.y), 0).rgb;
+      if (n > 2 && layer.z != layer.y) rf2 = texelFetch(uRefl, ivec3(x, y, layer.z), 0).rgb;
+    }
   }
-  vec3 col = tr.rgb;
+  if (layer.y == layer.x) rf1 = rf0;
+  if (layer.z == layer.y) rf2 = rf1;
+  vec3 col = tr;
   if (glass) {
     vec3 r;
     vec3 t;
@@ -374,30 +415,23 @@ void main() {
     }
     float k = m.a;
     t = 1.0 - k + k * t;
-    r = r * k;
-    vec3 rf = uPartCount > 0 ? rfParts : texelFetch(uRefl, ivec3(x, y, plane), 0).rgb;
-    int n = useB ? groupCount(uLutB, slot) : groupCount(uLutA, slot);
-    ivec2 gls = uGroupLayer[plane];
-    if (n > 1 && (gls.x >= 0 || gls.y >= 0)) {
-      // A unit: Σ_g refl_g · r_g (docs/viewer.md, "Units and their ghosts").
+    if (ghosts) {
+      // Σ_g refl_g · r_g, in compose's order.
       vec3 sum = vec3(0.0);
-      int layer = -1;
       for (int g = 0; g < GROUPS; g++) {
         if (g >= n) break;
-        int own = g == 1 ? gls.x : (g == 2 ? gls.y : -1);
-        if (own >= 0) layer = own;
         vec3 s = useB ? share(uLutB, slot, uSide[plane], g, m.b) : share(uLutA, slot, uSide[plane], g, m.b);
-        vec3 pass = layer >= 0 ? texelFetch(uRefl, ivec3(x, y, layer), 0).rgb : rf;
+        vec3 pass = g == 0 ? rf0 : (g == 1 ? rf1 : rf2);
         sum += pass * (s * k);
       }
-      col = tr.rgb * t + sum;
+      col = tr * t + sum;
     } else {
-      col = tr.rgb * t + rf * r;
+      col = tr * t + rf0 * (r * k);
     }
   }
   col *= uGain;
   if (uConvert && uView == 0) col = uDisplay * col;
-  if (tr.a > 0.0) col /= tr.a;
+  if (alpha > 0.0) col /= alpha;
   if (uView == 0) {
     outColor = vec4(srgb(col), 1.0);
   } else {
@@ -488,14 +522,28 @@ void main() {
     const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false, alpha: false });
     if (!gl) throw new Error('this browser has no WebGL2');
     if (scene.planes > 64) throw new Error('the page handles at most 64 planes');
-    const program = gl.createProgram();
-    gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX));
-    gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragmentSource(lutLayout)));
-    gl.linkProgram(program);
-    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
-    gl.useProgram(program);
+    // Two programs: the plain shader, and the relit one for frames with light parts; every
+    // uniform is set on both (`uni`), and a draw uses the frame's.
+    const programs = [false, true].map((relit) => {
+      const program = gl.createProgram();
+      gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX));
+      gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragmentSource(lutLayout, relit)));
+      gl.linkProgram(program);
+      if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
+      return program;
+    });
     gl.bindVertexArray(gl.createVertexArray());
-    const u = (name) => gl.getUniformLocation(program, name);
+    const locations = programs.map(() => new Map());
+    function uni(fn, name, ...args) {
+      programs.forEach((program, k) => {
+        if (!locations[k].has(name)) locations[k].set(name, gl.getUniformLocation(program, name));
+        const at = locations[k].get(name);
+        if (at !== null) {
+          gl.useProgram(program);
+          gl[fn](at, ...args);
+        }
+      });
+    }
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
 
     const transTex = texture(gl, gl.TEXTURE_2D);
@@ -520,7 +568,7 @@ void main() {
     }
     const partsTex = texture(gl, gl.TEXTURE_2D_ARRAY);
     // Complete from the start (one texel) until a frame's light parts replace it.
-    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, 1, 1, 1, 0, gl.RGBA, gl.HALF_FLOAT, new Uint16Array(4));
+    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, 1, 1, 1, 0, gl.RGBA_INTEGER, gl.UNSIGNED_INT, new Uint32Array(4));
     const units = [['uTrans', gl.TEXTURE_2D, transTex], ['uRefl', gl.TEXTURE_2D_ARRAY, reflTex],
       ['uMask', gl.TEXTURE_2D, maskTex], ['uLutA', gl.TEXTURE_2D, lutTex.A], ['uLutB', gl.TEXTURE_2D, lutTex.B],
       ['uShaper', gl.TEXTURE_2D, shaperTex], ['uCube', gl.TEXTURE_3D, cubeTex], ['uParts', gl.TEXTURE_2D_ARRAY, partsTex]];
@@ -528,7 +576,7 @@ void main() {
     units.forEach(([name, target, tex], i) => {
       gl.activeTexture(gl.TEXTURE0 + i);
       gl.bindTexture(target, tex);
-      gl.uniform1i(u(name), i);
+      uni('uniform1i', name, i);
     });
     // Texture units: one per sampler, then an idle one that uploads bind to.
     gl.activeTexture(gl.TEXTURE0 + units.length);
@@ -537,36 +585,36 @@ void main() {
     async function setView(i) {
       if (i >= 0 && !viewTables[i]) viewTables[i] = await source.view(i);
       const v = scene.views[i];
-      gl.uniform1i(u('uView'), v ? 1 : 0);
+      uni('uniform1i', 'uView', v ? 1 : 0);
       if (v) {
         const data = viewTables[i];
         const shaperFloats = v.shaper ? v.shaper.rows * lutLayout.width * 3 : 0;
-        gl.uniform1i(u('uHasShaper'), v.shaper ? 1 : 0);
-        gl.uniform1i(u('uHasCube'), v.cube ? 1 : 0);
+        uni('uniform1i', 'uHasShaper', v.shaper ? 1 : 0);
+        uni('uniform1i', 'uHasCube', v.cube ? 1 : 0);
         if (v.shaper) {
           gl.activeTexture(gl.TEXTURE0 + unitOf('uShaper'));
           gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, lutLayout.width, v.shaper.rows, 0, gl.RGB, gl.FLOAT, data.subarray(0, shaperFloats));
-          gl.uniform1i(u('uShaperLen'), v.shaper.len);
-          gl.uniform3fv(u('uShaperScale'), v.shaper.scale);
-          gl.uniform3fv(u('uShaperOffset'), v.shaper.offset);
+          uni('uniform1i', 'uShaperLen', v.shaper.len);
+          uni('uniform3fv', 'uShaperScale', v.shaper.scale);
+          uni('uniform3fv', 'uShaperOffset', v.shaper.offset);
         }
         if (v.cube) {
           const n = v.cube.n;
           gl.activeTexture(gl.TEXTURE0 + unitOf('uCube'));
           gl.texImage3D(gl.TEXTURE_3D, 0, gl.RGB32F, n, n, n, 0, gl.RGB, gl.FLOAT, data.subarray(shaperFloats, shaperFloats + n * n * n * 3));
-          gl.uniform1i(u('uCubeN'), n);
-          gl.uniform3fv(u('uCubeScale'), v.cube.scale);
-          gl.uniform3fv(u('uCubeOffset'), v.cube.offset);
+          uni('uniform1i', 'uCubeN', n);
+          uni('uniform3fv', 'uCubeScale', v.cube.scale);
+          uni('uniform3fv', 'uCubeOffset', v.cube.offset);
         }
         gl.activeTexture(gl.TEXTURE0 + units.length);
       }
       state.view = i;
     }
-    gl.uniform1i(u('uHeight'), H);
-    gl.uniform1i(u('uMode'), { code8: 0, cos: 1, normal: 2 }[scene.mask_mode]);
-    gl.uniform1i(u('uPlanes'), scene.planes);
-    gl.uniform1i(u('uConvert'), scene.display_matrix ? 1 : 0);
-    gl.uniformMatrix3fv(u('uDisplay'), true, scene.display_matrix || [1, 0, 0, 0, 1, 0, 0, 0, 1]);
+    uni('uniform1i', 'uHeight', H);
+    uni('uniform1i', 'uMode', { code8: 0, cos: 1, normal: 2 }[scene.mask_mode]);
+    uni('uniform1i', 'uPlanes', scene.planes);
+    uni('uniform1i', 'uConvert', scene.display_matrix ? 1 : 0);
+    uni('uniformMatrix3fv', 'uDisplay', true, scene.display_matrix || [1, 0, 0, 0, 1, 0, 0, 0, 1]);
 
     // Every product's table, on the CPU (a swap then uploads one slot's rows and nothing else).
     const luts = await source.luts(products.length);
@@ -611,10 +659,11 @@ void main() {
     }
 
     function draw() {
-      gl.uniform1f(u('uGain'), Math.pow(2, state.ev));
-      gl.uniform1i(u('uAB'), { A: 0, B: 1, split: 2 }[state.ab] ?? 0);
-      gl.uniform1f(u('uSplitX'), state.split * W);
+      uni('uniform1f', 'uGain', Math.pow(2, state.ev));
+      uni('uniform1i', 'uAB', { A: 0, B: 1, split: 2 }[state.ab] ?? 0);
+      uni('uniform1f', 'uSplitX', state.split * W);
       gl.viewport(0, 0, W, H);
+      gl.useProgram(programs[state.data && state.data.info.parts.length ? 1 : 0]);
       gl.drawArrays(gl.TRIANGLES, 0, 3);
       placeSplitLine();
       state.drawn += 1;
@@ -664,17 +713,20 @@ void main() {
       groups.forEach((g, j) => {
         if (g.plane < 64 && g.group >= 1 && g.group <= 2) layers[g.plane * 2 + g.group - 1] = scene.planes + j;
       });
-      gl.uniform2iv(u('uGroupLayer'), layers);
+      uni('uniform2iv', 'uGroupLayer', layers);
       if (data.info.groupsFolded) status('frame ' + i + ': ' + data.info.groupsFolded, false);
       gl.bindTexture(gl.TEXTURE_2D, maskTex);
       gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, W, H, gl.RGBA, gl.FLOAT, data.mask);
       // The side of each plane the camera sees in this frame (it may change as the camera moves).
-      gl.uniform1iv(u('uSide'), Int32Array.from({ length: 64 }, (_, k) => data.info.plane_sides[k] === 'back' ? 1 : 0));
+      uni('uniform1iv', 'uSide', Int32Array.from({ length: 64 }, (_, k) => data.info.plane_sides[k] === 'back' ? 1 : 0));
       if (data.info.parts.length > 16) throw new Error('frame ' + i + ': ' + data.info.parts.length + ' light parts; the page shows at most 16');
       if (data.info.parts.length) {
+        // Per part: its transmission and each pixel's plane's reflection, then its pane groups'.
+        const per = groups.length ? 2 : 1;
+        uni('uniform1i', 'uPartLayers', per);
         gl.bindTexture(gl.TEXTURE_2D_ARRAY, partsTex);
-        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA16F, W, H, data.info.parts.length * (1 + scene.planes), 0, gl.RGBA,
-          gl.HALF_FLOAT, data.parts);
+        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, W, H, data.info.parts.length * per, 0, gl.RGBA_INTEGER,
+          gl.UNSIGNED_INT, data.parts);
       }
       state.frame = i;
       state.data = data;
@@ -716,12 +768,12 @@ void main() {
     // The factors of the frame's parts for both sets, as the shader's uniforms.
     function setFactors() {
       const parts = state.data ? state.data.info.parts : [];
-      gl.uniform1i(u('uPartCount'), parts.length);
+      uni('uniform1i', 'uPartCount', parts.length);
       if (!parts.length) return;
       for (const set of ['A', 'B']) {
         const v = new Float32Array(16 * 3);
         parts.forEach((part, i) => v.set(partFactor(part, set), 3 * i));
-        gl.uniform3fv(u(set === 'A' ? 'uFactorA' : 'uFactorB'), v);
+        uni('uniform3fv', set === 'A' ? 'uFactorA' : 'uFactorB', v);
       }
     }
 

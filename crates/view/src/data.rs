@@ -4,6 +4,11 @@
 //!   reflection pass placed in the frame (0 where it holds no pixels: the kernel's "no
 //!   reflection" there), then each pane group's pass the frame composites apart
 //!   ([`group_pass_bytes`], in the order of `PageFrame::groups`), placed the same way;
+//! - a light part's passes ([`part_bytes`]): `u32` RGBA texels, each `u32` two halves (low bits
+//!   first): per pixel the transmission's R, G, B and the reflection of the pixel's own plane
+//!   (R, G, B), then the fourth `u32` 0; with pane-group passes a second layer of the plane's
+//!   groups 1 and 2 (R, G, B each), so that the shader fetches one texel per part on a glass
+//!   pixel, not one per pass;
 //! - mask: `f32` RGBA per pixel: glass slot + 1 (0: no glass), plane, cos θ (the 8-bit code
 //!   for an 8-bit mask; cos θ for 16-bit and float masks, NaN as 1 as the kernel reads it; 1
 //!   for a binary mask), coverage (1 without);
@@ -153,6 +158,70 @@ fn placed_pass(
             push(1.0);
         }
     }
+}
+
+/// Layers of one light part's passes ([`part_bytes`]): the transmission and the reflection of
+/// each pixel's own plane, and with pane-group passes a second layer of its groups 1 and 2.
+pub fn part_layers(groups: bool) -> usize {
+    if groups { 2 } else { 1 }
+}
+
+/// One light part's passes as the page's shader reads them, packed so that a glass pixel costs
+/// one texture fetch per part (see the module docs): per pixel, in `u32` RGBA texels of two
+/// halves each (low bits first), the transmission's R, G, B and the reflection of the pixel's
+/// plane (its mask plane's pass there; 0 off glass or outside the pass); with `groups`, a
+/// second layer with the reflections of that plane's pane groups 1 and 2 (0 where the plane has
+/// no such pass). The halves are [`pass_bytes`]' and [`group_pass_bytes`]' values.
+pub fn part_bytes(frame: &DecodedFrame<'_>, groups: bool) -> Vec<u8> {
+    let trans = &frame.trans.image;
+    let (w, h) = (trans.width as usize, trans.height as usize);
+    let n = w * h;
+    let layers = part_layers(groups);
+    let half = |v: f32| u32::from(half::f16::from_f32(v).to_bits());
+    let pack = |lo: f32, hi: f32| half(lo) | (half(hi) << 16);
+    // The pane-group passes of each plane, groups 1 and 2.
+    let mut of_plane: Vec<[Option<&glassdb_compose::DecodedGroupPass>; 2]> =
+        vec![[None; 2]; frame.refl.len()];
+    for g in &frame.groups {
+        if let Some(slots) = of_plane.get_mut(g.plane)
+            && (1..=2).contains(&g.group)
+        {
+            slots[g.group - 1] = Some(g);
+        }
+    }
+    let mut texels = vec![0u32; layers * n * 4];
+    for i in 0..n {
+        let (x, y) = ((i % w) as i64, (i / w) as i64);
+        let mut v = [0f32; 12];
+        for (c, out) in v[..3].iter_mut().enumerate() {
+            *out = trans.rgb[c][i];
+        }
+        let plane = usize::from(frame.mask.plane[i]);
+        if frame.mask.id[i] != 0 && plane < frame.refl.len() {
+            if let Some(j) = frame.refl_windows[plane].index_of(x, y) {
+                for c in 0..3 {
+                    v[3 + c] = frame.refl[plane].image.rgb[c][j];
+                }
+            }
+            for (k, g) in of_plane[plane].iter().enumerate() {
+                if let Some(g) = g.filter(|_| groups)
+                    && let Some(j) = g.window.index_of(x, y)
+                {
+                    for c in 0..3 {
+                        v[6 + 3 * k + c] = g.pass.image.rgb[c][j];
+                    }
+                }
+            }
+        }
+        for l in 0..layers {
+            let at = (l * n + i) * 4;
+            let v = &v[6 * l..6 * l + 6];
+            texels[at] = pack(v[0], v[1]);
+            texels[at + 1] = pack(v[2], v[3]);
+            texels[at + 2] = pack(v[4], v[5]);
+        }
+    }
+    texels.iter().flat_map(|t| t.to_le_bytes()).collect()
 }
 
 /// The passes of a decoded frame as half-float RGBA planes (see the module docs).

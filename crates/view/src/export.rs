@@ -252,7 +252,7 @@ pub fn write_export(
                 json!(frame.info),
                 packed_base64(&frame.passes, 2)?,
                 packed_base64(&frame.mask, 4)?,
-                packed_base64(&frame.parts, 2)?
+                packed_base64(&frame.parts, 4)?
             )
         })?;
     }

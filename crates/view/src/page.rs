@@ -13,7 +13,7 @@ use serde::Serialize;
 use crate::data;
 
 /// Value of [`PageScene::format`]; `viewer.js` refuses anything else.
-pub const PAGE_FORMAT: &str = "glassdb-viewer-page/3";
+pub const PAGE_FORMAT: &str = "glassdb-viewer-page/4";
 
 /// The scene the page starts from: the frames, their colour, the candidate products and the
 /// layout of their tables.

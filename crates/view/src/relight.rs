@@ -10,9 +10,10 @@ use glassdb_compose::colour::RegistryLuts;
 use glassdb_compose::light_parts::{LightPart, LightSource};
 use glassdb_compose::memory::MemoryBudget;
 use glassdb_compose::{
-    ApertureGlass, ComposeError, DecodeSettings, DecodeTarget, FactorKind, decode_frame,
-    part_factors, part_passes,
+    ApertureGlass, ComposeError, DecodeSettings, DecodeTarget, FactorKind, FrameFiles, InputLayers,
+    decode_frame, part_factors, part_passes,
 };
+use glassdb_pass::LightMix;
 use glassdb_side::Side;
 use serde::Serialize;
 
@@ -43,9 +44,12 @@ pub struct PagePart {
     pub factor: [f32; 3],
 }
 
-/// `data` with the light parts of `frame` (none: as it is): each part's passes decoded with its
-/// own layers ([`glassdb_compose::part_passes`] checks them against the record), one part at a
-/// time, and its [`PagePart`].
+/// `data` with the light parts of `frame` (none: as it is): each part's passes decoded alone
+/// (each pass read as that part's layer, [`LightMix`] of one part, as
+/// [`glassdb_compose::compose_light_parts`] reads them; [`glassdb_compose::part_passes`] checks
+/// them against the record), one part at a time, and its [`PagePart`]. A part's passes are the
+/// transmission, each pixel's plane's reflection and, where `data` composites pane groups apart
+/// (`PageFrame::groups`), its groups' ([`data::part_bytes`]).
 pub fn with_parts(
     mut data: FrameData,
     frame: &ViewerFrame,
@@ -56,19 +60,31 @@ pub fn with_parts(
     let Some(parts) = &frame.light_parts else {
         return Ok(data);
     };
-    let files = &frame.files;
     parts.check().map_err(|p| ComposeError::LightPartsRecord {
         record: format!("frame {}", frame.label),
         problem: p.0,
     })?;
     let names: Vec<&str> = parts.parts.iter().map(|p| p.group.as_str()).collect();
-    let layers = part_passes(files, &names, settings.pass.max_pixels)?;
-    let mut bytes = Vec::with_capacity(data.passes.len() * parts.parts.len());
+    part_passes(&frame.files, &names, settings.pass.max_pixels)?;
+    // The pane groups' passes the page composites apart, and no others.
+    let groups_apart = !data.info.groups.is_empty();
+    let files = FrameFiles {
+        groups: if groups_apart {
+            frame.files.groups.clone()
+        } else {
+            Vec::new()
+        },
+        ..frame.files.clone()
+    };
+    let mut bytes = Vec::new();
     let mut page = Vec::new();
-    for group in &layers {
+    for name in names {
         let mut one = settings.clone();
-        one.layers = group.layers.clone();
-        let decoded = decode_frame(files, &one, luts, budget, &DecodeTarget::display())?;
+        one.layers = InputLayers::default();
+        one.pass.light_mix = Some(LightMix {
+            weights: vec![(name.to_string(), [1.0; 3])],
+        });
+        let decoded = decode_frame(&files, &one, luts, budget, &DecodeTarget::display())?;
         if page.is_empty() {
             let basis = decoded.table.basis;
             let t_dif = |id: u16| {
@@ -90,7 +106,7 @@ pub fn with_parts(
                 .map(|(part, f)| page_part(part, f.kind, f.factor))
                 .collect();
         }
-        bytes.extend(data::pass_bytes(&decoded));
+        bytes.extend(data::part_bytes(&decoded, groups_apart));
     }
     data.parts = bytes;
     data.info.parts = page;

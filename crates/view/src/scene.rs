@@ -93,8 +93,8 @@ pub struct FrameData {
     pub passes: Vec<u8>,
     /// The mask ([`data::mask_bytes`]).
     pub mask: Vec<u8>,
-    /// The light parts' passes, part after part, each as [`FrameData::passes`] (empty without
-    /// light parts; [`crate::relight`]).
+    /// The light parts' passes, part after part, each packed by [`data::part_bytes`] (empty
+    /// without light parts; [`crate::relight`]).
     pub parts: Vec<u8>,
 }
 
@@ -174,7 +174,7 @@ impl Viewer {
         let first_data = Arc::new(crate::relight::with_parts(
             first_data,
             first_frame,
-            &inputs.settings,
+            &frame_settings(&inputs.settings, first_frame),
             &luts,
             &budget,
         )?);
@@ -326,7 +326,7 @@ impl Viewer {
         let data = Arc::new(crate::relight::with_parts(
             data,
             viewer_frame,
-            &self.inputs.settings,
+            &frame_settings(&self.inputs.settings, viewer_frame),
             &self.luts,
             &self.budget,
         )?);
@@ -437,14 +437,12 @@ fn find_product_in(candidates: &[&GlassRecord], name: &str) -> Result<usize, Vie
     }
 }
 
-/// A decoded frame as the page uploads it; `slots` gives each mask id's glass slot.
 /// How `frame` is decoded: as `settings` say, with its units' deeper pane groups folded onto
 /// their plane's pass (`compose --surfaces 1`) where it has no pane-group passes (a render
-/// with `--surfaces 1`) or light parts ([`groups_folded`]).
-fn frame_settings(settings: &DecodeSettings, frame: &ViewerFrame) -> DecodeSettings {
-    let fold = frame.files.groups.is_empty() || groups_folded(frame).is_some();
+/// with `--surfaces 1`).
+pub(crate) fn frame_settings(settings: &DecodeSettings, frame: &ViewerFrame) -> DecodeSettings {
     DecodeSettings {
-        max_groups: if fold {
+        max_groups: if frame.files.groups.is_empty() {
             std::num::NonZeroUsize::new(1)
         } else {
             settings.max_groups
@@ -453,25 +451,18 @@ fn frame_settings(settings: &DecodeSettings, frame: &ViewerFrame) -> DecodeSetti
     }
 }
 
-/// Why `frame`'s pane-group passes are not composited apart on the page, if they are not: the
-/// relit swap's light parts carry the planes' passes only.
-fn groups_folded(frame: &ViewerFrame) -> Option<&'static str> {
-    (frame.light_parts.is_some() && !frame.files.groups.is_empty()).then_some(
-        "the frame's passes are split by the light's path: the units' deeper pane groups \
-         reflect on their plane's pass (one surface per plane)",
-    )
-}
-
+/// A decoded frame as the page uploads it; `slots` gives each mask id's glass slot.
 fn frame_data(
     frame: &DecodedFrame<'_>,
     source: &ViewerFrame,
     slots: &HashMap<u16, usize>,
     settings: &DecodeSettings,
 ) -> FrameData {
-    let folded = groups_folded(source).or_else(|| {
-        (settings.max_groups == std::num::NonZeroUsize::new(1) && !frame.groups.is_empty())
-            .then_some("one surface per plane: the units' deeper pane groups reflect on their plane's pass")
-    });
+    let folded = (settings.max_groups == std::num::NonZeroUsize::new(1)
+        && !source.files.groups.is_empty())
+    .then_some(
+        "one surface per plane: the units' deeper pane groups reflect on their plane's pass",
+    );
     let mut passes = data::pass_bytes(frame);
     if folded.is_none() {
         passes.extend(data::group_pass_bytes(frame));
