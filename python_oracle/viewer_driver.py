@@ -8,7 +8,10 @@
 
     viewer_driver.py bench URL --id ID --products 'P1|P2' [--repeat N] [--unit 'P1|GAP_MM:GAS|P2']
         Times product choices through the page's automation hook: from the choice to the new
-        frame drawn (a 1-pixel read-back finishes the drawing), and the page's load time. With
+        frame drawn (a 1-pixel read-back finishes the drawing), the CPU time of the browser's
+        processes per choice (`swap_cpu_ms`: the first choice of each product not counted; load
+        moves it much less than the wall time), a choice for ID right after one for another glass
+        of the frame (`switch_ms_median`, 3 times), and the page's load time. With
         --unit, also units built on the page (the hook the builder's button calls) for glass ID,
         the gap widened by 0.1 mm each time so that every build is new: from the request to the
         frame on screen, and the server's share (stack engine, fit, table).
@@ -47,6 +50,7 @@ import argparse
 import base64
 import contextlib
 import json
+import os
 import sys
 import time
 import urllib.parse
@@ -149,6 +153,28 @@ def check(args):
         print(json.dumps(report))
 
 
+def browser_cpu_s(driver):
+    """CPU seconds (user + system) so far of the browser's processes: chromedriver's descendants
+    (SwiftShader draws in Chromium's GPU process). Less moved by other load than wall time."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        # after the name: state, ppid, ..., utime (11), stime (12) counted from state at 0
+        children.setdefault(int(fields[1]), []).append((int(entry), int(fields[11]) + int(fields[12])))
+    ticks, todo = 0, [driver.service.process.pid]
+    while todo:
+        for pid, t in children.get(todo.pop(), []):
+            ticks += t
+            todo.append(pid)
+    return ticks / os.sysconf("SC_CLK_TCK")
+
+
 def bench(args):
     driver = browser(args.gpu)
     try:
@@ -159,12 +185,27 @@ def bench(args):
         page_ms = driver.execute_script("return window.glassdbReadyMs")
         products = args.products.split("|")
         swaps = []
+        # The first choice of each product is not counted in the CPU time (first uses).
+        for p in products:
+            driver.execute_script("window.glassdb.choose(arguments[0], arguments[1])", args.id, p)
+        cpu0 = browser_cpu_s(driver)
         for k in range(args.repeat):
             for p in products:
                 ms = driver.execute_script(
                     "return window.glassdb.choose(arguments[0], arguments[1])", args.id, p)
                 swaps.append(ms)
+        cpu_ms = (browser_cpu_s(driver) - cpu0) * 1e3 / len(swaps)
         swaps.sort()
+        # A choice for ID right after one for another glass of the frame (on a frame with light
+        # parts the page then sums the other parts again: docs/viewer.md, "Relit swap").
+        others = [int(e.get_attribute("data-id")) for e in driver.find_elements(By.CSS_SELECTOR, "#glasses li")]
+        others = [i for i in others if i != args.id]
+        switches = []
+        for k in range(3 if others else 0):
+            driver.execute_script("window.glassdb.choose(arguments[0], arguments[1])", others[0], products[k % len(products)])
+            switches.append(driver.execute_script(
+                "return window.glassdb.choose(arguments[0], arguments[1])", args.id, products[k % len(products)]))
+        switches.sort()
         units, unit_server = [], []
         if args.unit:
             driver.execute_script("window.glassdb.choose(arguments[0], 0)", args.id)
@@ -195,6 +236,8 @@ def bench(args):
             "swap_ms_median": swaps[len(swaps) // 2],
             "swap_ms_min": swaps[0],
             "swap_ms_max": swaps[-1],
+            "swap_cpu_ms": cpu_ms,
+            **({"switch_ms_median": switches[len(switches) // 2]} if switches else {}),
             **({"units": len(units), "unit_ms_median": units[len(units) // 2], "unit_ms_min": units[0],
                 "unit_ms_max": units[-1], "unit_server_ms_median": unit_server[len(unit_server) // 2]}
                if units else {}),

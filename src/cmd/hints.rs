@@ -287,10 +287,10 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
              may change the data window, not the display window)"
                 .into(),
         ),
-        ComposeError::MaskWithoutPlanes { .. } => Some(
-            "name the mask's plane channel with --mask-channels plane=NAME, or give one --refl"
-                .into(),
-        ),
+        ComposeError::MaskWithoutPlanes { .. } => Some(format!(
+            "name the mask's plane channel with --mask-channels plane=NAME, or give one --refl; \
+             {OLD_RUN_MASKS}"
+        )),
         ComposeError::GlassOutsidePass { .. } => Some(
             "render the pass over its plane's whole screen rectangle, or choose \
              --outside-pass no-reflection or --outside-pass transmission"
@@ -359,9 +359,16 @@ fn compose_hint(e: &ComposeError) -> Option<String> {
     }
 }
 
+/// A `glassdb blender render` run whose EXR masks lack the plane channel: made before the masks
+/// always stored it (commit 51761fc), which nothing but a new render fixes.
+const OLD_RUN_MASKS: &str = "a `glassdb blender render` run whose masks have no plane channel \
+     was rendered before the masks always stored it: render it again with glassdb blender render \
+     (its masks cannot be repaired by compose)";
+
 fn blender_hint(e: &glassdb_blender::BlenderError) -> Option<String> {
     use glassdb_blender::BlenderError as B;
     Some(match e {
+        B::Compose(ComposeError::MaskWithoutPlanes { .. }) => OLD_RUN_MASKS.into(),
         B::NotFound { .. } | B::VersionUnreadable { .. } => {
             "install Blender 3.4 or newer (Debian: apt-get install blender), or give its path \
              with --blender PATH"

@@ -889,10 +889,15 @@ fn a_unit_swapped_in_shows_its_ghost_as_compose_does() {
 /// 8-bit codes of the linear RGB in `exr` (its beauty), as the page's standard view writes
 /// them (sRGB transfer, clipped, rounded): what the canvas shows of a composite at 0 EV.
 fn srgb_codes(exr: &Path) -> Vec<[f64; 3]> {
+    srgb_codes_at(exr, 0.0)
+}
+
+/// [`srgb_codes`] at `ev` stops (the page's exposure).
+fn srgb_codes_at(exr: &Path, ev: f64) -> Vec<[f64; 3]> {
     let p = crate::util::read_exr_planes(exr);
     let rgb = ["R", "G", "B"].map(|c| crate::blender_ghosts::channel(&p, c));
     let encode = |v: f64| {
-        let v = v.clamp(0.0, 1.0);
+        let v = (v * ev.exp2()).clamp(0.0, 1.0);
         let e = if v <= 0.0031308 {
             v * 12.92
         } else {
@@ -908,13 +913,18 @@ fn srgb_codes(exr: &Path) -> Vec<[f64; 3]> {
 /// `glassdb blender compose RUN` (with `registry`, else the bundled one): its composite of the
 /// first frame as 8-bit codes ([`srgb_codes`]).
 fn blender_composed(run: &Path, registry: Option<&Path>) -> Vec<[f64; 3]> {
+    blender_composed_at(run, registry, 0.0)
+}
+
+/// [`blender_composed`] at `ev` stops.
+fn blender_composed_at(run: &Path, registry: Option<&Path>, ev: f64) -> Vec<[f64; 3]> {
     let mut cmd = glassdb();
     cmd.args(["blender", "compose"]).arg(run);
     if let Some(r) = registry {
         cmd.arg("--registry").arg(r);
     }
     ok(&mut cmd);
-    srgb_codes(&run.join("composite.0001.exr"))
+    srgb_codes_at(&run.join("composite.0001.exr"), ev)
 }
 
 /// Pixels where `a` and `b` differ by more than `codes` in some channel.
@@ -1055,6 +1065,117 @@ fn a_relit_triple_unit_run_shows_both_ghosts_as_blender_compose_does() {
         frame["groups"],
         serde_json::json!([{"plane": 0, "group": 1}, {"plane": 0, "group": 2}]),
         "{frame}"
+    );
+}
+
+/// A run folder as `glassdb blender render` writes one, made by `scripts/bench_relight.py`: one
+/// 64×48 frame, two windows (glass ids 1 and 5 on planes 0 and 1) and 7 light parts (sun and sky
+/// through each window, and sun, sky and interior unglazed): `DIR/relit`.
+fn two_window_run(d: &Path) -> PathBuf {
+    let mut cmd = Command::new(crate::util::oracle_python());
+    cmd.arg(repo_path("scripts/bench_relight.py"))
+        .arg(d)
+        .args(["64", "48", "7", "1", "5"]);
+    ok(&mut cmd);
+    d.join("relit")
+}
+
+/// The products the relit tests choose for the two windows' ids.
+const WINDOW_PRODUCTS: [(u16, &str); 2] = [
+    (1, SWAP_PRODUCT),
+    (5, "AGC green-tinted float 4.8 mm (IGSDB 185)"),
+];
+
+/// Issue 28's relit swap on the page, glass id by glass id: a choice re-weights the chosen id's
+/// light parts over the sums of the others (docs/viewer.md, "Relit swap"), which are drawn again
+/// when another id is chosen and not for a second choice of the same id. After a product chosen
+/// for each window the page gives `glassdb blender compose RUN --registry` with both, within 1
+/// code value; set B (untouched) still gives the run's own products. At -3 EV, so that the room
+/// is not clipped white.
+#[test]
+fn products_chosen_for_two_ids_relight_the_frame_as_blender_compose_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = two_window_run(d);
+    const EV: f64 = -3.0;
+    let start = blender_composed_at(&run, None, EV);
+    let mut registry = repo_path("data/registry.json");
+    for (id, product) in WINDOW_PRODUCTS {
+        registry = swapped_registry(&registry, d, id, product);
+    }
+    let want = blender_composed_at(&run, Some(&registry), EV);
+    // the whole frame changes, not only the windows (a third of it)
+    let relit = pixels_apart(&start, &want, 2.0);
+    assert!(relit > start.len() * 9 / 10, "only {relit} pixels relit");
+
+    let mut cmd = glassdb();
+    cmd.arg("view").arg(&run);
+    let served = spawn_viewer(&mut cmd);
+    let choose = |(id, product): (u16, &str)| {
+        format!("window.glassdb.choose({id}, {product:?}); return window.glassdb.relitStats();")
+    };
+    let report = layout(
+        &format!("{}?ev={EV}", served.url),
+        &[
+            READ_CANVAS,
+            "return window.glassdb.relitStats();",
+            &choose(WINDOW_PRODUCTS[0]),
+            &choose(WINDOW_PRODUCTS[1]),
+            &choose(WINDOW_PRODUCTS[1]),
+            READ_CANVAS,
+            &format!("window.glassdb.setAB('B'); {READ_CANVAS}"),
+        ],
+        None,
+    );
+    let r = &report["results"];
+    let stats = |k: usize| (r[k]["active"].clone(), num(&r[k]["fixedDraws"]));
+    let (_, loaded) = stats(1);
+    assert_eq!(stats(2), (1.into(), loaded), "{report}");
+    assert_eq!(stats(3), (5.into(), loaded + 1.0), "{report}");
+    assert_eq!(stats(4), (5.into(), loaded + 1.0), "{report}");
+    for (k, want, what) in [
+        (0, &start, "the run's products"),
+        (5, &want, "both windows swapped"),
+        (6, &start, "set B"),
+    ] {
+        let apart = pixels_apart(&canvas_of(&r[k]), want, 1.0);
+        assert_eq!(
+            apart, 0,
+            "page vs blender compose, {what}: {apart} pixels apart"
+        );
+    }
+}
+
+/// A run whose EXR mask has no plane channel (rendered before the masks always stored it) is
+/// refused by `glassdb blender compose DIR` and `glassdb view DIR` with a hint to render it again.
+#[test]
+fn a_run_whose_masks_lack_the_plane_channel_says_to_render_it_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = two_window_run(dir.path());
+    let mask = run.join("mask.0001.exr");
+    let mut cmd = Command::new(crate::util::oracle_python());
+    cmd.arg("-c")
+        .arg(
+            "import sys, OpenEXR\n\
+             f = OpenEXR.File(sys.argv[1])\n\
+             ch = {k: c.pixels for k, c in f.channels().items() if k != 'plane'}\n\
+             OpenEXR.File(f.header(), ch).write(sys.argv[1])",
+        )
+        .arg(&mask);
+    ok(&mut cmd);
+    let names = [
+        "mask.0001.exr",
+        "stores no plane per pixel",
+        "render it again with glassdb blender render",
+    ];
+    fails_naming(glassdb().args(["blender", "compose"]).arg(&run), &names);
+    fails_naming(
+        glassdb()
+            .arg("view")
+            .arg(&run)
+            .arg("--export")
+            .arg(dir.path().join("export")),
+        &names,
     );
 }
 

@@ -190,9 +190,114 @@ void main() {
   gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
 }`;
 
-  // `relit`: with the light parts' loop (a frame with light parts); without it, the plain
-  // shader, which SwiftShader runs faster even though the loop's uniform branch is not taken
-  // (docs/performance.md, "Relit swap").
+  // The plain shader's mask and passes (a frame without light parts).
+  const plainMask = `  vec4 m = texelFetch(uMask, ivec2(x, y), 0);
+  int slot = int(m.r + 0.5) - 1;
+  int plane = int(m.g + 0.5);
+  bool glass = slot >= 0 && plane < uPlanes;`;
+  const plainPasses = `  vec4 t4 = texelFetch(uTrans, ivec2(x, y), 0);
+  tr = t4.rgb;
+  alpha = t4.a;
+  if (glass) {
+    rf0 = texelFetch(uRefl, ivec3(x, y, layer.x), 0).rgb;
+    if (ghosts && layer.y != layer.x) rf1 = texelFetch(uRefl, ivec3(x, y, layer.y), 0).rgb;
+    if (n > 2 && layer.z != layer.y) rf2 = texelFetch(uRefl, ivec3(x, y, layer.z), 0).rgb;
+  }`;
+
+  // The fixed sums' layers per set (fixedSource): the transmission, then the reflection of the
+  // pixel's plane, and with pane-group passes its groups 1 and 2.
+  const fixedLayers = (layers) => (layers === 2 ? 4 : 2);
+
+  // The relit shader's mask: the pixel's glass slot and plane from the fixed sums' first texel
+  // (its fourth word), so that a pixel off glass reads no mask texel.
+  function relitMask(relit) {
+    return `  int base = useB ? ${fixedLayers(relit.layers)} : 0;
+  uvec4 fixed0 = texelFetch(uFixed, ivec3(x, y, base), 0);
+  int slot = int(fixed0.w & 0xffffu) - 1;
+  int plane = int(fixed0.w >> 16);
+  bool glass = slot >= 0 && plane < uPlanes;
+  vec4 m = vec4(0.0);
+  if (glass) m = texelFetch(uMask, ivec2(x, y), 0);`;
+  }
+
+  // One light part's passes (part_bytes) added with factor `f`: `p` its index, `layers` per part;
+  // `all`: every pass whatever the pixel (the fixed sums), else only what the pixel composites.
+  function addPart(p, layers, f, all) {
+    const at = (l) => `texelFetch(uParts, ivec3(xy, ${p * layers + l}), 0)`;
+    const when = (cond, text) => (all ? text : `if (${cond}) ${text}`);
+    let text = `  {
+    vec3 f = ${f};
+    uvec4 a = ${at(0)};
+    vec2 a1 = unpackHalf2x16(a.y);
+    tr += f * vec3(unpackHalf2x16(a.x), a1.x);
+    ${when('glass', '{')}
+      rf0 += f * vec3(a1.y, unpackHalf2x16(a.z));`;
+    if (layers === 2) {
+      text += `
+      ${when('ghosts', '{')}
+        uvec4 b = ${at(1)};
+        vec2 b1 = unpackHalf2x16(b.y);
+        ${when('layer.y != layer.x', '')}rf1 += f * vec3(unpackHalf2x16(b.x), b1.x);
+        ${when('n > 2 && layer.z != layer.y', '')}rf2 += f * vec3(b1.y, unpackHalf2x16(b.z));
+      }`;
+    }
+    return text + `
+    }
+  }
+`;
+  }
+
+  // The relit shader's passes: the fixed sums of the parts a choice does not change, plus each
+  // part it does (`relit.active`, indices of the frame's parts), written out one by one (a loop
+  // over the parts costs SwiftShader about a third more; docs/performance.md, "Relit swap").
+  function relitSums(relit) {
+    let text = `  ivec2 xy = ivec2(x, y);
+  tr = uintBitsToFloat(fixed0.xyz);
+  if (glass) {
+    rf0 = uintBitsToFloat(texelFetch(uFixed, ivec3(xy, base + 1), 0).xyz);`;
+    if (relit.layers === 2) {
+      text += `
+    if (ghosts && layer.y != layer.x) rf1 = uintBitsToFloat(texelFetch(uFixed, ivec3(xy, base + 2), 0).xyz);
+    if (n > 2 && layer.z != layer.y) rf2 = uintBitsToFloat(texelFetch(uFixed, ivec3(xy, base + 3), 0).xyz);`;
+    }
+    text += '\n  }\n';
+    relit.active.forEach((p, k) => { text += addPart(p, relit.layers, `useB ? uFactorB[${k}] : uFactorA[${k}]`, false); });
+    return text;
+  }
+
+  // The sums of the parts `rest` (indices) with their factors of one set (uFactor), drawn into
+  // the fixed layers of that set as f32 bits (exact, unlike halves), the transmission's texel
+  // carrying the mask's glass slot + 1 and plane (low and high 16 bits).
+  function fixedSource(rest, layers) {
+    const outs = ['oTr', 'oRf0', 'oRf1', 'oRf2'].slice(0, fixedLayers(layers));
+    let text = `#version 300 es
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+precision highp usampler2DArray;
+uniform highp usampler2DArray uParts;
+uniform sampler2D uMask;
+uniform vec3 uFactor[16];
+${outs.map((o, k) => `layout(location = ${k}) out uvec4 ${o};`).join('\n')}
+void main() {
+  // Rows as the data's (top to bottom): the target is read as the parts are.
+  ivec2 xy = ivec2(gl_FragCoord.xy);
+  vec4 m = texelFetch(uMask, xy, 0);
+  vec3 tr = vec3(0.0);
+  vec3 rf0 = vec3(0.0);
+  vec3 rf1 = vec3(0.0);
+  vec3 rf2 = vec3(0.0);
+`;
+    rest.forEach((p, k) => { text += addPart(p, layers, `uFactor[${k}]`, true); });
+    text += `  oTr = uvec4(floatBitsToUint(tr), uint(int(m.r + 0.5)) | (uint(int(m.g + 0.5)) << 16));
+  oRf0 = uvec4(floatBitsToUint(rf0), 0u);
+`;
+    if (layers === 2) text += '  oRf1 = uvec4(floatBitsToUint(rf1), 0u);\n  oRf2 = uvec4(floatBitsToUint(rf2), 0u);\n';
+    return text + '}';
+  }
+
+  // `relit`: null for the plain shader, or for a frame with light parts {active, layers}: the
+  // parts a choice re-weights (those of the active glass id) and the layers per part.
   function fragmentSource(lut, relit) {
     return `#version 300 es
 precision highp float;
@@ -228,13 +333,13 @@ uniform vec3 uShaperOffset;
 uniform int uCubeN;
 uniform vec3 uCubeScale;
 uniform vec3 uCubeOffset;
-// The relit swap (docs/viewer.md): each light part's passes, part after part, packed as
-// halves (crates/view/src/data.rs, part_bytes: the transmission and the pixel's plane's
-// reflection in one texel, its pane groups' in a second), and its factor per set: what the
-// glass its light came through passes, times its exposure.
+// The relit swap (docs/viewer.md, "Relit swap"): each light part's passes, part after part,
+// packed as halves (crates/view/src/data.rs, part_bytes: the transmission and the pixel's
+// plane's reflection in one texel, its pane groups' in a second); the sums of the parts a choice
+// does not change, per set (fixedSource), and the factor of each part it does change, per set:
+// what the glass its light came through passes, times its exposure.
 uniform highp usampler2DArray uParts;
-uniform int uPartLayers; // layers per part: 1, or 2 with pane-group passes
-uniform int uPartCount;
+uniform highp usampler2DArray uFixed;
 uniform vec3 uFactorA[16];
 uniform vec3 uFactorB[16];
 out vec4 outColor;
@@ -350,11 +455,8 @@ vec3 cubeView(vec3 v) {
 void main() {
   int x = int(gl_FragCoord.x);
   int y = uHeight - 1 - int(gl_FragCoord.y);
-  vec4 m = texelFetch(uMask, ivec2(x, y), 0);
-  int slot = int(m.r + 0.5) - 1;
-  int plane = int(m.g + 0.5);
-  bool glass = slot >= 0 && plane < uPlanes;
   bool useB = uAB == 1 || (uAB == 2 && float(x) >= uSplitX);
+${relit ? relitMask(relit) : plainMask}
   // A unit on a plane with pane-group passes reflects once per group (docs/viewer.md, "Units
   // and their ghosts"): the uRefl layer of each of its groups' reflections, a group without a
   // pass of its own taking the deepest nearer group's (as compose folds it).
@@ -374,34 +476,7 @@ void main() {
   vec3 rf0 = vec3(0.0);
   vec3 rf1 = vec3(0.0);
   vec3 rf2 = vec3(0.0);
-  if (${relit ? 'uPartCount > 0' : 'false'}) {
-    for (int p = 0; p < 16; p++) {
-      if (p >= uPartCount) break;
-      vec3 f = useB ? uFactorB[p] : uFactorA[p];
-      uvec4 a = texelFetch(uParts, ivec3(x, y, p * uPartLayers), 0);
-      vec2 a0 = unpackHalf2x16(a.x);
-      vec2 a1 = unpackHalf2x16(a.y);
-      tr += f * vec3(a0, a1.x);
-      if (glass) {
-        rf0 += f * vec3(a1.y, unpackHalf2x16(a.z));
-        if (ghosts) {
-          uvec4 b = texelFetch(uParts, ivec3(x, y, p * uPartLayers + 1), 0);
-          vec2 b1 = unpackHalf2x16(b.y);
-          if (layer.y != layer.x) rf1 += f * vec3(unpackHalf2x16(b.x), b1.x);
-          if (n > 2 && layer.z != layer.y) rf2 += f * vec3(b1.y, unpackHalf2x16(b.z));
-        }
-      }
-    }
-  } else {
-    vec4 t4 = texelFetch(uTrans, ivec2(x, y), 0);
-    tr = t4.rgb;
-    alpha = t4.a;
-    if (glass) {
-      rf0 = texelFetch(uRefl, ivec3(x, y, layer.x), 0).rgb;
-      if (ghosts && layer.y != layer.x) rf1 = texelFetch(uRefl, ivec3(x, y, layer.y), 0).rgb;
-      if (n > 2 && layer.z != layer.y) rf2 = texelFetch(uRefl, ivec3(x, y, layer.z), 0).rgb;
-    }
-  }
+${relit ? relitSums(relit) : plainPasses}
   if (layer.y == layer.x) rf1 = rf0;
   if (layer.z == layer.y) rf2 = rf1;
   vec3 col = tr;
@@ -522,28 +597,36 @@ void main() {
     const gl = canvas.getContext('webgl2', { preserveDrawingBuffer: true, antialias: false, alpha: false });
     if (!gl) throw new Error('this browser has no WebGL2');
     if (scene.planes > 64) throw new Error('the page handles at most 64 planes');
-    // Two programs: the plain shader, and the relit one for frames with light parts; every
-    // uniform is set on both (`uni`), and a draw uses the frame's.
-    const programs = [false, true].map((relit) => {
+    // Programs: the plain shader, and for a frame with light parts a relit shader per set of
+    // parts a choice re-weights and a shader of the other parts' sums (relitReady); every
+    // uniform the page sets is kept (`uniforms`) and set on each program, those linked later too.
+    const uniforms = new Map();
+    const programs = [];
+    function setOn(entry, fn, name, args) {
+      if (!entry.locations.has(name)) entry.locations.set(name, gl.getUniformLocation(entry.program, name));
+      const at = entry.locations.get(name);
+      if (at !== null) {
+        gl.useProgram(entry.program);
+        gl[fn](at, ...args);
+      }
+    }
+    function link(fragment) {
       const program = gl.createProgram();
       gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX));
-      gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragmentSource(lutLayout, relit)));
+      gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragment));
       gl.linkProgram(program);
       if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
-      return program;
-    });
-    gl.bindVertexArray(gl.createVertexArray());
-    const locations = programs.map(() => new Map());
-    function uni(fn, name, ...args) {
-      programs.forEach((program, k) => {
-        if (!locations[k].has(name)) locations[k].set(name, gl.getUniformLocation(program, name));
-        const at = locations[k].get(name);
-        if (at !== null) {
-          gl.useProgram(program);
-          gl[fn](at, ...args);
-        }
-      });
+      const entry = { program, locations: new Map() };
+      uniforms.forEach(([fn, args], name) => setOn(entry, fn, name, args));
+      programs.push(entry);
+      return entry;
     }
+    function uni(fn, name, ...args) {
+      uniforms.set(name, [fn, args]);
+      programs.forEach((entry) => setOn(entry, fn, name, args));
+    }
+    const plain = link(fragmentSource(lutLayout, null));
+    gl.bindVertexArray(gl.createVertexArray());
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
 
     const transTex = texture(gl, gl.TEXTURE_2D);
@@ -566,12 +649,17 @@ void main() {
       gl.bindTexture(gl.TEXTURE_2D, lutTex[set]);
       gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, lutLayout.width, lutLayout.rows_per_slot * slots.length);
     }
-    const partsTex = texture(gl, gl.TEXTURE_2D_ARRAY);
-    // Complete from the start (one texel) until a frame's light parts replace it.
-    gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, 1, 1, 1, 0, gl.RGBA_INTEGER, gl.UNSIGNED_INT, new Uint32Array(4));
+    // The light parts' passes and the fixed sums (relitReady): complete from the start (one
+    // texel) until a frame with light parts replaces them.
+    const [partsTex, fixedTex] = [0, 1].map(() => {
+      const t = texture(gl, gl.TEXTURE_2D_ARRAY);
+      gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, 1, 1, 1, 0, gl.RGBA_INTEGER, gl.UNSIGNED_INT, new Uint32Array(4));
+      return t;
+    });
     const units = [['uTrans', gl.TEXTURE_2D, transTex], ['uRefl', gl.TEXTURE_2D_ARRAY, reflTex],
       ['uMask', gl.TEXTURE_2D, maskTex], ['uLutA', gl.TEXTURE_2D, lutTex.A], ['uLutB', gl.TEXTURE_2D, lutTex.B],
-      ['uShaper', gl.TEXTURE_2D, shaperTex], ['uCube', gl.TEXTURE_3D, cubeTex], ['uParts', gl.TEXTURE_2D_ARRAY, partsTex]];
+      ['uShaper', gl.TEXTURE_2D, shaperTex], ['uCube', gl.TEXTURE_3D, cubeTex], ['uParts', gl.TEXTURE_2D_ARRAY, partsTex],
+      ['uFixed', gl.TEXTURE_2D_ARRAY, fixedTex]];
     const unitOf = (name) => units.findIndex(([n]) => n === name);
     units.forEach(([name, target, tex], i) => {
       gl.activeTexture(gl.TEXTURE0 + i);
@@ -662,8 +750,9 @@ void main() {
       uni('uniform1f', 'uGain', Math.pow(2, state.ev));
       uni('uniform1i', 'uAB', { A: 0, B: 1, split: 2 }[state.ab] ?? 0);
       uni('uniform1f', 'uSplitX', state.split * W);
+      const program = state.data && state.data.info.parts.length ? relitReady() : plain;
       gl.viewport(0, 0, W, H);
-      gl.useProgram(programs[state.data && state.data.info.parts.length ? 1 : 0]);
+      gl.useProgram(program.program);
       gl.drawArrays(gl.TRIANGLES, 0, 3);
       placeSplitLine();
       state.drawn += 1;
@@ -723,14 +812,16 @@ void main() {
       if (data.info.parts.length) {
         // Per part: its transmission and each pixel's plane's reflection, then its pane groups'.
         const per = groups.length ? 2 : 1;
-        uni('uniform1i', 'uPartLayers', per);
         gl.bindTexture(gl.TEXTURE_2D_ARRAY, partsTex);
         gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, W, H, data.info.parts.length * per, 0, gl.RGBA_INTEGER,
           gl.UNSIGNED_INT, data.parts);
+        gl.bindTexture(gl.TEXTURE_2D_ARRAY, fixedTex);
+        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, W, H, 2 * fixedLayers(per), 0, gl.RGBA_INTEGER,
+          gl.UNSIGNED_INT, null);
       }
       state.frame = i;
       state.data = data;
-      setFactors();
+      relit.fixedKey = null;
       renderPartSliders();
       renderGlasses();
       draw();
@@ -765,16 +856,60 @@ void main() {
       return f.map((v) => v * gain);
     }
 
-    // The factors of the frame's parts for both sets, as the shader's uniforms.
-    function setFactors() {
-      const parts = state.data ? state.data.info.parts : [];
-      uni('uniform1i', 'uPartCount', parts.length);
-      if (!parts.length) return;
+    // The relit swap (docs/viewer.md, "Relit swap"): a choice for glass id `active` changes the
+    // factors of that id's parts only, so the other parts are summed once into the fixed layers
+    // (per set, with their factors; drawn again when those change: another active id, a part's
+    // exposure, another frame), and the frame is drawn from those sums and the active parts.
+    const relit = { active: null, fixedKey: null, fixedDraws: 0, programs: new Map(), fixed: new Map(), framebuffer: gl.createFramebuffer() };
+    const cached = (map, key, source) => {
+      if (!map.has(key)) map.set(key, link(source()));
+      return map.get(key);
+    };
+
+    // The program to draw the frame with, its active parts' factors set, the fixed sums drawn.
+    function relitReady() {
+      const parts = state.data.info.parts;
+      const layers = state.data.info.groups.length ? 2 : 1;
+      const id = relit.active ?? state.selected ?? Number(Object.keys(state.data.info.ids)[0]);
+      const all = parts.map((_, i) => i);
+      const active = all.filter((i) => parts[i].kind !== 'unglazed' && parts[i].id === id);
+      const rest = all.filter((i) => !active.includes(i));
+      const factors = { A: parts.map((p) => partFactor(p, 'A')), B: parts.map((p) => partFactor(p, 'B')) };
+      const program = cached(relit.programs, layers + ':' + active, () => fragmentSource(lutLayout, { active, layers }));
       for (const set of ['A', 'B']) {
-        const v = new Float32Array(16 * 3);
-        parts.forEach((part, i) => v.set(partFactor(part, set), 3 * i));
-        uni('uniform3fv', set === 'A' ? 'uFactorA' : 'uFactorB', v);
+        if (active.length) setOn(program, 'uniform3fv', 'uFactor' + set, [active.flatMap((i) => factors[set][i])]);
       }
+      const key = JSON.stringify([state.frame, layers, rest, rest.map((i) => [factors.A[i], factors.B[i]])]);
+      if (key !== relit.fixedKey) {
+        drawFixed(rest, layers, factors);
+        relit.fixedKey = key;
+      }
+      return program;
+    }
+
+    // Makes glass `id` the active one (its glass clicked in the list): the fixed sums are drawn
+    // now, so that the choice of a product for it draws only the frame.
+    function prepareActive(id) {
+      relit.active = id;
+      if (state.data && state.data.info.parts.length) relitReady();
+    }
+
+    // The fixed sums of parts `rest` for both sets into fixedTex (fixedSource).
+    function drawFixed(rest, layers, factors) {
+      const program = cached(relit.fixed, layers + ':' + rest, () => fixedSource(rest, layers));
+      const per = fixedLayers(layers);
+      const targets = Array.from({ length: per }, (_, k) => gl.COLOR_ATTACHMENT0 + k);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, relit.framebuffer);
+      gl.viewport(0, 0, W, H);
+      ['A', 'B'].forEach((set, s) => {
+        targets.forEach((t, k) => gl.framebufferTextureLayer(gl.FRAMEBUFFER, t, fixedTex, 0, s * per + k));
+        gl.drawBuffers(targets);
+        if (rest.length) setOn(program, 'uniform3fv', 'uFactor', [rest.flatMap((i) => factors[set][i])]);
+        gl.useProgram(program.program);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+      });
+      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      relit.fixedDraws += 1;
     }
 
     // One exposure slider per light part (light mixing), beside the frame.
@@ -792,7 +927,7 @@ void main() {
         const value = document.createElement('span');
         const say = () => { value.textContent = Number(input.value).toFixed(1) + ' EV'; };
         say();
-        input.oninput = () => { state.partEv[part.group] = Number(input.value); say(); setFactors(); draw(); };
+        input.oninput = () => { state.partEv[part.group] = Number(input.value); say(); draw(); };
         row.append(part.group + ' (' + part.source + through + ') ', input, ' ', value);
         return row;
       }));
@@ -805,8 +940,8 @@ void main() {
       const slot = slots.indexOf(id);
       if (slot < 0 || !luts[p]) throw new Error('no glass ' + id + ' or product ' + p);
       state.sets[set][slot] = p;
+      relit.active = id;
       uploadSlot(set, slot);
-      setFactors();
       draw();
       finish();
       state.lastSwapMs = performance.now() - t0;
@@ -868,7 +1003,7 @@ void main() {
         px.className = 'values';
         px.textContent = state.data.info.ids[id] + ' px';
         li.append(px);
-        li.onclick = () => { state.selected = id; renderGlasses(); renderProducts(); };
+        li.onclick = () => { state.selected = id; prepareActive(id); renderGlasses(); renderProducts(); };
         ul.append(li);
       }
     }
@@ -1180,8 +1315,10 @@ void main() {
       choose: (id, product, set) => choose(id, typeof product === 'number' ? product : findProduct(products, product), set),
       setEv: (ev) => { state.ev = ev; draw(); },
       // A light part's exposure in stops (its slider), by group name.
-      setPartEv: (group, ev) => { state.partEv[group] = ev; renderPartSliders(); setFactors(); draw(); },
+      setPartEv: (group, ev) => { state.partEv[group] = ev; renderPartSliders(); draw(); },
       // Each light part's factor per set (none: passes without a light-path split).
+      // The relit swap's active glass id and how often the other parts' sums were drawn.
+      relitStats: () => ({ active: relit.active, fixedDraws: relit.fixedDraws }),
       partFactors: () => (state.data ? state.data.info.parts : []).map((p) => ({ group: p.group, A: partFactor(p, 'A'), B: partFactor(p, 'B') })),
       setView: async (name) => { await setView(scene.views.findIndex((v) => v.name === name)); draw(); },
       setAB: (mode, split) => { state.ab = mode; if (split !== undefined) state.split = split; draw(); },
@@ -1217,7 +1354,7 @@ void main() {
     await loadFrame(state.frame);
     frameLabel();
     const first = state.data ? Object.keys(state.data.info.ids).map(Number)[0] : undefined;
-    if (state.selected === null && first !== undefined) { state.selected = first; renderGlasses(); }
+    if (state.selected === null && first !== undefined) { state.selected = first; prepareActive(first); renderGlasses(); }
     renderProducts();
     if (!errors.length) status('ready: ' + W + '×' + H + ', ' + scene.planes + ' plane(s), ' + products.length + ' products');
     // Milliseconds from the start of navigation to the first frame drawn and the page ready.
