@@ -207,17 +207,31 @@ void main() {
   // The fixed sums' layers per set (fixedSource): the transmission, then the reflection of the
   // pixel's plane, and with pane-group passes its groups 1 and 2.
   const fixedLayers = (layers) => (layers === 2 ? 4 : 2);
+  // Without pane-group passes, up to two active parts are gathered by the fixed pass into two
+  // texels after both sets' layers (set-independent, copies of their halves): their
+  // transmissions and reflections' red in one (words x, y of the first part, z, w of the
+  // second), the rest of their reflections with the mask's coverage and cos θ in the other, so
+  // that a pixel reads 2 texels off glass and 4 on glass (and the tables), not one per part.
+  const gathers = (relit) => relit.layers === 1 && relit.active.length <= 2;
 
   // The relit shader's mask: the pixel's glass slot and plane from the fixed sums' first texel
   // (its fourth word), so that a pixel off glass reads no mask texel.
   function relitMask(relit) {
-    return `  int base = useB ? ${fixedLayers(relit.layers)} : 0;
+    const per = fixedLayers(relit.layers);
+    const text = `  int base = useB ? ${per} : 0;
   uvec4 fixed0 = texelFetch(uFixed, ivec3(x, y, base), 0);
   int slot = int(fixed0.w & 0xffffu) - 1;
   int plane = int(fixed0.w >> 16);
   bool glass = slot >= 0 && plane < uPlanes;
-  vec4 m = vec4(0.0);
-  if (glass) m = texelFetch(uMask, ivec2(x, y), 0);`;
+  vec4 m = vec4(0.0);`;
+    if (!gathers(relit)) return text + '\n  if (glass) m = texelFetch(uMask, ivec2(x, y), 0);';
+    return text + `
+  uvec4 gt = ${relit.active.length ? `texelFetch(uFixed, ivec3(x, y, ${2 * per}), 0)` : 'uvec4(0u)'};
+  uvec4 gr = uvec4(0u);
+  if (glass) {
+    gr = texelFetch(uFixed, ivec3(x, y, ${2 * per + 1}), 0);
+    m = vec4(0.0, 0.0, uintBitsToFloat(gr.w), uintBitsToFloat(gr.z));
+  }`;
   }
 
   // One light part's passes (part_bytes) added with factor `f`: `p` its index, `layers` per part;
@@ -261,15 +275,29 @@ void main() {
     if (n > 2 && layer.z != layer.y) rf2 = uintBitsToFloat(texelFetch(uFixed, ivec3(xy, base + 3), 0).xyz);`;
     }
     text += '\n  }\n';
-    relit.active.forEach((p, k) => { text += addPart(p, relit.layers, `useB ? uFactorB[${k}] : uFactorA[${k}]`, false); });
+    const factor = (k) => `useB ? uFactorB[${k}] : uFactorA[${k}]`;
+    if (!gathers(relit)) {
+      relit.active.forEach((p, k) => { text += addPart(p, relit.layers, factor(k), false); });
+      return text;
+    }
+    relit.active.forEach((_, k) => {
+      text += `  {
+    vec3 f = ${factor(k)};
+    vec2 a1 = unpackHalf2x16(gt.${'yw'[k]});
+    tr += f * vec3(unpackHalf2x16(gt.${'xz'[k]}), a1.x);
+    if (glass) rf0 += f * vec3(a1.y, unpackHalf2x16(gr.${'xy'[k]}));
+  }
+`;
+    });
     return text;
   }
 
   // The sums of the parts `rest` (indices) with their factors of one set (uFactor), drawn into
   // the fixed layers of that set as f32 bits (exact, unlike halves), the transmission's texel
   // carrying the mask's glass slot + 1 and plane (low and high 16 bits).
-  function fixedSource(rest, layers) {
-    const outs = ['oTr', 'oRf0', 'oRf1', 'oRf2'].slice(0, fixedLayers(layers));
+  // `gather`: the active parts to gather (see `gathers`), or null.
+  function fixedSource(rest, layers, gather) {
+    const outs = ['oTr', 'oRf0', 'oRf1', 'oRf2'].slice(0, fixedLayers(layers)).concat(gather ? ['oGT', 'oGR'] : []);
     let text = `#version 300 es
 precision highp float;
 precision highp int;
@@ -293,6 +321,14 @@ void main() {
   oRf0 = uvec4(floatBitsToUint(rf0), 0u);
 `;
     if (layers === 2) text += '  oRf1 = uvec4(floatBitsToUint(rf1), 0u);\n  oRf2 = uvec4(floatBitsToUint(rf2), 0u);\n';
+    if (gather) {
+      const part = (k) => (k < gather.length ? `texelFetch(uParts, ivec3(xy, ${gather[k]}), 0)` : 'uvec4(0u)');
+      text += `  uvec4 g0 = ${part(0)};
+  uvec4 g1 = ${part(1)};
+  oGT = uvec4(g0.xy, g1.xy);
+  oGR = uvec4(g0.z, g1.z, floatBitsToUint(m.a), floatBitsToUint(m.b));
+`;
+    }
     return text + '}';
   }
 
@@ -816,7 +852,7 @@ ${relit ? relitSums(relit) : plainPasses}
         gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, W, H, data.info.parts.length * per, 0, gl.RGBA_INTEGER,
           gl.UNSIGNED_INT, data.parts);
         gl.bindTexture(gl.TEXTURE_2D_ARRAY, fixedTex);
-        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, W, H, 2 * fixedLayers(per), 0, gl.RGBA_INTEGER,
+        gl.texImage3D(gl.TEXTURE_2D_ARRAY, 0, gl.RGBA32UI, W, H, 2 * fixedLayers(per) + 2, 0, gl.RGBA_INTEGER,
           gl.UNSIGNED_INT, null);
       }
       state.frame = i;
@@ -881,7 +917,7 @@ ${relit ? relitSums(relit) : plainPasses}
       }
       const key = JSON.stringify([state.frame, layers, rest, rest.map((i) => [factors.A[i], factors.B[i]])]);
       if (key !== relit.fixedKey) {
-        drawFixed(rest, layers, factors);
+        drawFixed(rest, layers, factors, gathers({ active, layers }) ? active : null);
         relit.fixedKey = key;
       }
       return program;
@@ -895,14 +931,14 @@ ${relit ? relitSums(relit) : plainPasses}
     }
 
     // The fixed sums of parts `rest` for both sets into fixedTex (fixedSource).
-    function drawFixed(rest, layers, factors) {
-      const program = cached(relit.fixed, layers + ':' + rest, () => fixedSource(rest, layers));
+    function drawFixed(rest, layers, factors, gather) {
+      const program = cached(relit.fixed, layers + ':' + rest + ':' + gather, () => fixedSource(rest, layers, gather));
       const per = fixedLayers(layers);
-      const targets = Array.from({ length: per }, (_, k) => gl.COLOR_ATTACHMENT0 + k);
+      const targets = Array.from({ length: per + (gather ? 2 : 0) }, (_, k) => gl.COLOR_ATTACHMENT0 + k);
       gl.bindFramebuffer(gl.FRAMEBUFFER, relit.framebuffer);
       gl.viewport(0, 0, W, H);
       ['A', 'B'].forEach((set, s) => {
-        targets.forEach((t, k) => gl.framebufferTextureLayer(gl.FRAMEBUFFER, t, fixedTex, 0, s * per + k));
+        targets.forEach((t, k) => gl.framebufferTextureLayer(gl.FRAMEBUFFER, t, fixedTex, 0, k < per ? s * per + k : per + k));
         gl.drawBuffers(targets);
         if (rest.length) setOn(program, 'uniform3fv', 'uFactor', [rest.flatMap((i) => factors[set][i])]);
         gl.useProgram(program.program);
