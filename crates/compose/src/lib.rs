@@ -26,6 +26,7 @@
 
 #![warn(missing_docs)]
 
+mod bands;
 pub mod colour;
 mod composite;
 mod decode;
