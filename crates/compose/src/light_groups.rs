@@ -153,8 +153,9 @@ pub fn group_passes(
 }
 
 /// Composites a frame split into light groups: each group's passes ([`group_passes`])
-/// composited with its own light's tables, in turn (one group's passes decoded at a time, the
-/// frame's memory limit held per group; the mask decoded once), and the sum written as the
+/// composited with its own light's tables, in turn (the first decoded whole, each after it
+/// read and composited in row bands into the sum, [`crate::bands`]; the frame's memory limit
+/// held per group; the mask decoded once), and the sum written as the
 /// output's beauty, with the transmission file's other channels read after the groups (less
 /// their layers, never decoded). With
 /// `keep_groups` (EXR output only) each group's composite is also written, as a layer of the
