@@ -300,3 +300,70 @@ impl BandedFrame<'_> {
             .collect())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use glassdb_side::Side;
+
+    use crate::colour::RegistryLuts;
+    use crate::light_groups::{LightGroup, compose_groups_banded};
+    use crate::lut::GlassLut;
+    use crate::memory::MemoryBudget;
+    use crate::{ComposeJob, ComposeSettings, FrameFiles};
+
+    /// The light-group fixture's glass (ids 9 and 10) with r and t scaled by `k`, so that each
+    /// group's table differs.
+    fn group(name: &str, k: f64) -> LightGroup {
+        let lut = GlassLut::from_fn(
+            &[9, 10],
+            |id, side, c| {
+                let r = if side == Side::Front { 0.1 } else { 0.3 } * k * (2.0 - c);
+                ([r, r * 0.5, r * 0.25], [k * c * f64::from(id) / 10.0; 3])
+            },
+            |_, _| ([0.1 * k; 3], [0.9 * k; 3]),
+        );
+        let basis = glassdb_registry::ColourBasis::Space(glassdb_colour::RgbSpace::Srgb);
+        LightGroup {
+            name: name.into(),
+            luts: RegistryLuts::single(basis, lut),
+        }
+    }
+
+    /// Bands of any height, aligned with the passes' blocks or not (the fixture's 6 rows are
+    /// one ZIP block of 16), give the frame whole bands give, bit for bit, the beauty and each
+    /// group's kept composite alike.
+    #[test]
+    fn any_band_height_gives_the_same_frame() {
+        let fixture = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/light_groups");
+        let dir = tempfile::tempdir().unwrap();
+        let groups = [group("sun", 1.0), group("warm", 0.7)];
+        let mut settings = ComposeSettings::default();
+        settings.output.exr_data_type = Some(glassdb_encode::ExrDataType::Float);
+        let frame = |rows: usize| {
+            let job = ComposeJob {
+                inputs: FrameFiles::new(
+                    vec![fixture.join("refl.exr")],
+                    fixture.join("trans.exr"),
+                    fixture.join("mask.png"),
+                ),
+                output: dir.path().join(format!("bands_{rows}.exr")),
+            };
+            let budget = MemoryBudget::new(settings.decode.max_memory);
+            let progress = glassdb_io::NoProgress;
+            compose_groups_banded(&job, &settings, (&groups, rows), true, &budget, &progress)
+                .unwrap();
+            let bytes = std::fs::read(&job.output).unwrap();
+            glassdb_image::read_exr_exact(&bytes, 1 << 20)
+                .unwrap()
+                .parts
+        };
+        let whole = frame(super::BAND_ROWS);
+        let names: Vec<&str> = whole[0].channels.iter().map(|(n, _)| n.as_str()).collect();
+        assert!(names.contains(&"ViewLayer.Combined_warm.G"), "{names:?}");
+        for rows in [1, 2, 4, 5] {
+            assert!(frame(rows) == whole, "bands of {rows} rows");
+        }
+    }
+}

@@ -183,6 +183,27 @@ pub fn compose_light_groups_within(
     budget: &MemoryBudget,
     progress: &dyn glassdb_io::Progress,
 ) -> Result<FrameReport, ComposeError> {
+    let bands = crate::bands::BAND_ROWS;
+    compose_groups_banded(
+        job,
+        settings,
+        (groups, bands),
+        keep_groups,
+        budget,
+        progress,
+    )
+}
+
+/// [`compose_light_groups_within`] of `groups`, those after the first composited `band_rows`
+/// rows at a time.
+pub(crate) fn compose_groups_banded(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    (groups, band_rows): (&[LightGroup], usize),
+    keep_groups: bool,
+    budget: &MemoryBudget,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<FrameReport, ComposeError> {
     let names: Vec<&str> = groups.iter().map(|g| g.name.as_str()).collect();
     if keep_groups && glassdb_encode::output_format(&job.output)? != OutputFormat::Exr {
         return Err(ComposeError::KeepGroupsNotExr {
@@ -223,7 +244,7 @@ pub fn compose_light_groups_within(
                 &mask_slot,
                 total,
                 keep_groups,
-                crate::bands::BAND_ROWS,
+                band_rows,
             )?;
             timings.decode += added.timings.decode;
             timings.compose += added.timings.compose;
