@@ -154,7 +154,7 @@ pub fn group_passes(
 
 /// Composites a frame split into light groups: each group's passes ([`group_passes`])
 /// composited with its own light's tables, in turn (the first decoded whole, each after it
-/// read and composited in row bands into the sum, [`crate::bands`]; the frame's memory limit
+/// read and composited in row bands into the sum, `bands.rs`; the frame's memory limit
 /// held per group; the mask decoded once), and the sum written as the
 /// output's beauty, with the transmission file's other channels read after the groups (less
 /// their layers, never decoded). With
