@@ -42,19 +42,33 @@ fn blender_program() -> &'static str {
     "blender"
 }
 
-/// `glassdb blender render BLEND` with the test glasses, 2 threads, `seed` and `extra`.
-fn render_run(blend: &Path, out: &Path, seed: u32, extra: &[&str]) {
+/// `glassdb blender render BLEND --glass …` with the test glasses (`GLASS`), into `out`.
+fn render_test_glasses(blend: &Path, out: &Path) -> Command {
     let mut cmd = glassdb();
     cmd.args(["blender", "render"]).arg(blend);
     for g in GLASS {
         cmd.args(["--glass", g]);
     }
-    cmd.arg("--out-dir")
-        .arg(out)
+    cmd.arg("--out-dir").arg(out);
+    cmd
+}
+
+/// `glassdb blender render BLEND` with the test glasses, 2 threads, `seed` and `extra`.
+fn render_run(blend: &Path, out: &Path, seed: u32, extra: &[&str]) {
+    ok(render_test_glasses(blend, out)
         .args(["--threads", "2", "--seed"])
         .arg(seed.to_string())
-        .args(extra);
-    ok(&mut cmd);
+        .args(extra));
+}
+
+/// `blender -b OPTIONS… --python-exit-code 1`: Blender in the background, failing when its
+/// Python does; the caller adds the script (`-P FILE` or `--python-expr`).
+pub(crate) fn background_blender(options: &[&std::ffi::OsStr]) -> Command {
+    let mut cmd = Command::new(blender_program());
+    cmd.arg("-b")
+        .args(options)
+        .args(["--python-exit-code", "1"]);
+    cmd
 }
 
 /// `scripts/blender/make_glassdb_scene.py --scene KIND` saved as `blend`, with `extra` options.
@@ -98,19 +112,13 @@ pub(crate) fn rendered() -> &'static Rendered {
 /// `blender -b … -P SCRIPT -- --scene KIND --out BLEND EXTRA…`: a scene made by one of the
 /// repository's scene scripts.
 fn make_scene(script: &str, kind: &str, blend: &Path, extra: &[&std::ffi::OsStr]) {
-    let made = Command::new(blender_program())
-        .args(["-b", "--factory-startup", "-noaudio"])
-        .args(["--python-exit-code", "1", "-P"])
-        .arg(repo_path(script))
-        .args(["--", "--scene", kind, "--out"])
-        .arg(blend)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        made.status.success(),
-        "building the {kind} scene: {}",
-        String::from_utf8_lossy(&made.stderr)
+    ok(
+        background_blender(&["--factory-startup".as_ref(), "-noaudio".as_ref()])
+            .arg("-P")
+            .arg(repo_path(script))
+            .args(["--", "--scene", kind, "--out"])
+            .arg(blend)
+            .args(extra),
     );
 }
 

@@ -9,7 +9,7 @@ use serde_json::Value;
 
 use crate::util::{
     CURVE_FIT_STATS, assert_names, doc_after, fails, fails_naming, glassdb, ok, repo_path, run,
-    run_oracle, write_file,
+    run_oracle, strings_of, write_file,
 };
 
 #[path = "../../crates/fit/tests/common/inputs.rs"]
@@ -501,13 +501,7 @@ fn several_glasses_in_percent_with_repeated_angles() {
     assert!(res.status.success(), "{stderr}");
     assert!(stderr.contains("glass `clear`: angle 30° given on 2 rows: averaged (R spread 0.00020, T spread 0.00020)"), "{stderr}");
     let out = json(&stdout);
-    let names: Vec<&str> = out["glasses"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|g| g["name"].as_str().unwrap())
-        .collect();
-    assert_eq!(names, ["clear", "bronze"]);
+    assert_eq!(strings_of(&out["glasses"], "name"), ["clear", "bronze"]);
     let clear = &out["glasses"][0];
     assert_eq!(f(&clear["reflectance"]["normal"]), 0.0788);
     assert_eq!(f(&clear["reflectance"]["points"]), 7.0); // 30° counted once

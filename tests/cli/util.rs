@@ -408,16 +408,21 @@ pub fn example_copy() -> tempfile::TempDir {
 /// reflection passes `refl`, into `out`.
 pub fn atrium_compose(refl: &[PathBuf], out: &Path) -> Command {
     let a = repo_path("fixtures/atrium");
+    let mut c = compose_frame(refl, &a.join("trans.exr"), &a.join("mask.png"), out);
+    c.arg("--planes").arg(a.join("virtual/planes.json"));
+    c
+}
+
+/// `compose --refl R… --trans TRANS --mask MASK -o OUT`: one frame's composite.
+pub fn compose_frame(refl: &[PathBuf], trans: &Path, mask: &Path, out: &Path) -> Command {
     let mut c = compose();
     for r in refl {
         c.arg("--refl").arg(r);
     }
     c.arg("--trans")
-        .arg(a.join("trans.exr"))
+        .arg(trans)
         .arg("--mask")
-        .arg(a.join("mask.png"))
-        .arg("--planes")
-        .arg(a.join("virtual/planes.json"))
+        .arg(mask)
         .arg("-o")
         .arg(out);
     c
@@ -450,12 +455,39 @@ where
     V: std::fmt::Display,
     serde_json::Value: PartialEq<V>,
 {
-    table["glasses"]
+    element_where(&table["glasses"], key, value)
+}
+
+/// The element of the JSON array `items` whose `key` is `value`; panics naming it when none is.
+pub fn element_where<'a, V>(
+    items: &'a serde_json::Value,
+    key: &str,
+    value: V,
+) -> &'a serde_json::Value
+where
+    V: std::fmt::Display,
+    serde_json::Value: PartialEq<V>,
+{
+    items
         .as_array()
-        .unwrap()
+        .unwrap_or_else(|| panic!("not an array: {items}"))
         .iter()
-        .find(|g| g[key] == value)
-        .unwrap_or_else(|| panic!("no glass with {key} {value}"))
+        .find(|e| e[key] == value)
+        .unwrap_or_else(|| panic!("no element with {key} {value} in {items}"))
+}
+
+/// The string `key` of each element of the JSON array `items`.
+pub fn strings_of<'a>(items: &'a serde_json::Value, key: &str) -> Vec<&'a str> {
+    items
+        .as_array()
+        .unwrap_or_else(|| panic!("not an array: {items}"))
+        .iter()
+        .map(|e| {
+            e[key]
+                .as_str()
+                .unwrap_or_else(|| panic!("no string {key} in {e}"))
+        })
+        .collect()
 }
 
 /// Sends `SIG<signal>` (`TERM`, `INT`, …) to a started child with `kill`.
