@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::util::{glass_where, glassdb, ok, registry_build, repo_path, run_oracle, write_file};
+use crate::util::{element_where, glassdb, ok, registry_build, repo_path, run_oracle, write_file};
 
 /// The lights of the oracle comparison: daylight, tungsten, a CIE LED, a fluorescent and a
 /// custom SPD (a warm-white LED, fixtures/lights/warm_led.csv).
@@ -172,7 +172,11 @@ fn per_light_tables_equal_colour_science() {
     for (id, source) in &sources {
         for (light, _) in LIGHTS {
             for space in SPACES {
-                let record = glass_where(table(&registry, light, space), "id", u64::from(*id));
+                let record = element_where(
+                    &table(&registry, light, space)["glasses"],
+                    "id",
+                    u64::from(*id),
+                );
                 let want_all = &oracle[source.as_str()][light][space];
                 for (quantity, field) in fields {
                     let want = rgb(&want_all[quantity]).map(|v| v.clamp(0.0, 1.0));

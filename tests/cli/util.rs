@@ -445,19 +445,6 @@ pub fn names(dir: &Path) -> Vec<String> {
     v
 }
 
-/// The glass of a registry table (its JSON) whose `key` is `value`; panics naming it when none is.
-pub fn glass_where<'a, V>(
-    table: &'a serde_json::Value,
-    key: &str,
-    value: V,
-) -> &'a serde_json::Value
-where
-    V: std::fmt::Display,
-    serde_json::Value: PartialEq<V>,
-{
-    element_where(&table["glasses"], key, value)
-}
-
 /// The element of the JSON array `items` whose `key` is `value`; panics naming it when none is.
 pub fn element_where<'a, V>(
     items: &'a serde_json::Value,
@@ -468,19 +455,22 @@ where
     V: std::fmt::Display,
     serde_json::Value: PartialEq<V>,
 {
-    items
-        .as_array()
-        .unwrap_or_else(|| panic!("not an array: {items}"))
+    elements(items)
         .iter()
         .find(|e| e[key] == value)
         .unwrap_or_else(|| panic!("no element with {key} {value} in {items}"))
 }
 
-/// The string `key` of each element of the JSON array `items`.
-pub fn strings_of<'a>(items: &'a serde_json::Value, key: &str) -> Vec<&'a str> {
+/// The elements of the JSON array `items`; panics showing it when it is not an array.
+pub fn elements(items: &serde_json::Value) -> &[serde_json::Value] {
     items
         .as_array()
         .unwrap_or_else(|| panic!("not an array: {items}"))
+}
+
+/// The string `key` of each element of the JSON array `items`.
+pub fn strings_of<'a>(items: &'a serde_json::Value, key: &str) -> Vec<&'a str> {
+    elements(items)
         .iter()
         .map(|e| {
             e[key]

@@ -10,8 +10,7 @@ use std::sync::OnceLock;
 
 use super::{background_blender, channel, copy_dir, json, make_glassdb_scene, render_test_glasses};
 use crate::util::{
-    Planes, element_where, fails_naming, glass_where, glassdb, ok, read_exr_planes, registry_build,
-    repo_path,
+    Planes, element_where, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path,
 };
 
 struct GroupRuns {
@@ -251,7 +250,11 @@ fn compose(dir: &Path, registry: &Path) -> Command {
 /// Each glass's t0 in the registry `path` under light `light`.
 fn t0(path: &Path, light: &str, id: u64) -> [f64; 3] {
     let reg = json(path);
-    let g = glass_where(element_where(&reg["tables"], "light", light), "id", id);
+    let g = element_where(
+        &element_where(&reg["tables"], "light", light)["glasses"],
+        "id",
+        id,
+    );
     [0, 1, 2].map(|c| g["t0"][c].as_f64().unwrap())
 }
 
