@@ -6,9 +6,10 @@
 //! the same window as two real panes than one pass per plane (`--surfaces 1`) is;
 //! `glassdb mask --bounds` gives the group's rectangle the run cropped to.
 
-use crate::blender::background_blender;
-use crate::util::{Planes, compose_frame, glassdb, ok, read_exr_planes, repo_path};
 use std::path::{Path, PathBuf};
+
+use crate::blender::background_blender;
+use crate::util::{Planes, compose_frame, glassdb, mask_from, ok, read_exr_planes, repo_path};
 
 /// `make_ghost_scene.py --panes PANES` saved in `dir`, with its facts.
 pub(crate) fn ghost_scene(dir: &Path, panes: &str) -> (PathBuf, serde_json::Value) {
@@ -242,11 +243,7 @@ fn a_double_unit_renders_each_panes_reflection_at_its_depth() {
     );
 
     // `glassdb mask --bounds`: the group's rectangle, the one the run cropped its pass to.
-    ok(glassdb()
-        .arg("mask")
-        .arg(run.join("scene.obj"))
-        .arg("--camera")
-        .arg(run.join("camera.json"))
+    ok(mask_from(run.join("scene.obj"), run.join("camera.json"))
         .args(["--glass", "Unit=11", "--frames", "1", "--samples", "4"])
         .arg("--planes")
         .arg(run.join("planes.json"))

@@ -413,6 +413,13 @@ pub fn atrium_compose(refl: &[PathBuf], out: &Path) -> Command {
     c
 }
 
+/// `glassdb mask OBJ --camera CAMERA`: callers add the glasses, the output and any other flag.
+pub fn mask_from(obj: impl AsRef<std::ffi::OsStr>, camera: impl AsRef<std::ffi::OsStr>) -> Command {
+    let mut c = glassdb();
+    c.arg("mask").arg(obj).arg("--camera").arg(camera);
+    c
+}
+
 /// `compose --refl R… --trans TRANS --mask MASK -o OUT`: one frame's composite.
 pub fn compose_frame(refl: &[PathBuf], trans: &Path, mask: &Path, out: &Path) -> Command {
     let mut c = compose();
