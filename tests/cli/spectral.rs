@@ -12,7 +12,9 @@ use glassdb_spectral::{
 };
 use serde_json::Value;
 
-use crate::util::{fails, fails_naming, glassdb, ok, repo_path, run_oracle, write_file};
+use crate::util::{
+    fails, fails_naming, glassdb, max_abs_diff, ok, repo_path, run_oracle, write_file,
+};
 
 /// The illuminants `python_oracle/spectral_oracle.py` integrates under (every bundled one is
 /// checked by `python_oracle/light_oracle.py`, tests/cli/lights.rs).
@@ -611,9 +613,7 @@ fn off_grid_start_is_evaluated_at_the_right_wavelengths() {
     for c in 0..3 {
         assert_close(&format!("off-grid channel {c}"), got[c], right[c], 1e-9);
     }
-    let worst = (0..3)
-        .map(|c| (colour[c] - right[c]).abs())
-        .fold(0.0, f64::max);
+    let worst = max_abs_diff(&colour, &right);
     assert!(
         worst > 1e-4,
         "colour-science's re-spacing should visibly differ: {worst}"

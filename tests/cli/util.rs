@@ -413,6 +413,18 @@ pub fn atrium_compose(refl: &[PathBuf], out: &Path) -> Command {
     c
 }
 
+/// The largest |a − b| over the pairs of `a` and `b` (0 for none; a NaN difference is passed
+/// over, as `f64::max` does).
+pub fn max_abs_diff<'a>(
+    a: impl IntoIterator<Item = &'a f64>,
+    b: impl IntoIterator<Item = &'a f64>,
+) -> f64 {
+    a.into_iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
 /// `glassdb mask OBJ --camera CAMERA`: callers add the glasses, the output and any other flag.
 pub fn mask_from(obj: impl AsRef<std::ffi::OsStr>, camera: impl AsRef<std::ffi::OsStr>) -> Command {
     let mut c = glassdb();

@@ -10,7 +10,8 @@ use std::sync::OnceLock;
 
 use super::{background_blender, channel, copy_dir, json, make_glassdb_scene, render_test_glasses};
 use crate::util::{
-    Planes, element_where, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path,
+    Planes, element_where, fails_naming, glassdb, max_abs_diff, ok, read_exr_planes,
+    registry_build, repo_path,
 };
 
 struct GroupRuns {
@@ -280,9 +281,8 @@ fn each_light_group_composites_with_its_lights_table() {
         let (_, two) = recompose(run, &format!("{tag}_two"), &r.two);
         for c in ["R", "G", "B"] {
             let (a, b) = (channel(&one_table, c), channel(&same, c));
-            let worst = (0..a.len())
-                .map(|i| (a[i] - b[i]).abs())
-                .fold(0.0, f64::max);
+            assert_eq!(a.len(), b.len(), "{tag} {c}");
+            let worst = max_abs_diff(a, b);
             assert!(
                 worst < 1e-3,
                 "{tag} {c}: one table vs warm with D65's numbers: {worst}"
