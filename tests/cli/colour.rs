@@ -9,8 +9,8 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::util::{
-    atrium_compose, atrium_refl, compose, fails, glassdb, ok, oracle_python, read_exr_planes,
-    repo_path, run_oracle, write_file,
+    atrium_compose, atrium_refl, compose, fails, glassdb, json_rgb, ok, oracle_python,
+    read_exr_planes, repo_path, run_oracle, write_file,
 };
 
 const ALL_SPACES: [&str; 6] = [
@@ -28,10 +28,6 @@ fn acescg(file: &str) -> PathBuf {
 }
 fn rec709(file: &str) -> PathBuf {
     repo_path("fixtures/blender/masks/b50").join(file)
-}
-
-fn rgb(v: &Value) -> [f64; 3] {
-    [0, 1, 2].map(|i| v[i].as_f64().expect("number"))
 }
 
 #[test]
@@ -68,8 +64,8 @@ fn registry_tables_in_every_space_match_colour_science() {
             ("r0", "reflectance"),
             ("r0_back", "reflectance_back"),
         ] {
-            let want = rgb(&expected[quantity]["colorimetric"]["cie1931"]["D65"][space]);
-            let got = rgb(&g[key]);
+            let want = json_rgb(&expected[quantity]["colorimetric"]["cie1931"]["D65"][space]);
+            let got = json_rgb(&g[key]);
             for c in 0..3 {
                 assert!(
                     (got[c] - want[c]).abs() <= 1e-9,
@@ -84,7 +80,7 @@ fn registry_tables_in_every_space_match_colour_science() {
     let docs = std::fs::read_to_string(repo_path("docs/colour.md")).unwrap();
     for (table, space) in tables.iter().zip(ALL_SPACES) {
         for key in ["t0", "r0"] {
-            let v = rgb(&table["glasses"][0][key]);
+            let v = json_rgb(&table["glasses"][0][key]);
             let cells = format!(
                 "(`{space}`) | {key} | {:.6}, {:.6}, {:.6} |",
                 v[0], v[1], v[2]
@@ -96,7 +92,7 @@ fn registry_tables_in_every_space_match_colour_science() {
         }
     }
     // The spaces differ by more than the tolerance: the test would see a wrong table.
-    let t0 = |k: usize| rgb(&tables[k]["glasses"][0]["t0"]);
+    let t0 = |k: usize| json_rgb(&tables[k]["glasses"][0]["t0"]);
     assert!(
         (t0(0)[0] - t0(2)[0]).abs() > 0.03,
         "{:?} {:?}",

@@ -413,6 +413,14 @@ pub fn atrium_compose(refl: &[PathBuf], out: &Path) -> Command {
     c
 }
 
+/// The JSON triple `v` (`[r, g, b]`) as numbers; panics showing it when it is not one.
+pub fn json_rgb(v: &serde_json::Value) -> [f64; 3] {
+    [0, 1, 2].map(|c| {
+        v[c].as_f64()
+            .unwrap_or_else(|| panic!("not an RGB triple of numbers: {v}"))
+    })
+}
+
 /// The largest |a − b| over the pairs of `a` and `b` (0 for none; a NaN difference is passed
 /// over, as `f64::max` does).
 pub fn max_abs_diff<'a>(

@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 
 use super::{background_blender, channel, copy_dir, json, make_glassdb_scene, render_test_glasses};
 use crate::util::{
-    Planes, element_where, fails_naming, glassdb, max_abs_diff, ok, read_exr_planes,
+    Planes, element_where, fails_naming, glassdb, json_rgb, max_abs_diff, ok, read_exr_planes,
     registry_build, repo_path,
 };
 
@@ -256,7 +256,7 @@ fn t0(path: &Path, light: &str, id: u64) -> [f64; 3] {
         "id",
         id,
     );
-    [0, 1, 2].map(|c| g["t0"][c].as_f64().unwrap())
+    json_rgb(&g["t0"])
 }
 
 /// Each group composites with its light's table: the one-light registry (the bundled D65 one)
