@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::util::{glass_where, glassdb, ok, registry_build, repo_path, run_oracle, write_file};
+use crate::util::{
+    element_where, glassdb, json_rgb, ok, registry_build, repo_path, run_oracle, write_file,
+};
 
 /// The lights of the oracle comparison: daylight, tungsten, a CIE LED, a fluorescent and a
 /// custom SPD (a warm-white LED, fixtures/lights/warm_led.csv).
@@ -115,10 +117,6 @@ fn table<'a>(registry: &'a Value, light: &str, space: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no table for light {light} in {space}"))
 }
 
-fn rgb(v: &Value) -> [f64; 3] {
-    [0, 1, 2].map(|c| v[c].as_f64().expect("a number"))
-}
-
 /// Builds a registry with every light of [`LIGHTS`] in every space of [`SPACES`].
 fn build_light_registry(dir: &Path) -> Value {
     let catalog = write_catalog(dir);
@@ -175,11 +173,15 @@ fn per_light_tables_equal_colour_science() {
     for (id, source) in &sources {
         for (light, _) in LIGHTS {
             for space in SPACES {
-                let record = glass_where(table(&registry, light, space), "id", u64::from(*id));
+                let record = element_where(
+                    &table(&registry, light, space)["glasses"],
+                    "id",
+                    u64::from(*id),
+                );
                 let want_all = &oracle[source.as_str()][light][space];
                 for (quantity, field) in fields {
-                    let want = rgb(&want_all[quantity]).map(|v| v.clamp(0.0, 1.0));
-                    let got = rgb(&record[field]);
+                    let want = json_rgb(&want_all[quantity]).map(|v| v.clamp(0.0, 1.0));
+                    let got = json_rgb(&record[field]);
                     for c in 0..3 {
                         let diff = (got[c] - want[c]).abs();
                         worst = worst.max(diff);
