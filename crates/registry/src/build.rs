@@ -248,11 +248,7 @@ pub(crate) fn build_glass(
     layer_spec: &LayerSpec,
     ctx: &BuildContext<'_>,
 ) -> Result<Vec<GlassRecord>, RegistryError> {
-    let &BuildContext {
-        ref files,
-        integrators,
-        opts,
-    } = ctx;
+    let (files, integrators, opts) = (&ctx.files, ctx.integrators, ctx.opts);
     let glass = format!("{} (\"{}\")", spec.id, spec.name);
     let mut read = read_layer(layer_spec, files, &glass)?;
     read.layer.flipped = false;

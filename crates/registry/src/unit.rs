@@ -172,11 +172,7 @@ pub(crate) fn build_unit(
     elements: &[ElementSpec],
     ctx: &BuildContext<'_>,
 ) -> Result<Vec<GlassRecord>, RegistryError> {
-    let &BuildContext {
-        ref files,
-        integrators,
-        opts,
-    } = ctx;
+    let (files, integrators, opts) = (&ctx.files, ctx.integrators, ctx.opts);
     let unit = UnitBuild::read(spec, elements, files, opts)?;
     if unit.layers.len() == 1 {
         let (_, l, unit_layer) = &unit.layers[0];
