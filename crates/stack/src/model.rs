@@ -3,6 +3,7 @@
 //! file's product type or the data themselves ([`choose_model`]); and the model evaluated for
 //! one wavelength or channel ([`model_at`]). Equations in `docs/registry.md`.
 
+use std::fmt;
 use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
@@ -48,24 +49,39 @@ impl ModelChoice {
         ModelChoice::CoatedBronzePublished,
         ModelChoice::Opaque,
     ];
+
+    /// The name used in catalogs and in the registry's `angle_model.kind`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelChoice::Auto => "auto",
+            ModelChoice::Uncoated => "uncoated",
+            ModelChoice::Coated => "coated",
+            ModelChoice::CoatedClear => "coated-clear",
+            ModelChoice::CoatedBronze => "coated-bronze",
+            ModelChoice::CoatedBronzePublished => "coated-bronze-published",
+            ModelChoice::Opaque => "opaque",
+        }
+    }
 }
 
-// The names used in catalogs and in the registry's `angle_model.kind`.
-glassdb_io::enum_names!(ModelChoice {
-    Auto => "auto", Uncoated => "uncoated", Coated => "coated", CoatedClear => "coated-clear",
-    CoatedBronze => "coated-bronze", CoatedBronzePublished => "coated-bronze-published",
-    Opaque => "opaque",
-});
+impl fmt::Display for ModelChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 impl FromStr for ModelChoice {
     type Err = String;
 
     /// A model's name as [`ModelChoice::name`] writes it, any case.
     fn from_str(s: &str) -> Result<ModelChoice, String> {
-        ModelChoice::from_name(s.trim()).ok_or_else(|| {
-            let names: Vec<&str> = ModelChoice::ALL.iter().map(|m| m.name()).collect();
-            format!("unknown model `{s}`; expected one of {}", names.join(", "))
-        })
+        ModelChoice::ALL
+            .into_iter()
+            .find(|m| m.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| {
+                let names: Vec<&str> = ModelChoice::ALL.iter().map(|m| m.name()).collect();
+                format!("unknown model `{s}`; expected one of {}", names.join(", "))
+            })
     }
 }
 
