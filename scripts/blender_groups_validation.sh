@@ -13,17 +13,11 @@
 #         (default target/blender-groups 32 128x96)
 #
 # Needs Blender 3.4+ on PATH and the project's .venv (numpy, OpenEXR).
-set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "$0")/blender_common.sh"
 OUT=${1:-target/blender-groups}
 SAMPLES=${2:-32}
 SIZE=${3:-128x96}
-mkdir -p "$OUT"
-cargo build --quiet --bin glassdb  # debug: Blender dominates, the composite is tiny
-G=${CARGO_TARGET_DIR:-target}/debug/glassdb
-nice blender -b --factory-startup -noaudio --python-exit-code 1 \
-    -P scripts/blender/make_glassdb_scene.py -- --scene relit --out "$OUT/relit.blend" \
-    > "$OUT/scene.log" 2>&1
+prepare_scene_validation debug relit
 nice blender -b "$OUT/relit.blend" --python-exit-code 1 \
     -P scripts/blender/make_light_groups_scene.py -- --out "$OUT/groups.blend" >> "$OUT/scene.log" 2>&1
 "$G" registry build data/catalog.toml -o "$OUT/lights.json" --light sun=D65 --light warm=A > /dev/null

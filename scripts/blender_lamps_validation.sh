@@ -11,17 +11,11 @@
 #
 # Needs Blender 3.4+ on PATH and the project's .venv (numpy, OpenEXR). About 3 minutes on 2
 # shared cores at the defaults.
-set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "$0")/blender_common.sh"
 OUT=${1:-target/blender-lamps}
 SAMPLES=${2:-128}
 SIZE=${3:-160x120}
-mkdir -p "$OUT"
-cargo build --quiet --bin glassdb  # debug: Blender dominates, the composite is tiny
-G=${CARGO_TARGET_DIR:-target}/debug/glassdb
-nice blender -b --factory-startup -noaudio --python-exit-code 1 \
-    -P scripts/blender/make_glassdb_scene.py -- --scene lamps --out "$OUT/lamps.blend" \
-    > "$OUT/scene.log" 2>&1
+prepare_scene_validation debug lamps
 for variant in with without; do
     extra=()
     [ "$variant" = without ] && extra=(--no-lamps-in-reflections)

@@ -9,16 +9,10 @@
 #
 # Needs Blender 3.4+ on PATH, the project's .venv (numpy, OpenEXR) and /usr/bin/time. About
 # 4 minutes on 2 shared cores at 64 samples.
-set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "$0")/blender_common.sh"
 OUT=${1:-target/blender-validation}
 SAMPLES=${2:-64}
-mkdir -p "$OUT"
-cargo build --release --quiet --bin glassdb
-G=${CARGO_TARGET_DIR:-target}/release/glassdb
-nice blender -b --factory-startup -noaudio --python-exit-code 1 \
-    -P scripts/blender/make_glassdb_scene.py -- --scene example --out "$OUT/example.blend" \
-    > "$OUT/scene.log" 2>&1
+prepare_scene_validation release example
 for seed in 0 1; do
     rm -rf "$OUT/seed$seed"
     nice "$G" blender render "$OUT/example.blend" --glass 'Glass_clear=1' --glass 'Tinted*=5' \

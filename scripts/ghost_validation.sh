@@ -11,20 +11,19 @@
 #
 # Needs Blender 3.4+ on PATH and the project's .venv (numpy, OpenEXR). About 6 minutes on 2
 # shared cores with the defaults (the reference's run renders passes it does not need too).
-set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "$0")/blender_common.sh"
 OUT=${1:-target/ghost-validation}
 SAMPLES=${2:-64}
 REF_SAMPLES=${3:-1024}
 mkdir -p "$OUT"
 # GLASSDB: a glassdb binary to use instead of building the release one.
 if [ -z "${GLASSDB:-}" ]; then
-    cargo build --release --quiet --bin glassdb
+    build_glassdb release
+else
+    G=$GLASSDB
 fi
-G=${GLASSDB:-${CARGO_TARGET_DIR:-target}/release/glassdb}
 for panes in unit two; do
-    nice blender -b --factory-startup -noaudio --python-exit-code 1 \
-        -P scripts/blender/make_ghost_scene.py -- --panes "$panes" --size 256x192 \
+    run_blender_script make_ghost_scene.py --panes "$panes" --size 256x192 \
         --out "$OUT/$panes.blend" --facts "$OUT/$panes.json" > "$OUT/$panes.log" 2>&1
 done
 run() { # NAME BLEND GLASS ARGS…

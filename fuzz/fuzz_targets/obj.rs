@@ -3,25 +3,26 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
+#[path = "files.rs"]
+mod files;
+
 fuzz_target!(|data: &[u8]| {
-    let Ok(dir) = tempfile::tempdir() else { return };
     let (obj_bytes, mtl_bytes) = match data.iter().position(|&b| b == 0) {
         Some(k) => (&data[..k], &data[k + 1..]),
         None => (data, &[][..]),
     };
-    let obj = dir.path().join("scene.obj");
-    if std::fs::write(&obj, obj_bytes).is_err()
-        || std::fs::write(dir.path().join("scene.mtl"), mtl_bytes).is_err()
-    {
-        return;
-    }
-    if let Ok(scene) = glassdb_scene::load_obj(&obj) {
-        // Every material whose name starts with "G" is glass.
-        let is_glass = |m: Option<usize>| {
-            m.and_then(|i| scene.materials.get(i))
-                .is_some_and(|name| name.starts_with('G'))
-        };
-        let tol = glassdb_scene::PlaneTolerance::default_for(&scene);
-        let _ = glassdb_scene::detect_planes(&scene, is_glass, tol, "G*");
-    }
+    files::with_files(
+        &[("scene.obj", obj_bytes), ("scene.mtl", mtl_bytes)],
+        |dir| {
+            if let Ok(scene) = glassdb_scene::load_obj(&dir.join("scene.obj")) {
+                // Every material whose name starts with "G" is glass.
+                let is_glass = |m: Option<usize>| {
+                    m.and_then(|i| scene.materials.get(i))
+                        .is_some_and(|name| name.starts_with('G'))
+                };
+                let tol = glassdb_scene::PlaneTolerance::default_for(&scene);
+                let _ = glassdb_scene::detect_planes(&scene, is_glass, tol, "G*");
+            }
+        },
+    );
 });

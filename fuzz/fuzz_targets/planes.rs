@@ -2,13 +2,13 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
+#[path = "files.rs"]
+mod files;
+
 fuzz_target!(|data: &[u8]| {
-    let Ok(dir) = tempfile::tempdir() else { return };
-    let path = dir.path().join("planes.json");
-    if std::fs::write(&path, data).is_err() {
-        return;
-    }
-    if let Ok(planes) = glassdb_scene::PlanesFile::load(&path) {
-        let _ = planes.planes();
-    }
+    files::with_files(&[("planes.json", data)], |dir| {
+        if let Ok(planes) = glassdb_scene::PlanesFile::load(&dir.join("planes.json")) {
+            let _ = planes.planes();
+        }
+    });
 });

@@ -322,6 +322,31 @@ def scene_light_groups(scene):
             "properties": properties}
 
 
+def new_node(nt, kind, operation, name=None, location=None):
+    """A new node of `kind` (a Math or Vector Math node) in the node tree nt doing `operation`,
+    with its name and location when given."""
+    node = nt.nodes.new(kind)
+    node.operation = operation
+    if name is not None:
+        node.name = name
+    if location is not None:
+        node.location = location
+    return node
+
+
+def plane_side_nodes(nt, name_prefix=None):
+    """The Geometry, dot and add nodes whose output is n·P + d at the shading point P, linked
+    (n on `dot`, d on `add`, set per pass): its sign says on which side of the plane P lies.
+    With name_prefix the dot and add nodes are named PREFIX_dot and PREFIX_add."""
+    names = (name_prefix + "_dot", name_prefix + "_add") if name_prefix else (None, None)
+    geo = nt.nodes.new("ShaderNodeNewGeometry")
+    dot = new_node(nt, "ShaderNodeVectorMath", "DOT_PRODUCT", name=names[0])
+    add = new_node(nt, "ShaderNodeMath", "ADD", name=names[1])
+    nt.links.new(geo.outputs["Position"], dot.inputs[0])
+    nt.links.new(dot.outputs["Value"], add.inputs[0])
+    return geo, dot, add
+
+
 def output_node(nt):
     outs = [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
     active = [n for n in outs if n.is_active_output]
@@ -356,14 +381,10 @@ def make_thin_pane(mat, glass, camera_sees_through):
     out.location = (900, 0)
     geo = nt.nodes.new("ShaderNodeNewGeometry")
     geo.location = (-900, 0)
-    dot = nt.nodes.new("ShaderNodeVectorMath")
-    dot.operation = "DOT_PRODUCT"
-    dot.location = (-700, 0)
+    dot = new_node(nt, "ShaderNodeVectorMath", "DOT_PRODUCT", location=(-700, 0))
     nt.links.new(geo.outputs["Normal"], dot.inputs[0])
     nt.links.new(geo.outputs["Incoming"], dot.inputs[1])
-    absn = nt.nodes.new("ShaderNodeMath")
-    absn.operation = "ABSOLUTE"
-    absn.location = (-500, 0)
+    absn = new_node(nt, "ShaderNodeMath", "ABSOLUTE", location=(-500, 0))
     nt.links.new(dot.outputs["Value"], absn.inputs[0])
     cos = glass["cos"]
     r_front = colour_ramp(nt, cos, glass["r_front"], (-300, 300))
@@ -396,32 +417,24 @@ def make_thin_pane(mat, glass, camera_sees_through):
     # other glass seen in the mirror stays a pane. set_clip chooses the pass.
     lp = nt.nodes.new("ShaderNodeLightPath")
     lp.location = (400, 600)
-    first = nt.nodes.new("ShaderNodeMath")
-    first.operation = "LESS_THAN"
+    first = new_node(nt, "ShaderNodeMath", "LESS_THAN")
     first.inputs[1].default_value = 0.5
     nt.links.new(lp.outputs["Transparent Depth"], first.inputs[0])
-    enable_trans = nt.nodes.new("ShaderNodeMath")
-    enable_trans.operation = "MULTIPLY"
+    enable_trans = new_node(nt, "ShaderNodeMath", "MULTIPLY")
     nt.links.new(first.outputs[0], enable_trans.inputs[0])
-    dot_p = nt.nodes.new("ShaderNodeVectorMath")
-    dot_p.operation = "DOT_PRODUCT"
+    dot_p = new_node(nt, "ShaderNodeVectorMath", "DOT_PRODUCT")
     nt.links.new(geo.outputs["Position"], dot_p.inputs[0])
-    add_p = nt.nodes.new("ShaderNodeMath")
-    add_p.operation = "ADD"
+    add_p = new_node(nt, "ShaderNodeMath", "ADD")
     nt.links.new(dot_p.outputs["Value"], add_p.inputs[0])
-    behind = nt.nodes.new("ShaderNodeMath")
-    behind.operation = "GREATER_THAN"
-    behind.name = CLIP_PREFIX + "_glass_tolerance"
+    behind = new_node(nt, "ShaderNodeMath", "GREATER_THAN",
+                      name=CLIP_PREFIX + "_glass_tolerance")
     nt.links.new(add_p.outputs["Value"], behind.inputs[0])
-    enable_refl = nt.nodes.new("ShaderNodeMath")
-    enable_refl.operation = "MULTIPLY"
+    enable_refl = new_node(nt, "ShaderNodeMath", "MULTIPLY")
     nt.links.new(behind.outputs[0], enable_refl.inputs[0])
-    either = nt.nodes.new("ShaderNodeMath")
-    either.operation = "MAXIMUM"
+    either = new_node(nt, "ShaderNodeMath", "MAXIMUM")
     nt.links.new(enable_trans.outputs[0], either.inputs[0])
     nt.links.new(enable_refl.outputs[0], either.inputs[1])
-    camera = nt.nodes.new("ShaderNodeMath")
-    camera.operation = "MULTIPLY"
+    camera = new_node(nt, "ShaderNodeMath", "MULTIPLY")
     nt.links.new(lp.outputs["Is Camera Ray"], camera.inputs[0])
     nt.links.new(either.outputs[0], camera.inputs[1])
     for k, node in enumerate((first, enable_trans, dot_p, add_p, behind, enable_refl, either,
@@ -455,30 +468,18 @@ def add_clip(mat):
     if out is None or not out.inputs["Surface"].links:
         return None
     source = out.inputs["Surface"].links[0].from_socket
-    geo = nt.nodes.new("ShaderNodeNewGeometry")
-    dot = nt.nodes.new("ShaderNodeVectorMath")
-    dot.operation = "DOT_PRODUCT"
-    dot.name = CLIP_PREFIX + "_dot"
-    add = nt.nodes.new("ShaderNodeMath")
-    add.operation = "ADD"
-    add.name = CLIP_PREFIX + "_add"
-    gt = nt.nodes.new("ShaderNodeMath")
-    gt.operation = "GREATER_THAN"
+    geo, dot, add = plane_side_nodes(nt, CLIP_PREFIX)
+    gt = new_node(nt, "ShaderNodeMath", "GREATER_THAN")
     gt.inputs[1].default_value = 0.0
     lp = nt.nodes.new("ShaderNodeLightPath")
-    mul = nt.nodes.new("ShaderNodeMath")
-    mul.operation = "MULTIPLY"
-    enable = nt.nodes.new("ShaderNodeMath")
-    enable.operation = "MULTIPLY"
-    enable.name = CLIP_PREFIX + "_enable"
+    mul = new_node(nt, "ShaderNodeMath", "MULTIPLY")
+    enable = new_node(nt, "ShaderNodeMath", "MULTIPLY", name=CLIP_PREFIX + "_enable")
     tr = nt.nodes.new("ShaderNodeBsdfTransparent")
     tr.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     mix = nt.nodes.new("ShaderNodeMixShader")
     x, y = out.location
     for k, node in enumerate((geo, dot, add, gt, lp, mul, enable, tr, mix)):
         node.location = (x - 1400 + 150 * k, y + 500)
-    nt.links.new(geo.outputs["Position"], dot.inputs[0])
-    nt.links.new(dot.outputs["Value"], add.inputs[0])
     nt.links.new(add.outputs["Value"], gt.inputs[0])
     nt.links.new(lp.outputs["Is Camera Ray"], mul.inputs[0])
     nt.links.new(gt.outputs["Value"], mul.inputs[1])
@@ -699,17 +700,10 @@ def add_light_opening(mat):
     nt = mat.node_tree
     out = output_node(nt)
     source = out.inputs["Surface"].links[0].from_socket
-    geo = nt.nodes.new("ShaderNodeNewGeometry")
-    dot = nt.nodes.new("ShaderNodeVectorMath")
-    dot.operation = "DOT_PRODUCT"
-    add = nt.nodes.new("ShaderNodeMath")
-    add.operation = "ADD"
-    dist = nt.nodes.new("ShaderNodeMath")
-    dist.operation = "ABSOLUTE"
-    near = nt.nodes.new("ShaderNodeMath")
-    near.operation = "LESS_THAN"
-    enable = nt.nodes.new("ShaderNodeMath")
-    enable.operation = "MULTIPLY"
+    geo, dot, add = plane_side_nodes(nt)
+    dist = new_node(nt, "ShaderNodeMath", "ABSOLUTE")
+    near = new_node(nt, "ShaderNodeMath", "LESS_THAN")
+    enable = new_node(nt, "ShaderNodeMath", "MULTIPLY")
     enable.inputs[1].default_value = 0.0
     opening = nt.nodes.new("ShaderNodeBsdfTransparent")
     lp = nt.nodes.new("ShaderNodeLightPath")
@@ -717,8 +711,6 @@ def add_light_opening(mat):
     x, y = out.location
     for k, node in enumerate((geo, dot, add, dist, near, enable, opening, lp, mix)):
         node.location = (x - 1400 + 150 * k, y - 600)
-    nt.links.new(geo.outputs["Position"], dot.inputs[0])
-    nt.links.new(dot.outputs["Value"], add.inputs[0])
     nt.links.new(add.outputs["Value"], dist.inputs[0])
     nt.links.new(dist.outputs["Value"], near.inputs[0])
     nt.links.new(near.outputs["Value"], enable.inputs[0])

@@ -40,6 +40,29 @@ pub(crate) fn invalid(py: Python<'_>, what: String) -> PyErr {
     to_py(py, anyhow::Error::msg(what))
 }
 
+/// The value of `choices` named `given` for the argument `argument`; an `InvalidInput` naming
+/// the choices otherwise (`aovs: "x"; expected "glass-only" or "every-material"`).
+pub(crate) fn choose<T: Copy>(
+    py: Python<'_>,
+    argument: &str,
+    given: &str,
+    choices: &[(&str, T)],
+) -> PyResult<T> {
+    match choices.iter().find(|(name, _)| *name == given) {
+        Some(&(_, value)) => Ok(value),
+        None => {
+            let names: Vec<String> = choices
+                .iter()
+                .map(|(name, _)| format!("{name:?}"))
+                .collect();
+            Err(invalid(
+                py,
+                format!("{argument}: {given:?}; expected {}", names.join(" or ")),
+            ))
+        }
+    }
+}
+
 /// `Result<T, E>` into a `PyResult<T>` through [`to_py`].
 pub(crate) trait OrRaise<T> {
     /// The value, or the error raised as its class.

@@ -25,8 +25,20 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::errors::{OrRaise, invalid};
+use crate::errors::{OrRaise, choose, invalid};
 use crate::registry::PyRegistry;
+
+/// `compose(unknown=…)`: what mask ids without a registry entry do.
+const UNKNOWN_IDS: [(&str, UnknownIds); 2] = [
+    ("error", UnknownIds::Error),
+    ("passthrough", UnknownIds::Passthrough),
+];
+
+/// `cryptomatte_mask(aovs=…)`: how the cos θ and plane AOVs were written.
+const AOV_WEIGHTINGS: [(&str, AovWeighting); 2] = [
+    ("glass-only", AovWeighting::GlassOnly),
+    ("every-material", AovWeighting::EveryMaterial),
+];
 
 /// A pass as `compose` reads it: linear, premultiplied RGB (and alpha) over its data window.
 #[pyclass(module = "glassdb", name = "Pass", frozen)]
@@ -493,16 +505,7 @@ pub fn compose<'py>(
         .map(|s| s.parse::<RgbSpace>())
         .transpose()
         .map_err(|e| invalid(py, format!("space: {e}")))?;
-    let unknown = match unknown {
-        "error" => UnknownIds::Error,
-        "passthrough" => UnknownIds::Passthrough,
-        other => {
-            return Err(invalid(
-                py,
-                format!("unknown: {other:?}; expected \"error\" or \"passthrough\""),
-            ));
-        }
-    };
+    let unknown = choose(py, "unknown", unknown, &UNKNOWN_IDS)?;
     let mut settings = ComposeSettings::default();
     settings.decode.unknown = unknown;
     settings.decode.outside = OutsidePolicy::Error;
@@ -585,16 +588,7 @@ pub fn cryptomatte_mask<'py>(
         .map(|(pattern, id)| GlassMapping::parse(&format!("{pattern}={id}")))
         .collect::<Result<Vec<_>, _>>()
         .or_raise(py)?;
-    let weighting = match aovs {
-        "glass-only" => AovWeighting::GlassOnly,
-        "every-material" => AovWeighting::EveryMaterial,
-        other => {
-            return Err(invalid(
-                py,
-                format!("aovs: {other:?}; expected \"glass-only\" or \"every-material\""),
-            ));
-        }
-    };
+    let weighting = choose(py, "aovs", aovs, &AOV_WEIGHTINGS)?;
     let opts = MaskReadOptions {
         cryptomatte: Some(CryptomatteOptions {
             layer,

@@ -126,6 +126,28 @@ def grey_world(scene):
     return bg
 
 
+def plain_world(scene, rgb):
+    """A world of the one background colour `rgb` as the scene's."""
+    import bpy
+
+    world = bpy.data.worlds.new("World")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (*rgb, 1.0)
+    scene.world = world
+
+
+def scene_camera(scene, lens_mm):
+    """A camera of focal length `lens_mm` as the scene's camera; returns its object."""
+    import bpy
+
+    cam_data = bpy.data.cameras.new("Camera")
+    cam_data.lens = lens_mm
+    cam = bpy.data.objects.new("Camera", cam_data)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    return cam
+
+
 def set_exr_format(im, multilayer=True, half=True):
     """RGBA OpenEXR, ZIP, half or float, multi-layer or one layer, on image settings `im`."""
     if hasattr(im, "media_type"):  # Blender 5.0: media type first, then the format

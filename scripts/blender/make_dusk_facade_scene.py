@@ -5,7 +5,7 @@ into fixtures/dusk/.
 
     blender -b --factory-startup -noaudio --python-exit-code 1 \
         -P scripts/blender/make_dusk_facade_scene.py -- --out dusk.blend \
-        [--size 960x540] [--samples 64] [--preview preview.exr] [--only-group sun|warm]
+        [--size 960x540] [--samples 64] [--preview preview.exr]
 
 The building stands in x <= 0, y <= 0 (metres, Z up). Two glazed facades meet at its corner:
 
@@ -29,11 +29,6 @@ Two Cycles light groups (`view_layer.lightgroups`):
   Rec.709 (no white balance: a camera balanced to daylight sees tungsten orange), so the
   group matches a registry built with `--light warm=A --white-balance D65`.
 
-`--only-group NAME` saves the scene lit by that group alone (the other group's lamps left out
-of the render, its emitters' strength 0, the world black without `sun`): rendering the scene
-once per group with the same seed gives each group's light, what Cycles' light-group layers
-hold (light is additive), for a `glassdb blender render` that writes one layer per pass.
-
 Cycles, `--samples` (default 64) with a fixed seed (0), no adaptive sampling and no denoising
 (Debian's Blender 3.4 is built without OpenImageDenoise; `glassdb blender render` turns
 denoising off anyway). `--preview FILE.exr` also renders the saved scene's beauty (glass as
@@ -54,8 +49,8 @@ import fixture_scene  # noqa: E402
 
 OPTS = fixture_scene.parse_options(
     sys.argv, "make_dusk_facade_scene.py", __doc__,
-    {"out": None, "size": "960x540", "samples": "64", "preview": None, "only_group": None},
-    paths=("out", "preview"), values=("size", "samples", "only-group"))
+    {"out": None, "size": "960x540", "samples": "64", "preview": None},
+    paths=("out", "preview"), values=("size", "samples"))
 if not OPTS["out"]:
     sys.exit("make_dusk_facade_scene.py: --out FILE.blend is required")
 WIDTH, _, HEIGHT = OPTS["size"].partition("x")
@@ -349,21 +344,6 @@ def sun_and_sky():
     scene.world = world
 
 
-def only_group(name):
-    """Leaves out every light source that is not in light group `name`."""
-    if name not in ("sun", "warm"):
-        sys.exit("make_dusk_facade_scene.py: --only-group sun|warm, not %r" % name)
-    for ob in scene.objects:
-        if ob.type == "LIGHT" and ob.lightgroup != name:
-            ob.hide_render = True
-    if name != "warm":
-        for mat_name in EMITTERS:
-            nt = bpy.data.materials[mat_name].node_tree
-            nt.nodes["Emission"].inputs["Strength"].default_value = 0.0
-    if name != "sun":
-        scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-
-
 def camera():
     data = bpy.data.cameras.new("Camera")
     data.lens = 26.0
@@ -384,8 +364,6 @@ def main():
     build()
     sun_and_sky()
     camera()
-    if OPTS["only_group"]:
-        only_group(OPTS["only_group"])
     vl = scene.view_layers[0]
     for group in ("sun", "warm"):
         vl.lightgroups.add(name=group)

@@ -16,13 +16,9 @@ without changing a pixel that compose reads:
   relative name `scene.obj` (the run's absolute path means nothing in a clone).
 
 Usage: .venv/bin/python scripts/blender/make_dusk_repack.py OUT_DIR RUN_DIR
-       .venv/bin/python scripts/blender/make_dusk_repack.py OUT_DIR --group sun=RUN1 --group warm=RUN2
 
-The first form reads a run whose passes hold the light-group layers; the second, one run per
-group (the scene rendered with that group's lights alone, `make_dusk_facade_scene.py
---only-group`, same seed, single-layer passes), whose RGB becomes the layer
-`ViewLayer.Combined_<group>` of each pass, as Cycles names it; the runs must have the same
-frame size, the same mask (bit for bit) and the same pass files and windows.
+RUN_DIR is a `glassdb blender render --light GROUP=ILLUMINANT … --light-split off` run: every
+pass holds one layer `ViewLayer.Combined_<group>` per light group, as Cycles names them.
 Writes OUT_DIR/trans.exr, refl_K.exr, refl_K_G.exr, mask.exr, planes.json; prints each file's
 size and the groups found. Fails (exit 1) when a pass has no light-group layer, or when the
 passes do not all have the same groups.
@@ -84,20 +80,6 @@ def group_layers(path):
     return header, kept, sorted(groups)
 
 
-def one_group(path, group):
-    """A single-layer pass's RGB (bare R, G, B or the only …Combined layer) as the layer
-    `ViewLayer.Combined_<group>`."""
-    header, channels = read(path)
-    for prefix in ("", "ViewLayer.Combined.", "Combined."):
-        if all(prefix + c in channels for c in "RGB"):
-            break
-    else:
-        fail("%s has no RGB layer: channels %s" % (path, sorted(channels)))
-    kept = {"ViewLayer.Combined_%s.%s" % (group, c): np.ascontiguousarray(channels[prefix + c], dtype=np.float16)
-            for c in "RGB"}
-    return header, kept
-
-
 def zero_off_plane(kept, header, plane, ids, planes):
     """Zeroes the samples of a reflection pass of `plane` where the mask has no glass of that
     plane (the pass's data window placed in the mask's frame)."""
@@ -129,47 +111,17 @@ def window(header):
 
 
 def main(argv):
-    args = argv[1:]
-    if len(args) < 2:
-        fail("usage: make_dusk_repack.py OUT_DIR RUN_DIR | OUT_DIR --group NAME=RUN ...")
-    out, rest = args[0], args[1:]
-    if rest[0] == "--group":
-        if len(rest) % 2:
-            fail("--group takes NAME=RUN_DIR")
-        runs = []
-        for flag, value in zip(rest[::2], rest[1::2]):
-            name, _, run = value.partition("=")
-            if flag != "--group" or not name or not run:
-                fail("expected --group NAME=RUN_DIR, got %s %s" % (flag, value))
-            runs.append((name, run))
-    else:
-        runs = [(None, rest[0])]
-    first = runs[0][1]
-    frame = frame_of(first)
+    if len(argv) != 3:
+        fail("usage: make_dusk_repack.py OUT_DIR RUN_DIR")
+    out, run = argv[1], argv[2]
+    frame = frame_of(run)
     os.makedirs(out, exist_ok=True)
-    mask_bytes = open(os.path.join(first, frame["mask"]), "rb").read()
-    for name, run in runs[1:]:
-        other = frame_of(run)
-        if pass_files(other) != pass_files(frame) or other["bounds"] != frame["bounds"]:
-            fail("%s's passes or windows differ from %s's" % (run, first))
-        if open(os.path.join(run, other["mask"]), "rb").read() != mask_bytes:
-            fail("%s's mask differs from %s's" % (run, first))
-    mask_header, mask = read(os.path.join(first, frame["mask"]))
+    mask_header, mask = read(os.path.join(run, frame["mask"]))
     ids, planes = np.asarray(mask["id"]), np.asarray(mask["plane"])
     plane_of = {dst: int(dst.split("_")[1].split(".")[0]) for _, dst in pass_files(frame) if dst.startswith("refl_")}
     total, groups_seen = 0, None
     for src, dst in pass_files(frame):
-        if runs[0][0] is None:
-            header, kept, groups = group_layers(os.path.join(first, src))
-        else:
-            kept, groups, header = {}, sorted(name for name, _ in runs), None
-            for name, run in runs:
-                header_k, layer = one_group(os.path.join(run, src), name)
-                if header is None:
-                    header = header_k
-                elif window(header_k) != window(header):
-                    fail("%s/%s's data window differs from %s's" % (run, src, first))
-                kept.update(layer)
+        header, kept, groups = group_layers(os.path.join(run, src))
         if dst in plane_of:
             zero_off_plane(kept, header, plane_of[dst], ids, planes)
         if groups_seen is None:
@@ -187,7 +139,7 @@ def main(argv):
     size = write(os.path.join(out, "mask.exr"), header, channels)
     total += size
     print("mask.exr <- %s: %d bytes (%s)" % (frame["mask"], size, ", ".join(sorted(channels))))
-    with open(os.path.join(first, "planes.json")) as fh:
+    with open(os.path.join(run, "planes.json")) as fh:
         planes = json.load(fh)
     planes["source"] = "scene.obj"
     with open(os.path.join(out, "planes.json"), "w") as fh:

@@ -35,6 +35,9 @@ import bpy
 from bpy_extras.object_utils import world_to_camera_view
 from mathutils import Vector
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fixture_scene  # noqa: E402
+
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 opts = dict(zip(argv[::2], argv[1::2]))
 panes = opts.get("--panes", "unit")
@@ -130,16 +133,9 @@ for name, x, y, rgb, strength in BARS:
     mesh_object(name, *box(x - BAR_HALF, y - BAR_HALF, BAR_Z[0], x + BAR_HALF, y + BAR_HALF, BAR_Z[1]),
                 emissive(name, rgb, strength))
 
-world = bpy.data.worlds.new("World")
-world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.08, 0.08, 0.08, 1.0)
-scene.world = world
+fixture_scene.plain_world(scene, (0.08, 0.08, 0.08))
 
-cam_data = bpy.data.cameras.new("Camera")
-cam_data.lens = 100.0
-cam = bpy.data.objects.new("Camera", cam_data)
-scene.collection.objects.link(cam)
-scene.camera = cam
+cam = fixture_scene.scene_camera(scene, 100.0)
 cam.location = EYE
 cam.rotation_euler = (CENTRE - cam.location).to_track_quat("-Z", "Y").to_euler()
 
@@ -175,7 +171,7 @@ if "--facts" in opts:
         "window": WINDOW,
         "bars": {name: {"x": x, "y": y, "z": BAR_Z, "half_width": BAR_HALF}
                  for name, x, y, _rgb, _s in BARS},
-        "camera": {"location": list(cam.location), "theta_deg": THETA_DEG, "lens_mm": cam_data.lens},
+        "camera": {"location": list(cam.location), "theta_deg": THETA_DEG, "lens_mm": cam.data.lens},
         "size": [r.resolution_x, r.resolution_y],
         # Per mirror-plane depth (mm behind the face): each bar's mirror image (u right, v up).
         "mirror_images_uv": images,

@@ -234,15 +234,8 @@ def build(kind):
     sun = bpy.data.objects.new("Sun", sun_data)
     sun.rotation_euler = tuple(math.radians(a) for a in sun_rot)
     scene.collection.objects.link(sun)
-    world = bpy.data.worlds.new("World")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.35, 0.45, 0.65, 1.0)
-    scene.world = world
-    cam_data = bpy.data.cameras.new("Camera")
-    cam_data.lens = 24.0
-    cam = bpy.data.objects.new("Camera", cam_data)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
+    fixture_scene.plain_world(scene, (0.35, 0.45, 0.65))
+    cam = fixture_scene.scene_camera(scene, 24.0)
     from mathutils import Vector
     for frame, (eye, target) in cameras.items():
         cam.location = eye

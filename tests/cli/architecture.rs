@@ -328,23 +328,18 @@ fn every_library_error_has_a_kind() {
 /// The glassdb crates each workspace crate depends on, directly (normal dependencies), from
 /// `cargo metadata`.
 fn direct_edges() -> BTreeMap<String, BTreeSet<String>> {
-    let out = std::process::Command::new(env!("CARGO"))
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--no-deps",
-            "--offline",
-        ])
-        .current_dir(repo_path(""))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let metadata = crate::util::ok(
+        std::process::Command::new(env!("CARGO"))
+            .args([
+                "metadata",
+                "--format-version",
+                "1",
+                "--no-deps",
+                "--offline",
+            ])
+            .current_dir(repo_path("")),
     );
-    let meta: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let meta: serde_json::Value = serde_json::from_str(&metadata).unwrap();
     let mut edges = BTreeMap::new();
     for package in meta["packages"].as_array().unwrap() {
         let name = package["name"].as_str().unwrap().to_string();

@@ -42,19 +42,33 @@ fn blender_program() -> &'static str {
     "blender"
 }
 
-/// `glassdb blender render BLEND` with the test glasses, 2 threads, `seed` and `extra`.
-fn render_run(blend: &Path, out: &Path, seed: u32, extra: &[&str]) {
+/// `glassdb blender render BLEND --glass …` with the test glasses (`GLASS`), into `out`.
+fn render_test_glasses(blend: &Path, out: &Path) -> Command {
     let mut cmd = glassdb();
     cmd.args(["blender", "render"]).arg(blend);
     for g in GLASS {
         cmd.args(["--glass", g]);
     }
-    cmd.arg("--out-dir")
-        .arg(out)
+    cmd.arg("--out-dir").arg(out);
+    cmd
+}
+
+/// `glassdb blender render BLEND` with the test glasses, 2 threads, `seed` and `extra`.
+fn render_run(blend: &Path, out: &Path, seed: u32, extra: &[&str]) {
+    ok(render_test_glasses(blend, out)
         .args(["--threads", "2", "--seed"])
         .arg(seed.to_string())
-        .args(extra);
-    ok(&mut cmd);
+        .args(extra));
+}
+
+/// `blender -b OPTIONS… --python-exit-code 1`: Blender in the background, failing when its
+/// Python does; the caller adds the script (`-P FILE` or `--python-expr`).
+pub(crate) fn background_blender(options: &[&std::ffi::OsStr]) -> Command {
+    let mut cmd = Command::new(blender_program());
+    cmd.arg("-b")
+        .args(options)
+        .args(["--python-exit-code", "1"]);
+    cmd
 }
 
 /// `scripts/blender/make_glassdb_scene.py --scene KIND` saved as `blend`, with `extra` options.
@@ -98,19 +112,13 @@ pub(crate) fn rendered() -> &'static Rendered {
 /// `blender -b … -P SCRIPT -- --scene KIND --out BLEND EXTRA…`: a scene made by one of the
 /// repository's scene scripts.
 fn make_scene(script: &str, kind: &str, blend: &Path, extra: &[&std::ffi::OsStr]) {
-    let made = Command::new(blender_program())
-        .args(["-b", "--factory-startup", "-noaudio"])
-        .args(["--python-exit-code", "1", "-P"])
-        .arg(repo_path(script))
-        .args(["--", "--scene", kind, "--out"])
-        .arg(blend)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        made.status.success(),
-        "building the {kind} scene: {}",
-        String::from_utf8_lossy(&made.stderr)
+    ok(
+        background_blender(&["--factory-startup".as_ref(), "-noaudio".as_ref()])
+            .arg("-P")
+            .arg(repo_path(script))
+            .args(["--", "--scene", kind, "--out"])
+            .arg(blend)
+            .args(extra),
     );
 }
 
@@ -500,6 +508,11 @@ fn fake_blender(dir: &Path, version: &str, body: &str) -> PathBuf {
     )
 }
 
+/// A stand-in Blender 3.4.1, the oldest `glassdb blender` accepts (see [`fake_blender`]).
+fn fake_blender_3_4(dir: &Path, body: &str) -> PathBuf {
+    fake_blender(dir, "3.4.1", body)
+}
+
 fn render_with(blender: &Path, blend: &Path, out: &Path, extra: &[&str]) -> Command {
     let mut cmd = glassdb();
     cmd.args(["blender", "render"])
@@ -517,10 +530,16 @@ fn blend_stub(dir: &Path) -> PathBuf {
     write_file(dir, "scene.blend", b"BLENDER-v304RENDH")
 }
 
-#[test]
-fn missing_and_old_blender_are_refused() {
+/// A new temporary folder holding a [`blend_stub`]: the folder and the stub's path.
+fn folder_with_blend_stub() -> (tempfile::TempDir, PathBuf) {
     let t = tempfile::tempdir().unwrap();
     let blend = blend_stub(t.path());
+    (t, blend)
+}
+
+#[test]
+fn missing_and_old_blender_are_refused() {
+    let (t, blend) = folder_with_blend_stub();
     let out = t.path().join("out");
     fails_naming(
         &mut render_with(&t.path().join("no-such-blender"), &blend, &out, &[]),
@@ -541,10 +560,9 @@ fn missing_and_old_blender_are_refused() {
 #[test]
 fn a_blender_that_writes_nothing_is_named_with_its_log() {
     // It once said "cannot move …/scene.obj: No such file or directory".
-    let t = tempfile::tempdir().unwrap();
-    let blend = blend_stub(t.path());
+    let (t, blend) = folder_with_blend_stub();
     let out = t.path().join("out");
-    let silent = fake_blender(t.path(), "3.4.1", "exit 0");
+    let silent = fake_blender_3_4(t.path(), "exit 0");
     fails_naming(
         &mut render_with(&silent, &blend, &out, &[]),
         &[
@@ -559,8 +577,7 @@ fn a_blender_that_writes_nothing_is_named_with_its_log() {
 
 #[test]
 fn python_without_bpy_is_refused() {
-    let t = tempfile::tempdir().unwrap();
-    let blend = blend_stub(t.path());
+    let (t, blend) = folder_with_blend_stub();
     let mut cmd = glassdb();
     cmd.args(["blender", "render"])
         .arg(&blend)
@@ -579,12 +596,10 @@ fn python_without_bpy_is_refused() {
 
 #[test]
 fn crashing_and_hanging_blender_are_reported() {
-    let t = tempfile::tempdir().unwrap();
-    let blend = blend_stub(t.path());
+    let (t, blend) = folder_with_blend_stub();
     let out = t.path().join("out");
-    let crash = fake_blender(
+    let crash = fake_blender_3_4(
         t.path(),
-        "3.4.1",
         "echo 'Writing: /tmp/blender.crash.txt'\nkill -SEGV $$",
     );
     let err = fails_naming(
@@ -596,7 +611,7 @@ fn crashing_and_hanging_blender_are_reported() {
         ],
     );
     assert!(err.contains("blender.log"), "{err}");
-    let hang = fake_blender(t.path(), "3.4.1", "exec sleep 30");
+    let hang = fake_blender_3_4(t.path(), "exec sleep 30");
     let started = std::time::Instant::now();
     fails_naming(
         &mut render_with(&hang, &blend, &out, &["--timeout-s", "1"]),
@@ -645,12 +660,10 @@ fn assert_stop(pids: &[String], what: &str) {
 #[cfg(unix)]
 #[test]
 fn a_stopped_or_timed_out_render_leaves_no_blender_running() {
-    let t = tempfile::tempdir().unwrap();
-    let blend = blend_stub(t.path());
+    let (t, blend) = folder_with_blend_stub();
     let pids = t.path().join("pids");
-    let blender = fake_blender(
+    let blender = fake_blender_3_4(
         t.path(),
-        "3.4.1",
         &format!("sleep 300 &\necho \"$! $$\" > {}\nwait", pids.display()),
     );
     let started = std::time::Instant::now();
@@ -691,9 +704,8 @@ fn a_scene_named_like_an_option_reaches_blender_as_a_file() {
     let seen = t.path().join("args");
     blend_stub(t.path());
     std::fs::rename(t.path().join("scene.blend"), t.path().join("-P")).unwrap();
-    let blender = fake_blender(
+    let blender = fake_blender_3_4(
         t.path(),
-        "3.4.1",
         &format!("printf '%s\\n' \"$@\" > {}\nexit 1", seen.display()),
     );
     let mut cmd = glassdb();
@@ -718,7 +730,7 @@ fn a_scene_named_like_an_option_reaches_blender_as_a_file() {
 #[test]
 fn bad_scene_files_and_output_dirs_are_refused() {
     let t = tempfile::tempdir().unwrap();
-    let fake = fake_blender(t.path(), "3.4.1", "exit 0");
+    let fake = fake_blender_3_4(t.path(), "exit 0");
     let text = t.path().join("notes.blend");
     std::fs::write(&text, "just text").unwrap();
     let out = t.path().join("out");
@@ -767,9 +779,8 @@ fn exporting_blender(dir: &Path, camera: &serde_json::Value, frames: &[u32]) -> 
         "materials": ["Clear_6mm", "Tinted_Grey", "Concrete", "Wood"],
     });
     write_file(&files, "export.json", export.to_string().as_bytes());
-    fake_blender(
+    fake_blender_3_4(
         dir,
-        "3.4.1",
         &format!(
             "out=; prev=\nfor a in \"$@\"; do [ \"$prev\" = --out ] && out=$a; prev=$a; done\n\
              if [ -n \"$out\" ]; then mkdir -p \"$out\" && cp '{}'/* \"$out\"/; fi",
@@ -780,8 +791,7 @@ fn exporting_blender(dir: &Path, camera: &serde_json::Value, frames: &[u32]) -> 
 
 #[test]
 fn exports_without_frames_or_with_frames_of_two_sizes_are_refused() {
-    let t = tempfile::tempdir().unwrap();
-    let blend = blend_stub(t.path());
+    let (t, blend) = folder_with_blend_stub();
     let cam = json(&repo_path("fixtures/scene/camera.json"));
     let mut small = cam.clone();
     (small["width"], small["height"]) = (80.into(), 60.into());

@@ -7,28 +7,22 @@
 //! `glassdb mask --bounds` gives the group's rectangle the run cropped to.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-use crate::util::{Planes, compose, glassdb, ok, read_exr_planes, repo_path};
+use crate::blender::background_blender;
+use crate::util::{Planes, compose_frame, glassdb, mask_from, ok, read_exr_planes, repo_path};
 
 /// `make_ghost_scene.py --panes PANES` saved in `dir`, with its facts.
 pub(crate) fn ghost_scene(dir: &Path, panes: &str) -> (PathBuf, serde_json::Value) {
     let blend = dir.join(format!("{panes}.blend"));
     let facts = dir.join(format!("{panes}.json"));
-    let made = Command::new("blender")
-        .args(["-b", "--factory-startup", "-noaudio"])
-        .args(["--python-exit-code", "1", "-P"])
-        .arg(repo_path("scripts/blender/make_ghost_scene.py"))
-        .args(["--", "--panes", panes, "--size", "128x96", "--out"])
-        .arg(&blend)
-        .arg("--facts")
-        .arg(&facts)
-        .output()
-        .expect("these tests need Blender 3.4+ on PATH (scripts/test-all installs it)");
-    assert!(
-        made.status.success(),
-        "building the {panes} scene: {}",
-        String::from_utf8_lossy(&made.stderr)
+    ok(
+        background_blender(&["--factory-startup".as_ref(), "-noaudio".as_ref()])
+            .arg("-P")
+            .arg(repo_path("scripts/blender/make_ghost_scene.py"))
+            .args(["--", "--panes", panes, "--size", "128x96", "--out"])
+            .arg(&blend)
+            .arg("--facts")
+            .arg(&facts),
     );
     let facts = serde_json::from_str(&std::fs::read_to_string(&facts).unwrap()).unwrap();
     (blend, facts)
@@ -44,6 +38,15 @@ pub(crate) fn render(blend: &Path, glass: &str, out: &Path, extra: &[&str]) -> S
         .arg(out)
         .args(["--threads", "2", "--seed", "0"])
         .args(extra))
+}
+
+/// The `unit` scene built in `d` and rendered with the bundled double unit 11 into `d/run`
+/// with `extra`: the scene's facts, the run folder and the render's stdout.
+fn render_unit_11(d: &Path, extra: &[&str]) -> (serde_json::Value, PathBuf, String) {
+    let (unit, facts) = ghost_scene(d, "unit");
+    let run = d.join("run");
+    let stdout = render(&unit, "Unit=11", &run, extra);
+    (facts, run, stdout)
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -134,9 +137,7 @@ fn glass_interior(mask: &Planes) -> Vec<bool> {
 fn a_double_unit_renders_each_panes_reflection_at_its_depth() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let (unit, facts) = ghost_scene(d, "unit");
-    let run = d.join("run");
-    let stdout = render(&unit, "Unit=11", &run, &["--samples", "16"]);
+    let (facts, run, stdout) = render_unit_11(d, &["--samples", "16"]);
     assert!(
         stdout.contains("pane groups: 1 reflection pass(es) of units' deeper panes"),
         "{stdout}"
@@ -214,16 +215,13 @@ fn a_double_unit_renders_each_panes_reflection_at_its_depth() {
         &["--samples", "128", "--reference", "--no-composite"],
     );
     let one_pass = d.join("surfaces1.exr");
-    ok(compose()
-        .arg("--refl")
-        .arg(run.join("refl_0.0001.exr"))
-        .arg("--trans")
-        .arg(run.join("trans.0001.exr"))
-        .arg("--mask")
-        .arg(run.join("mask.0001.exr"))
-        .arg("-o")
-        .arg(&one_pass)
-        .args(["--surfaces", "1"]));
+    ok(compose_frame(
+        &[run.join("refl_0.0001.exr")],
+        &run.join("trans.0001.exr"),
+        &run.join("mask.0001.exr"),
+        &one_pass,
+    )
+    .args(["--surfaces", "1"]));
     let keep = glass_interior(&read_exr_planes(&run.join("mask.0001.exr")));
     assert!(keep.iter().filter(|&&k| k).count() > 5000);
     let want = read_exr_planes(&reference.join("reference.0001.exr"));
@@ -245,11 +243,7 @@ fn a_double_unit_renders_each_panes_reflection_at_its_depth() {
     );
 
     // `glassdb mask --bounds`: the group's rectangle, the one the run cropped its pass to.
-    ok(glassdb()
-        .arg("mask")
-        .arg(run.join("scene.obj"))
-        .arg("--camera")
-        .arg(run.join("camera.json"))
+    ok(mask_from(run.join("scene.obj"), run.join("camera.json"))
         .args(["--glass", "Unit=11", "--frames", "1", "--samples", "4"])
         .arg("--planes")
         .arg(run.join("planes.json"))
@@ -278,12 +272,8 @@ fn a_double_unit_renders_each_panes_reflection_at_its_depth() {
 fn surfaces_1_renders_one_pass_per_plane_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let (unit, _) = ghost_scene(d, "unit");
-    let run = d.join("run");
-    let stdout = render(
-        &unit,
-        "Unit=11",
-        &run,
+    let (_, run, stdout) = render_unit_11(
+        d,
         &["--samples", "2", "--resolution", "48x36", "--surfaces", "1"],
     );
     assert!(

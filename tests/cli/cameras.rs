@@ -17,7 +17,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::util::{
-    Planes, assert_images_match, fails, fails_naming, glassdb, ok, read_exr_planes,
+    Planes, assert_images_match, fails, fails_naming, mask_from, ok, read_exr_planes,
     read_png_planes, repo_path, run, write_file,
 };
 
@@ -27,12 +27,8 @@ fn room() -> PathBuf {
 
 /// `glassdb mask` of the room (both glasses) from `camera` into `out`.
 fn mask(camera: &Path, out: &Path) -> std::process::Command {
-    let mut c = glassdb();
-    c.arg("mask")
-        .arg(room())
-        .arg("--camera")
-        .arg(camera)
-        .args(["--glass", "Clear*=1", "--glass", "Tinted*=2"])
+    let mut c = mask_from(room(), camera);
+    c.args(["--glass", "Clear*=1", "--glass", "Tinted*=2"])
         .arg("-o")
         .arg(out);
     c
@@ -297,14 +293,8 @@ fn masks_match_blenders_material_index_render() {
     let fixture = repo_path("fixtures/blender/camera_render");
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("mask.####.png");
-    let mut c = glassdb();
-    c.arg("mask")
-        .arg(fixture.join("scene.obj"))
-        .arg("--camera")
-        .arg(fixture.join("camera.json"))
-        .args(["--glass", "Glass=1"])
-        .arg("-o")
-        .arg(&out);
+    let mut c = mask_from(fixture.join("scene.obj"), fixture.join("camera.json"));
+    c.args(["--glass", "Glass=1"]).arg("-o").arg(&out);
     ok(&mut c);
     let index: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(fixture.join("index_ma.json")).unwrap())

@@ -4,12 +4,13 @@
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 use serde_json::Value;
 
 use crate::util::{
-    atrium_compose, atrium_refl, compose, fails, glassdb, ok, read_exr_planes, repo_path,
-    run_oracle, write_file,
+    atrium_compose, atrium_refl, compose, fails, glassdb, json_rgb, ok, oracle_python,
+    read_exr_planes, repo_path, run_oracle, write_file,
 };
 
 const ALL_SPACES: [&str; 6] = [
@@ -27,10 +28,6 @@ fn acescg(file: &str) -> PathBuf {
 }
 fn rec709(file: &str) -> PathBuf {
     repo_path("fixtures/blender/masks/b50").join(file)
-}
-
-fn rgb(v: &Value) -> [f64; 3] {
-    [0, 1, 2].map(|i| v[i].as_f64().expect("number"))
 }
 
 #[test]
@@ -67,8 +64,8 @@ fn registry_tables_in_every_space_match_colour_science() {
             ("r0", "reflectance"),
             ("r0_back", "reflectance_back"),
         ] {
-            let want = rgb(&expected[quantity]["colorimetric"]["cie1931"]["D65"][space]);
-            let got = rgb(&g[key]);
+            let want = json_rgb(&expected[quantity]["colorimetric"]["cie1931"]["D65"][space]);
+            let got = json_rgb(&g[key]);
             for c in 0..3 {
                 assert!(
                     (got[c] - want[c]).abs() <= 1e-9,
@@ -83,7 +80,7 @@ fn registry_tables_in_every_space_match_colour_science() {
     let docs = std::fs::read_to_string(repo_path("docs/colour.md")).unwrap();
     for (table, space) in tables.iter().zip(ALL_SPACES) {
         for key in ["t0", "r0"] {
-            let v = rgb(&table["glasses"][0][key]);
+            let v = json_rgb(&table["glasses"][0][key]);
             let cells = format!(
                 "(`{space}`) | {key} | {:.6}, {:.6}, {:.6} |",
                 v[0], v[1], v[2]
@@ -95,7 +92,7 @@ fn registry_tables_in_every_space_match_colour_science() {
         }
     }
     // The spaces differ by more than the tolerance: the test would see a wrong table.
-    let t0 = |k: usize| rgb(&tables[k]["glasses"][0]["t0"]);
+    let t0 = |k: usize| json_rgb(&tables[k]["glasses"][0]["t0"]);
     assert!(
         (t0(0)[0] - t0(2)[0]).abs() > 0.03,
         "{:?} {:?}",
@@ -145,23 +142,28 @@ fn registry_tables_in_every_space_match_colour_science() {
     assert!(err.contains("--method colorimetric"), "{err}");
 }
 
+/// `python_oracle/exr_oracle.py COMMAND --NAME VALUE…` run by the oracle Python.
+fn exr_oracle(command: &str, options: &[(&str, &Path)]) -> Command {
+    let mut cmd = Command::new(oracle_python());
+    cmd.arg(repo_path("python_oracle/exr_oracle.py"))
+        .arg(command);
+    for (name, value) in options {
+        cmd.arg(format!("--{name}")).arg(value);
+    }
+    cmd
+}
+
 /// An 8-bit mask the size of `like` with glass `id` at normal incidence inside `rect`.
 fn rect_mask(dir: &Path, like: &Path, rect: &str, id: u16) -> PathBuf {
     let out = dir.join(format!("mask_{id}.png"));
-    run_oracle(
-        "exr_oracle.py",
-        &[
-            OsStr::new("mask-png"),
-            OsStr::new("--like"),
-            like.as_os_str(),
-            OsStr::new("--out"),
-            out.as_os_str(),
-            OsStr::new("--rect"),
-            OsStr::new(rect),
-            OsStr::new("--id"),
-            OsStr::new(&id.to_string()),
-        ],
-    );
+    let id = id.to_string();
+    let options = [
+        ("like", like),
+        ("out", out.as_path()),
+        ("rect", rect.as_ref()),
+        ("id", id.as_ref()),
+    ];
+    ok(&mut exr_oracle("mask-png", &options));
     out
 }
 
@@ -169,36 +171,24 @@ fn rect_mask(dir: &Path, like: &Path, rect: &str, id: u16) -> PathBuf {
 /// from data/registry.json's JSON, not by glassdb).
 fn bundled_gain(id: u16, space: &str) -> String {
     let registry = repo_path("data/registry.json");
-    run_oracle(
-        "exr_oracle.py",
-        &[
-            OsStr::new("gain"),
-            OsStr::new("--registry"),
-            registry.as_os_str(),
-            OsStr::new("--id"),
-            OsStr::new(&id.to_string()),
-            OsStr::new("--space"),
-            OsStr::new(space),
-        ],
-    )
-    .trim()
-    .to_string()
+    let id = id.to_string();
+    let options = [
+        ("registry", registry.as_path()),
+        ("id", id.as_ref()),
+        ("space", space.as_ref()),
+    ];
+    ok(&mut exr_oracle("gain", &options)).trim().to_string()
 }
 
 /// Runs `exr_oracle.py check-composite`; whether it passed, and its stderr.
 fn check_composite(input: &Path, output: &Path, mask: &Path, gain: &str) -> (bool, String) {
-    let out = std::process::Command::new(crate::util::oracle_python())
-        .arg(repo_path("python_oracle/exr_oracle.py"))
-        .arg("check-composite")
-        .arg("--input")
-        .arg(input)
-        .arg("--output")
-        .arg(output)
-        .arg("--mask")
-        .arg(mask)
-        .args(["--gain", gain])
-        .output()
-        .unwrap();
+    let options = [
+        ("input", input),
+        ("output", output),
+        ("mask", mask),
+        ("gain", gain.as_ref()),
+    ];
+    let out = exr_oracle("check-composite", &options).output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(
         matches!(out.status.code(), Some(0 | 1)),
@@ -273,18 +263,12 @@ fn an_acescg_blender_render_composites_with_the_acescg_table_without_a_flag() {
         stats.contains("PNG converted from ACEScg [acescg] to linear Rec.709"),
         "{stats}"
     );
-    let summary = run_oracle(
-        "exr_oracle.py",
-        &[
-            OsStr::new("check-display"),
-            OsStr::new("--exr"),
-            out.as_os_str(),
-            OsStr::new("--png"),
-            png.as_os_str(),
-            OsStr::new("--space"),
-            OsStr::new("acescg"),
-        ],
-    );
+    let options = [
+        ("exr", out.as_path()),
+        ("png", png.as_path()),
+        ("space", Path::new("acescg")),
+    ];
+    let summary = ok(&mut exr_oracle("check-display", &options));
     assert!(summary.contains("max_code_diff"), "{summary}");
 
     // --input-space overrides the tag: the Rec.709 table, and the output says so.

@@ -7,7 +7,9 @@
 use std::path::Path;
 
 use crate::first_contact::readme_commands;
-use crate::util::{Planes, compose, glass_where, ok, read_exr_planes, read_png_planes, repo_root};
+use crate::util::{
+    Planes, compose, element_where, json_rgb, ok, read_exr_planes, read_png_planes, repo_root,
+};
 
 /// The README's first command's compose arguments (after `target/release/compose`).
 fn readme_job() -> Vec<String> {
@@ -91,8 +93,7 @@ fn t0(registry: &serde_json::Value, light: &str, id: u64) -> [f64; 3] {
         .iter()
         .find(|t| t["light"] == light)
         .unwrap_or_else(|| panic!("no table of light {light}"));
-    let t = &glass_where(table, "id", id)["t0"];
-    [0, 1, 2].map(|c| t[c].as_f64().unwrap())
+    json_rgb(&element_where(&table["glasses"], "id", id)["t0"])
 }
 
 #[test]

@@ -8,8 +8,8 @@ use std::process::Command;
 use serde_json::Value;
 
 use crate::util::{
-    CURVE_FIT_STATS, assert_names, doc_after, fails, fails_naming, glassdb, ok, repo_path, run,
-    run_oracle, write_file,
+    CURVE_FIT_STATS, assert_names, doc_after, fails, fails_naming, glassdb, max_abs_diff, ok,
+    repo_path, run, run_oracle, strings_of, write_file,
 };
 
 #[path = "../../crates/fit/tests/common/inputs.rs"]
@@ -67,11 +67,7 @@ fn table_column(rel: &str, col: usize) -> Vec<(f64, f64)> {
 fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
     let scale = b.iter().map(|v| v.abs()).fold(0.0, f64::max);
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
-        / scale
+    max_abs_diff(a, b) / scale
 }
 
 /// Fitted values (normal · C) from a curve of a fit file, at the given angles.
@@ -501,13 +497,7 @@ fn several_glasses_in_percent_with_repeated_angles() {
     assert!(res.status.success(), "{stderr}");
     assert!(stderr.contains("glass `clear`: angle 30° given on 2 rows: averaged (R spread 0.00020, T spread 0.00020)"), "{stderr}");
     let out = json(&stdout);
-    let names: Vec<&str> = out["glasses"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|g| g["name"].as_str().unwrap())
-        .collect();
-    assert_eq!(names, ["clear", "bronze"]);
+    assert_eq!(strings_of(&out["glasses"], "name"), ["clear", "bronze"]);
     let clear = &out["glasses"][0];
     assert_eq!(f(&clear["reflectance"]["normal"]), 0.0788);
     assert_eq!(f(&clear["reflectance"]["points"]), 7.0); // 30° counted once
@@ -660,6 +650,13 @@ fn typo_above_one_fails(
     table
 }
 
+/// Writes `text` as the table `dir/name` and asserts that `glassdb fit` of it fails naming every
+/// one of `parts`.
+fn table_fails_naming(dir: &Path, name: &str, text: &str, parts: &[&str]) {
+    let table = write_file(dir, name, text.as_bytes());
+    fails_naming(&mut fit(&table, &[]), parts);
+}
+
 #[test]
 fn a_shifted_decimal_point_is_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -699,9 +696,10 @@ fn r_and_t_swapped_on_a_row_are_named() {
     let text = std::fs::read_to_string(hand_table(dir.path(), "h.csv", None))
         .unwrap()
         .replace("angle_deg,R,T", "angle_deg,T,R");
-    let table = write_file(dir.path(), "columns.csv", text.as_bytes());
-    fails_naming(
-        &mut fit(&table, &[]),
+    table_fails_naming(
+        dir.path(),
+        "columns.csv",
+        &text,
         &["columns.csv", "with the angle at most readings", "swapped"],
     );
 }
@@ -730,9 +728,10 @@ fn a_percent_value_in_a_fraction_column_is_named() {
             _ => format!("{l}\n"),
         })
         .collect();
-    let table = write_file(dir.path(), "mixed.csv", text.as_bytes());
-    fails_naming(
-        &mut fit(&table, &[]),
+    table_fails_naming(
+        dir.path(),
+        "mixed.csv",
+        &text,
         &["column T is in percent but column R is in fractions"],
     );
 }
@@ -772,9 +771,10 @@ fn a_fit_far_from_its_data_or_unphysical_beyond_it_is_refused() {
         .filter(|l| !l.starts_with("90,"))
         .map(|l| format!("{l}\n"))
         .collect();
-    let table = write_file(dir.path(), "to80.csv", text.as_bytes());
-    fails_naming(
-        &mut fit(&table, &[]),
+    table_fails_naming(
+        dir.path(),
+        "to80.csv",
+        &text,
         &["r > 1", "beyond the measured angles", "add a 90° row"],
     );
 }

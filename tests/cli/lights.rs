@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::util::{glass_where, glassdb, ok, registry_build, repo_path, run_oracle, write_file};
+use crate::util::{
+    element_where, glassdb, json_rgb, ok, registry_build, repo_path, run_oracle, write_file,
+};
 
 /// The lights of the oracle comparison: daylight, tungsten, a CIE LED, a fluorescent and a
 /// custom SPD (a warm-white LED, fixtures/lights/warm_led.csv).
@@ -18,6 +20,9 @@ const LIGHTS: [(&str, &str); 5] = [
     ("office", "FL11"),
     ("lamp", "fixtures/lights/warm_led.csv"),
 ];
+
+/// The lights of the composites of three groups: daylight, tungsten and an LED.
+const THREE_LIGHTS: [(&str, &str); 3] = [("sun", "D65"), ("warm", "A"), ("lamp", "LED-B1")];
 
 /// The spaces of the oracle comparison (the bundled registry's).
 const SPACES: [&str; 4] = ["srgb", "acescg", "rec2020", "aces2065-1"];
@@ -112,10 +117,6 @@ fn table<'a>(registry: &'a Value, light: &str, space: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no table for light {light} in {space}"))
 }
 
-fn rgb(v: &Value) -> [f64; 3] {
-    [0, 1, 2].map(|c| v[c].as_f64().expect("a number"))
-}
-
 /// Builds a registry with every light of [`LIGHTS`] in every space of [`SPACES`].
 fn build_light_registry(dir: &Path) -> Value {
     let catalog = write_catalog(dir);
@@ -172,11 +173,15 @@ fn per_light_tables_equal_colour_science() {
     for (id, source) in &sources {
         for (light, _) in LIGHTS {
             for space in SPACES {
-                let record = glass_where(table(&registry, light, space), "id", u64::from(*id));
+                let record = element_where(
+                    &table(&registry, light, space)["glasses"],
+                    "id",
+                    u64::from(*id),
+                );
                 let want_all = &oracle[source.as_str()][light][space];
                 for (quantity, field) in fields {
-                    let want = rgb(&want_all[quantity]).map(|v| v.clamp(0.0, 1.0));
-                    let got = rgb(&record[field]);
+                    let want = json_rgb(&want_all[quantity]).map(|v| v.clamp(0.0, 1.0));
+                    let got = json_rgb(&record[field]);
                     for c in 0..3 {
                         let diff = (got[c] - want[c]).abs();
                         worst = worst.max(diff);
@@ -484,8 +489,7 @@ fn light_groups_composite_is_the_sum_of_each_group_with_its_table() {
 fn light_groups_refuse_what_does_not_match() {
     let dir = tempfile::tempdir().unwrap();
     let catalog = write_catalog(dir.path());
-    let lights = [("sun", "D65"), ("warm", "A"), ("lamp", "LED-B1")];
-    let registry = registry_with_lights(&catalog, dir.path(), "lights.json", &lights);
+    let registry = registry_with_lights(&catalog, dir.path(), "lights.json", &THREE_LIGHTS);
     let out = dir.path().join("out.exr");
     // the warm group has no table given
     crate::util::fails_naming(
@@ -638,4 +642,187 @@ fn light_groups_carry_the_transmission_files_other_channels_exactly() {
         let name = format!("ViewLayer.Combined.{c}");
         assert_eq!(channel(&with, &name), channel(&without, &name), "{name}");
     }
+}
+
+/// Writes the light-group layers `layers` (`name` → R, G, B, float, ZIP16: blocks of 16 rows)
+/// holding the pixels `window` (x, y, width, height) of a `frame`-sized display window.
+fn write_group_layers(
+    path: &Path,
+    frame: (usize, usize),
+    window: (i32, i32, usize, usize),
+    layers: &[(String, [Vec<f32>; 3])],
+) {
+    use exr::prelude::*;
+    let (x, y, w, h) = window;
+    let channels: Vec<AnyChannel<FlatSamples>> = layers
+        .iter()
+        .flat_map(|(name, rgb)| {
+            ["R", "G", "B"].iter().zip(rgb).map(move |(c, plane)| {
+                AnyChannel::new(
+                    format!("{name}.{c}").as_str(),
+                    FlatSamples::F32(plane.clone()),
+                )
+            })
+        })
+        .collect();
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
+    let layer = Layer::new(
+        (w, h),
+        LayerAttributes::default().with_position(Vec2(x, y)),
+        encoding,
+        AnyChannels::sort(channels.into()),
+    );
+    let attributes = ImageAttributes::new(IntegerBounds::from_dimensions(frame));
+    Image::new(attributes, layer).write().to_file(path).unwrap();
+}
+
+/// A frame of three light groups taller than a band of the groups' sum (256 rows) and not a
+/// multiple of it, with glass of two planes crossing the band's edge and the second plane's
+/// reflection pass cropped across it (its blocks not aligned with the frame's): the beauty is,
+/// bit for bit, each group composited alone (files holding its layers only) summed in f32 in
+/// the groups' order, and `--keep-groups` keeps each group's composite exactly.
+#[test]
+fn light_groups_sum_exactly_across_band_edges() {
+    let dir = tempfile::tempdir().unwrap();
+    let lights = THREE_LIGHTS;
+    let (w, h) = (13usize, 300usize);
+    let catalog = write_catalog(dir.path());
+    let registry = registry_with_lights(&catalog, dir.path(), "lights.json", &lights);
+    let value = |seed: usize, i: usize| ((i * 7919 + seed * 104_729) % 1000) as f32 / 997.0;
+    let planes =
+        |seed: usize, n: usize| [0, 1, 2].map(|c| (0..n).map(|i| value(seed + c, i)).collect());
+    let crop = (3, 230, 9, 61); // rows 230..=290 of columns 3..=11
+    let layers = |groups: &[&str], n: usize, seed: usize| -> Vec<(String, [Vec<f32>; 3])> {
+        let mut out = vec![("ViewLayer.Combined".to_string(), planes(seed, n))];
+        for (g, group) in lights.iter().map(|l| l.0).enumerate() {
+            if groups.contains(&group) {
+                out.push((
+                    format!("ViewLayer.Combined_{group}"),
+                    planes(seed + 10 * (g + 1), n),
+                ));
+            }
+        }
+        out
+    };
+    let write = |stem: &str, groups: &[&str]| {
+        let folder = dir.path().join(stem);
+        std::fs::create_dir_all(&folder).unwrap();
+        write_group_layers(
+            &folder.join("trans.exr"),
+            (w, h),
+            (0, 0, w, h),
+            &layers(groups, w * h, 1),
+        );
+        write_group_layers(
+            &folder.join("refl0.exr"),
+            (w, h),
+            (0, 0, w, h),
+            &layers(groups, w * h, 100),
+        );
+        write_group_layers(
+            &folder.join("refl1.exr"),
+            (w, h),
+            crop,
+            &layers(groups, crop.2 * crop.3, 200),
+        );
+        folder
+    };
+    // glass: id 5 on plane 0 across row 256, id 9 on plane 1 across it (inside the crop), id 10
+    // on plane 0 in the last, partial band
+    let mut mask = glassdb_mask::MaskImage {
+        width: w as u32,
+        height: h as u32,
+        id: vec![0; w * h],
+        cos_theta: glassdb_mask::CosTheta::Quantized8(vec![0; w * h]),
+        plane: vec![0; w * h],
+        coverage: None,
+    };
+    let glassdb_mask::CosTheta::Quantized8(cos) = &mut mask.cos_theta else {
+        unreachable!()
+    };
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let (id, plane) = match (x, y) {
+                (1..=5, 240..=272) => (5, 0),
+                (4..=10, 250..=262) => (9, 1),
+                (0..=12, 295..=299) => (10, 0),
+                _ => continue,
+            };
+            mask.id[i] = id;
+            mask.plane[i] = plane;
+            cos[i] = (40 + (i * 37) % 215) as u8;
+        }
+    }
+    let mask_path = dir.path().join("mask.png");
+    glassdb_mask::write_mask(&mask_path, &mask, glassdb_mask::MaskFormat::Png8).unwrap();
+    let run = |folder: &Path, groups: &str, out: &Path, extra: &[&str]| {
+        let mut cmd = crate::util::compose();
+        cmd.arg("--registry")
+            .arg(&registry)
+            .arg("--trans")
+            .arg(folder.join("trans.exr"))
+            .arg("--refl")
+            .arg(folder.join("refl0.exr"))
+            .arg("--refl")
+            .arg(folder.join("refl1.exr"))
+            .arg("--mask")
+            .arg(&mask_path)
+            .args(["--light-groups", groups, "--data-type", "float", "-o"])
+            .arg(out)
+            .args(extra);
+        ok(&mut cmd);
+        crate::util::read_exr_planes(out)
+    };
+    let all = write("all", &["sun", "warm", "lamp"]);
+    let together = run(
+        &all,
+        "sun,warm,lamp",
+        &dir.path().join("together.exr"),
+        &["--keep-groups"],
+    );
+    let channel = |p: &crate::util::Planes, name: &str| -> Vec<f32> {
+        let k = p.names.iter().position(|n| n == name);
+        let k = k.unwrap_or_else(|| panic!("no {name} in {:?}", p.names));
+        p.channels[k].iter().map(|&v| v as f32).collect()
+    };
+    let mut sum: Option<[Vec<f32>; 3]> = None;
+    for (group, _) in lights {
+        let folder = write(group, &[group]);
+        let alone = run(
+            &folder,
+            group,
+            &dir.path().join(format!("{group}.exr")),
+            &[],
+        );
+        let rgb = ["R", "G", "B"].map(|c| channel(&alone, &format!("ViewLayer.Combined.{c}")));
+        for (c, plane) in ["R", "G", "B"].iter().zip(&rgb) {
+            let kept = channel(&together, &format!("ViewLayer.Combined_{group}.{c}"));
+            assert!(kept == *plane, "{group} {c}: kept differs from alone");
+        }
+        sum = Some(match sum {
+            None => rgb,
+            Some(s) => [0, 1, 2].map(|c| s[c].iter().zip(&rgb[c]).map(|(a, b)| a + b).collect()),
+        });
+    }
+    let sum = sum.unwrap();
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let beauty = channel(&together, &format!("ViewLayer.Combined.{name}"));
+        for (i, (b, s)) in beauty.iter().zip(&sum[c]).enumerate() {
+            assert!(
+                b.to_bits() == s.to_bits(),
+                "{name} at (x {}, y {}): {b}, the groups alone summed {s}",
+                i % w,
+                i / w
+            );
+        }
+    }
+    // the glass is composited: at (3, 256), on plane 0, the sum is not the groups' transmission
+    let at = 256 * w + 3;
+    let trans: f32 = (1..=3).map(|g| value(1 + 10 * g, at)).sum();
+    assert!((sum[0][at] - trans).abs() > 1e-4, "{} {trans}", sum[0][at]);
 }

@@ -12,7 +12,7 @@ use glassdb_mask::{
     MaskReadOptions, PlacedMask, PlaneSource, read_placed_mask,
 };
 
-use crate::util::{compose, fails, ok, repo_path};
+use crate::util::{compose, fails, mask_from, ok, repo_path};
 
 fn crypto(cos: CosSource, plane_aov: Option<&str>, weighting: AovWeighting) -> MaskReadOptions {
     let glass = GlassNames::new(&[
@@ -309,24 +309,21 @@ fn glassdb_mask_agrees_with_blenders_material_index_for_an_animated_shifted_came
     let dir = tempfile::tempdir().unwrap();
     let glass = ["--glass", "Glass_clear=1", "--glass", "Tinted*=5"];
     let out = dir.path().join("mask.####.png");
-    ok(crate::util::glassdb()
-        .arg("mask")
-        .arg(fixture.join("scene.obj"))
-        .arg("--camera")
-        .arg(fixture.join("cameras.json"))
-        .args(["--frames", "1-3"])
-        .args(glass)
-        .arg("-o")
-        .arg(&out));
+    ok(
+        mask_from(fixture.join("scene.obj"), fixture.join("cameras.json"))
+            .args(["--frames", "1-3"])
+            .args(glass)
+            .arg("-o")
+            .arg(&out),
+    );
     let portrait = dir.path().join("portrait.png");
-    ok(crate::util::glassdb()
-        .arg("mask")
-        .arg(fixture.join("scene.obj"))
-        .arg("--camera")
-        .arg(fixture.join("camera_portrait.json"))
-        .args(glass)
-        .arg("-o")
-        .arg(&portrait));
+    ok(mask_from(
+        fixture.join("scene.obj"),
+        fixture.join("camera_portrait.json"),
+    )
+    .args(glass)
+    .arg("-o")
+    .arg(&portrait));
     for version in ["b34", "b50"] {
         for frame in 1..=3 {
             let ids = blender_ids(version, &format!("index.{frame:04}.exr"));
@@ -379,14 +376,12 @@ fn the_cryptomatte_mask_agrees_with_glassdb_mask_and_so_do_the_composites() {
     ok(&mut readme_cmd);
 
     let mask = dir.path().join("mask.exr");
-    ok(crate::util::glassdb()
-        .arg("mask")
-        .arg(fixture.join("scene.obj"))
-        .arg("--camera")
-        .arg(fixture.join("camera.0001.json"))
-        .args(["--glass", "Glass_clear=1", "--glass", "Tinted*=5"])
-        .arg("-o")
-        .arg(&mask));
+    ok(
+        mask_from(fixture.join("scene.obj"), fixture.join("camera.0001.json"))
+            .args(["--glass", "Glass_clear=1", "--glass", "Tinted*=5"])
+            .arg("-o")
+            .arg(&mask),
+    );
     let beauty = fixture.join("b34/beauty.0001.exr");
     let crypto = read_placed_mask(
         &beauty,

@@ -124,9 +124,24 @@ fn registry(dir: &Path) -> (PathBuf, GlassValues) {
     (p, values)
 }
 
-/// An 8-bit packed mask PNG of `w × h`: glass `id` at cos θ = 1 inside `rect` (x0, y0, x1, y1
-/// inclusive, in the PNG's pixels), none elsewhere.
-fn rect_mask_png(path: &Path, w: usize, h: usize, rect: [usize; 4], id: u16) {
+/// A new temporary folder holding the constant-curve [`registry`]: the folder, the registry's
+/// path and its values.
+fn folder_with_registry() -> (tempfile::TempDir, PathBuf, GlassValues) {
+    let dir = tempfile::tempdir().unwrap();
+    let (reg, values) = registry(dir.path());
+    (dir, reg, values)
+}
+
+/// OpenEXR's sample image `fixtures/exr_windows/NAME.exr` (t01: full frame, t08: data window
+/// larger than the display window).
+fn openexr_sample(name: &str) -> PathBuf {
+    repo_path(&format!("fixtures/exr_windows/{name}.exr"))
+}
+
+/// An 8-bit packed mask PNG of `w × h`, `dir/m.png`: glass `id` at cos θ = 1 inside `rect` (x0,
+/// y0, x1, y1 inclusive, in the PNG's pixels), none elsewhere. Returns its path.
+fn rect_mask_png(dir: &Path, w: usize, h: usize, rect: [usize; 4], id: u16) -> PathBuf {
+    let path = dir.join("m.png");
     let inside = |i: usize| {
         let (x, y) = (i % w, i / w);
         x >= rect[0] && x <= rect[2] && y >= rect[1] && y <= rect[3]
@@ -140,7 +155,8 @@ fn rect_mask_png(path: &Path, w: usize, h: usize, rect: [usize; 4], id: u16) {
         plane: vec![0; n],
         coverage: None,
     };
-    write_mask(path, &mask, MaskFormat::Png8).unwrap();
+    write_mask(&path, &mask, MaskFormat::Png8).unwrap();
+    path
 }
 
 /// `compose` of the reflection passes `refl`, the transmission pass `trans` (a path, or
@@ -218,6 +234,16 @@ fn write_windowed_exr(
     write_exr(path, image, ExrStorage::Float);
 }
 
+/// Writes float planes (name, samples) as one part holding the whole `frame`; returns `path`.
+fn write_full_frame_exr(
+    path: PathBuf,
+    frame: PixelWindow,
+    planes: Vec<(&str, Vec<f32>)>,
+) -> PathBuf {
+    write_windowed_exr(&path, frame, frame, planes);
+    path
+}
+
 /// The sample of `channel` at absolute pixel (x, y) of a part, if its data window holds it.
 fn at(part: &Part, channel: &str, x: i64, y: i64) -> Option<f32> {
     part.data.index_of(x, y).map(|i| part.channels[channel][i])
@@ -232,12 +258,10 @@ fn cropped_openexr_sample_keeps_its_windows_and_every_pixel_its_place() {
     // OpenEXR's t08: data (30, 40)–(429, 339) in a (0, 0)–(500, 400) frame. The mask covers the
     // display window; its glass rectangle straddles the data window's top-left corner, so
     // pixels in the rectangle but outside the data window must not show up anywhere.
-    let dir = tempfile::tempdir().unwrap();
-    let (reg, values) = registry(dir.path());
-    let t08 = repo_path("fixtures/exr_windows/t08.exr");
-    let mask = dir.path().join("m.png");
+    let (dir, reg, values) = folder_with_registry();
+    let t08 = openexr_sample("t08");
     let rect = [10, 20, 120, 90];
-    rect_mask_png(&mask, 501, 401, rect, 1);
+    let mask = rect_mask_png(dir.path(), 501, 401, rect, 1);
     let out = dir.path().join("o.exr");
     ok(compose_cmd(&[&t08], &t08, &mask, &reg)
         .args(["--data-type", "float", "-o"])
@@ -301,7 +325,7 @@ fn cropped_openexr_sample_keeps_its_windows_and_every_pixel_its_place() {
         "exr_oracle.py",
         &args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(),
     );
-    let shifted = check(&repo_path("fixtures/exr_windows/t01.exr"));
+    let shifted = check(&openexr_sample("t01"));
     let (status, _, stderr) = run(Command::new(oracle_python())
         .arg(repo_path("python_oracle/exr_oracle.py"))
         .args(&shifted));
@@ -315,9 +339,8 @@ fn cropped_openexr_sample_keeps_its_windows_and_every_pixel_its_place() {
 fn cropped_mask_and_cropped_reflection_are_placed_by_coordinates() {
     // Full-frame 400×300 passes (OpenEXR's t01); an EXR mask holding only (100, 50)–(149, 89);
     // a reflection pass holding only (90, 40)–(199, 139), filled with a constant.
-    let dir = tempfile::tempdir().unwrap();
-    let (reg, values) = registry(dir.path());
-    let t01 = repo_path("fixtures/exr_windows/t01.exr");
+    let (dir, reg, values) = folder_with_registry();
+    let t01 = openexr_sample("t01");
     let frame = PixelWindow::at_origin(400, 300);
     let mask_window = PixelWindow {
         x: 100,
@@ -407,12 +430,10 @@ fn cropped_mask_and_cropped_reflection_are_placed_by_coordinates() {
 
 #[test]
 fn frames_that_differ_and_masks_without_planes_are_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let (reg, _) = registry(dir.path());
-    let t01 = repo_path("fixtures/exr_windows/t01.exr");
-    let t08 = repo_path("fixtures/exr_windows/t08.exr");
-    let mask = dir.path().join("m.png");
-    rect_mask_png(&mask, 400, 300, [0, 0, 9, 9], 1);
+    let (dir, reg, _) = folder_with_registry();
+    let t01 = openexr_sample("t01");
+    let t08 = openexr_sample("t08");
+    let mask = rect_mask_png(dir.path(), 400, 300, [0, 0, 9, 9], 1);
     let err = fails(
         compose_cmd(&[&t08], &t01, &mask, &reg)
             .arg("-o")
@@ -427,12 +448,10 @@ fn frames_that_differ_and_masks_without_planes_are_refused() {
         assert!(err.contains(part), "{part} missing: {err}");
     }
     // An EXR mask without a plane channel cannot say which of two passes a pixel takes.
-    let exr_mask = dir.path().join("m.exr");
     let frame = PixelWindow::at_origin(400, 300);
     let n = 400 * 300;
-    write_windowed_exr(
-        &exr_mask,
-        frame,
+    let exr_mask = write_full_frame_exr(
+        dir.path().join("m.exr"),
         frame,
         vec![("id", vec![1.0; n]), ("cos_theta", vec![1.0; n])],
     );
@@ -465,8 +484,7 @@ fn blender_composite(dir: &Path, render: &str, extra: &[&str]) -> (PathBuf, Path
 
 #[test]
 fn blender_3_and_5_renders_composite_with_the_same_command_line() {
-    let dir = tempfile::tempdir().unwrap();
-    let (_, values) = registry(dir.path());
+    let (dir, _, values) = folder_with_registry();
     for (render, multi_part, index) in [
         (
             "fixtures/blender/b34/multilayer.exr",
@@ -554,12 +572,10 @@ fn a_composite_is_composited_again() {
     // wrote it) are replaced by this run's, in a single-part file (its attributes carried) and a
     // multi-part one (every part carried). Both once failed at the write: "duplicate attribute
     // name: `glassdb/version`".
-    let dir = tempfile::tempdir().unwrap();
-    let (reg, values) = registry(dir.path());
+    let (dir, reg, values) = folder_with_registry();
     let (r0, t0) = values[&1];
-    let t08 = repo_path("fixtures/exr_windows/t08.exr");
-    let mask = dir.path().join("m.png");
-    rect_mask_png(&mask, 501, 401, [10, 20, 120, 90], 1);
+    let t08 = openexr_sample("t08");
+    let mask = rect_mask_png(dir.path(), 501, 401, [10, 20, 120, 90], 1);
     let once = dir.path().join("once.exr");
     ok(compose_cmd(&[&t08], &t08, &mask, &reg)
         .args(["--data-type", "float", "-o"])
@@ -640,8 +656,7 @@ fn keep_channels_none_and_an_output_layer() {
 fn layers_are_chosen_per_input_by_file_and_flag() {
     // A stereo pair in one part (OpenEXR's multi-view layout: the hero view `left` in the bare
     // channels, `right.*` for the other) as the transmission pass; each view picked by name.
-    let dir = tempfile::tempdir().unwrap();
-    let (reg, values) = registry(dir.path());
+    let (dir, reg, values) = folder_with_registry();
     let frame = PixelWindow::at_origin(4, 2);
     let stereo = dir.path().join("stereo.exr");
     let attributes = glassdb_image::ExrLayerAttributes {
@@ -673,8 +688,7 @@ fn layers_are_chosen_per_input_by_file_and_flag() {
         }],
     };
     write_exr(&stereo, image, ExrStorage::Float);
-    let mask = dir.path().join("m.png");
-    rect_mask_png(&mask, 4, 2, [0, 0, 3, 1], 1);
+    let mask = rect_mask_png(dir.path(), 4, 2, [0, 0, 3, 1], 1);
     let (r0, t0) = values[&1];
     let composite = |trans: String, extra: &[&str]| -> [f32; 3] {
         let out = dir.path().join("o.exr");
@@ -727,13 +741,10 @@ fn layers_are_chosen_per_input_by_file_and_flag() {
 #[test]
 fn png_alpha_is_straight_and_exr_alpha_premultiplied() {
     // A premultiplied EXR pixel (0.25, 0.25, 0.25, A 0.5) without glass is straight 0.5 in PNG.
-    let dir = tempfile::tempdir().unwrap();
-    let (reg, _) = registry(dir.path());
+    let (dir, reg, _) = folder_with_registry();
     let frame = PixelWindow::at_origin(2, 1);
-    let trans = dir.path().join("t.exr");
-    write_windowed_exr(
-        &trans,
-        frame,
+    let trans = write_full_frame_exr(
+        dir.path().join("t.exr"),
         frame,
         vec![
             ("R", vec![0.25, 0.0]),
@@ -742,12 +753,9 @@ fn png_alpha_is_straight_and_exr_alpha_premultiplied() {
             ("A", vec![0.5, 0.0]),
         ],
     );
-    let mask = dir.path().join("m.png");
-    rect_mask_png(&mask, 2, 1, [1, 0, 1, 0], 1);
-    let refl = dir.path().join("r.exr");
-    write_windowed_exr(
-        &refl,
-        frame,
+    let mask = rect_mask_png(dir.path(), 2, 1, [1, 0, 1, 0], 1);
+    let refl = write_full_frame_exr(
+        dir.path().join("r.exr"),
         frame,
         rgb_planes(vec![0.0, 0.5], vec![0.0, 0.5], vec![0.0, 0.5]),
     );
@@ -779,18 +787,14 @@ fn half_output_clamps_values_beyond_half_range_and_reads_back() {
     // Finite values beyond ±65504 are stored as the largest half, said with the first pixel,
     // so that the output composites again (an infinity was written, and it came back as
     // non-finite transmission samples).
-    let dir = tempfile::tempdir().unwrap();
-    let (reg, values) = registry(dir.path());
+    let (dir, reg, values) = folder_with_registry();
     let frame = PixelWindow::at_origin(3, 1);
-    let trans = dir.path().join("t.exr");
-    write_windowed_exr(
-        &trans,
-        frame,
+    let trans = write_full_frame_exr(
+        dir.path().join("t.exr"),
         frame,
         rgb_planes(vec![1e5, 1.0, 1.0], vec![1.0; 3], vec![-7e4, 1.0, 1.0]),
     );
-    let mask = dir.path().join("m.png");
-    rect_mask_png(&mask, 3, 1, [2, 0, 2, 0], 1);
+    let mask = rect_mask_png(dir.path(), 3, 1, [2, 0, 2, 0], 1);
     let half = dir.path().join("half.exr");
     let (_, _, stderr) = run(compose_cmd(&[&trans], &trans, &mask, &reg)
         .args(["--data-type", "half", "-o"])
@@ -824,8 +828,7 @@ fn half_output_clamps_values_beyond_half_range_and_reads_back() {
 #[test]
 fn every_sample_type_survives_a_keep() {
     // uint channels (object ids) are carried over exactly, not through f32.
-    let dir = tempfile::tempdir().unwrap();
-    let (reg, _) = registry(dir.path());
+    let (dir, reg, _) = folder_with_registry();
     let frame = PixelWindow::at_origin(2, 1);
     let trans = dir.path().join("t.exr");
     let image = ExrImageOut {
@@ -847,8 +850,7 @@ fn every_sample_type_survives_a_keep() {
         }],
     };
     write_exr(&trans, image, ExrStorage::Half);
-    let mask = dir.path().join("m.png");
-    rect_mask_png(&mask, 2, 1, [0, 0, 0, 0], 1);
+    let mask = rect_mask_png(dir.path(), 2, 1, [0, 0, 0, 0], 1);
     let out = dir.path().join("o.exr");
     ok(compose_cmd(&[&trans], &trans, &mask, &reg)
         .arg("-o")

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage};
 
 use crate::util::{
-    CURVE_FIT_STATS, fails, glass_where, glassdb, make_ref, ok, registry_build as build, repo_path,
-    repo_root, run_oracle, write_file,
+    CURVE_FIT_STATS, element_where, fails, glassdb, make_ref, ok, registry_build as build,
+    repo_path, repo_root, run_oracle, write_file,
 };
 
 const EXPLICIT_GLASS: &str = "r0 = [0.08, 0.08, 0.08]\nt0 = [0.85, 0.86, 0.84]\n";
@@ -39,7 +39,7 @@ fn glass_ids(reg: &serde_json::Value) -> Vec<u64> {
 }
 
 fn glass_by_name<'a>(reg: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
-    glass_where(&reg["tables"][0], "name", name)
+    element_where(&reg["tables"][0]["glasses"], "name", name)
 }
 
 #[test]

@@ -10,8 +10,8 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use crate::util::{
-    assert_names, compose, fails, glassdb, names, ok, registry_build, repo_path, send_signal,
-    write_file,
+    assert_names, compose, fails, glassdb, mask_from, names, ok, registry_build, repo_path,
+    send_signal, write_file,
 };
 
 /// Runs `cmd` (no standard input) and returns its output, failing the test if it runs longer
@@ -154,12 +154,8 @@ fn room_in(dir: &Path) -> PathBuf {
 }
 
 fn mask_cmd(obj: &Path, out: &Path) -> Command {
-    let mut c = glassdb();
-    c.arg("mask")
-        .arg(obj)
-        .arg("--camera")
-        .arg(obj.with_file_name("camera.json"))
-        .args(["--glass", "Clear*=1", "--format", "png8", "-o"])
+    let mut c = mask_from(obj, obj.with_file_name("camera.json"));
+    c.args(["--glass", "Clear*=1", "--format", "png8", "-o"])
         .arg(out);
     c
 }
@@ -762,11 +758,7 @@ fn camera_and_planes_errors_quote_huge_values_bounded() {
     for (k, text) in cameras.iter().enumerate() {
         let cam = write_file(d, &format!("camera{k}.json"), text.as_bytes());
         let said = fails(
-            glassdb()
-                .arg("mask")
-                .arg(repo_path("fixtures/scene/room.obj"))
-                .arg("--camera")
-                .arg(&cam)
+            mask_from(repo_path("fixtures/scene/room.obj"), &cam)
                 .args(["--glass", "Clear_6mm=1", "-o"])
                 .arg(d.join("m.png")),
         );

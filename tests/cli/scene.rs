@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use glassdb_mask::{CosTheta, MaskReadOptions, read_mask};
 
-use crate::util::{fails, fails_naming, glassdb, ok, repo_path, write_file};
+use crate::util::{fails, fails_naming, glassdb, mask_from, ok, repo_path, write_file};
 
 fn room() -> PathBuf {
     repo_path("fixtures/scene/room.obj")
@@ -502,13 +502,8 @@ fn mask_of_a_u_shaped_pane_leaves_its_notch_clear() {
     let dir = tempfile::tempdir().unwrap();
     let (obj, camera) = u_pane_scene(dir.path());
     let out = dir.path().join("u.png");
-    let mut cmd = glassdb();
-    cmd.arg("mask")
-        .arg(&obj)
-        .arg("--camera")
-        .arg(&camera)
-        .args(["--glass", "Glass*=3", "-o"])
-        .arg(&out);
+    let mut cmd = mask_from(&obj, &camera);
+    cmd.args(["--glass", "Glass*=3", "-o"]).arg(&out);
     let (status, _, stderr) = crate::util::run(&mut cmd);
     assert!(status.status.success(), "{stderr}");
     assert!(!stderr.contains("warning"), "{stderr}");

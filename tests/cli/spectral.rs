@@ -12,7 +12,9 @@ use glassdb_spectral::{
 };
 use serde_json::Value;
 
-use crate::util::{fails, fails_naming, glassdb, ok, repo_path, run_oracle, write_file};
+use crate::util::{
+    fails, fails_naming, glassdb, json_rgb, max_abs_diff, ok, repo_path, run_oracle, write_file,
+};
 
 /// The illuminants `python_oracle/spectral_oracle.py` integrates under (every bundled one is
 /// checked by `python_oracle/light_oracle.py`, tests/cli/lights.rs).
@@ -66,11 +68,6 @@ fn quantities(data: &SpectralData) -> Vec<(&'static str, &Vec<f64>)> {
     q
 }
 
-fn rgb_of(v: &Value) -> [f64; 3] {
-    let a = v.as_array().expect("rgb array");
-    [0, 1, 2].map(|i| a[i].as_f64().expect("number"))
-}
-
 /// Compares every method, observer, illuminant and space with the oracle's numbers for `files`.
 fn compare_with_oracle(files: &[PathBuf], opts: &ReadOptions, extrapolate: bool, rel: f64) {
     let mut args: Vec<&OsStr> = files.iter().map(|p| p.as_os_str()).collect();
@@ -93,7 +90,7 @@ fn compare_with_oracle(files: &[PathBuf], opts: &ReadOptions, extrapolate: bool,
                 })
                 .unwrap();
                 let got = it.channels(&data.wavelength_nm, values).unwrap();
-                let want = rgb_of(&exp["paper"][cmf.name()]);
+                let want = json_rgb(&exp["paper"][cmf.name()]);
                 for c in 0..3 {
                     assert_close(
                         &format!("{name} {q} paper {cmf} channel {c}"),
@@ -118,7 +115,7 @@ fn compare_with_oracle(files: &[PathBuf], opts: &ReadOptions, extrapolate: bool,
                         })
                         .unwrap();
                         let got = it.channels(&data.wavelength_nm, values).unwrap();
-                        let want = rgb_of(
+                        let want = json_rgb(
                             &exp["colorimetric"][observer.name()][illuminant.name()][space.name()],
                         );
                         for c in 0..3 {
@@ -202,7 +199,7 @@ fn every_rgb_space_matches_colour_science_on_clear_and_tinted_glass() {
                         })
                         .unwrap();
                         let got = it.channels(&data.wavelength_nm, values).unwrap();
-                        let want = rgb_of(
+                        let want = json_rgb(
                             &expected[q]["colorimetric"][observer.name()][illuminant.name()]
                                 [space.name()],
                         );
@@ -252,7 +249,7 @@ fn cli_json_matches_the_library_and_has_the_documented_keys() {
         .unwrap();
         for (q, values) in quantities(&data) {
             let want = it.channels(&data.wavelength_nm, values).unwrap();
-            assert_eq!(rgb_of(&v[q]["rgb"]), want, "{name} {q}");
+            assert_eq!(json_rgb(&v[q]["rgb"]), want, "{name} {q}");
             let lum = glassdb_spectral::luminous_iso9050(&data.wavelength_nm, values).unwrap();
             assert_eq!(v[q]["luminous"].as_f64().unwrap(), lum);
         }
@@ -397,7 +394,7 @@ fn spectral_json(args: &[&str], file: &Path) -> Value {
 
 /// The transmittance RGB of `glassdb spectral --json [args…] <file>`.
 fn transmittance_rgb(args: &[&str], file: &Path) -> [f64; 3] {
-    rgb_of(&spectral_json(args, file)["transmittance"]["rgb"])
+    json_rgb(&spectral_json(args, file)["transmittance"]["rgb"])
 }
 
 #[test]
@@ -606,14 +603,12 @@ fn off_grid_start_is_evaluated_at_the_right_wavelengths() {
     let got = it
         .channels(&data.wavelength_nm, data.transmittance.as_ref().unwrap())
         .unwrap();
-    let right = rgb_of(&v["right"]);
-    let colour = rgb_of(&v["colour"]);
+    let right = json_rgb(&v["right"]);
+    let colour = json_rgb(&v["colour"]);
     for c in 0..3 {
         assert_close(&format!("off-grid channel {c}"), got[c], right[c], 1e-9);
     }
-    let worst = (0..3)
-        .map(|c| (colour[c] - right[c]).abs())
-        .fold(0.0, f64::max);
+    let worst = max_abs_diff(&colour, &right);
     assert!(
         worst > 1e-4,
         "colour-science's re-spacing should visibly differ: {worst}"

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::util::{
-    assert_names, fails_naming, glass_where, glassdb, ok, registry_build, repo_path, run_oracle,
+    assert_names, element_where, fails_naming, glassdb, ok, registry_build, repo_path, run_oracle,
     write_file,
 };
 
@@ -274,7 +274,7 @@ fn read_json(path: &Path) -> Value {
 }
 
 fn glass(table: &Value, id: u64) -> &Value {
-    glass_where(table, "id", id)
+    element_where(&table["glasses"], "id", id)
 }
 
 /// A unit of one layer is that layer's registry entry exactly (turned round when flipped).

@@ -408,16 +408,48 @@ pub fn example_copy() -> tempfile::TempDir {
 /// reflection passes `refl`, into `out`.
 pub fn atrium_compose(refl: &[PathBuf], out: &Path) -> Command {
     let a = repo_path("fixtures/atrium");
+    let mut c = compose_frame(refl, &a.join("trans.exr"), &a.join("mask.png"), out);
+    c.arg("--planes").arg(a.join("virtual/planes.json"));
+    c
+}
+
+/// The JSON triple `v` (`[r, g, b]`) as numbers; panics showing it when it is not one.
+pub fn json_rgb(v: &serde_json::Value) -> [f64; 3] {
+    [0, 1, 2].map(|c| {
+        v[c].as_f64()
+            .unwrap_or_else(|| panic!("not an RGB triple of numbers: {v}"))
+    })
+}
+
+/// The largest |a − b| over the pairs of `a` and `b` (0 for none; a NaN difference is passed
+/// over, as `f64::max` does).
+pub fn max_abs_diff<'a>(
+    a: impl IntoIterator<Item = &'a f64>,
+    b: impl IntoIterator<Item = &'a f64>,
+) -> f64 {
+    a.into_iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+/// `glassdb mask OBJ --camera CAMERA`: callers add the glasses, the output and any other flag.
+pub fn mask_from(obj: impl AsRef<std::ffi::OsStr>, camera: impl AsRef<std::ffi::OsStr>) -> Command {
+    let mut c = glassdb();
+    c.arg("mask").arg(obj).arg("--camera").arg(camera);
+    c
+}
+
+/// `compose --refl R… --trans TRANS --mask MASK -o OUT`: one frame's composite.
+pub fn compose_frame(refl: &[PathBuf], trans: &Path, mask: &Path, out: &Path) -> Command {
     let mut c = compose();
     for r in refl {
         c.arg("--refl").arg(r);
     }
     c.arg("--trans")
-        .arg(a.join("trans.exr"))
+        .arg(trans)
         .arg("--mask")
-        .arg(a.join("mask.png"))
-        .arg("--planes")
-        .arg(a.join("virtual/planes.json"))
+        .arg(mask)
         .arg("-o")
         .arg(out);
     c
@@ -440,9 +472,9 @@ pub fn names(dir: &Path) -> Vec<String> {
     v
 }
 
-/// The glass of a registry table (its JSON) whose `key` is `value`; panics naming it when none is.
-pub fn glass_where<'a, V>(
-    table: &'a serde_json::Value,
+/// The element of the JSON array `items` whose `key` is `value`; panics naming it when none is.
+pub fn element_where<'a, V>(
+    items: &'a serde_json::Value,
     key: &str,
     value: V,
 ) -> &'a serde_json::Value
@@ -450,12 +482,29 @@ where
     V: std::fmt::Display,
     serde_json::Value: PartialEq<V>,
 {
-    table["glasses"]
-        .as_array()
-        .unwrap()
+    elements(items)
         .iter()
-        .find(|g| g[key] == value)
-        .unwrap_or_else(|| panic!("no glass with {key} {value}"))
+        .find(|e| e[key] == value)
+        .unwrap_or_else(|| panic!("no element with {key} {value} in {items}"))
+}
+
+/// The elements of the JSON array `items`; panics showing it when it is not an array.
+pub fn elements(items: &serde_json::Value) -> &[serde_json::Value] {
+    items
+        .as_array()
+        .unwrap_or_else(|| panic!("not an array: {items}"))
+}
+
+/// The string `key` of each element of the JSON array `items`.
+pub fn strings_of<'a>(items: &'a serde_json::Value, key: &str) -> Vec<&'a str> {
+    elements(items)
+        .iter()
+        .map(|e| {
+            e[key]
+                .as_str()
+                .unwrap_or_else(|| panic!("no string {key} in {e}"))
+        })
+        .collect()
 }
 
 /// Sends `SIG<signal>` (`TERM`, `INT`, …) to a started child with `kill`.

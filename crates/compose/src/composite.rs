@@ -49,7 +49,7 @@ pub(crate) struct FrameFacts {
 /// plane's pass takes every group's share, as `--surfaces 1`). Files and arrays
 /// (`compose_in_memory`) alike.
 pub(crate) fn run_kernel<'a>(
-    trans: &mut [Vec<f32>; 3],
+    trans: [&mut [f32]; 3],
     refl: impl Iterator<Item = (&'a [Vec<f32>; 3], PixelWindow)>,
     groups: &[PlacedGroupRefl<'a>],
     mask: &MaskImage,
@@ -68,8 +68,7 @@ pub(crate) fn run_kernel<'a>(
         OutsidePolicy::Transmission => OutsidePass::Transmission,
         OutsidePolicy::Error | OutsidePolicy::NoReflection => OutsidePass::NoReflection,
     };
-    let [r, g, b] = trans;
-    let input = KernelInput::placed([r, g, b], &placed, mask, lut, outside_mode)?
+    let input = KernelInput::placed(trans, &placed, mask, lut, outside_mode)?
         .with_groups(groups, settings.decode.max_groups)?;
     Ok(kernel::compose_in_place(input))
 }
@@ -101,14 +100,8 @@ pub(crate) fn composite(
             }
         })
         .collect();
-    let counts = run_kernel(
-        &mut frame.trans.image.rgb,
-        refl,
-        &groups,
-        &frame.mask,
-        frame.lut,
-        settings,
-    )?;
+    let [r, g, b] = &mut frame.trans.image.rgb;
+    let counts = run_kernel([r, g, b], refl, &groups, &frame.mask, frame.lut, settings)?;
     let cos_range = frame.mask.cos_theta_range();
     drop(groups);
     // Returning a frame's decoded passes to the system takes tens of milliseconds on one core;

@@ -114,6 +114,25 @@ fn read_mask(
     Ok(mask)
 }
 
+/// The frame's mask placed in the frame `frame` (a transmission pass's windows): the one `once`
+/// holds (handed back by the previous composite of the frame), else read from its file and
+/// checked to frame the same display window.
+pub(crate) fn mask_in_frame(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    once: &MaskOnce,
+    frame: &ImageWindows,
+) -> Result<MaskImage, ComposeError> {
+    let mask = read_mask(files, settings, Some(once))?;
+    let windows = in_frame(mask.windows, !mask.has_coordinates, &frame.display);
+    check_frames(&files.trans, frame, &[(files.mask.as_path(), windows)])?;
+    Ok(if windows.data == frame.data {
+        mask.image
+    } else {
+        mask.image.placed(&windows.data, &frame.data)
+    })
+}
+
 /// The decoded inputs of one image, as read.
 struct DecodedInputs {
     trans: Pass,
@@ -143,6 +162,7 @@ pub(crate) fn decode_planned<'a>(
         refl_windows: stored_refl_windows,
         memory,
         reservation,
+        ..
     } = plan;
     let inputs = decode_inputs(files, settings, &reads, &display, carry, mask_once)?;
     let mut placed = place_inputs(files, inputs)?;
@@ -172,20 +192,22 @@ pub(crate) fn decode_planned<'a>(
         .collect();
     placed.refl_windows.truncate(planes);
     placed.stored_windows.truncate(planes);
-    let outside = glass_outside_passes(&placed.mask, lut, &placed.refl_windows);
-    if let (OutsidePolicy::Error, Some((&plane, &(pixels, bounds)))) =
-        (settings.outside, outside.iter().next())
-    {
-        return Err(ComposeError::GlassOutsidePass {
-            plane,
-            pass: files.refl[plane].clone(),
-            pixels,
-            pass_window: stored_refl_windows
-                .get(plane)
-                .map_or(placed.stored_windows[plane], |w| w.data),
-            bounds: absolute_from(&bounds, &placed.trans.windows.data),
-        });
-    }
+    let pass_windows: Vec<PixelWindow> = (0..planes)
+        .map(|k| {
+            stored_refl_windows
+                .get(k)
+                .map_or(placed.stored_windows[k], |w| w.data)
+        })
+        .collect();
+    let outside = refuse_glass_outside(
+        files,
+        settings,
+        &placed.mask,
+        lut,
+        &placed.refl_windows,
+        &pass_windows,
+        &placed.trans.windows.data,
+    )?;
     Ok(DecodedFrame {
         trans: placed.trans,
         frame: placed.frame,
@@ -257,6 +279,28 @@ fn read_reflections(
     reads: &[PassReadOptions],
     rows: &BTreeMap<u16, (i64, i64)>,
 ) -> Result<Vec<Pass>, ComposeError> {
+    let rows_of = |plane: usize| {
+        Some(
+            u16::try_from(plane)
+                .ok()
+                .and_then(|plane| rows.get(&plane))
+                .copied()
+                .unwrap_or((i64::MIN, i64::MIN)),
+        )
+    };
+    Ok(read_reflection_rows(files, reads, &rows_of)?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// Every reflection input's rows `rows_of(plane)` (frame coordinates, inclusive; `None`: the
+/// input is not read), a few inputs at a time, as [`read_reflections`] reads them.
+pub(crate) fn read_reflection_rows(
+    files: &FrameFiles,
+    reads: &[PassReadOptions],
+    rows_of: &(dyn Fn(usize) -> Option<(i64, i64)> + Sync),
+) -> Result<Vec<Option<Pass>>, ComposeError> {
     let at_once = memory::decoding_at_once();
     let inputs = files.reflection_inputs();
     let mut passes = Vec::with_capacity(inputs.len());
@@ -266,12 +310,9 @@ fn read_reflections(
             .enumerate()
             .map(|(i, &(plane, p))| {
                 let k = c * at_once + i;
-                let rows = u16::try_from(plane)
-                    .ok()
-                    .and_then(|plane| rows.get(&plane))
-                    .copied()
-                    .unwrap_or((i64::MIN, i64::MIN));
-                glassdb_pass::read_pass_rows(p, &reads[k], rows)
+                rows_of(plane)
+                    .map(|rows| glassdb_pass::read_pass_rows(p, &reads[k], rows))
+                    .transpose()
             })
             .collect::<Result<Vec<_>, _>>()?;
         passes.extend(decoded);
@@ -379,6 +420,34 @@ pub(crate) fn check_inputs(
         }
     }
     Ok(())
+}
+
+/// Glass pixels (with a table) outside their plane's reflection pass (`windows[k]`, plane k's,
+/// relative to the frame `data`), refused where `settings` says so ([`OutsidePolicy::Error`],
+/// naming the plane's pass and its data window as stored, `stored[k]`); else per plane, the
+/// count and bounding box.
+pub(crate) fn refuse_glass_outside(
+    files: &FrameFiles,
+    settings: &DecodeSettings,
+    mask: &MaskImage,
+    lut: &GlassLut,
+    windows: &[PixelWindow],
+    stored: &[PixelWindow],
+    data: &PixelWindow,
+) -> Result<BTreeMap<usize, (u64, PixelWindow)>, ComposeError> {
+    let outside = glass_outside_passes(mask, lut, windows);
+    if let (OutsidePolicy::Error, Some((&plane, &(pixels, bounds)))) =
+        (settings.outside, outside.iter().next())
+    {
+        return Err(ComposeError::GlassOutsidePass {
+            plane,
+            pass: files.refl[plane].clone(),
+            pixels,
+            pass_window: stored[plane],
+            bounds: absolute_from(&bounds, data),
+        });
+    }
+    Ok(outside)
 }
 
 /// Glass pixels (with a table) outside their plane's reflection pass: per plane, the count and

@@ -258,6 +258,21 @@ pub enum ComposeError {
     /// Light groups asked for with none named, or one named twice.
     #[error("light groups: {0}")]
     LightGroupList(String),
+    /// A light group's layer of the transmission pass holds other pixels than the first
+    /// group's (the frame), so that the groups' composites cannot be summed pixel by pixel.
+    #[error(
+        "{path}: layer {layer} holds the pixels {window}, but the frame (the first light group's layer) is {frame}: every group's layer must hold the same pixels"
+    )]
+    GroupWindowMismatch {
+        /// The transmission pass.
+        path: PathBuf,
+        /// The group's layer.
+        layer: String,
+        /// Its data window.
+        window: glassdb_image::PixelWindow,
+        /// The frame's data window.
+        frame: glassdb_image::PixelWindow,
+    },
     /// Each group's composite kept as a layer of a PNG output, which has none.
     #[error("{output}: each light group's composite is kept as a layer of an EXR output only")]
     KeepGroupsNotExr {
@@ -374,6 +389,7 @@ impl ComposeError {
             | ComposeError::GroupWithoutTable { .. }
             | ComposeError::NoTableForGroup { .. }
             | ComposeError::LightGroupList(_)
+            | ComposeError::GroupWindowMismatch { .. }
             | ComposeError::LightPartsRecord { .. }
             | ComposeError::LightPartUnknownId { .. }
             | ComposeError::PartWithoutLayer { .. }

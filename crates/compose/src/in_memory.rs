@@ -169,8 +169,9 @@ fn compose_planes(
         mask: labels.mask.clone().into(),
     };
     crate::pane_groups::check_group_passes(&files, &settings.decode, lut, mask, &[], &[], &whole)?;
+    let [r, g, b] = &mut trans;
     let counts = composite::run_kernel(
-        &mut trans,
+        [r, g, b],
         refl.iter().map(|p| (p, whole)),
         &[],
         mask,

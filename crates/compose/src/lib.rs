@@ -18,7 +18,8 @@
 //! [`compose_frame_with_progress`] also reports each stage to a `glassdb_io::Progress`. The
 //! viewer runs the first two ([`decode_frame`]), with no output at all. A frame split into
 //! light groups is [`compose_light_groups`]: the phases once per group, each with its light's
-//! table, and the sum written ([`light_groups`]). A frame split by the light's path is
+//! table (the groups after the first in row bands, into the sum), and the sum written
+//! ([`light_groups`]). A frame split by the light's path is
 //! [`compose_light_parts`]: each part scaled by what its aperture's glass passes, the parts
 //! summed as each pass is read, composited once ([`relight`], the relit swap).
 //! [`compose_in_memory`] composites a host
@@ -26,6 +27,7 @@
 
 #![warn(missing_docs)]
 
+mod bands;
 pub mod colour;
 mod composite;
 mod decode;

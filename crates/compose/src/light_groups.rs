@@ -153,8 +153,9 @@ pub fn group_passes(
 }
 
 /// Composites a frame split into light groups: each group's passes ([`group_passes`])
-/// composited with its own light's tables, in turn (one group's passes decoded at a time, the
-/// frame's memory limit held per group; the mask decoded once), and the sum written as the
+/// composited with its own light's tables, in turn (the first decoded whole, each after it
+/// read and composited in row bands into the sum, `bands.rs`; the frame's memory limit
+/// held per group; the mask decoded once), and the sum written as the
 /// output's beauty, with the transmission file's other channels read after the groups (less
 /// their layers, never decoded). With
 /// `keep_groups` (EXR output only) each group's composite is also written, as a layer of the
@@ -182,6 +183,27 @@ pub fn compose_light_groups_within(
     budget: &MemoryBudget,
     progress: &dyn glassdb_io::Progress,
 ) -> Result<FrameReport, ComposeError> {
+    let bands = crate::bands::BAND_ROWS;
+    compose_groups_banded(
+        job,
+        settings,
+        (groups, bands),
+        keep_groups,
+        budget,
+        progress,
+    )
+}
+
+/// [`compose_light_groups_within`] of `groups`, those after the first composited `band_rows`
+/// rows at a time.
+pub(crate) fn compose_groups_banded(
+    job: &ComposeJob,
+    settings: &ComposeSettings,
+    (groups, band_rows): (&[LightGroup], usize),
+    keep_groups: bool,
+    budget: &MemoryBudget,
+    progress: &dyn glassdb_io::Progress,
+) -> Result<FrameReport, ComposeError> {
     let names: Vec<&str> = groups.iter().map(|g| g.name.as_str()).collect();
     if keep_groups && glassdb_encode::output_format(&job.output)? != OutputFormat::Exr {
         return Err(ComposeError::KeepGroupsNotExr {
@@ -204,33 +226,48 @@ pub fn compose_light_groups_within(
         carry: Carry::NONE,
         ..target.clone()
     };
-    for (k, (group, group_passes)) in groups.iter().zip(&passes).enumerate() {
+    for (group, group_passes) in groups.iter().zip(&passes) {
         let mut one = settings.clone();
         one.decode.layers = group_passes.layers.clone();
+        let job = group_passes.pane_group_job(job);
+        let layer = || group_passes.layers.trans.clone().unwrap_or_default();
+        if let Some(total) = &mut sum {
+            // the groups after the first: read and composited in row bands into the sum
+            progress.stage(crate::FRAME_STAGES[0]);
+            let plan =
+                crate::plan::plan_frame(&job.inputs, &one.decode, &group.luts, budget, &rest)?;
+            progress.stage(crate::FRAME_STAGES[1]);
+            let added = crate::bands::add_in_bands(
+                &job.inputs,
+                &one,
+                plan,
+                &mask_slot,
+                total,
+                keep_groups,
+                band_rows,
+            )?;
+            timings.decode += added.timings.decode;
+            timings.compose += added.timings.compose;
+            kept.extend(added.own.map(|rgb| (layer(), rgb)));
+            continue;
+        }
+        // the first group: decoded and composited whole, as a frame of one group
         let read = crate::SharedRead {
-            carry: if k == 0 && !carry_after {
-                target.carry
-            } else {
+            carry: if carry_after {
                 Carry::NONE
+            } else {
+                target.carry
             },
             mask,
         };
-        let (composited, t) = crate::decode_and_composite(
-            &group_passes.pane_group_job(job),
-            &one,
-            if k == 0 { &target } else { &rest },
-            &group.luts,
-            budget,
-            read,
-            progress,
-        )?;
+        let (composited, t) =
+            crate::decode_and_composite(&job, &one, &target, &group.luts, budget, read, progress)?;
         timings.decode += t.decode;
         timings.compose += t.compose;
         if keep_groups {
-            let layer = group_passes.layers.trans.clone().unwrap_or_default();
-            kept.push((layer, composited.image.trans.image.rgb.clone()));
+            kept.push((layer(), composited.image.trans.image.rgb.clone()));
         }
-        add_to_sum(&mut sum, composited);
+        sum = Some(composited);
     }
     drop(mask_slot);
     let mut total = sum.ok_or_else(|| ComposeError::LightGroupList("none named".into()))?;
@@ -279,23 +316,18 @@ fn in_layers(name: &str, layers: &[String]) -> bool {
     })
 }
 
-/// Adds a composite of the frame to the sum of those before it (the first is the sum, with what
-/// its output carries).
-pub(crate) fn add_to_sum(sum: &mut Option<Composited>, composited: Composited) {
-    match sum {
-        None => *sum = Some(composited),
-        Some(total) => add_group_composite(
-            &mut total.image.trans.image.rgb,
-            &composited.image.trans.image.rgb,
-        ),
-    }
-}
-
 /// `total += add`, plane by plane, in f32: the sum of the groups' composites, the next group
 /// added to the groups before it (the file and in-memory composites alike, so that they agree
 /// bit for bit).
 pub(crate) fn add_group_composite(total: &mut [Vec<f32>; 3], add: &[Vec<f32>; 3]) {
-    for (t, a) in total.iter_mut().zip(add) {
+    let [r, g, b] = total;
+    add_planes([r, g, b], [&add[0], &add[1], &add[2]]);
+}
+
+/// `total += add`, plane by plane, in f32, over planes or the rows of a band of them
+/// ([`crate::bands`]): every sum of groups is made by this one addition.
+pub(crate) fn add_planes(total: [&mut [f32]; 3], add: [&[f32]; 3]) {
+    for (t, a) in total.into_iter().zip(add) {
         for (t, a) in t.iter_mut().zip(a) {
             *t += a;
         }

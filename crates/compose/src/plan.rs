@@ -86,6 +86,8 @@ pub(crate) struct FramePlan<'a> {
     pub(crate) lut: &'a GlassLut,
     /// The frame's display window (the transmission pass's), where a PNG mask is placed.
     pub(crate) display: glassdb_image::PixelWindow,
+    /// The transmission pass's windows as its header states them (the frame).
+    pub(crate) trans_windows: ImageWindows,
     /// Each reflection pass's windows in the frame as its file stores them (decoding may keep
     /// only the rows its plane's glass needs).
     pub(crate) refl_windows: Vec<ImageWindows>,
@@ -157,6 +159,7 @@ pub(crate) fn plan_frame<'a>(
         table,
         lut,
         display,
+        trans_windows: trans.windows,
         refl_windows,
         memory,
         reservation,

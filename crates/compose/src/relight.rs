@@ -15,11 +15,10 @@ use glassdb_pass::{Carry, LightMix};
 use glassdb_registry::Registry;
 use glassdb_side::Side;
 
+use crate::bands::add_in_bands;
 use crate::colour::RegistryLuts;
 use crate::composite::Composited;
-use crate::light_groups::{
-    GroupPasses, add_to_sum, carry_groups, group_passes, read_carried_after_groups,
-};
+use crate::light_groups::{GroupPasses, carry_groups, group_passes, read_carried_after_groups};
 use crate::light_parts::{LightPart, LightParts, LightSource};
 use crate::lut::{FINE_STEPS, GlassLut};
 use crate::memory::MemoryBudget;
@@ -366,14 +365,22 @@ pub fn compose_light_parts(
         } else {
             Carry::NONE
         };
+        if let Some(total) = &mut sum {
+            // the lights after the first: read and composited in row bands into the sum
+            progress.stage(composite_stage);
+            let band_rows = crate::bands::BAND_ROWS;
+            let t = add_in_bands(&job.inputs, &one, plan, &mask_slot, total, false, band_rows)?;
+            timings.decode += t0.elapsed() - t.timings.compose;
+            timings.compose += t.timings.compose;
+            continue;
+        }
         let frame =
             crate::decode::decode_planned(&job.inputs, &one.decode, plan, carry, mask_once)?;
         timings.decode += t0.elapsed();
         progress.stage(composite_stage);
         let t1 = Instant::now();
-        let composited = crate::composite::composite(frame, &one, mask_once)?;
+        sum = Some(crate::composite::composite(frame, &one, mask_once)?);
         timings.compose += t1.elapsed();
-        add_to_sum(&mut sum, composited);
     }
     drop(mask_slot);
     let mut total = sum.ok_or_else(|| ComposeError::LightPartsRecord {

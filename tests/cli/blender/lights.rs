@@ -8,8 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use super::{blender_program, channel, copy_dir, json, make_glassdb_scene};
-use crate::util::{Planes, fails_naming, glassdb, ok, read_exr_planes, registry_build, repo_path};
+use super::{background_blender, channel, copy_dir, json, make_glassdb_scene, render_test_glasses};
+use crate::util::{
+    Planes, element_where, fails_naming, glassdb, json_rgb, max_abs_diff, ok, read_exr_planes,
+    registry_build, repo_path,
+};
 
 struct GroupRuns {
     _dir: tempfile::TempDir,
@@ -28,20 +31,13 @@ struct GroupRuns {
 
 /// `make_light_groups_scene.py` run on `relit`, saved as `out`, with `extra` options.
 fn make_groups_scene(relit: &Path, out: &Path, extra: &[&str]) {
-    let made = Command::new(blender_program())
-        .args(["-b", "-noaudio"])
-        .arg(relit)
-        .args(["--python-exit-code", "1", "-P"])
-        .arg(repo_path("scripts/blender/make_light_groups_scene.py"))
-        .args(["--", "--out"])
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        made.status.success(),
-        "{}",
-        String::from_utf8_lossy(&made.stderr)
+    ok(
+        background_blender(&["-noaudio".as_ref(), relit.as_os_str()])
+            .arg("-P")
+            .arg(repo_path("scripts/blender/make_light_groups_scene.py"))
+            .args(["--", "--out"])
+            .arg(out)
+            .args(extra),
     );
 }
 
@@ -52,18 +48,8 @@ fn render(blend: &Path, out: &Path, extra: &[&str]) -> Command {
 
 /// `glassdb blender render BLEND` of frame 2 at `(WxH, samples)`, one thread, seed 0.
 fn render_at(blend: &Path, out: &Path, (size, samples): (&str, &str), extra: &[&str]) -> Command {
-    let mut cmd = glassdb();
-    cmd.args(["blender", "render"])
-        .arg(blend)
-        .args([
-            "--glass",
-            "Glass_clear=1",
-            "--glass",
-            "Tinted*=5",
-            "--out-dir",
-        ])
-        .arg(out)
-        .args(["--frames", "2", "--resolution", size, "--samples", samples])
+    let mut cmd = render_test_glasses(blend, out);
+    cmd.args(["--frames", "2", "--resolution", size, "--samples", samples])
         .args(["--threads", "1", "--seed", "0"])
         .args(extra);
     cmd
@@ -80,9 +66,8 @@ fn group_runs() -> &'static GroupRuns {
         make_glassdb_scene("relit", &relit, &[]);
         let groups = root.join("groups.blend");
         make_groups_scene(&relit, &groups, &[]);
-        let catalog = repo_path("data/catalog.toml");
         let two = root.join("two.json");
-        ok(&mut registry_build(&catalog, &two, &LIGHTS));
+        bundled_registry_under(&two, &LIGHTS);
         // `warm` says A but holds the sun's (D65) numbers: compositing with it is the one-table
         // composite exactly when each group takes its own light's table.
         let mut reg = json(&two);
@@ -109,6 +94,16 @@ fn group_runs() -> &'static GroupRuns {
             same,
         }
     })
+}
+
+/// The bundled catalog's registry built into `out` with the `--light NAME=ILLUMINANT` options
+/// `lights`.
+fn bundled_registry_under(out: &Path, lights: &[&str]) {
+    ok(&mut registry_build(
+        &repo_path("data/catalog.toml"),
+        out,
+        lights,
+    ));
 }
 
 fn frame2(dir: &Path, stem: &str) -> Planes {
@@ -256,19 +251,12 @@ fn compose(dir: &Path, registry: &Path) -> Command {
 /// Each glass's t0 in the registry `path` under light `light`.
 fn t0(path: &Path, light: &str, id: u64) -> [f64; 3] {
     let reg = json(path);
-    let table = reg["tables"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|t| t["light"] == light)
-        .unwrap();
-    let g = table["glasses"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|g| g["id"] == id)
-        .unwrap();
-    [0, 1, 2].map(|c| g["t0"][c].as_f64().unwrap())
+    let g = element_where(
+        &element_where(&reg["tables"], "light", light)["glasses"],
+        "id",
+        id,
+    );
+    json_rgb(&g["t0"])
 }
 
 /// Each group composites with its light's table: the one-light registry (the bundled D65 one)
@@ -293,9 +281,8 @@ fn each_light_group_composites_with_its_lights_table() {
         let (_, two) = recompose(run, &format!("{tag}_two"), &r.two);
         for c in ["R", "G", "B"] {
             let (a, b) = (channel(&one_table, c), channel(&same, c));
-            let worst = (0..a.len())
-                .map(|i| (a[i] - b[i]).abs())
-                .fold(0.0, f64::max);
+            assert_eq!(a.len(), b.len(), "{tag} {c}");
+            let worst = max_abs_diff(a, b);
             assert!(
                 worst < 1e-3,
                 "{tag} {c}: one table vs warm with D65's numbers: {worst}"
@@ -348,12 +335,7 @@ fn bad_light_groups_are_refused_by_name() {
         &["no light group `sun`", "has no light groups"],
     );
     let led = tmp.path().join("led.json");
-    let lights = ["--light", "sun=D65", "--light", "led=LED-B3"];
-    ok(&mut registry_build(
-        &repo_path("data/catalog.toml"),
-        &led,
-        &lights,
-    ));
+    bundled_registry_under(&led, &["--light", "sun=D65", "--light", "led=LED-B3"]);
     fails_naming(
         &mut render(
             &r.groups,
@@ -368,12 +350,7 @@ fn bad_light_groups_are_refused_by_name() {
     copy_dir(&r.split, &copy);
     fails_naming(&mut compose(&copy, &led), &["`warm`", "led.json"]);
     let d50 = tmp.path().join("d50.json");
-    let lights = ["--light", "sun=D65", "--light", "warm=D50"];
-    ok(&mut registry_build(
-        &repo_path("data/catalog.toml"),
-        &d50,
-        &lights,
-    ));
+    bundled_registry_under(&d50, &["--light", "sun=D65", "--light", "warm=D50"]);
     fails_naming(
         &mut compose(&copy, &d50),
         &["`warm` was rendered as A", "d50.json", "warm (D50)"],

@@ -6,9 +6,11 @@
 //! … stores no plane per pixel, but 2 reflection passes were given".
 
 use std::path::Path;
-use std::process::Command;
 
-use super::{assert_within_noise, blender_program, channel, copy_dir, json, make_glassdb_scene};
+use super::{
+    assert_within_noise, background_blender, channel, copy_dir, json, make_glassdb_scene,
+    render_test_glasses,
+};
 use crate::util::{glassdb, ok, read_exr_planes};
 
 /// Moves the camera of the tiny scene `blend` (saved in place): frame 2 close in front of the
@@ -29,34 +31,24 @@ for frame, eye, target in ((2, (-0.5, -1.0, 1.0), (-0.5, 1.0, 1.0)),
 scene.frame_end = 3
 bpy.ops.wm.save_mainfile()
 ";
-    let moved = Command::new(blender_program())
-        .args(["-b", "--factory-startup", "-noaudio"])
-        .arg(blend)
-        .args(["--python-exit-code", "1", "--python-expr", script])
-        .output()
-        .unwrap();
-    assert!(
-        moved.status.success(),
-        "moving the camera: {}",
-        String::from_utf8_lossy(&moved.stderr)
-    );
+    ok(background_blender(&[
+        "--factory-startup".as_ref(),
+        "-noaudio".as_ref(),
+        blend.as_os_str(),
+    ])
+    .args(["--python-expr", script]));
 }
 
 /// `glassdb blender render` of `blend` into `out` with the tiny scene's glasses, seed `seed`,
 /// the Cycles reference too, on one thread.
 fn render(blend: &Path, out: &Path, seed: u32) -> String {
-    ok(glassdb()
-        .args(["blender", "render"])
-        .arg(blend)
-        .args([
-            "--glass",
-            "Glass_clear=1",
-            "--glass",
-            "Tinted*=5",
-            "--out-dir",
-        ])
-        .arg(out)
-        .args(["--threads", "1", "--reference", "--seed", &seed.to_string()]))
+    ok(render_test_glasses(blend, out).args([
+        "--threads",
+        "1",
+        "--reference",
+        "--seed",
+        &seed.to_string(),
+    ]))
 }
 
 #[test]
