@@ -8,7 +8,6 @@
 
 pub mod display;
 
-use std::fmt;
 use std::str::FromStr;
 
 pub use display::{CubeError, CubeLut, DisplayView};
@@ -140,41 +139,21 @@ impl RgbSpace {
         RgbSpace::DisplayP3,
         RgbSpace::Xyz,
     ];
-
-    /// The name used on the command line and in JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            RgbSpace::Srgb => "srgb",
-            RgbSpace::Rec2020 => "rec2020",
-            RgbSpace::AcesCg => "acescg",
-            RgbSpace::Aces2065_1 => "aces2065-1",
-            RgbSpace::DisplayP3 => "display-p3",
-            RgbSpace::Xyz => "xyz",
-        }
-    }
 }
 
-impl fmt::Display for RgbSpace {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+glassdb_io::enum_names!(RgbSpace {
+    Srgb => "srgb" | "rec709", Rec2020 => "rec2020", AcesCg => "acescg", Aces2065_1 => "aces2065-1",
+    DisplayP3 => "display-p3", Xyz => "xyz",
+});
 
 impl FromStr for RgbSpace {
     type Err = String;
     /// A [`RgbSpace::name`] or `rec709` (= `srgb`), any case.
     fn from_str(s: &str) -> Result<Self, String> {
-        if s.eq_ignore_ascii_case("rec709") {
-            return Ok(RgbSpace::Srgb);
-        }
-        RgbSpace::ALL
-            .iter()
-            .copied()
-            .find(|r| r.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| {
-                let names: Vec<&str> = RgbSpace::ALL.iter().map(|r| r.name()).collect();
-                format!("unknown value `{s}`; expected one of: {}", names.join(", "))
-            })
+        RgbSpace::from_name(s).ok_or_else(|| {
+            let names: Vec<&str> = RgbSpace::ALL.iter().map(|r| r.name()).collect();
+            format!("unknown value `{s}`; expected one of: {}", names.join(", "))
+        })
     }
 }
 

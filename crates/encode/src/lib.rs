@@ -43,15 +43,16 @@ pub enum OutputFormat {
     Png,
 }
 
+// Each format's name is its file extension.
+glassdb_io::enum_names!(OutputFormat { Exr => "exr", Png => "png" });
+
 /// The output format from the extension (`.exr`, `.png`, any case).
 pub fn output_format(path: &Path) -> Result<OutputFormat, EncodeError> {
-    match glassdb_io::lowercase_extension(path).as_deref() {
-        Some("exr") => Ok(OutputFormat::Exr),
-        Some("png") => Ok(OutputFormat::Png),
-        _ => Err(EncodeError::OutputExtension {
+    glassdb_io::lowercase_extension(path)
+        .and_then(|ext| OutputFormat::from_name(&ext))
+        .ok_or_else(|| EncodeError::OutputExtension {
             path: path.to_path_buf(),
-        }),
-    }
+        })
 }
 
 /// Output encoding settings; `None` fields take defaults from the transmission pass.

@@ -2,8 +2,6 @@
 //! type says its class through a `kind()` method; the binaries choose exit codes and hints by
 //! it, the viewer its HTTP status, a farm report its `kind` field.
 
-use std::fmt;
-
 /// What a user can do about a failure (the taxonomy of exrs and image-rs: invalid,
 /// unsupported, limits, I/O, and glassdb's own bugs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -32,24 +30,15 @@ impl ErrorKind {
         ErrorKind::Io,
         ErrorKind::Internal,
     ];
-
-    /// Its name in reports and JSON: `invalid`, `unsupported`, `limits`, `io`, `internal`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ErrorKind::Invalid => "invalid",
-            ErrorKind::Unsupported => "unsupported",
-            ErrorKind::Limits => "limits",
-            ErrorKind::Io => "io",
-            ErrorKind::Internal => "internal",
-        }
-    }
 }
 
-impl fmt::Display for ErrorKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+crate::enum_names!(ErrorKind {
+    Invalid => "invalid",
+    Unsupported => "unsupported",
+    Limits => "limits",
+    Io => "io",
+    Internal => "internal",
+});
 
 #[cfg(test)]
 mod tests {

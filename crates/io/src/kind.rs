@@ -30,32 +30,28 @@ pub enum FileKind {
 impl FileKind {
     /// The kind of `t` (not following a symbolic link: `t` says what it is).
     pub fn of(t: &FileType) -> FileKind {
-        if t.is_file() {
-            return FileKind::Regular;
-        }
-        if t.is_dir() {
-            return FileKind::Directory;
-        }
-        if t.is_symlink() {
-            return FileKind::Symlink;
-        }
         #[cfg(unix)]
-        {
-            use std::os::unix::fs::FileTypeExt;
-            if t.is_char_device() {
-                return FileKind::CharDevice;
-            }
-            if t.is_block_device() {
-                return FileKind::BlockDevice;
-            }
-            if t.is_fifo() {
-                return FileKind::Fifo;
-            }
-            if t.is_socket() {
-                return FileKind::Socket;
-            }
-        }
-        FileKind::Other
+        use std::os::unix::fs::FileTypeExt;
+        /// A test of a file type and the kind it names.
+        type Test = (fn(&FileType) -> bool, FileKind);
+        // Tested in this order; the first test that holds names the kind.
+        let tests: &[Test] = &[
+            (FileType::is_file, FileKind::Regular),
+            (FileType::is_dir, FileKind::Directory),
+            (FileType::is_symlink, FileKind::Symlink),
+            #[cfg(unix)]
+            (FileType::is_char_device, FileKind::CharDevice),
+            #[cfg(unix)]
+            (FileType::is_block_device, FileKind::BlockDevice),
+            #[cfg(unix)]
+            (FileType::is_fifo, FileKind::Fifo),
+            #[cfg(unix)]
+            (FileType::is_socket, FileKind::Socket),
+        ];
+        tests
+            .iter()
+            .find(|(is, _)| is(t))
+            .map_or(FileKind::Other, |&(_, kind)| kind)
     }
 }
 

@@ -14,6 +14,8 @@
 //! - [`progress`]: the observer through which libraries report the progress of long work.
 //! - [`quoted`]: a value from an input quoted in a message, cut to a bounded length.
 //! - [`sniff`]: binary data handed to a text reader, named from its signature.
+//! - [`enum_names!`]: the names of a small enum (`name()`, `Display`, `from_name`), from one
+//!   table.
 //! - [`ErrorKind`]: the class of every glassdb error (invalid, unsupported, limits, I/O,
 //!   internal), which each library's error type reports through its `kind()`.
 
@@ -24,6 +26,7 @@ mod error_kind;
 pub mod frames;
 pub mod input;
 mod kind;
+mod names;
 pub mod output;
 mod registry;
 pub mod sniff;

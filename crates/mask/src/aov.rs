@@ -5,27 +5,52 @@
 use crate::MaskError;
 use crate::channels::PixelError;
 
-/// cos θ on glass pixels from an |N·I| AOV (divided by the glass coverage when the AOV is
-/// written by glass only).
-pub(crate) fn cos_from_aov(
-    aov: &[f32],
-    id: &[u16],
-    channel: &str,
-    divide: &impl Fn(f32, usize) -> f32,
-    pixel: &PixelError<'_>,
-) -> Result<Vec<f32>, MaskError> {
-    on_glass(id, |i| {
-        let v = divide(aov[i], i);
-        if !(v.is_finite() && (-1e-3..=1.0 + 1e-2).contains(&v)) {
-            return Err(pixel.at(
-                i,
-                format!(
+/// The glass pixels of a frame as its AOVs are read: their ids, how an AOV's value is divided
+/// by the glass coverage (when the AOV is written by glass only), and how an error names a
+/// pixel.
+pub(crate) struct GlassAovs<'a, D> {
+    pub(crate) id: &'a [u16],
+    pub(crate) divide: D,
+    pub(crate) pixel: &'a PixelError<'a>,
+}
+
+impl<D: Fn(f32, usize) -> f32> GlassAovs<'_, D> {
+    /// cos θ on glass pixels from an |N·I| AOV.
+    pub(crate) fn cos(&self, aov: &[f32], channel: &str) -> Result<Vec<f32>, MaskError> {
+        self.on_glass(aov, |v| {
+            if !(v.is_finite() && (-1e-3..=1.0 + 1e-2).contains(&v)) {
+                return Err(format!(
                     "cos θ {v} from AOV {channel:?} is not in [0, 1] (is the AOV |N·I|, and written by the materials the options say: the glass only, or every material?)"
-                ),
-            ));
-        }
-        Ok(v.clamp(0.0, 1.0))
-    })
+                ));
+            }
+            Ok(v.clamp(0.0, 1.0))
+        })
+    }
+
+    /// Plane indices on glass pixels from a plane AOV, rounded.
+    pub(crate) fn planes(&self, aov: &[f32], name: &str) -> Result<Vec<u16>, MaskError> {
+        self.on_glass(aov, |v| {
+            let r = v.round();
+            if !(0.0..=65535.0).contains(&r) {
+                return Err(format!(
+                    "plane {v} from AOV {name:?} is not an index in 0–65535"
+                ));
+            }
+            Ok(r as u16)
+        })
+    }
+
+    /// `convert` of each glass pixel's divided AOV value, zero elsewhere; the first value it
+    /// refuses is an error naming the pixel.
+    fn on_glass<T: Copy + Default>(
+        &self,
+        aov: &[f32],
+        convert: impl Fn(f32) -> Result<T, String>,
+    ) -> Result<Vec<T>, MaskError> {
+        on_glass(self.id, |i| {
+            convert((self.divide)(aov[i], i)).map_err(|message| self.pixel.at(i, message))
+        })
+    }
 }
 
 /// cos θ on glass pixels from world-space Normal (planes 0–2) and Position (planes 3–5) passes
@@ -48,27 +73,6 @@ pub(crate) fn cos_from_geometry(
         }
         let dot = nrm[0] * v[0] + nrm[1] * v[1] + nrm[2] * v[2];
         Ok((dot.abs() / (ln * lv)).clamp(0.0, 1.0) as f32)
-    })
-}
-
-/// Plane indices on glass pixels from a plane AOV, rounded.
-pub(crate) fn planes_from_aov(
-    aov: &[f32],
-    id: &[u16],
-    name: &str,
-    divide: &impl Fn(f32, usize) -> f32,
-    pixel: &PixelError<'_>,
-) -> Result<Vec<u16>, MaskError> {
-    on_glass(id, |i| {
-        let v = divide(aov[i], i);
-        let r = v.round();
-        if !(0.0..=65535.0).contains(&r) {
-            return Err(pixel.at(
-                i,
-                format!("plane {v} from AOV {name:?} is not an index in 0–65535"),
-            ));
-        }
-        Ok(r as u16)
     })
 }
 

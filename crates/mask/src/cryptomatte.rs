@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use glassdb_image::{ExrFile, ExrHeaders, ExrPart, ImageWindows, ReadMemory};
 
-use crate::aov::{cos_from_aov, cos_from_geometry, planes_from_aov, planes_from_geometry};
+use crate::aov::{GlassAovs, cos_from_geometry, planes_from_geometry};
 use crate::channels::{MaskHeader, PixelError, decode_channels, locate_channel, plan_channels};
 use crate::{CosTheta, GlassNames, MaskError, MaskImage, PlacedMask};
 
@@ -434,15 +434,16 @@ pub(crate) fn decode_cryptomatte(
         width: windows.data.width,
     };
     let glass = dominant_glass(ranks_data, &glass_of, &names_of, &pixel)?;
-    let divide = |v: f32, i: usize| match opts.weighting {
-        AovWeighting::GlassOnly if glass.total[i] > 0.0 => v / glass.total[i],
-        _ => v,
+    let aovs = GlassAovs {
+        id: &glass.id,
+        divide: |v: f32, i: usize| match opts.weighting {
+            AovWeighting::GlassOnly if glass.total[i] > 0.0 => v / glass.total[i],
+            _ => v,
+        },
+        pixel: &pixel,
     };
     let (cos, after_cos) = match &opts.cos {
-        CosSource::Aov { channel } => (
-            cos_from_aov(&rest[0], &glass.id, channel, &divide, &pixel)?,
-            &rest[1..],
-        ),
+        CosSource::Aov { channel } => (aovs.cos(&rest[0], channel)?, &rest[1..]),
         CosSource::Geometry { camera_origin, .. } => (
             cos_from_geometry(&rest[..6], &glass.id, *camera_origin, &pixel)?,
             &rest[6..],
@@ -450,7 +451,7 @@ pub(crate) fn decode_cryptomatte(
     };
     let plane = match &opts.planes {
         PlaneSource::Single => vec![0; glass.id.len()],
-        PlaneSource::Aov(name) => planes_from_aov(&after_cos[0], &glass.id, name, &divide, &pixel)?,
+        PlaneSource::Aov(name) => aovs.planes(&after_cos[0], name)?,
         PlaneSource::Geometry {
             equations,
             max_angle_deg,

@@ -22,16 +22,17 @@ pub enum ImageFormat {
     Svg,
 }
 
+// Each format's name is its file extension.
+glassdb_io::enum_names!(ImageFormat { Png => "png", Svg => "svg" });
+
 impl ImageFormat {
     /// The format named by `path`'s extension (case-insensitive `png` or `svg`).
     pub fn from_path(path: &Path) -> Result<Self, PlotError> {
-        match glassdb_io::lowercase_extension(path).as_deref() {
-            Some("png") => Ok(Self::Png),
-            Some("svg") => Ok(Self::Svg),
-            _ => Err(PlotError::UnknownFormat {
+        glassdb_io::lowercase_extension(path)
+            .and_then(|ext| Self::from_name(&ext))
+            .ok_or_else(|| PlotError::UnknownFormat {
                 path: path.to_path_buf(),
-            }),
-        }
+            })
     }
 }
 

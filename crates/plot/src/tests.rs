@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use glassdb_fit::{Basis, CosPolynomial, FitSummary};
-use glassdb_mask::{CosTheta, MaskImage};
+use glassdb_mask::MaskImage;
 use glassdb_registry::{AngleCurve, GlassRecord, Registry, RegistryTable};
 use glassdb_spectral::{IntegrationSettings, Method};
 
@@ -189,15 +189,9 @@ fn linear_registry() -> Registry {
 #[test]
 fn mask_values_follow_the_registry_per_pixel() {
     let reg = linear_registry();
-    // Pixels: no glass; glass 3 at cos 255/255; at cos 51/255 = 0.2; on plane 1 (back face).
-    let mask = MaskImage {
-        width: 4,
-        height: 1,
-        id: vec![0, 3, 3, 3],
-        cos_theta: CosTheta::Quantized8(vec![0, 255, 51, 51]),
-        plane: vec![0, 0, 0, 1],
-        coverage: None,
-    };
+    // Pixels (plane, id, cos code): no glass; glass 3 at cos 255/255; at cos 51/255 = 0.2;
+    // on plane 1 (back face).
+    let mask = MaskImage::from_packed8(4, 1, 3, &[0, 0, 0, 0, 3, 255, 0, 3, 51, 1, 3, 51]);
     let opts = MaskPlotOptions {
         back_planes: vec![1],
         ..MaskPlotOptions::default()

@@ -120,7 +120,11 @@ pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Regist
         path: catalog_path.display().to_string(),
         sha256: catalog_sha,
     };
-    let files = CatalogFiles { catalog_path };
+    let ctx = BuildContext {
+        files: CatalogFiles { catalog_path },
+        integrators: &integrators,
+        opts,
+    };
     let chosen: Vec<&GlassSpec> = specs
         .iter()
         .filter(|spec| wanted.as_ref().is_none_or(|w| w.contains(&spec.id)))
@@ -129,7 +133,7 @@ pub fn build_registry(catalog_path: &Path, opts: &BuildOptions) -> Result<Regist
     // one reported, whichever thread met it.
     let built: Vec<Result<Vec<GlassRecord>, RegistryError>> = chosen
         .par_iter()
-        .map(|spec| build_entry(spec, &files, &integrators, opts))
+        .map(|spec| build_entry(spec, &ctx))
         .collect();
     for records in built {
         for (table, mut g) in tables.iter_mut().zip(records?) {
@@ -182,18 +186,22 @@ pub(crate) fn integrators_of(
     Ok((tables, integrators))
 }
 
+/// What every glass of one build shares: the catalog's files, one integrator per table and
+/// the options.
+pub(crate) struct BuildContext<'a> {
+    pub(crate) files: CatalogFiles<'a>,
+    pub(crate) integrators: &'a [Integrator],
+    pub(crate) opts: &'a BuildOptions,
+}
+
 /// One catalog entry's record in each table (one per integrator).
 pub(crate) fn build_entry(
     spec: &GlassSpec,
-    files: &CatalogFiles<'_>,
-    integrators: &[Integrator],
-    opts: &BuildOptions,
+    ctx: &BuildContext<'_>,
 ) -> Result<Vec<GlassRecord>, RegistryError> {
     match &spec.build {
-        GlassBuild::Single(layer) => build_glass(spec, layer, files, integrators, opts),
-        GlassBuild::Unit(elements) => {
-            crate::unit::build_unit(spec, elements, files, integrators, opts)
-        }
+        GlassBuild::Single(layer) => build_glass(spec, layer, ctx),
+        GlassBuild::Unit(elements) => crate::unit::build_unit(spec, elements, ctx),
     }
 }
 
@@ -238,10 +246,9 @@ fn wanted_ids(
 pub(crate) fn build_glass(
     spec: &GlassSpec,
     layer_spec: &LayerSpec,
-    files: &CatalogFiles<'_>,
-    integrators: &[Integrator],
-    opts: &BuildOptions,
+    ctx: &BuildContext<'_>,
 ) -> Result<Vec<GlassRecord>, RegistryError> {
+    let (files, integrators, opts) = (&ctx.files, ctx.integrators, ctx.opts);
     let glass = format!("{} (\"{}\")", spec.id, spec.name);
     let mut read = read_layer(layer_spec, files, &glass)?;
     read.layer.flipped = false;

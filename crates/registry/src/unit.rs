@@ -12,7 +12,7 @@ use glassdb_stack::{
 };
 
 use crate::angle_model::{ModelTables, integration_error, read_measured_table};
-use crate::build::{BuildOptions, build_glass, glass_record, oriented};
+use crate::build::{BuildContext, BuildOptions, build_glass, glass_record, oriented};
 use crate::catalog::{ElementSpec, GlassSpec, LayerSpec, NormalSource};
 use crate::catalog_files::CatalogFiles;
 use crate::curves::{fit_glass_curves, fit_share_curves};
@@ -170,14 +170,13 @@ fn broadband_model(layer: &Layer) -> Result<(Vec<f64>, Vec<f64>), StackError> {
 pub(crate) fn build_unit(
     spec: &GlassSpec,
     elements: &[ElementSpec],
-    files: &CatalogFiles<'_>,
-    integrators: &[Integrator],
-    opts: &BuildOptions,
+    ctx: &BuildContext<'_>,
 ) -> Result<Vec<GlassRecord>, RegistryError> {
+    let (files, integrators, opts) = (&ctx.files, ctx.integrators, ctx.opts);
     let unit = UnitBuild::read(spec, elements, files, opts)?;
     if unit.layers.len() == 1 {
         let (_, l, unit_layer) = &unit.layers[0];
-        return one_layer_unit(spec, l, unit_layer, &unit.stack, files, integrators, opts);
+        return one_layer_unit(spec, l, unit_layer, &unit.stack, ctx);
     }
     let angles = model_angles_deg();
     let eval_opts = EvalOptions {
@@ -517,10 +516,9 @@ fn one_layer_unit(
     layer_spec: &LayerSpec,
     unit_layer: &UnitLayer,
     stack: &Stack,
-    files: &CatalogFiles<'_>,
-    integrators: &[Integrator],
-    opts: &BuildOptions,
+    ctx: &BuildContext<'_>,
 ) -> Result<Vec<GlassRecord>, RegistryError> {
+    let integrators = ctx.integrators;
     let mut single = layer_spec.clone();
     if let NormalSource::AngleTable = single.normal {
         let LayerData::Spectral { t, rf, rb, .. } = &unit_layer.read.layer.data else {
@@ -533,7 +531,7 @@ fn one_layer_unit(
         };
     }
     let glass = format!("{} (\"{}\")", spec.id, spec.name);
-    let mut records = build_glass(spec, &single, files, integrators, opts)?;
+    let mut records = build_glass(spec, &single, ctx)?;
     let group = &stack.groups()[0];
     for (record, integrator) in records.iter_mut().zip(integrators) {
         let layer = layer_record(

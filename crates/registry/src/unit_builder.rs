@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use glassdb_spectral::Integrator;
 use glassdb_stack::Gas;
 
-use crate::build::{BuildOptions, integrators_of, load_catalog};
+use crate::build::{BuildContext, BuildOptions, integrators_of, load_catalog};
 use crate::catalog::{ElementSpec, GlassBuild, GlassSpec};
 use crate::catalog_files::CatalogFiles;
 use crate::unit::build_unit;
@@ -122,19 +122,21 @@ impl UnitBuilder {
             line: 0,
             build: GlassBuild::Unit(elements.clone()),
         };
-        let files = CatalogFiles {
-            catalog_path: &self.catalog_path,
-        };
-        let records = build_unit(&spec, &elements, &files, &self.integrators, &self.opts).map_err(
-            |e| match e {
-                RegistryError::Unit { glass, source, .. } => RegistryError::UnitChoice {
-                    path: self.catalog_path.clone(),
-                    glass,
-                    source,
-                },
-                other => other,
+        let ctx = BuildContext {
+            files: CatalogFiles {
+                catalog_path: &self.catalog_path,
             },
-        )?;
+            integrators: &self.integrators,
+            opts: &self.opts,
+        };
+        let records = build_unit(&spec, &elements, &ctx).map_err(|e| match e {
+            RegistryError::Unit { glass, source, .. } => RegistryError::UnitChoice {
+                path: self.catalog_path.clone(),
+                glass,
+                source,
+            },
+            other => other,
+        })?;
         let tables = self
             .tables
             .iter()

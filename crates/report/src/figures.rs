@@ -25,8 +25,10 @@ use crate::spectral::spectral_methods;
 use crate::text::shown;
 use crate::{ReportError, ReportOptions, SpectrumFigure};
 
-/// Where the figures go and what has been staged.
+/// Where the figures go, what has been staged, and the page that links them.
 struct FigureSink<'a> {
+    /// The page's text.
+    md: &'a mut String,
     dir: &'a Path,
     /// How the page links the directory.
     link: &'a str,
@@ -36,19 +38,13 @@ struct FigureSink<'a> {
 
 impl FigureSink<'_> {
     /// Stages a figure for the figures directory and links it from the page.
-    fn add<F: Figure>(
-        &mut self,
-        md: &mut String,
-        file: &str,
-        caption: &str,
-        fig: &F,
-    ) -> Result<(), ReportError> {
+    fn add<F: Figure>(&mut self, file: &str, caption: &str, fig: &F) -> Result<(), ReportError> {
         let path = self.dir.join(file);
         let (bytes, _) = glassdb_plot::render_for(fig, &path)?;
         self.staged.write_bytes(&path, &bytes)?;
         let kb = bytes.len() / 1024;
         let _ = writeln!(
-            md,
+            self.md,
             "![{caption}]({}/{file})\n\n*{caption}* ({kb} KB)\n",
             self.link
         );
@@ -69,38 +65,35 @@ pub(crate) fn section_figures(
         path: dir.into(),
         source,
     })?;
-    let mut sink = FigureSink {
-        dir,
-        link: &opts.figures_link,
-        staged,
-    };
     let _ = writeln!(md, "## Figures\n");
     let _ = writeln!(
         md,
         "Drawn by the same code as `glassdb plot` (the command for each is given with its caption).\n"
     );
-    fit_figures(md, opts, &mut sink)?;
+    let mut sink = FigureSink {
+        md,
+        dir,
+        link: &opts.figures_link,
+        staged,
+    };
+    fit_figures(opts, &mut sink)?;
     if let Some(spectrum) = opts
         .spectrum_figure
         .as_ref()
         .filter(|s| s.spectrum.exists())
     {
-        spectral_figures(md, opts, spectrum, &mut sink)?;
+        spectral_figures(opts, spectrum, &mut sink)?;
     }
-    registry_figure(md, opts, &mut sink)?;
+    registry_figure(opts, &mut sink)?;
     if let Some(sm) = scene_mask {
-        mask_figure(md, sm, &mut sink)?;
+        mask_figure(sm, &mut sink)?;
     }
-    cos_storage_figure(md, refs, &mut sink)?;
+    cos_storage_figure(refs, &mut sink)?;
     Ok(())
 }
 
 /// One fit figure per angle table: measured points, default fit and paper basis.
-fn fit_figures(
-    md: &mut String,
-    opts: &ReportOptions,
-    sink: &mut FigureSink<'_>,
-) -> Result<(), ReportError> {
+fn fit_figures(opts: &ReportOptions, sink: &mut FigureSink<'_>) -> Result<(), ReportError> {
     for table in &opts.angle_tables {
         let stem = table
             .file_stem()
@@ -114,7 +107,6 @@ fn fit_figures(
             },
         )?;
         sink.add(
-            md,
             &format!("fit_{stem}.png"),
             &format!(
                 "`glassdb plot fit {} --compare-paper`: measured (exact) points, default fit (solid) and paper basis (dashed), residuals below",
@@ -128,7 +120,6 @@ fn fit_figures(
 
 /// The spectrum integrated by the paper method and by the colorimetric default.
 fn spectral_figures(
-    md: &mut String,
     opts: &ReportOptions,
     spectrum: &SpectrumFigure,
     sink: &mut FigureSink<'_>,
@@ -156,7 +147,6 @@ fn spectral_figures(
             },
         )?;
         sink.add(
-            md,
             &format!("spectral_{}_{tag}.png", spectrum.name),
             &format!(
                 "`glassdb plot spectral {} {label}`",
@@ -169,11 +159,7 @@ fn spectral_figures(
 }
 
 /// Curves of a few glasses of the catalog's registry.
-fn registry_figure(
-    md: &mut String,
-    opts: &ReportOptions,
-    sink: &mut FigureSink<'_>,
-) -> Result<(), ReportError> {
+fn registry_figure(opts: &ReportOptions, sink: &mut FigureSink<'_>) -> Result<(), ReportError> {
     let Ok(reg) = build_registry(&opts.catalog, &BuildOptions::default()) else {
         return Ok(());
     };
@@ -192,7 +178,6 @@ fn registry_figure(
     )?;
     let id_args: Vec<String> = ids.iter().map(|i| format!("--id {i}")).collect();
     sink.add(
-        md,
         "registry_default.png",
         &format!(
             "`glassdb plot registry registry.json {}` (registry built from {catalog})",
@@ -203,11 +188,7 @@ fn registry_figure(
 }
 
 /// The reflectance heat map of the Gouraud section's exact mask.
-fn mask_figure(
-    md: &mut String,
-    sm: &SceneMask,
-    sink: &mut FigureSink<'_>,
-) -> Result<(), ReportError> {
+fn mask_figure(sm: &SceneMask, sink: &mut FigureSink<'_>) -> Result<(), ReportError> {
     let fig = mask_figure_of(
         &sm.mask,
         &sm.registry,
@@ -216,7 +197,6 @@ fn mask_figure(
     )?;
     let stem = sm.name.split('.').next().unwrap_or_default();
     sink.add(
-        md,
         &format!("mask_{stem}_reflectance.png"),
         &format!(
             "`glassdb plot mask mask.png --registry registry.json` of the {stem} fixture (mask from `glassdb mask`): reflectance rises towards grazing view"
@@ -226,11 +206,7 @@ fn mask_figure(
 }
 
 /// Reflectance error against angle for each cos θ storage.
-fn cos_storage_figure(
-    md: &mut String,
-    refs: &[Reference],
-    sink: &mut FigureSink<'_>,
-) -> Result<(), ReportError> {
+fn cos_storage_figure(refs: &[Reference], sink: &mut FigureSink<'_>) -> Result<(), ReportError> {
     let fig = GridFigure {
         title: "Reflectance error from storing cos θ".into(),
         subtitle: Some(format!(
@@ -245,7 +221,6 @@ fn cos_storage_figure(
         cell_size: (820, 480),
     };
     sink.add(
-        md,
         "cos_storage_error.png",
         "reflectance error against angle for each cos θ storage (report only)",
         &fig,

@@ -1,28 +1,19 @@
-//! `names!`: the command-line and JSON names of the crate's small enums (name, `ALL`,
-//! `Display`, `FromStr` with aliases, any case); `serde_as_name!`: JSON as that name.
+//! `names!`: the command-line and JSON names of the crate's small enums (`glassdb_io::enum_names!`
+//! with `ALL` and a `FromStr` with aliases, any case); `serde_as_name!`: JSON as that name.
 
 macro_rules! names {
-    ($ty:ty { $($variant:ident => $name:literal $(| $alias:literal)*),+ $(,)? }) => {
+    ($ty:ident { $($variant:ident => $name:literal $(| $alias:literal)*),+ $(,)? }) => {
+        glassdb_io::enum_names!($ty { $($variant => $name $(| $alias)*),+ });
         impl $ty {
-            /// The name used on the command line and in JSON.
-            pub fn name(self) -> &'static str {
-                match self { $(<$ty>::$variant => $name),+ }
-            }
             /// Every value, for help texts.
             pub const ALL: &'static [$ty] = &[$(<$ty>::$variant),+];
-        }
-        impl ::std::fmt::Display for $ty {
-            fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
-                f.write_str(self.name())
-            }
         }
         impl ::std::str::FromStr for $ty {
             type Err = String;
             fn from_str(s: &str) -> Result<Self, String> {
-                $(if s.eq_ignore_ascii_case($name) $(|| s.eq_ignore_ascii_case($alias))* {
-                    return Ok(<$ty>::$variant);
-                })+
-                Err(format!("unknown value `{s}`; expected one of: {}", [$($name),+].join(", ")))
+                Self::from_name(s).ok_or_else(|| {
+                    format!("unknown value `{s}`; expected one of: {}", [$($name),+].join(", "))
+                })
             }
         }
     };

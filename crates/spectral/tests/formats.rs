@@ -41,12 +41,20 @@ fn quantities(d: &SpectralData) -> [&Option<Vec<f64>>; 3] {
     [&d.transmittance, &d.reflectance_front, &d.reflectance_back]
 }
 
+/// The fixture `name`, read, after checking it holds exactly the numbers of the plain Optics
+/// file of the same product (`CLEAR_3.DAT`).
+#[track_caller]
+fn read_as_clear_3(name: &str) -> SpectralData {
+    let optics = read("CLEAR_3.DAT");
+    let d = read(name);
+    assert_eq!(d.wavelength_nm, optics.wavelength_nm, "{name}");
+    assert_eq!(quantities(&d), quantities(&optics), "{name}");
+    d
+}
+
 #[test]
 fn igsdb_v2_reads_to_exactly_the_optics_files_numbers() {
-    let optics = read("CLEAR_3.DAT");
-    let v2 = read("igsdb_v2_clear_3.json");
-    assert_eq!(v2.wavelength_nm, optics.wavelength_nm);
-    assert_eq!(quantities(&v2), quantities(&optics));
+    let v2 = read_as_clear_3("igsdb_v2_clear_3.json");
     let p = &v2.product;
     assert_eq!(p.format, SpectralFormat::IgsdbJson);
     assert_eq!(p.name.as_deref(), Some("Generic Clear Glass"));
@@ -66,19 +74,13 @@ fn igsdb_v2_reads_to_exactly_the_optics_files_numbers() {
 
 #[test]
 fn optics_with_all_zero_diffuse_columns_reads_its_direct_columns() {
-    let optics = read("CLEAR_3.DAT");
-    let dir_dif = read("CLEAR_3_dir_dif.DAT");
-    assert_eq!(dir_dif.wavelength_nm, optics.wavelength_nm);
-    assert_eq!(quantities(&dir_dif), quantities(&optics));
+    let dir_dif = read_as_clear_3("CLEAR_3_dir_dif.DAT");
     assert_eq!(dir_dif.product.name.as_deref(), Some("Generic Clear Glass"));
 }
 
 #[test]
 fn instrument_csv_exports_read_to_the_plain_csvs_numbers() {
-    let optics = read("CLEAR_3.DAT");
-    let plain = read("CLEAR_3.csv");
-    assert_eq!(plain.wavelength_nm, optics.wavelength_nm);
-    assert_eq!(quantities(&plain), quantities(&optics));
+    let plain = read_as_clear_3("CLEAR_3.csv");
     // (file, has Rb): Cary's layout carries T and R only.
     for (name, has_rb) in [
         ("CLEAR_3_cary.csv", false),

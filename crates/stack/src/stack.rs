@@ -348,6 +348,15 @@ mod tests {
         })
     }
 
+    /// A 4 mm pane, a 10 mm gap, then `layer`.
+    fn behind_a_gap(layer: Layer) -> Result<Stack, StackError> {
+        Stack::new(vec![
+            pane("a", 4.0, 0.8),
+            gap(10.0),
+            Element::Layer(Box::new(layer)),
+        ])
+    }
+
     #[test]
     fn depths_of_6_12_7_6() {
         let s = Stack::new(vec![pane("a", 6.0, 0.8), gap(12.7), pane("b", 6.0, 0.8)]).unwrap();
@@ -418,12 +427,7 @@ mod tests {
         )
         .unwrap();
         b.thickness_mm = Some(3.0);
-        let s = Stack::new(vec![
-            pane("a", 4.0, 0.8),
-            gap(10.0),
-            Element::Layer(Box::new(b.clone())),
-        ])
-        .unwrap();
+        let s = behind_a_gap(b.clone()).unwrap();
         assert_eq!(
             s.grid(),
             &Grid::Wavelengths(vec![350.0, 400.0, 450.0, 500.0, 2500.0])
@@ -432,12 +436,7 @@ mod tests {
             unreachable!()
         };
         *wavelength_nm = vec![2600.0, 2700.0, 2800.0, 3000.0];
-        let e = Stack::new(vec![
-            pane("a", 4.0, 0.8),
-            gap(10.0),
-            Element::Layer(Box::new(b)),
-        ])
-        .unwrap_err();
+        let e = behind_a_gap(b).unwrap_err();
         assert!(
             e.to_string()
                 .contains("layer 3 (b, 2600–3000 nm) does not overlap"),
@@ -451,12 +450,7 @@ mod tests {
             &LayerOptions::default(),
         );
         c.thickness_mm = None;
-        let e = Stack::new(vec![
-            pane("a", 4.0, 0.8),
-            gap(10.0),
-            Element::Layer(Box::new(c)),
-        ])
-        .unwrap_err();
+        let e = behind_a_gap(c).unwrap_err();
         assert!(
             e.to_string().contains("layer 3 (rgb) has no thickness"),
             "{e}"

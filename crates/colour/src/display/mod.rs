@@ -94,23 +94,38 @@ impl Domain {
     }
 }
 
-/// A per-channel 1D table of `len` entries over its domain.
+/// One table of a `.cube` file over its domain: a per-channel 1D table of `size` entries,
+/// or a 3D table of `size³` RGB entries, red index fastest.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Table1d {
+pub(crate) struct DomainTable {
+    pub(crate) size: usize,
     pub(crate) scale: [f32; 3],
     pub(crate) offset: [f32; 3],
-    /// Interleaved R, G, B.
+    /// Interleaved R, G, B (at `r + n·g + n²·b` in a 3D table of edge n).
     pub(crate) values: Vec<f32>,
 }
 
-/// A 3D table of `n³` RGB entries, red index fastest.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Table3d {
-    pub(crate) n: usize,
-    pub(crate) scale: [f32; 3],
-    pub(crate) offset: [f32; 3],
-    /// Interleaved R, G, B at `r + n·g + n²·b`.
-    pub(crate) values: Vec<f32>,
+impl DomainTable {
+    /// The table of `values` with `size` entries (1D) or edge `size` (3D) over `domain`.
+    pub(crate) fn new(size: usize, domain: Domain, values: Vec<f32>) -> DomainTable {
+        let (scale, offset) = domain.scale_offset();
+        DomainTable {
+            size,
+            scale,
+            offset,
+            values,
+        }
+    }
+
+    /// The table as [`CubeLut::apply`] and the viewer's shader read it.
+    fn as_cube_table(&self) -> CubeTable<'_> {
+        CubeTable {
+            size: self.size,
+            scale: self.scale,
+            offset: self.offset,
+            values: &self.values,
+        }
+    }
 }
 
 /// One table of a `.cube` file as [`CubeLut::apply`] reads it.
@@ -133,8 +148,8 @@ pub struct CubeLut {
     pub path: PathBuf,
     /// Its `TITLE`, if any.
     pub title: Option<String>,
-    pub(crate) shaper: Option<Table1d>,
-    pub(crate) cube: Option<Table3d>,
+    pub(crate) shaper: Option<DomainTable>,
+    pub(crate) cube: Option<DomainTable>,
 }
 
 /// Maps `x` (already scaled to the table's unit domain) to a fractional index in `[0, last]`;
@@ -172,39 +187,29 @@ impl CubeLut {
 
     /// The 1D table, if any (the viewer's shader evaluates it as [`CubeLut::apply`]).
     pub fn shaper_table(&self) -> Option<CubeTable<'_>> {
-        self.shaper.as_ref().map(|t| CubeTable {
-            size: t.values.len() / 3,
-            scale: t.scale,
-            offset: t.offset,
-            values: &t.values,
-        })
+        self.shaper.as_ref().map(DomainTable::as_cube_table)
     }
 
     /// The 3D table, if any: `size` is its edge n, `values` its n³ entries, red index fastest.
     pub fn cube_table(&self) -> Option<CubeTable<'_>> {
-        self.cube.as_ref().map(|t| CubeTable {
-            size: t.n,
-            scale: t.scale,
-            offset: t.offset,
-            values: &t.values,
-        })
+        self.cube.as_ref().map(DomainTable::as_cube_table)
     }
 
     /// Edge of the 3D table, if there is one.
     pub fn cube_size(&self) -> Option<usize> {
-        self.cube.as_ref().map(|c| c.n)
+        self.cube.as_ref().map(|c| c.size)
     }
 
     /// Length of the 1D table (the shaper when there is a 3D table too), if there is one.
     pub fn shaper_size(&self) -> Option<usize> {
-        self.shaper.as_ref().map(|s| s.values.len() / 3)
+        self.shaper.as_ref().map(|s| s.size)
     }
 
     /// Applies the 1D table (if any) then the 3D table (if any) to one RGB triple.
     pub fn apply(&self, rgb: [f32; 3]) -> [f32; 3] {
         let mut v = rgb;
         if let Some(t) = &self.shaper {
-            let len = t.values.len() / 3;
+            let len = t.size;
             let last = (len - 1) as f32;
             for (c, x) in v.iter_mut().enumerate() {
                 let f = index(*x * t.scale[c] + t.offset[c], last);
@@ -217,7 +222,7 @@ impl CubeLut {
             }
         }
         if let Some(t) = &self.cube {
-            let n = t.n;
+            let n = t.size;
             let last = (n - 1) as f32;
             let mut lo = [0usize; 3];
             let mut hi = [0usize; 3];

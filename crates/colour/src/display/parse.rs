@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use super::{CubeError, CubeLut, Domain, MAX_CUBE_1D_SIZE, MAX_CUBE_3D_SIZE, Table1d, Table3d};
+use super::{CubeError, CubeLut, Domain, DomainTable, MAX_CUBE_1D_SIZE, MAX_CUBE_3D_SIZE};
 
 /// One non-empty, non-comment line of the file, trimmed, with its 1-based number.
 struct Line<'a> {
@@ -211,25 +211,13 @@ impl CubeHeader {
         };
         let shaper = match self.size1 {
             Some(_) => {
-                let (scale, offset) = domain_from(self.range1)?.scale_offset();
-                Some(Table1d {
-                    scale,
-                    offset,
-                    values: rows.rows1,
-                })
+                let len = rows.rows1.len() / 3;
+                Some(DomainTable::new(len, domain_from(self.range1)?, rows.rows1))
             }
             None => None,
         };
         let cube = match self.size3 {
-            Some(n) => {
-                let (scale, offset) = domain_from(self.range3)?.scale_offset();
-                Some(Table3d {
-                    n,
-                    scale,
-                    offset,
-                    values: rows.rows3,
-                })
-            }
+            Some(n) => Some(DomainTable::new(n, domain_from(self.range3)?, rows.rows3)),
             None => None,
         };
         Ok(CubeLut {

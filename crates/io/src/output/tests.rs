@@ -8,8 +8,7 @@ use crate::ErrorChain;
 #[test]
 fn a_large_file_written_with_syncs_and_a_seek_back_is_exact() {
     use std::io::{Seek, SeekFrom};
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("big.bin");
+    let (dir, [path]) = scratch(["big.bin"]);
     let len = SyncingFile::SYNC_EVERY as usize * 2 + 12_345;
     let expected: Vec<u8> = (0..len).map(|i| (i * 7 % 251) as u8).collect();
     write_atomic(&path, |w| {
@@ -21,6 +20,13 @@ fn a_large_file_written_with_syncs_and_a_seek_back_is_exact() {
     .unwrap();
     assert!(std::fs::read(&path).unwrap() == expected);
     assert_eq!(names(dir.path()), ["big.bin"]);
+}
+
+/// A new temporary directory and the paths of `names` in it (not created).
+fn scratch<const N: usize>(names: [&str; N]) -> (tempfile::TempDir, [PathBuf; N]) {
+    let dir = tempfile::tempdir().unwrap();
+    let paths = names.map(|name| dir.path().join(name));
+    (dir, paths)
 }
 
 /// The names in `dir`, sorted.
@@ -35,8 +41,7 @@ fn names(dir: &Path) -> Vec<String> {
 
 #[test]
 fn failed_producer_leaves_target_untouched() {
-    let dir = tempfile::tempdir().unwrap();
-    let target = dir.path().join("out.txt");
+    let (dir, [target]) = scratch(["out.txt"]);
     std::fs::write(&target, b"old").unwrap();
     let r = write_atomic(&target, |w| {
         w.write_all(b"partial")?;
@@ -75,8 +80,7 @@ fn missing_or_unusable_directory_is_named_and_each_cause_printed_once() {
 
 #[test]
 fn success_replaces_target() {
-    let dir = tempfile::tempdir().unwrap();
-    let target = dir.path().join("out.txt");
+    let (dir, [target]) = scratch(["out.txt"]);
     write_bytes_atomic(&target, b"new").unwrap();
     assert_eq!(std::fs::read(&target).unwrap(), b"new");
     assert_eq!(names(dir.path()), ["out.txt"]);
@@ -86,8 +90,7 @@ fn success_replaces_target() {
 #[test]
 fn new_output_is_not_private_and_replaced_output_keeps_its_mode() {
     use std::os::unix::fs::PermissionsExt;
-    let dir = tempfile::tempdir().unwrap();
-    let fresh = dir.path().join("fresh.txt");
+    let (dir, [fresh]) = scratch(["fresh.txt"]);
     write_bytes_atomic(&fresh, b"x").unwrap();
     let mode = std::fs::metadata(&fresh).unwrap().permissions().mode() & 0o777;
     // Any usual umask (022, 002, 077 aside) leaves the owner read+write; the private
@@ -110,8 +113,7 @@ fn missing_directory_is_an_error_naming_the_path() {
 
 #[test]
 fn output_equal_to_input_is_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let a = dir.path().join("a.exr");
+    let (dir, [a]) = scratch(["a.exr"]);
     std::fs::write(&a, b"x").unwrap();
     let dotted = dir.path().join(".").join("a.exr");
     assert!(same_file_as(&dotted, &[a.as_path()]).is_some());
@@ -167,8 +169,7 @@ fn outputs_that_are_not_regular_files_are_refused_and_kept() {
             .file_type()
             .is_char_device()
     );
-    let dir = tempfile::tempdir().unwrap();
-    let sub = dir.path().join("sub");
+    let (dir, [sub]) = scratch(["sub"]);
     std::fs::create_dir(&sub).unwrap();
     let e = write_bytes_atomic(&sub, b"x").unwrap_err();
     assert!(
@@ -209,8 +210,7 @@ fn outputs_that_are_not_regular_files_are_refused_and_kept() {
 #[cfg(unix)]
 #[test]
 fn a_link_replaced_is_never_followed() {
-    let dir = tempfile::tempdir().unwrap();
-    let outside = dir.path().join("outside.txt");
+    let (dir, [outside]) = scratch(["outside.txt"]);
     std::fs::write(&outside, b"kept").unwrap();
     let inside = dir.path().join("folder");
     std::fs::create_dir(&inside).unwrap();
@@ -242,8 +242,7 @@ fn a_link_replaced_is_never_followed() {
 #[cfg(unix)]
 #[test]
 fn symbolic_links_are_written_through() {
-    let dir = tempfile::tempdir().unwrap();
-    let real = dir.path().join("real.txt");
+    let (dir, [real]) = scratch(["real.txt"]);
     std::fs::write(&real, b"old").unwrap();
     let link = dir.path().join("link.txt");
     std::os::unix::fs::symlink("real.txt", &link).unwrap();
@@ -280,9 +279,7 @@ fn symbolic_links_are_written_through() {
 
 #[test]
 fn staged_outputs_land_together() {
-    let dir = tempfile::tempdir().unwrap();
-    let a = dir.path().join("a.txt");
-    let b = dir.path().join("b.txt");
+    let (dir, [a, b]) = scratch(["a.txt", "b.txt"]);
     std::fs::write(&a, b"old a").unwrap();
     let mut staged = StagedOutput::new();
     staged.write_bytes(&a, b"new a").unwrap();
@@ -301,9 +298,7 @@ fn staged_outputs_land_together() {
 
 #[test]
 fn a_failing_staged_file_leaves_nothing() {
-    let dir = tempfile::tempdir().unwrap();
-    let a = dir.path().join("a.txt");
-    let b = dir.path().join("b");
+    let (dir, [a, b]) = scratch(["a.txt", "b"]);
     std::fs::create_dir(&b).unwrap();
     let mut staged = StagedOutput::new();
     staged.write_bytes(&a, b"a").unwrap();
@@ -315,10 +310,7 @@ fn a_failing_staged_file_leaves_nothing() {
 #[cfg(unix)]
 #[test]
 fn a_failing_rename_puts_back_the_files_renamed_before() {
-    let dir = tempfile::tempdir().unwrap();
-    let a = dir.path().join("a.txt");
-    let b = dir.path().join("b.txt");
-    let c = dir.path().join("c.txt");
+    let (dir, [a, b, c]) = scratch(["a.txt", "b.txt", "c.txt"]);
     std::fs::write(&a, b"old a").unwrap();
     let mut staged = StagedOutput::new();
     staged.write_bytes(&a, b"new a").unwrap();

@@ -11,7 +11,7 @@ use serde::de::{Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, de};
 use serde_json::Value;
 
-use super::{Camera, CameraSpec};
+use super::{Camera, CameraSpec, bad_camera};
 use crate::error::SceneError;
 
 /// Largest camera file read (a camera is a few hundred bytes; an animation file of ten
@@ -115,13 +115,9 @@ impl CameraSource {
                 let text = read_camera_text(&path, Some(f))?;
                 match parse_camera_json(&text, &path, Some(f))? {
                     CameraJson::One(spec) => Camera::from_spec(&spec, &path, Some(f)),
-                    CameraJson::Frames(_) => Err(SceneError::BadCamera {
-                        path,
-                        frame: Some(f),
-                        message: "holds a \"frames\" object, but a per-frame file holds one \
-                                  camera"
-                            .into(),
-                    }),
+                    CameraJson::Frames(_) => Err(bad_camera(&path, Some(f))(
+                        "holds a \"frames\" object, but a per-frame file holds one camera".into(),
+                    )),
                 }
             }
             (CameraSource::Animation { path, frames }, Some(f)) => {
@@ -135,10 +131,8 @@ impl CameraSource {
                             frame_ranges(frames.keys())
                         ),
                     })?;
-                let spec = CameraSpec::deserialize(value).map_err(|e| SceneError::BadCamera {
-                    path: path.clone(),
-                    frame: Some(f),
-                    message: glassdb_io::bounded_message(&e.to_string()),
+                let spec = CameraSpec::deserialize(value).map_err(|e| {
+                    bad_camera(path, Some(f))(glassdb_io::bounded_message(&e.to_string()))
                 })?;
                 Camera::from_spec(&spec, path, Some(f))
             }
@@ -181,11 +175,7 @@ fn parse_camera_json(
     path: &Path,
     frame: Option<u32>,
 ) -> Result<CameraJson, SceneError> {
-    let bad = |message: String| SceneError::BadCamera {
-        path: path.to_path_buf(),
-        frame,
-        message,
-    };
+    let bad = bad_camera(path, frame);
     let json_err = |e: serde_json::Error| {
         bad(glassdb_io::bounded_message(&format!(
             "line {}, column {}: {e}",

@@ -84,6 +84,18 @@ pub fn check_image_size(width: u32, height: u32) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// The error of the camera file `path` (at animation frame `frame`) that says `message`.
+pub(crate) fn bad_camera(
+    path: &Path,
+    frame: Option<u32>,
+) -> impl Fn(String) -> SceneError + Copy + '_ {
+    move |message| SceneError::BadCamera {
+        path: path.to_path_buf(),
+        frame,
+        message,
+    }
+}
+
 impl Camera {
     /// Validates a camera spec; `path` only names the source in errors.
     pub fn new(spec: &CameraSpec, path: &Path) -> Result<Camera, SceneError> {
@@ -96,11 +108,7 @@ impl Camera {
         path: &Path,
         frame: Option<u32>,
     ) -> Result<Camera, SceneError> {
-        let bad = |message: String| SceneError::BadCamera {
-            path: path.to_path_buf(),
-            frame,
-            message,
-        };
+        let bad = bad_camera(path, frame);
         check_image_size(spec.width, spec.height)?;
         let pose = spec.pose().map_err(bad)?;
         let (centre, half) = spec.window().map_err(bad)?;

@@ -17,24 +17,42 @@ fn spec() -> CameraSpec {
     )
 }
 
-/// A camera at the origin looking down −z with Blender's lens settings.
-fn blender(
-    size: (u32, u32),
-    focal: f64,
-    fit: Option<SensorFit>,
-    shift: (f64, f64),
-    pixel_aspect: Option<f64>,
-) -> CameraSpec {
+/// A camera at the origin looking down −z with Blender's lens settings: `focal` mm, sensor
+/// fit AUTO, no shift, square pixels.
+fn blender(size: (u32, u32), focal: f64) -> CameraSpec {
     CameraSpec {
         matrix_world: Some(IDENTITY),
         focal_length_mm: Some(focal),
-        sensor_fit: fit,
-        shift_x: Some(shift.0),
-        shift_y: Some(shift.1),
-        pixel_aspect,
+        shift_x: Some(0.0),
+        shift_y: Some(0.0),
         width: size.0,
         height: size.1,
         ..CameraSpec::default()
+    }
+}
+
+/// [`blender`] with an explicit sensor fit.
+fn fitted(size: (u32, u32), focal: f64, fit: SensorFit) -> CameraSpec {
+    CameraSpec {
+        sensor_fit: Some(fit),
+        ..blender(size, focal)
+    }
+}
+
+/// `spec` with Blender's Shift X and Y.
+fn shifted(spec: CameraSpec, (x, y): (f64, f64)) -> CameraSpec {
+    CameraSpec {
+        shift_x: Some(x),
+        shift_y: Some(y),
+        ..spec
+    }
+}
+
+/// `spec` with a pixel aspect (width over height).
+fn aspect(spec: CameraSpec, pixel_aspect: f64) -> CameraSpec {
+    CameraSpec {
+        pixel_aspect: Some(pixel_aspect),
+        ..spec
     }
 }
 
@@ -50,8 +68,10 @@ fn view(s: &CameraSpec) -> [f64; 4] {
     [v.x_min, v.x_max, v.y_min, v.y_max]
 }
 
+/// The view plane of `spec` is `want` (to 1e-15 relative).
 #[track_caller]
-fn assert_view(got: [f64; 4], want: [f64; 4]) {
+fn assert_view(spec: &CameraSpec, want: [f64; 4]) {
+    let got = view(spec);
     for k in 0..4 {
         assert!(
             (got[k] - want[k]).abs() <= 1e-15 * want[k].abs().max(1.0),
@@ -160,62 +180,41 @@ fn fov_cameras_project_bit_for_bit_as_the_symmetric_pinhole() {
 #[test]
 fn horizontal_fit_is_blenders_view_plane() {
     // 320×240, 50 mm on 36 mm: s = 36/(50·320); x ±160·s = ±0.36, y ±120·s = ±0.27.
-    let s = blender(
-        (320, 240),
-        50.0,
-        Some(SensorFit::Horizontal),
-        (0.0, 0.0),
-        None,
+    assert_view(
+        &fitted((320, 240), 50.0, SensorFit::Horizontal),
+        [-0.36, 0.36, -0.27, 0.27],
     );
-    assert_view(view(&s), [-0.36, 0.36, -0.27, 0.27]);
     // Auto resolves to horizontal for a landscape frame: the same.
-    let s = blender((320, 240), 50.0, None, (0.0, 0.0), None);
-    assert_view(view(&s), [-0.36, 0.36, -0.27, 0.27]);
+    assert_view(&blender((320, 240), 50.0), [-0.36, 0.36, -0.27, 0.27]);
 }
 
 #[test]
 fn vertical_fit_uses_the_sensor_height() {
     // Vertical: sensor 24 mm over the 240 rows: s = 24/(50·240) = 0.002.
-    let s = blender(
-        (320, 240),
-        50.0,
-        Some(SensorFit::Vertical),
-        (0.0, 0.0),
-        None,
+    assert_view(
+        &fitted((320, 240), 50.0, SensorFit::Vertical),
+        [-0.32, 0.32, -0.24, 0.24],
     );
-    assert_view(view(&s), [-0.32, 0.32, -0.24, 0.24]);
     // A custom sensor height counts only for the vertical fit.
-    let mut s = blender(
-        (320, 240),
-        50.0,
-        Some(SensorFit::Vertical),
-        (0.0, 0.0),
-        None,
-    );
+    let mut s = fitted((320, 240), 50.0, SensorFit::Vertical);
     s.sensor_height_mm = Some(12.0);
-    assert_view(view(&s), [-0.16, 0.16, -0.12, 0.12]);
+    assert_view(&s, [-0.16, 0.16, -0.12, 0.12]);
     s.sensor_fit = Some(SensorFit::Horizontal);
-    assert_view(view(&s), [-0.36, 0.36, -0.27, 0.27]);
+    assert_view(&s, [-0.36, 0.36, -0.27, 0.27]);
 }
 
 #[test]
 fn auto_fit_of_a_portrait_frame_spans_the_sensor_width_vertically() {
     // 240×320: aspx·W < aspy·H, so vertical, but AUTO keeps sensor_x = 36 mm:
     // viewfac = 320, s = 36/(50·320) = 0.00225; x ±120·s, y ±160·s.
-    let s = blender((240, 320), 50.0, None, (0.0, 0.0), None);
-    assert_view(view(&s), [-0.27, 0.27, -0.36, 0.36]);
+    assert_view(&blender((240, 320), 50.0), [-0.27, 0.27, -0.36, 0.36]);
     // An explicit vertical fit uses the 24 mm height instead.
-    let s = blender(
-        (240, 320),
-        50.0,
-        Some(SensorFit::Vertical),
-        (0.0, 0.0),
-        None,
+    assert_view(
+        &fitted((240, 320), 50.0, SensorFit::Vertical),
+        [-0.18, 0.18, -0.24, 0.24],
     );
-    assert_view(view(&s), [-0.18, 0.18, -0.24, 0.24]);
     // A square frame is horizontal under AUTO (aspx·W ≥ aspy·H).
-    let s = blender((100, 100), 36.0, None, (0.0, 0.0), None);
-    assert_view(view(&s), [-0.5, 0.5, -0.5, 0.5]);
+    assert_view(&blender((100, 100), 36.0), [-0.5, 0.5, -0.5, 0.5]);
 }
 
 #[test]
@@ -224,46 +223,47 @@ fn shift_moves_the_view_plane_in_units_of_the_fitted_side() {
     // shift_x 0.25 → +80 px, shift_y −0.1 → −32 px:
     // x ∈ [(−160 + 80)·s, (160 + 80)·s] = [−9/35, 27/35],
     // y ∈ [(−120 − 32)·s, (120 − 32)·s] = [−171/350, 99/350].
-    let s = blender((320, 240), 35.0, None, (0.25, -0.1), None);
     assert_view(
-        view(&s),
+        &shifted(blender((320, 240), 35.0), (0.25, -0.1)),
         [-9.0 / 35.0, 27.0 / 35.0, -171.0 / 350.0, 99.0 / 350.0],
     );
     // Vertical fit: the shift is in units of the height (viewfac = 240, s = 0.002):
     // shift_x 0.5 → +120 px: x ∈ [−40·s, 280·s].
-    let s = blender(
-        (320, 240),
-        50.0,
-        Some(SensorFit::Vertical),
-        (0.5, 0.0),
-        None,
+    assert_view(
+        &shifted(fitted((320, 240), 50.0, SensorFit::Vertical), (0.5, 0.0)),
+        [-0.08, 0.56, -0.24, 0.24],
     );
-    assert_view(view(&s), [-0.08, 0.56, -0.24, 0.24]);
     // fov_x_deg shifts the same way, viewfac = W: centre 2·shift·tan(fov/2).
     let mut s = CameraSpec::look_at([0.0; 3], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0], 90.0, 200, 100);
     s.shift_x = Some(0.25);
     s.shift_y = Some(0.5);
-    assert_view(view(&s), [-0.5, 1.5, 0.5, 1.5]);
+    assert_view(&s, [-0.5, 1.5, 0.5, 1.5]);
 }
 
 #[test]
 fn pixel_aspect_scales_the_image_height() {
     // 200×100 with pixels twice as wide as high (aspx 2, aspy 1): ycor = 0.5, horizontal;
     // s = 36/(50·200) = 0.0036: x ±100·s = ±0.36, y ±0.5·50·s = ±0.09.
-    let s = blender((200, 100), 50.0, None, (0.0, 0.0), Some(2.0));
-    assert_view(view(&s), [-0.36, 0.36, -0.09, 0.09]);
+    assert_view(
+        &aspect(blender((200, 100), 50.0), 2.0),
+        [-0.36, 0.36, -0.09, 0.09],
+    );
     // 100×150, aspx 1, aspy 2: ycor = 2, aspx·W = 100 < aspy·H = 300: vertical with the
     // sensor width (AUTO); viewfac = 300, s = 36/(50·300) = 0.0024: x ±0.12, y ±150·s = ±0.36.
-    let s = blender((100, 150), 50.0, None, (0.0, 0.0), Some(0.5));
-    assert_view(view(&s), [-0.12, 0.12, -0.36, 0.36]);
+    assert_view(
+        &aspect(blender((100, 150), 50.0), 0.5),
+        [-0.12, 0.12, -0.36, 0.36],
+    );
     // 100×100, aspy 2, shift (0.1, 0.2): vertical, viewfac = 200, s = 0.0036;
     // x ∈ [(−50 + 20)·s, (50 + 20)·s], y ∈ [(−100 + 40)·s, (100 + 40)·s].
-    let s = blender((100, 100), 50.0, None, (0.1, 0.2), Some(0.5));
-    assert_view(view(&s), [-0.108, 0.252, -0.216, 0.504]);
+    assert_view(
+        &aspect(shifted(blender((100, 100), 50.0), (0.1, 0.2)), 0.5),
+        [-0.108, 0.252, -0.216, 0.504],
+    );
     // With fov_x_deg: x keeps tan(fov/2), y is ycor·H/W of it.
     let mut s = CameraSpec::look_at([0.0; 3], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0], 90.0, 200, 100);
     s.pixel_aspect = Some(2.0);
-    assert_view(view(&s), [-1.0, 1.0, -0.25, 0.25]);
+    assert_view(&s, [-1.0, 1.0, -0.25, 0.25]);
 }
 
 #[test]
@@ -271,7 +271,7 @@ fn fov_x_deg_is_the_horizontal_fit_of_the_same_lens() {
     // 50 mm on a 36 mm sensor: fov = 2·atan(18/50).
     let fov = 2.0 * (18.0f64 / 50.0).atan().to_degrees();
     for (size, shift) in [((320, 240), (0.0, 0.0)), ((240, 320), (0.3, -0.2))] {
-        let mut a = blender(size, 50.0, Some(SensorFit::Horizontal), shift, None);
+        let mut a = shifted(fitted(size, 50.0, SensorFit::Horizontal), shift);
         let mut b = a.clone();
         b.focal_length_mm = None;
         b.sensor_fit = None;
@@ -286,7 +286,7 @@ fn fov_x_deg_is_the_horizontal_fit_of_the_same_lens() {
 
 #[test]
 fn pixels_sample_their_centres_on_the_shifted_view_plane() {
-    let s = blender((320, 240), 35.0, None, (0.25, -0.1), Some(1.5));
+    let s = aspect(shifted(blender((320, 240), 35.0), (0.25, -0.1)), 1.5);
     let cam = Camera::new(&s, Path::new("c.json")).unwrap();
     let v = cam.view;
     for (i, j) in [(0, 0), (319, 239), (17, 200), (160, 120)] {
@@ -518,21 +518,15 @@ fn contradicting_or_missing_fields_are_errors_naming_the_field() {
             },
             &["shift_y"],
         ),
-        (
-            blender((64, 48), -35.0, None, (0.0, 0.0), None),
-            &["focal_length_mm"],
-        ),
+        (blender((64, 48), -35.0), &["focal_length_mm"]),
         (
             CameraSpec {
                 sensor_height_mm: Some(0.0),
-                ..blender((64, 48), 35.0, None, (0.0, 0.0), None)
+                ..blender((64, 48), 35.0)
             },
             &["sensor_height_mm"],
         ),
-        (
-            blender((64, 48), 1e-320, None, (0.0, 0.0), None),
-            &["view plane"],
-        ),
+        (blender((64, 48), 1e-320), &["view plane"]),
     ];
     for (s, parts) in cases {
         let e = err(&s);
@@ -662,9 +656,9 @@ fn oversized_camera_files_are_refused_before_parsing() {
 #[test]
 fn the_worked_example_of_docs_scene_md() {
     // 1920×1080, 35 mm on 36×24, auto, shift_y 0.1: horizontal, s = 36/(35·1920).
-    let s = blender((1920, 1080), 35.0, None, (0.0, 0.1), None);
+    let s = shifted(blender((1920, 1080), 35.0), (0.0, 0.1));
     let px = 36.0 / (35.0 * 1920.0);
-    assert_view(view(&s), [-960.0 * px, 960.0 * px, -348.0 * px, 732.0 * px]);
+    assert_view(&s, [-960.0 * px, 960.0 * px, -348.0 * px, 732.0 * px]);
     let [x_min, x_max, y_min, y_max] = view(&s);
     assert!((x_max - 0.514286).abs() < 5e-7 && (y_min + 0.186429).abs() < 5e-7);
     assert!((y_max - 0.392143).abs() < 5e-7);

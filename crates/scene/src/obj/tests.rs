@@ -12,30 +12,29 @@ fn load_str(obj: &str) -> Result<Scene, SceneError> {
     load_obj(&p)
 }
 
+/// Loading `obj` fails with a message that contains each of `needles`.
+#[track_caller]
+fn assert_load_error(obj: &str, needles: &[&str]) {
+    let e = load_str(obj).unwrap_err().to_string();
+    for needle in needles {
+        assert!(e.contains(needle), "{needle:?} not in {e}");
+    }
+}
+
 #[test]
 fn syntax_errors_name_file_and_line() {
-    let e = load_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n")
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("s.obj:4:"), "{e}");
-    let e = load_str("v 0 0\n").unwrap_err().to_string();
-    assert!(
-        e.contains("s.obj:1:") && e.contains("found 2 values"),
-        "{e}"
+    assert_load_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", &["s.obj:4:"]);
+    assert_load_error("v 0 0\n", &["s.obj:1:", "found 2 values"]);
+    assert_load_error(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\n\n# c\nf 1 2 4\n",
+        &["s.obj:6:", "out of range"],
     );
-    let e = load_str("v 0 0 0\nv 1 0 0\nv 0 1 0\n\n# c\nf 1 2 4\n")
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("s.obj:6:") && e.contains("out of range"), "{e}");
-    let e = load_str("v 0 0 nan\n").unwrap_err().to_string();
-    assert!(e.contains("s.obj:1:") && e.contains("finite"), "{e}");
-    let e = load_str("v 0 0 0\nbogus 1 2\n").unwrap_err().to_string();
-    assert!(
-        e.contains("s.obj:2:") && e.contains("unknown OBJ statement"),
-        "{e}"
+    assert_load_error("v 0 0 nan\n", &["s.obj:1:", "finite"]);
+    assert_load_error(
+        "v 0 0 0\nbogus 1 2\n",
+        &["s.obj:2:", "unknown OBJ statement"],
     );
-    let e = load_str("v 0 0 0\n").unwrap_err().to_string();
-    assert!(e.contains("no faces"), "{e}");
+    assert_load_error("v 0 0 0\n", &["no faces"]);
 }
 
 #[test]
@@ -94,10 +93,8 @@ fn weights_short_texcoords_tabs_and_continuations_are_normalised() {
     assert_eq!(m.texcoords[t[0] as usize], [0.25, 0.0]);
     assert_eq!(m.texcoords[t[1] as usize], [0.5, 0.75]);
     // A continued line keeps the number of its first line in errors.
-    let e = load_str("v 0 0 \\\n x\n").unwrap_err().to_string();
-    assert!(e.contains("s.obj:1:"), "{e}");
-    let e = load_str("v 1 2 3 0\n").unwrap_err().to_string();
-    assert!(e.contains("w is 0"), "{e}");
+    assert_load_error("v 0 0 \\\n x\n", &["s.obj:1:"]);
+    assert_load_error("v 1 2 3 0\n", &["w is 0"]);
 }
 
 /// The U-shaped pane of the triangulation tests (3 × 2, a 1 × 1 notch from the top

@@ -138,16 +138,9 @@ pub struct IntegrationSettings {
 }
 
 impl Default for IntegrationSettings {
+    /// The colorimetric method in sRGB under the default illuminant.
     fn default() -> Self {
-        IntegrationSettings {
-            method: Method::Colorimetric {
-                observer: Observer::Cie1931,
-                illuminant: Illuminant::default(),
-                space: RgbSpace::Srgb,
-                white_balance: WhiteBalance::Light,
-            },
-            extrapolate: false,
-        }
+        IntegrationSettings::colorimetric(RgbSpace::Srgb, Illuminant::default())
     }
 }
 
