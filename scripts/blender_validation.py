@@ -37,18 +37,26 @@ from blender_example_figure import srgb8  # noqa: E402
 
 
 def read(path, names):
-    """The named channels as float64 arrays (OpenEXR 3.5 groups R, G, B, A as "RGBA")."""
+    """The named channels as float64 arrays. OpenEXR 3.5 groups R, G, B(, A) into one array,
+    keyed "RGBA" when bare and by the layer's name ("ViewLayer.Combined") when layered. A pass
+    of a light-split run also holds a layer per light group (`ViewLayer.Combined_sun`, …);
+    the beauty (the layer without a group suffix) is read, a group layer only where a channel
+    has no other source."""
     with OpenEXR.File(path) as f:
-        ch = f.channels()
-        planes = {}
-        for key, c in ch.items():
+        planes, group_planes = {}, {}
+        for key, c in f.channels().items():
             px = np.asarray(c.pixels, dtype=np.float64)
+            last = key.split(".")[-1]
+            into = group_planes if last.startswith("Combined_") else planes
             if px.ndim == 3:
-                for i, letter in enumerate(key.split(".")[-1]):
-                    planes[letter] = px[..., i]
+                letters = last
+                if len(letters) != px.shape[-1] or not set(letters) <= set("RGBA"):
+                    letters = "RGBA"[: px.shape[-1]]
+                for i, letter in enumerate(letters):
+                    into[letter] = px[..., i]
             else:
-                planes[key.split(".")[-1]] = px
-        return [planes[n] for n in names]
+                into[last] = px
+        return [planes[n] if n in planes else group_planes[n] for n in names]
 
 
 def rgb(path):
