@@ -92,8 +92,9 @@ pub(crate) fn add_in_bands(
         decode: t0.elapsed(),
         ..StageTimings::default()
     };
-    for first in (0..height).step_by(band_rows.max(1)) {
-        let rows = band_rows.max(1).min(height - first);
+    let band_rows = band_rows.max(1);
+    for first in (0..height).step_by(band_rows) {
+        let rows = band_rows.min(height - first);
         let (read, composite) = group.add_band(first, rows, sum, kept.as_mut())?;
         timings.decode += read;
         timings.compose += composite;
@@ -265,7 +266,16 @@ impl BandedFrame<'_> {
             && data.width == band.width
             && data.y <= band.y
             && data.end_y() >= band.end_y();
-        if !holds || trans.image.width as usize != data.width {
+        // The decoded planes must be the rows the window names, so that the band's slice of
+        // them is in bounds.
+        let sized = trans.image.width as usize == data.width
+            && trans.image.height as usize == data.height
+            && trans
+                .image
+                .rgb
+                .iter()
+                .all(|p| p.len() == data.width * data.height);
+        if !holds || !sized {
             return Err(window_mismatch(self.files, self.plan, data, frame));
         }
         Ok((band.y - data.y) as usize * data.width)

@@ -1352,9 +1352,9 @@ ${relit ? relitSums(relit) : plainPasses}
       setEv: (ev) => { state.ev = ev; draw(); },
       // A light part's exposure in stops (its slider), by group name.
       setPartEv: (group, ev) => { state.partEv[group] = ev; renderPartSliders(); draw(); },
-      // Each light part's factor per set (none: passes without a light-path split).
       // The relit swap's active glass id and how often the other parts' sums were drawn.
       relitStats: () => ({ active: relit.active, fixedDraws: relit.fixedDraws }),
+      // Each light part's factor per set (none: passes without a light-path split).
       partFactors: () => (state.data ? state.data.info.parts : []).map((p) => ({ group: p.group, A: partFactor(p, 'A'), B: partFactor(p, 'B') })),
       setView: async (name) => { await setView(scene.views.findIndex((v) => v.name === name)); draw(); },
       setAB: (mode, split) => { state.ab = mode; if (split !== undefined) state.split = split; draw(); },
