@@ -56,6 +56,14 @@ fn serve(extra: &[&std::ffi::OsStr]) -> Served {
     spawn_viewer(&mut cmd)
 }
 
+/// `glassdb view` of the atrium whose page may export into `dir/from-page` (`--export-dir`),
+/// and that folder.
+fn serve_exporting_into(dir: &Path) -> (Served, PathBuf) {
+    let export = dir.join("from-page");
+    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    (served, export)
+}
+
 /// Starts `cmd` (a `glassdb view` with its inputs) on a free port and reads its URL.
 fn spawn_viewer(cmd: &mut Command) -> Served {
     cmd.args(["--port", "0"])
@@ -114,6 +122,13 @@ fn compose_png(dir: &Path, registry: Option<&Path>, name: &str) -> Vec<[f64; 3]>
     }
     ok(&mut cmd);
     png_pixels(&out)
+}
+
+/// [`compose_png`] with the bundled registry's `product` on glass [`SWAP_ID`]: the picture the
+/// page shows after that swap.
+fn compose_png_with_swap(dir: &Path, product: &str, name: &str) -> Vec<[f64; 3]> {
+    let registry = swapped_registry(&repo_path("data/registry.json"), dir, SWAP_ID, product);
+    compose_png(dir, Some(&registry), name)
 }
 
 /// A PNG's RGB per pixel, rows top to bottom.
@@ -177,16 +192,25 @@ fn psnr(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     }
 }
 
+/// Asserts that the canvas `got` shows compose's pixels `want` (a PSNR of 50 dB or more);
+/// `what` names the comparison in the failure message.
+fn assert_composes_pixels(got: &[[f64; 3]], want: &[[f64; 3]], what: &str) {
+    let db = psnr(got, want);
+    assert!(db >= 50.0, "{what}: {db:.1} dB");
+}
+
+/// Asserts that the page at `url`, without swaps (its canvas read back into `out`), draws
+/// without errors and shows compose's pixels `want` (see [`assert_composes_pixels`]).
+fn assert_page_shows(url: &str, out: &Path, want: &[[f64; 3]], what: &str) {
+    let (got, report) = canvas(url, &[], out);
+    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
+    assert_composes_pixels(&got, want, what);
+}
+
 #[test]
 fn a_product_swapped_on_the_page_gives_composes_pixels_and_the_export_the_same() {
     let dir = tempfile::tempdir().unwrap();
-    let registry = swapped_registry(
-        &repo_path("data/registry.json"),
-        dir.path(),
-        SWAP_ID,
-        SWAP_PRODUCT,
-    );
-    let want = compose_png(dir.path(), Some(&registry), "swapped.png");
+    let want = compose_png_with_swap(dir.path(), SWAP_PRODUCT, "swapped.png");
     let unswapped = compose_png(dir.path(), None, "bundled.png");
     // The swap changes the picture visibly, so matching `want` says the swap happened.
     assert!(psnr(&want, &unswapped) < 40.0);
@@ -200,14 +224,12 @@ fn a_product_swapped_on_the_page_gives_composes_pixels_and_the_export_the_same()
         report["marker"], "2",
         "first frame, then the swap: {report}"
     );
-    let db = psnr(&got, &want);
-    assert!(db >= 50.0, "page vs compose after the swap: {db:.1} dB");
+    assert_composes_pixels(&got, &want, "page vs compose after the swap");
 
     // URL parameters choose the same product (by a unique part of its name).
     let by_url = format!("{}?glass=5:Stopray&ev=0", served.url);
     let (got, _) = canvas(&by_url, &[], &dir.path().join("url.rgba"));
-    let db = psnr(&got, &want);
-    assert!(db >= 50.0, "page with ?glass= vs compose: {db:.1} dB");
+    assert_composes_pixels(&got, &want, "page with ?glass= vs compose");
 
     // A/B split: set A as bundled left of the middle, set B with the swap right of it.
     let split = format!("{}?glassB=5:Stopray&ab=split&split=0.5", served.url);
@@ -222,16 +244,18 @@ fn a_product_swapped_on_the_page_gives_composes_pixels_and_the_export_the_same()
             .collect()
     };
     for (right, reference, name) in [(false, &unswapped, "A (left)"), (true, &want, "B (right)")] {
-        let db = psnr(&half(&got, right), &half(reference, right));
-        assert!(db >= 50.0, "split view, {name}: {db:.1} dB");
+        assert_composes_pixels(
+            &half(&got, right),
+            &half(reference, right),
+            &format!("split view, {name}"),
+        );
     }
     drop(served);
 
     // The export, opened from disk, starts with the chosen product.
     let (got, report) = exported_canvas(dir.path(), &["--glass", "5:stopray titanium"]);
     assert_eq!(report["products"]["A"]["5"], SWAP_PRODUCT, "{report}");
-    let db = psnr(&got, &want);
-    assert!(db >= 50.0, "exported page vs compose: {db:.1} dB");
+    assert_composes_pixels(&got, &want, "exported page vs compose");
 }
 
 /// The `host:port` a served URL names.
@@ -321,8 +345,7 @@ fn post_with(url: &str, path: &str, body: &[u8], headers: &[(&str, &str)]) -> u1
 #[test]
 fn the_server_answers_bad_requests_with_4xx_and_serves_no_files() {
     let dir = tempfile::tempdir().unwrap();
-    let export = dir.path().join("from-page");
-    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    let (served, export) = serve_exporting_into(dir.path());
     let u = &served.url;
     assert_eq!(get(u, "/"), 200);
     assert_eq!(get(u, "/api/scene"), 200);
@@ -378,8 +401,7 @@ fn the_server_answers_bad_requests_with_4xx_and_serves_no_files() {
 #[test]
 fn the_server_answers_only_this_machine_and_only_its_page_may_export() {
     let dir = tempfile::tempdir().unwrap();
-    let export = dir.path().join("from-page");
-    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    let (served, export) = serve_exporting_into(dir.path());
     let u = &served.url;
     let port = u.rsplit(':').next().unwrap().trim_end_matches('/');
     for host in [
@@ -493,8 +515,7 @@ fn the_server_answers_only_this_machine_and_only_its_page_may_export() {
 #[test]
 fn in_chromium_a_rebinding_page_gets_nothing_and_the_real_page_exports() {
     let dir = tempfile::tempdir().unwrap();
-    let export = dir.path().join("from-page");
-    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    let (served, export) = serve_exporting_into(dir.path());
     let said = run_oracle(
         "viewer_driver.py",
         &[
@@ -773,12 +794,11 @@ fn a_second_frame_with_a_float_mask_gives_composes_pixels() {
     files(&mut cmd, "####");
     cmd.args(["--frames", "1-2"]);
     let served = spawn_viewer(&mut cmd);
-    let (got, report) = canvas(&format!("{}?frame=1", served.url), &[], &d.join("f2.rgba"));
-    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
-    let db = psnr(&got, &want);
-    assert!(
-        db >= 50.0,
-        "frame 2 with the float mask vs compose: {db:.1} dB"
+    assert_page_shows(
+        &format!("{}?frame=1", served.url),
+        &d.join("f2.rgba"),
+        &want,
+        "frame 2 with the float mask vs compose",
     );
 }
 
@@ -803,10 +823,12 @@ fn a_multi_part_reflection_file_gives_composes_pixels() {
         .arg("--planes")
         .arg(a("virtual/planes.json"));
     let served = spawn_viewer(&mut cmd);
-    let (got, report) = canvas(&served.url, &[], &dir.path().join("parts.rgba"));
-    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
-    let db = psnr(&got, &want);
-    assert!(db >= 50.0, "page from planes.exr vs compose: {db:.1} dB");
+    assert_page_shows(
+        &served.url,
+        &dir.path().join("parts.rgba"),
+        &want,
+        "page from planes.exr vs compose",
+    );
 }
 
 /// The unit the ghost test puts on the atrium's glass 5 (plane 1): two pane groups.
@@ -1221,16 +1243,11 @@ fn a_cube_view_on_the_page_gives_composes_pixels_through_it() {
     );
 
     let served = serve(&["--view".as_ref(), cube.as_os_str()]);
-    let (got, report) = canvas(
+    assert_page_shows(
         &format!("{}?view=look", served.url),
-        &[],
         &dir.path().join("look.rgba"),
-    );
-    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
-    let db = psnr(&got, &want);
-    assert!(
-        db >= 50.0,
-        "page through the .cube view vs compose: {db:.1} dB"
+        &want,
+        "page through the .cube view vs compose",
     );
 }
 
@@ -1262,8 +1279,7 @@ fn candidates_built_from_a_catalog_give_composes_pixels() {
         2,
         "{report}"
     );
-    let db = psnr(&got, &want);
-    assert!(db >= 50.0, "page from the catalog vs compose: {db:.1} dB");
+    assert_composes_pixels(&got, &want, "page from the catalog vs compose");
 }
 
 /// The driver's `layout` report of `url` (the window `window`, default 1400×1000) after the JS
@@ -1469,14 +1485,12 @@ fn a_blender_run_folder_opens_directly() {
     let mut cmd = glassdb();
     cmd.arg("view").arg(run);
     let served = spawn_viewer(&mut cmd);
-    let (got, report) = canvas(
+    assert_page_shows(
         &format!("{}?frame=1", served.url),
-        &[],
         &dir.path().join("f2.rgba"),
+        &want,
+        "frame 2 of the run vs compose",
     );
-    assert_eq!(report["errors"], serde_json::json!([]), "{report}");
-    let db = psnr(&got, &want);
-    assert!(db >= 50.0, "frame 2 of the run vs compose: {db:.1} dB");
     let (code, scene) = get_as(&served.url, "/api/scene", host_of(&served.url));
     assert_eq!(code, 200);
     let scene: serde_json::Value = serde_json::from_str(&scene).unwrap();
@@ -1531,13 +1545,7 @@ const CATALOG_UNIT: &str = "Solarban R67 #2 | 12.7 argon | clear 6";
 #[test]
 fn a_unit_built_on_the_page_gives_composes_pixels_of_that_unit() {
     let dir = tempfile::tempdir().unwrap();
-    let registry = swapped_registry(
-        &repo_path("data/registry.json"),
-        dir.path(),
-        SWAP_ID,
-        CATALOG_UNIT,
-    );
-    let want = compose_png(dir.path(), Some(&registry), "unit.png");
+    let want = compose_png_with_swap(dir.path(), CATALOG_UNIT, "unit.png");
     let served = serve(&[]);
     let out = dir.path().join("unit.rgba");
     let report = build_unit_on_page(&served.url, UNIT_PANES, Some(&out));
@@ -1550,8 +1558,7 @@ fn a_unit_built_on_the_page_gives_composes_pixels_of_that_unit() {
     );
     assert_eq!(report["drawn"], 1, "{report}");
     let got = rgba_pixels(&out);
-    let db = psnr(&got, &want);
-    assert!(db >= 50.0, "unit built on the page vs compose: {db:.1} dB");
+    assert_composes_pixels(&got, &want, "unit built on the page vs compose");
 
     // The width box left empty: the server's reason on the page, nothing drawn.
     let report = build_unit_on_page(&served.url, "6|nan:argon|2", None);
@@ -1634,8 +1641,7 @@ fn post_with_reply(url: &str, path: &str, body: &[u8], headers: &[(&str, &str)])
 #[test]
 fn unit_requests_are_checked_and_only_the_page_may_send_them() {
     let dir = tempfile::tempdir().unwrap();
-    let export = dir.path().join("from-page");
-    let served = serve(&["--export-dir".as_ref(), export.as_os_str()]);
+    let (served, export) = serve_exporting_into(dir.path());
     let u = &served.url;
     let good = br#"{"elements": [{"glass": 6}, {"gap_mm": 12.7, "gas": "argon"}, {"glass": 2}]}"#;
     let (code, body) = post_reply(u, "/api/unit", good);
