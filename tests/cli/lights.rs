@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::util::{
-    element_where, glassdb, json_rgb, ok, registry_build, repo_path, run_oracle, write_file,
+    element_where, glassdb, glazing_fixture, json_rgb, ok, registry_build, repo_path, run_oracle,
+    write_file,
 };
 
 /// The lights of the oracle comparison: daylight, tungsten, a CIE LED, a fluorescent and a
@@ -27,18 +28,14 @@ const THREE_LIGHTS: [(&str, &str); 3] = [("sun", "D65"), ("warm", "A"), ("lamp",
 /// The spaces of the oracle comparison (the bundled registry's).
 const SPACES: [&str; 4] = ["srgb", "acescg", "rec2020", "aces2065-1"];
 
-fn glazing(name: &str) -> PathBuf {
-    repo_path("fixtures/glazing").join(name)
-}
-
 /// The single glasses of the light tests, by id: tinted and coated products, where the light's
 /// spectrum matters most.
 fn single_glasses() -> Vec<(u16, PathBuf)> {
     vec![
-        (5, glazing("913.json")),
-        (9, glazing("nfrc_9962.json")),
-        (10, glazing("nfrc_9223.json")),
-        (4, glazing("LOW-E_5.LOF")),
+        (5, glazing_fixture("913.json")),
+        (9, glazing_fixture("nfrc_9962.json")),
+        (10, glazing_fixture("nfrc_9223.json")),
+        (4, glazing_fixture("LOW-E_5.LOF")),
     ]
 }
 
@@ -61,8 +58,8 @@ fn write_catalog(dir: &Path) -> PathBuf {
         "[[glass]]\nid = 21\nname = \"Arctic Blue | air | clear\"\nlayers = [\n  \
          {{ spectral = \"{}\" }},\n  {{ gap_mm = 12.7, gas = \"air\" }},\n  \
          {{ spectral = \"{}\" }},\n]\n",
-        glazing("nfrc_9962.json").display(),
-        glazing("CLEAR_6.DAT").display()
+        glazing_fixture("nfrc_9962.json").display(),
+        glazing_fixture("CLEAR_6.DAT").display()
     );
     write_file(dir, "catalog.toml", text.as_bytes())
 }
@@ -133,8 +130,8 @@ fn build_light_registry(dir: &Path) -> Value {
 fn unit_spectra(dir: &Path) -> PathBuf {
     let json = ok(glassdb()
         .arg("stack")
-        .arg(glazing("nfrc_9962.json"))
-        .arg(glazing("CLEAR_6.DAT"))
+        .arg(glazing_fixture("nfrc_9962.json"))
+        .arg(glazing_fixture("CLEAR_6.DAT"))
         .args(["--gap", "12.7:air", "--angles", "0", "--json", "--spectra"]));
     write_file(dir, "unit.json", json.as_bytes())
 }
@@ -306,9 +303,9 @@ fn flat_emitter_through_tinted_glass_matches_its_light_table() {
     let catalog = write_catalog(dir.path());
     let unit = format!("stack:{}", unit_spectra(dir.path()).display());
     let glasses: Vec<(u16, String)> = vec![
-        (5, glazing("913.json").display().to_string()),
-        (9, glazing("nfrc_9962.json").display().to_string()),
-        (10, glazing("nfrc_9223.json").display().to_string()),
+        (5, glazing_fixture("913.json").display().to_string()),
+        (9, glazing_fixture("nfrc_9962.json").display().to_string()),
+        (10, glazing_fixture("nfrc_9223.json").display().to_string()),
         (21, unit),
     ];
     let d65 = dir.path().join("d65.json");

@@ -13,7 +13,8 @@ use glassdb_spectral::{
 use serde_json::Value;
 
 use crate::util::{
-    fails, fails_naming, glassdb, json_rgb, max_abs_diff, ok, repo_path, run_oracle, write_file,
+    fails, fails_naming, glassdb, glazing_fixture, json_rgb, max_abs_diff, ok, run_oracle,
+    write_file,
 };
 
 /// The illuminants `python_oracle/spectral_oracle.py` integrates under (every bundled one is
@@ -36,12 +37,8 @@ const FIXTURES: &[&str] = &[
     "CLEAR_3.csv",
 ];
 
-fn fixture(name: &str) -> PathBuf {
-    repo_path("fixtures/glazing").join(name)
-}
-
 fn read_fixture(name: &str) -> SpectralData {
-    read_spectral_file(&fixture(name), &ReadOptions::default()).unwrap()
+    read_spectral_file(&glazing_fixture(name), &ReadOptions::default()).unwrap()
 }
 
 /// Relative agreement with an absolute floor for channels that cancel to near zero.
@@ -163,7 +160,7 @@ fn compare_with_oracle(files: &[PathBuf], opts: &ReadOptions, extrapolate: bool,
 
 #[test]
 fn every_fixture_matches_colour_science_to_1e9() {
-    let files: Vec<PathBuf> = FIXTURES.iter().map(|f| fixture(f)).collect();
+    let files: Vec<PathBuf> = FIXTURES.iter().map(|f| glazing_fixture(f)).collect();
     compare_with_oracle(&files, &ReadOptions::default(), false, 1e-9);
 }
 
@@ -175,7 +172,7 @@ fn every_fixture_matches_colour_science_to_1e9() {
 fn every_rgb_space_matches_colour_science_on_clear_and_tinted_glass() {
     let files: Vec<PathBuf> = ["CLEAR_3.DAT", "913.json", "nfrc_20748.oag"]
         .iter()
-        .map(|f| fixture(f))
+        .map(|f| glazing_fixture(f))
         .collect();
     let args: Vec<&OsStr> = files.iter().map(|p| p.as_os_str()).collect();
     let oracle: Value =
@@ -222,7 +219,7 @@ fn every_rgb_space_matches_colour_science_on_clear_and_tinted_glass() {
         println!("{space}: {count} numbers, largest relative difference {worst:.1e}");
     }
     // The CLI exposes every space by name, and rec709 as sRGB.
-    let clear = fixture("CLEAR_3.DAT");
+    let clear = glazing_fixture("CLEAR_3.DAT");
     let srgb = transmittance_rgb(&["--space", "srgb"], &clear);
     assert_eq!(transmittance_rgb(&["--space", "rec709"], &clear), srgb);
     let v = spectral_json(&["--space", "rec709"], &clear);
@@ -237,7 +234,7 @@ fn every_rgb_space_matches_colour_science_on_clear_and_tinted_glass() {
 fn cli_json_matches_the_library_and_has_the_documented_keys() {
     for name in ["CLEAR_3.DAT", "913.json", "nfrc_20748.oag"] {
         let paper_1959 = ["--method", "paper", "--cmf", "stiles-burch-1959"];
-        let v = spectral_json(&paper_1959, &fixture(name));
+        let v = spectral_json(&paper_1959, &glazing_fixture(name));
         assert_eq!(v["method"], "paper");
         assert_eq!(v["cmf"], "stiles-burch-1959");
         assert!(v["illuminant"].is_null() && v["space"].is_null());
@@ -262,7 +259,7 @@ fn cli_json_matches_the_library_and_has_the_documented_keys() {
         "--observer",
         "cie1964",
     ];
-    let v = spectral_json(&colorimetric, &fixture("CSR42_3.afg"));
+    let v = spectral_json(&colorimetric, &glazing_fixture("CSR42_3.afg"));
     assert_eq!(
         (
             v["method"].as_str(),
@@ -289,7 +286,7 @@ fn luminous_values_agree_with_the_igsdb_nfrc_summaries() {
         "igsdb_product_10693.json",
         "nfrc_9223.json",
     ] {
-        let path = fixture(name);
+        let path = glazing_fixture(name);
         let json: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
         let summary = &json["integrated_results_summary"][0];
         let data = read_fixture(name);
@@ -617,7 +614,7 @@ fn off_grid_start_is_evaluated_at_the_right_wavelengths() {
 
 #[test]
 fn cli_rejects_options_that_do_not_apply_and_missing_files() {
-    let f = fixture("CLEAR_3.DAT");
+    let f = glazing_fixture("CLEAR_3.DAT");
     let paper_acescg = ["--method", "paper", "--space", "acescg"];
     fails_naming(&mut spectral(&paper_acescg, &f), &["--space"]);
     let cmf_1955 = ["--cmf", "stiles-burch-1955"];

@@ -3,17 +3,15 @@
 //! and `glassdb registry build`; shading products, BSDF XML, diffuse data and binary files fail
 //! with messages that name what they are. Fixtures: fixtures/glazing/README.md.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde_json::Value;
 
-use crate::util::{fails_naming, glassdb, ok, registry_build, repo_path, write_file};
+use crate::util::{
+    fails_naming, glassdb, glazing_fixture, ok, registry_build, repo_path, write_file,
+};
 
 const QUANTITIES: [&str; 3] = ["transmittance", "reflectance", "reflectance_back"];
-
-fn fixture(name: &str) -> PathBuf {
-    repo_path("fixtures/glazing").join(name)
-}
 
 /// `glassdb spectral --json [args…] <file>`, parsed.
 fn spectral_json(args: &[&str], file: &Path) -> Value {
@@ -58,17 +56,17 @@ const METHODS: [&[&str]; 3] = [
 
 #[test]
 fn igsdb_v2_json_gives_exactly_the_optics_files_numbers() {
-    let optics = fixture("CLEAR_3.DAT");
+    let optics = glazing_fixture("CLEAR_3.DAT");
     for other in ["igsdb_v2_clear_3.json", "CLEAR_3_dir_dif.DAT"] {
         for args in METHODS {
             assert_eq!(
-                numbers(args, &fixture(other)),
+                numbers(args, &glazing_fixture(other)),
                 numbers(args, &optics),
                 "{other} {args:?}"
             );
         }
     }
-    let v = spectral_json(&[], &fixture("igsdb_v2_clear_3.json"));
+    let v = spectral_json(&[], &glazing_fixture("igsdb_v2_clear_3.json"));
     let p = &v["product"];
     assert_eq!(
         (
@@ -87,7 +85,7 @@ fn igsdb_v2_json_gives_exactly_the_optics_files_numbers() {
     assert!(p.get("other_incidence_angles_deg").is_none(), "{p}");
     let text = ok(glassdb()
         .arg("spectral")
-        .arg(fixture("igsdb_v2_clear_3.json")));
+        .arg(glazing_fixture("igsdb_v2_clear_3.json")));
     assert!(
         text.contains("Generic Clear Glass, Generic, MONOLITHIC, coated side NA, 3.048 mm"),
         "{text}"
@@ -98,7 +96,7 @@ fn igsdb_v2_json_gives_exactly_the_optics_files_numbers() {
 fn registry_glass(dir: &Path, file: &str) -> Value {
     let catalog = format!(
         "[[glass]]\nid = 1\nname = \"glass\"\nspectral = \"{}\"\n",
-        fixture(file).display()
+        glazing_fixture(file).display()
     );
     let catalog = write_file(dir, &format!("{file}.toml"), catalog.as_bytes());
     let out = dir.join(format!("{file}.registry.json"));
@@ -129,11 +127,11 @@ fn registry_r0_t0_from_igsdb_v2_json_equal_the_optics_files() {
 
 #[test]
 fn instrument_csv_exports_give_the_plain_csvs_numbers() {
-    let plain = fixture("CLEAR_3.csv");
+    let plain = glazing_fixture("CLEAR_3.csv");
     for args in METHODS {
         assert_eq!(
             numbers(args, &plain),
-            numbers(args, &fixture("CLEAR_3.DAT")),
+            numbers(args, &glazing_fixture("CLEAR_3.DAT")),
             "{args:?}"
         );
         for name in [
@@ -141,7 +139,7 @@ fn instrument_csv_exports_give_the_plain_csvs_numbers() {
             "CLEAR_3_semicolon.csv",
             "CLEAR_3_tab.txt",
         ] {
-            let got = numbers(args, &fixture(name));
+            let got = numbers(args, &glazing_fixture(name));
             let want = numbers(args, &plain);
             for (k, (g, w)) in got.iter().zip(&want).enumerate() {
                 // The Cary layout holds T and R, not Rb.
@@ -167,7 +165,7 @@ fn unsupported_kinds_get_messages_that_name_them() {
         fails_naming(glassdb().arg("spectral").arg(file), parts);
     };
     named(
-        &fixture("igsdb_v1_venetian.json"),
+        &glazing_fixture("igsdb_v1_venetian.json"),
         &[
             "igsdb_v1_venetian.json",
             "is an IGSDB shading product (venetian blind, \"Slim White Open\")",
@@ -175,7 +173,7 @@ fn unsupported_kinds_get_messages_that_name_them() {
         ],
     );
     named(
-        &fixture("diffuse_optics_file_2.txt"),
+        &glazing_fixture("diffuse_optics_file_2.txt"),
         &[
             "diffuse_optics_file_2.txt",
             "is an Optics file with diffuse columns",
@@ -183,7 +181,7 @@ fn unsupported_kinds_get_messages_that_name_them() {
         ],
     );
     named(
-        &fixture("2011-SA1_trimmed.XML"),
+        &glazing_fixture("2011-SA1_trimmed.XML"),
         &[
             "2011-SA1_trimmed.XML",
             "is a BSDF XML file",
@@ -218,7 +216,7 @@ fn unsupported_kinds_get_messages_that_name_them() {
     // The registry passes the reader's message on.
     let catalog = format!(
         "[[glass]]\nid = 1\nname = \"blind\"\nspectral = \"{}\"\n",
-        fixture("igsdb_v1_venetian.json").display()
+        glazing_fixture("igsdb_v1_venetian.json").display()
     );
     let catalog = write_file(dir.path(), "catalog.toml", catalog.as_bytes());
     let out = dir.path().join("reg.json");
@@ -234,7 +232,8 @@ fn igsdb_v2_other_incidence_angles_are_named_not_read() {
     // and both outputs say which angles the file has beside it.
     let dir = tempfile::tempdir().unwrap();
     let mut v: Value =
-        serde_json::from_slice(&std::fs::read(fixture("igsdb_v2_clear_3.json")).unwrap()).unwrap();
+        serde_json::from_slice(&std::fs::read(glazing_fixture("igsdb_v2_clear_3.json")).unwrap())
+            .unwrap();
     let blocks = v["physical_properties"]["optical_properties"]["optical_data"]["angle_blocks"]
         .as_array_mut()
         .unwrap();
@@ -254,6 +253,6 @@ fn igsdb_v2_other_incidence_angles_are_named_not_read() {
     );
     assert_eq!(
         numbers(&[], &file),
-        numbers(&[], &fixture("igsdb_v2_clear_3.json"))
+        numbers(&[], &glazing_fixture("igsdb_v2_clear_3.json"))
     );
 }

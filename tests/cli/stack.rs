@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::util::{
-    assert_names, element_where, fails_naming, glassdb, ok, registry_build, repo_path, run_oracle,
-    write_file,
+    assert_names, element_where, fails_naming, glassdb, glazing_fixture, ok, registry_build,
+    repo_path, run_oracle, write_file,
 };
 
 /// The angles every comparison uses: 0–80° in 10° steps.
@@ -21,7 +21,7 @@ fn glazing(file: &str) -> String {
     let path = if data.exists() {
         data
     } else {
-        repo_path("fixtures/glazing").join(file)
+        glazing_fixture(file)
     };
     path.display().to_string()
 }

@@ -15,6 +15,12 @@ pub fn repo_path(rel: &str) -> PathBuf {
     repo_root().join(rel)
 }
 
+/// A file of `fixtures/glazing`, the spectral files of the tests
+/// (fixtures/glazing/README.md).
+pub fn glazing_fixture(name: &str) -> PathBuf {
+    repo_path("fixtures/glazing").join(name)
+}
+
 /// A `Command` for the built `glassdb` binary.
 pub fn glassdb() -> Command {
     Command::new(env!("CARGO_BIN_EXE_glassdb"))
