@@ -269,6 +269,16 @@ fn catalog_with(dir: &Path, body: &str) -> PathBuf {
     write_file(dir, "catalog.toml", text.as_bytes())
 }
 
+/// `glassdb registry build` of the catalog `body` ([`catalog_with`]) with `extra` flags into
+/// `dir/reg.json`: that file and its JSON.
+fn registry_with(dir: &Path, body: &str, extra: &[&str]) -> (PathBuf, Value) {
+    let catalog = catalog_with(dir, body);
+    let out = dir.join("reg.json");
+    ok(&mut registry_build(&catalog, &out, extra));
+    let reg = read_json(&out);
+    (out, reg)
+}
+
 fn read_json(path: &Path) -> Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
@@ -281,7 +291,7 @@ fn glass(table: &Value, id: u64) -> &Value {
 #[test]
 fn a_unit_of_one_layer_is_the_glass_itself() {
     let dir = tempfile::tempdir().unwrap();
-    let catalog = catalog_with(
+    let (_, reg) = registry_with(
         dir.path(),
         r#"
 [[glass]]
@@ -299,14 +309,8 @@ id = 3
 name = "R67 turned round"
 layers = [{ spectral = "GLAZING/igsdb_product_10693.json", flip = true }]
 "#,
-    );
-    let out = dir.path().join("reg.json");
-    ok(&mut registry_build(
-        &catalog,
-        &out,
         &["--space", "srgb,acescg"],
-    ));
-    let reg = read_json(&out);
+    );
     assert_eq!(reg["schema"], 4);
     for table in reg["tables"].as_array().unwrap() {
         let (single, unit, turned) = (glass(table, 1), glass(table, 2), glass(table, 3));
@@ -343,7 +347,7 @@ layers = [{ spectral = "GLAZING/igsdb_product_10693.json", flip = true }]
 #[test]
 fn a_double_unit_in_the_registry() {
     let dir = tempfile::tempdir().unwrap();
-    let catalog = catalog_with(
+    let (out, reg) = registry_with(
         dir.path(),
         r#"
 [[glass]]
@@ -355,10 +359,8 @@ layers = [
     { spectral = "GLAZING/CLEAR_6.DAT" },
 ]
 "#,
+        &[],
     );
-    let out = dir.path().join("reg.json");
-    ok(&mut registry_build(&catalog, &out, &[]));
-    let reg = read_json(&out);
     let g = glass(&reg["tables"][0], 12);
     assert_eq!(g["angle_model"]["kind"], "unit");
     let u = &g["unit"];
@@ -603,10 +605,7 @@ layers = [
 "#,
         t = table.display()
     );
-    let catalog = catalog_with(dir.path(), &body);
-    let out = dir.path().join("reg.json");
-    ok(&mut registry_build(&catalog, &out, &[]));
-    let reg = read_json(&out);
+    let (_, reg) = registry_with(dir.path(), &body, &[]);
     let table_rows: Vec<(f64, f64, f64)> = std::fs::read_to_string(&table)
         .unwrap()
         .lines()
