@@ -5,30 +5,20 @@
 //!
 //! `cargo run --release -p glassdb-compose --example make_bench_inputs -- OUT_DIR WIDTH HEIGHT half|float COMPRESSION`
 
-use std::path::PathBuf;
-
 mod bench_passes;
 
-use glassdb_encode::{ExrDataType, parse_exr_compression};
-use glassdb_mask::{MaskFormat, write_mask};
+use bench_passes::FrameArgs;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
     if a.len() != 6 {
         return Err("usage: make_bench_inputs OUT_DIR WIDTH HEIGHT half|float COMPRESSION".into());
     }
-    let out = PathBuf::from(&a[1]);
-    let (w, h): (u32, u32) = (a[2].parse()?, a[3].parse()?);
-    let ty = if a[4] == "half" {
-        ExrDataType::Half
-    } else {
-        ExrDataType::Float
-    };
-    let compression = parse_exr_compression(&a[5])?;
-    std::fs::create_dir_all(&out)?;
-    bench_passes::write_passes(&out, w as usize, h as usize, ty, compression)?;
-    let mask = bench_passes::half_glass_mask(w, h);
-    write_mask(&out.join("mask.png"), &mask, MaskFormat::Png8)?;
+    let frame = FrameArgs::parse(&a)?;
+    let (out, w, h) = (&frame.out, frame.width, frame.height);
+    std::fs::create_dir_all(out)?;
+    bench_passes::write_passes(&frame)?;
+    bench_passes::write_half_glass_mask(out, w as u32, h as u32)?;
     println!(
         "wrote {}/{{trans.exr, refl.exr, mask.png}} ({w}×{h}, {}, {})",
         out.display(),

@@ -15,7 +15,6 @@ mod bench_passes;
 
 use glassdb_encode::parse_exr_compression;
 use glassdb_image::{DEFAULT_ZIP_LEVEL, ExrPlane, ExrStorage, ExrWriteOptions, write_exr_planes};
-use glassdb_mask::{MaskFormat, write_mask};
 
 /// Writes `path` with the layer `ViewLayer.Combined` (`combined`) and one layer per group.
 fn write_layers(
@@ -99,8 +98,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             )?;
         }
     }
-    let mask = bench_passes::half_glass_mask(w as u32, h as u32);
-    write_mask(&out.join("mask.png"), &mask, MaskFormat::Png8)?;
+    bench_passes::write_half_glass_mask(&out, w as u32, h as u32)?;
     println!(
         "wrote {}/{{groups, g1…g{groups}}}/{{trans,refl}}.exr and mask.png ({w}×{h}, {groups} groups, {}, {})",
         out.display(),

@@ -10,11 +10,10 @@
 //!
 //! `cargo run --release -p glassdb-compose --example make_plane_bench_inputs -- OUT_DIR WIDTH HEIGHT half|float COMPRESSION PLANES [IDS]`
 
-use std::path::PathBuf;
-
 mod bench_passes;
 
-use glassdb_encode::{ExrDataType, parse_exr_compression};
+use bench_passes::FrameArgs;
+use glassdb_encode::ExrDataType;
 use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -32,18 +31,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if ids.is_empty() || ids.contains(&0) {
         return Err("IDS: glass ids 1 or more, separated by commas".into());
     }
-    let out = PathBuf::from(&a[1]);
-    let (w, h): (usize, usize) = (a[2].parse()?, a[3].parse()?);
-    let ty = if a[4] == "half" {
-        ExrDataType::Half
-    } else {
-        ExrDataType::Float
-    };
-    let compression = parse_exr_compression(&a[5])?;
+    let frame = FrameArgs::parse(&a)?;
+    let (out, w, h, ty) = (&frame.out, frame.width, frame.height, frame.data_type);
     let planes: usize = a[6].parse()?;
-    std::fs::create_dir_all(&out)?;
+    std::fs::create_dir_all(out)?;
     let n = w * h;
-    bench_passes::write_passes(&out, w, h, ty, compression)?;
+    bench_passes::write_passes(&frame)?;
 
     // Windows on a grid of 6 columns, each inset by a tenth of its cell on every side.
     let cols = 6;

@@ -2,11 +2,45 @@
 //! a transmission and a reflection pass of smooth gradients plus render-like noise, so that
 //! compression sees realistic data.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use glassdb_encode::{ExrDataType, OutputOptions, write_output};
-use glassdb_mask::{CosTheta, MaskImage};
+use glassdb_encode::{ExrDataType, OutputOptions, parse_exr_compression, write_output};
+use glassdb_mask::{CosTheta, MaskFormat, MaskImage, write_mask};
 use glassdb_pass::{CarriedFrame, LinearImage, PassSource, PngBits};
+
+/// The arguments `make_bench_inputs` and `make_plane_bench_inputs` start with:
+/// `OUT_DIR WIDTH HEIGHT half|float COMPRESSION`.
+#[allow(dead_code)] // not every generator takes these arguments
+pub struct FrameArgs {
+    /// The folder the inputs are written to.
+    pub out: PathBuf,
+    /// The frame's width in pixels.
+    pub width: usize,
+    /// The frame's height in pixels.
+    pub height: usize,
+    /// The passes' sample type (`half`, else float).
+    pub data_type: ExrDataType,
+    /// The passes' EXR compression.
+    pub compression: exr::compression::Compression,
+}
+
+#[allow(dead_code)] // not every generator takes these arguments
+impl FrameArgs {
+    /// Reads them from `a[1..=5]` (`a[0]` is the program).
+    pub fn parse(a: &[String]) -> Result<FrameArgs, Box<dyn std::error::Error>> {
+        Ok(FrameArgs {
+            out: PathBuf::from(&a[1]),
+            width: a[2].parse()?,
+            height: a[3].parse()?,
+            data_type: if a[4] == "half" {
+                ExrDataType::Half
+            } else {
+                ExrDataType::Float
+            },
+            compression: parse_exr_compression(&a[5])?,
+        })
+    }
+}
 
 /// A deterministic hash of `i` in [0, 1).
 fn noise(i: u64) -> f32 {
@@ -47,35 +81,31 @@ pub fn pass_image(w: usize, h: usize, seed: u64, base: [f32; 3]) -> LinearImage 
 #[allow(dead_code)] // not every generator writes these passes
 pub const REFL: (u64, [f32; 3]) = (1 << 40, [0.9, 1.0, 1.2]);
 
-/// Writes `out/trans.exr` and `out/refl.exr`, `w × h`, in `ty` with `compression`.
+/// Writes `frame.out/trans.exr` and `frame.out/refl.exr`, `frame.width × frame.height`, in
+/// `frame.data_type` with `frame.compression`.
 #[allow(dead_code)] // not every generator writes these passes
-pub fn write_passes(
-    out: &Path,
-    w: usize,
-    h: usize,
-    ty: ExrDataType,
-    compression: exr::compression::Compression,
-) -> Result<(), Box<dyn std::error::Error>> {
+pub fn write_passes(frame: &FrameArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let (out, w, h) = (&frame.out, frame.width, frame.height);
     let opts = OutputOptions {
-        exr_data_type: Some(ty),
-        exr_compression: Some(compression),
+        exr_data_type: Some(frame.data_type),
+        exr_compression: Some(frame.compression),
         ..OutputOptions::default()
     };
     let src = PassSource::Png {
         bits: PngBits::Eight,
     };
-    let frame = || CarriedFrame::whole(w as u32, h as u32);
+    let whole = || CarriedFrame::whole(w as u32, h as u32);
     let trans = pass_image(w, h, 1, [0.6, 0.5, 0.4]);
-    write_output(&out.join("trans.exr"), trans, frame(), &src, &opts)?;
+    write_output(&out.join("trans.exr"), trans, whole(), &src, &opts)?;
     let refl = pass_image(w, h, REFL.0, REFL.1);
-    write_output(&out.join("refl.exr"), refl, frame(), &src, &opts)?;
+    write_output(&out.join("refl.exr"), refl, whole(), &src, &opts)?;
     Ok(())
 }
 
 /// The benchmarks' mask, `w × h`: every other quarter of the rows glass (ids 2 and 6 of the
 /// bundled catalog, left and right halves), cos θ varying across the frame, 8-bit.
 #[allow(dead_code)] // not every generator writes this mask
-pub fn half_glass_mask(w: u32, h: u32) -> MaskImage {
+fn half_glass_mask(w: u32, h: u32) -> MaskImage {
     let n = (w * h) as usize;
     let mut id = vec![0u16; n];
     let mut cos = vec![0u8; n];
@@ -94,4 +124,15 @@ pub fn half_glass_mask(w: u32, h: u32) -> MaskImage {
         plane: vec![0; n],
         coverage: None,
     }
+}
+
+/// Writes the benchmarks' mask ([`half_glass_mask`]), `w × h`, as `out/mask.png`.
+#[allow(dead_code)] // not every generator writes this mask
+pub fn write_half_glass_mask(out: &Path, w: u32, h: u32) -> Result<(), Box<dyn std::error::Error>> {
+    write_mask(
+        &out.join("mask.png"),
+        &half_glass_mask(w, h),
+        MaskFormat::Png8,
+    )?;
+    Ok(())
 }
