@@ -307,17 +307,17 @@ fn run_render(a: RenderArgs) -> anyhow::Result<ExitCode> {
     outln!(
         "Blender export {:.2} s, passes {:.2} s{}; planes and masks {:.3} s",
         report.export_s,
-        report.render_s,
+        report.render.wall_s,
         if request.reference {
-            format!(", reference {:.2} s", report.reference_s)
+            format!(", reference {:.2} s", report.reference.wall_s)
         } else {
             String::new()
         },
         report.mask_s
     );
-    if let Some(cpu) = report.render_cpu_s {
+    if let Some(cpu) = report.render.cpu_s {
         out!("Blender CPU: passes {cpu:.2} s");
-        if let Some(r) = report.reference_cpu_s {
+        if let Some(r) = report.reference.cpu_s {
             out!(", reference {r:.2} s");
         }
         outln!();

@@ -23,8 +23,8 @@ pub mod thin_pane;
 pub use error::BlenderError;
 pub use job::{PixelBounds, RunRecord};
 pub use pipeline::{
-    ComposeReport, DEFAULT_MASK_SAMPLES, RegistryChoice, RenderReport, RenderRequest, compose_dir,
-    render,
+    BlenderTime, ComposeReport, DEFAULT_MASK_SAMPLES, RegistryChoice, RenderReport, RenderRequest,
+    compose_dir, render,
 };
 pub use program::{Blender, Launcher};
 pub use swap::{PassGlass, SwapWarning, swap_warnings};

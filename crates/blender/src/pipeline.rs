@@ -114,23 +114,44 @@ pub struct RenderReport {
     pub glass_materials: Vec<(String, u16)>,
     /// Wall seconds of Blender's export.
     pub export_s: f64,
-    /// Wall seconds of Blender's passes.
-    pub render_s: f64,
-    /// Wall seconds of Blender's reference render.
-    pub reference_s: f64,
     /// Wall seconds of glassdb's planes and masks.
     pub mask_s: f64,
-    /// CPU seconds (user + system) of Blender's passes ([`children_cpu_seconds`]), where the
-    /// system says.
-    pub render_cpu_s: Option<f64>,
-    /// CPU seconds of its reference render.
-    pub reference_cpu_s: Option<f64>,
+    /// The time of Blender's passes.
+    pub render: BlenderTime,
+    /// The time of Blender's reference render (0 s when none was asked for).
+    pub reference: BlenderTime,
     /// The composites.
     pub compose: ComposeReport,
     /// Blender's pass renders over all frames, and how many the same frames take without the
     /// light split (`(A + 1)(1 + P)` against `1 + P` per frame: A apertures, P reflection
     /// passes).
     pub renders: (usize, usize),
+}
+
+/// The time one Blender stage took.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BlenderTime {
+    /// Wall seconds.
+    pub wall_s: f64,
+    /// CPU seconds (user + system) of Blender ([`children_cpu_seconds`]), where the system
+    /// says.
+    pub cpu_s: Option<f64>,
+}
+
+impl BlenderTime {
+    /// Runs `stage`, and the time it took.
+    fn of<T>(
+        stage: impl FnOnce() -> Result<T, BlenderError>,
+    ) -> Result<(T, BlenderTime), BlenderError> {
+        let t = Instant::now();
+        let cpu = children_cpu_seconds();
+        let out = stage()?;
+        let wall_s = t.elapsed().as_secs_f64();
+        let cpu_s = children_cpu_seconds()
+            .zip(cpu)
+            .map(|(after, before)| after - before);
+        Ok((out, BlenderTime { wall_s, cpu_s }))
+    }
 }
 
 /// The composites of a run.
@@ -185,11 +206,7 @@ pub fn render(
 
     let renders = crate::light_split::render_counts(&masks.script_frames, request.light_split);
     progress.stage("render passes");
-    let t = Instant::now();
-    let cpu = children_cpu_seconds();
-    let job = render_passes(&work, &mut masks, &lights)?;
-    let render_s = t.elapsed().as_secs_f64();
-    let render_cpu_s = cpu_since(cpu);
+    let (job, render_time) = BlenderTime::of(|| render_passes(&work, &mut masks, &lights))?;
     let lit_by = crate::swap::pass_glasses(masks.glass_materials.iter().map(|m| m.1), registry);
     let record = write_record(
         &work,
@@ -200,14 +217,10 @@ pub fn render(
         lights,
     )?;
 
-    let (mut reference_s, mut reference_cpu_s) = (0.0, None);
+    let mut reference_time = BlenderTime::default();
     if request.reference {
         progress.stage("render reference");
-        let t = Instant::now();
-        let cpu = children_cpu_seconds();
-        render_reference(&work, &record, job, registry)?;
-        reference_s = t.elapsed().as_secs_f64();
-        reference_cpu_s = cpu_since(cpu);
+        reference_time = BlenderTime::of(|| render_reference(&work, &record, job, registry))?.1;
     }
 
     let compose = if request.composite {
@@ -229,11 +242,9 @@ pub fn render(
         planes: masks.planes,
         glass_materials: masks.glass_materials,
         export_s,
-        render_s,
-        reference_s,
         mask_s,
-        render_cpu_s,
-        reference_cpu_s,
+        render: render_time,
+        reference: reference_time,
         compose,
         renders,
     })
@@ -513,11 +524,6 @@ pub fn render_reference(
         rename(&f.trans, &work.dir.join(frame_name("reference", f.frame)))?;
     }
     Ok(())
-}
-
-/// Children's CPU seconds since `before`.
-fn cpu_since(before: Option<f64>) -> Option<f64> {
-    Some(children_cpu_seconds()? - before?)
 }
 
 /// Writes the job and has Blender render it.

@@ -20,8 +20,7 @@ use glassdb_mask::{CosCode, CosTheta, MaskImage};
 use glassdb_side::Side;
 use rayon::prelude::*;
 
-use crate::lut::{GlassLut, GlassSideLut, RtTriple};
-use crate::shares::ShareSideLut;
+use crate::lut::{GlassLut, GlassSideLut, Lerp, RtTriple, SideLut};
 
 mod pane_groups;
 
@@ -291,58 +290,50 @@ impl KernelCounts {
 trait CosLookup: Sync {
     /// The same source restricted to the pixels `range`.
     fn band(&self, range: Range<usize>) -> Self;
-    /// r and t at pixel `j` of the band.
-    fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple;
-    /// A pane group's share of r at pixel `j` of the band.
-    fn share(&self, lut: &ShareSideLut, j: usize) -> [f32; 3];
+    /// The entry of a side's table (r and t, or a pane group's share of r) at pixel `j` of the
+    /// band.
+    fn at<E: Lerp>(&self, lut: &SideLut<E>, j: usize) -> E;
 }
 
+/// A mask's cos θ sample, looked up in a side's table as its kind is.
+trait CosSample: Copy + Sync {
+    /// The entry of `lut` at this sample.
+    fn at<E: Lerp>(self, lut: &SideLut<E>) -> E;
+}
+
+impl CosSample for u8 {
+    #[inline(always)]
+    fn at<E: Lerp>(self, lut: &SideLut<E>) -> E {
+        lut.at_code8(self)
+    }
+}
+impl CosSample for u16 {
+    #[inline(always)]
+    fn at<E: Lerp>(self, lut: &SideLut<E>) -> E {
+        lut.at_cos(CosCode::Bits16.decode_f32(self))
+    }
+}
+impl CosSample for f32 {
+    #[inline(always)]
+    fn at<E: Lerp>(self, lut: &SideLut<E>) -> E {
+        lut.at_cos(self)
+    }
+}
+
+/// A mask's cos θ plane: 8-bit codes, 16-bit codes or floats.
 #[derive(Clone, Copy)]
-struct Code8<'a>(&'a [u8]);
-#[derive(Clone, Copy)]
-struct Code16<'a>(&'a [u16]);
-#[derive(Clone, Copy)]
-struct FloatCos<'a>(&'a [f32]);
+struct Samples<'a, T>(&'a [T]);
+/// A binary mask's: normal incidence everywhere.
 #[derive(Clone, Copy)]
 struct Normal;
 
-impl CosLookup for Code8<'_> {
+impl<T: CosSample> CosLookup for Samples<'_, T> {
     fn band(&self, range: Range<usize>) -> Self {
-        Code8(&self.0[range])
+        Samples(&self.0[range])
     }
     #[inline(always)]
-    fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
-        lut.at_code8(self.0[j])
-    }
-    #[inline(always)]
-    fn share(&self, lut: &ShareSideLut, j: usize) -> [f32; 3] {
-        lut.at_code8(self.0[j])
-    }
-}
-impl CosLookup for Code16<'_> {
-    fn band(&self, range: Range<usize>) -> Self {
-        Code16(&self.0[range])
-    }
-    #[inline(always)]
-    fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
-        lut.at_cos(CosCode::Bits16.decode_f32(self.0[j]))
-    }
-    #[inline(always)]
-    fn share(&self, lut: &ShareSideLut, j: usize) -> [f32; 3] {
-        lut.at_cos(CosCode::Bits16.decode_f32(self.0[j]))
-    }
-}
-impl CosLookup for FloatCos<'_> {
-    fn band(&self, range: Range<usize>) -> Self {
-        FloatCos(&self.0[range])
-    }
-    #[inline(always)]
-    fn rt(&self, lut: &GlassSideLut, j: usize) -> RtTriple {
-        lut.at_cos(self.0[j])
-    }
-    #[inline(always)]
-    fn share(&self, lut: &ShareSideLut, j: usize) -> [f32; 3] {
-        lut.at_cos(self.0[j])
+    fn at<E: Lerp>(&self, lut: &SideLut<E>, j: usize) -> E {
+        self.0[j].at(lut)
     }
 }
 impl CosLookup for Normal {
@@ -350,11 +341,7 @@ impl CosLookup for Normal {
         Normal
     }
     #[inline(always)]
-    fn rt(&self, lut: &GlassSideLut, _j: usize) -> RtTriple {
-        lut.normal
-    }
-    #[inline(always)]
-    fn share(&self, lut: &ShareSideLut, _j: usize) -> [f32; 3] {
+    fn at<E: Lerp>(&self, lut: &SideLut<E>, _j: usize) -> E {
         lut.normal
     }
 }
@@ -383,9 +370,9 @@ pub fn compose_in_place(input: KernelInput<'_>) -> KernelCounts {
         groups: &groups,
     };
     match &mask.cos_theta {
-        CosTheta::Quantized8(c) => sweep.run(trans, &Code8(c)),
-        CosTheta::Quantized16(c) => sweep.run(trans, &Code16(c)),
-        CosTheta::Float(c) => sweep.run(trans, &FloatCos(c)),
+        CosTheta::Quantized8(c) => sweep.run(trans, &Samples(c)),
+        CosTheta::Quantized16(c) => sweep.run(trans, &Samples(c)),
+        CosTheta::Float(c) => sweep.run(trans, &Samples(c)),
         CosTheta::Normal => sweep.run(trans, &Normal),
     }
 }
@@ -463,7 +450,7 @@ impl Sweep<'_> {
                 counts.passthrough_pixels += 1;
                 continue;
             };
-            let rt = cos.rt(lut, j);
+            let rt = cos.at(lut, j);
             composite_pixel(&mut counts, [r_out, g_out, b_out], &rt, [fr, fg, fb]);
         }
         counts
@@ -502,7 +489,7 @@ impl Sweep<'_> {
                 counts.passthrough_pixels += 1;
                 continue;
             };
-            let mut rt = cos.rt(&sides[pass.side], j);
+            let mut rt = cos.at(&sides[pass.side], j);
             if let Some(coverage) = coverage {
                 let k = coverage[j];
                 for c in 0..3 {

@@ -33,7 +33,13 @@ pub struct RtTriple {
     pub t: [f32; 3],
 }
 
-impl RtTriple {
+/// An entry of a side's table, which the fine table interpolates linearly.
+pub trait Lerp: Copy {
+    /// `a + (b − a)·f`, value by value.
+    fn lerp(a: &Self, b: &Self, f: f32) -> Self;
+}
+
+impl Lerp for RtTriple {
     #[inline]
     fn lerp(a: &RtTriple, b: &RtTriple, f: f32) -> RtTriple {
         let mut out = RtTriple::default();
@@ -42,6 +48,13 @@ impl RtTriple {
             out.t[c] = a.t[c] + (b.t[c] - a.t[c]) * f;
         }
         out
+    }
+}
+
+impl Lerp for [f32; 3] {
+    #[inline]
+    fn lerp(a: &[f32; 3], b: &[f32; 3], f: f32) -> [f32; 3] {
+        std::array::from_fn(|c| a[c] + (b[c] - a[c]) * f)
     }
 }
 
@@ -58,32 +71,43 @@ pub(crate) fn fine_position(cos_theta: f32) -> (usize, f32) {
     (i, x - i as f32)
 }
 
-/// One glass seen from one side.
+/// A table of one glass seen from one side, at every cos θ the kernel looks up.
 #[derive(Debug, Clone, PartialEq)]
-pub struct GlassSideLut {
+pub struct SideLut<E> {
     /// At the cos θ of each 8-bit code, `CosCode::decode8(i)`.
-    pub q8: Box<[RtTriple; 256]>,
+    pub q8: Box<[E; 256]>,
     /// At cos θ = i/FINE_STEPS, i = 0…FINE_STEPS.
-    pub fine: Box<[RtTriple; FINE_STEPS + 1]>,
-    /// At normal incidence (r0, t0).
-    pub normal: RtTriple,
+    pub fine: Box<[E; FINE_STEPS + 1]>,
+    /// At normal incidence.
+    pub normal: E,
 }
 
-impl GlassSideLut {
-    /// r and t at an arbitrary cos θ (clamped to [0, 1]; NaN → normal incidence) by linear
+impl<E: Lerp> SideLut<E> {
+    /// The entry at an arbitrary cos θ (clamped to [0, 1]; NaN → normal incidence) by linear
     /// interpolation in the fine table.
     #[inline]
-    pub fn at_cos(&self, cos_theta: f32) -> RtTriple {
+    pub fn at_cos(&self, cos_theta: f32) -> E {
         let (i, f) = fine_position(cos_theta);
-        RtTriple::lerp(&self.fine[i], &self.fine[i + 1], f)
+        E::lerp(&self.fine[i], &self.fine[i + 1], f)
     }
 
     /// At an 8-bit cos θ code: an exact table entry.
     #[inline]
-    pub fn at_code8(&self, code: u8) -> RtTriple {
+    pub fn at_code8(&self, code: u8) -> E {
         self.q8[usize::from(code)]
     }
+
+    /// Every entry: the 8-bit codes', then the fine table's, then normal incidence's.
+    pub fn entries(&self) -> impl Iterator<Item = &E> {
+        self.q8
+            .iter()
+            .chain(self.fine.iter())
+            .chain(std::iter::once(&self.normal))
+    }
 }
+
+/// One glass seen from one side: r and t (at normal incidence r0 and t0).
+pub type GlassSideLut = SideLut<RtTriple>;
 
 /// Per-id lookup for the kernel. Ids not in the table are "unknown".
 #[derive(Debug, Clone)]

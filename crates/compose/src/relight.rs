@@ -12,7 +12,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use glassdb_pass::{Carry, LightMix};
-use glassdb_registry::Registry;
+use glassdb_registry::{Registry, RegistryTable};
 use glassdb_side::Side;
 
 use crate::bands::add_in_bands;
@@ -70,8 +70,9 @@ pub struct PartFactor {
 pub struct ApertureGlass<'a> {
     /// The lookup table the kernel composites with.
     pub lut: &'a GlassLut,
-    /// `t_dif` of an id (the registry's stored hemispherical value), `None` when it has none.
-    pub t_dif: &'a dyn Fn(u16) -> Option<[f64; 3]>,
+    /// The registry table whose records give `t_dif` (their stored hemispherical value);
+    /// `None`, or an id it has no record of: `t_dif` integrated from `lut`.
+    pub table: Option<&'a RegistryTable>,
     /// The registry's name for messages.
     pub registry: &'a str,
 }
@@ -149,7 +150,10 @@ fn part_factor(
             ))
         }
         LightSource::Sky | LightSource::Other => {
-            let t_dif = (glass.t_dif)(id)
+            let t_dif = glass
+                .table
+                .and_then(|t| t.glass(id))
+                .map(|g| g.t_dif())
                 .or_else(|| glass.lut.side(id, Side::Front).map(lut_t_dif))
                 .ok_or_else(unknown)?;
             Ok(done(
@@ -335,15 +339,9 @@ pub fn compose_light_parts(
         progress.stage(decode_stage);
         let t0 = Instant::now();
         let mut plan = crate::plan::plan_frame(&job.inputs, &one.decode, luts, &budget, &target)?;
-        let basis = plan.table.basis;
-        let t_dif = |id: u16| {
-            luts.table(basis)
-                .and_then(|t| t.glass(id))
-                .map(|g| g.t_dif())
-        };
         let glass = ApertureGlass {
             lut: plan.lut,
-            t_dif: &t_dif,
+            table: luts.table(plan.table.basis),
             registry: &settings.decode.registry_label,
         };
         let these = part_factors(members, planes, &job.inputs.mask, &glass)?;

@@ -51,10 +51,9 @@ fn factors_are_the_registry_at_the_suns_angle_and_its_hemispherical_value() {
     let table = reg.default_table();
     let g = table.glass(id).unwrap();
     let lut = GlassLut::from_table(table);
-    let t_dif = |id: u16| table.glass(id).map(|g| g.t_dif());
     let glass = ApertureGlass {
         lut: &lut,
-        t_dif: &t_dif,
+        table: Some(table),
         registry: "bundled",
     };
     let wall = [0.0, -1.0, 0.0];
@@ -148,10 +147,9 @@ fn a_table_without_records_integrates_its_lookup_table() {
         |_, _, c| ([0.0; 3], [0.8 * c; 3]),
         |_, _| ([0.0; 3], [0.8; 3]),
     );
-    let none = |_: u16| None;
     let glass = ApertureGlass {
         lut: &lut,
-        t_dif: &none,
+        table: None,
         registry: "test",
     };
     let sky = part("sky", LightSource::Sky, Some((0, [0.0, 0.0, 1.0], 4)));

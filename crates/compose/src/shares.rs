@@ -8,35 +8,12 @@ use glassdb_mask::CosCode;
 use glassdb_registry::GlassRecord;
 use glassdb_side::Side;
 
-use crate::lut::FINE_STEPS;
+use crate::lut::{FINE_STEPS, SideLut};
 
-/// One pane group's share of the reflectance, seen from one side, per channel.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ShareSideLut {
-    /// At the cos θ of each 8-bit code.
-    pub q8: Box<[[f32; 3]; 256]>,
-    /// At cos θ = i/FINE_STEPS.
-    pub fine: Box<[[f32; 3]; FINE_STEPS + 1]>,
-    /// At normal incidence (the group's `r0`, scaled to the system's).
-    pub normal: [f32; 3],
-}
-
-impl ShareSideLut {
-    /// The share at an arbitrary cos θ (clamped; NaN → normal incidence), interpolated in the
-    /// fine table as [`crate::lut::GlassSideLut::at_cos`] does.
-    #[inline]
-    pub fn at_cos(&self, cos_theta: f32) -> [f32; 3] {
-        let (i, f) = crate::lut::fine_position(cos_theta);
-        let (a, b) = (&self.fine[i], &self.fine[i + 1]);
-        std::array::from_fn(|c| a[c] + (b[c] - a[c]) * f)
-    }
-
-    /// At an 8-bit cos θ code: an exact entry.
-    #[inline]
-    pub fn at_code8(&self, code: u8) -> [f32; 3] {
-        self.q8[usize::from(code)]
-    }
-}
+/// One pane group's share of the reflectance, seen from one side, per channel, tabulated as
+/// [`crate::lut::GlassSideLut`] is (at normal incidence: the group's `r0`, scaled to the
+/// system's).
+pub type ShareSideLut = SideLut<[f32; 3]>;
 
 /// The pane groups of one glass, per side (0 front, 1 back), in the order the rays meet them;
 /// empty for a glass of one group (a monolithic glass or a unit of one pane group).

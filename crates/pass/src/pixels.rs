@@ -119,35 +119,20 @@ impl LinearImage {
         };
         let samples = match bits {
             PngBits::Eight => {
-                let mut out = vec![0u8; n * channels];
-                out.par_chunks_mut(w.max(1) * channels)
-                    .enumerate()
-                    .for_each(|(y, row)| {
-                        for (x, px) in row.chunks_exact_mut(channels).enumerate() {
-                            let threshold = if dither { BAYER8[y % 8][x % 8] } else { 0.5 };
-                            let v = encode_pixel(y, x);
-                            for (c, s) in px.iter_mut().enumerate() {
-                                // Alpha is never dithered.
-                                let t = if c == 3 { 0.5 } else { threshold };
-                                *s = (v[c] * 255.0 + t).floor().clamp(0.0, 255.0) as u8;
-                            }
-                        }
-                    });
-                EncodedSamples::U8(out)
+                EncodedSamples::U8(quantise_rows(w, n, channels, encode_pixel, |y, x, c, v| {
+                    // Alpha is never dithered.
+                    let t = if dither && c != 3 {
+                        BAYER8[y % 8][x % 8]
+                    } else {
+                        0.5
+                    };
+                    (v * 255.0 + t).floor().clamp(0.0, 255.0) as u8
+                }))
             }
             PngBits::Sixteen => {
-                let mut out = vec![0u16; n * channels];
-                out.par_chunks_mut(w.max(1) * channels)
-                    .enumerate()
-                    .for_each(|(y, row)| {
-                        for (x, px) in row.chunks_exact_mut(channels).enumerate() {
-                            let v = encode_pixel(y, x);
-                            for (c, s) in px.iter_mut().enumerate() {
-                                *s = (v[c] * 65535.0 + 0.5).floor().clamp(0.0, 65535.0) as u16;
-                            }
-                        }
-                    });
-                EncodedSamples::U16(out)
+                EncodedSamples::U16(quantise_rows(w, n, channels, encode_pixel, |_, _, _, v| {
+                    (v * 65535.0 + 0.5).floor().clamp(0.0, 65535.0) as u16
+                }))
             }
         };
         EncodedImage {
@@ -157,6 +142,30 @@ impl LinearImage {
             samples,
         }
     }
+}
+
+/// The samples of `n` pixels, `width` a row and `channels` a pixel, filled row by row in
+/// parallel: `quantise(y, x, c, v)` is the sample of channel `c` of pixel (`x`, `y`), whose
+/// encoded value `v` is channel `c` of `encode_pixel(y, x)`.
+fn quantise_rows<S: Copy + Default + Send>(
+    width: usize,
+    n: usize,
+    channels: usize,
+    encode_pixel: impl Fn(usize, usize) -> [f32; 4] + Sync,
+    quantise: impl Fn(usize, usize, usize, f32) -> S + Sync,
+) -> Vec<S> {
+    let mut out = vec![S::default(); n * channels];
+    out.par_chunks_mut(width.max(1) * channels)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, px) in row.chunks_exact_mut(channels).enumerate() {
+                let v = encode_pixel(y, x);
+                for (c, s) in px.iter_mut().enumerate() {
+                    *s = quantise(y, x, c, v[c]);
+                }
+            }
+        });
+    out
 }
 
 /// Bit depth of PNG samples.

@@ -89,12 +89,7 @@ pub fn lut_bytes(sides: [&GlassSideLut; 2], shares: Option<&GroupShares>) -> Vec
     for side in sides {
         for pick in picks {
             let curve = &mut texels[k * curve_len..(k + 1) * curve_len];
-            let entries = side
-                .q8
-                .iter()
-                .chain(side.fine.iter())
-                .chain(std::iter::once(&side.normal));
-            for (texel, e) in curve.chunks_exact_mut(4).zip(entries) {
+            for (texel, e) in curve.chunks_exact_mut(4).zip(side.entries()) {
                 texel[..3].copy_from_slice(&pick(e));
             }
             k += 1;
@@ -106,12 +101,7 @@ pub fn lut_bytes(sides: [&GlassSideLut; 2], shares: Option<&GroupShares>) -> Vec
             for (g, share) in tables.iter().enumerate() {
                 let k = 4 + side * PAGE_GROUPS + g.min(PAGE_GROUPS - 1);
                 let curve = &mut texels[k * curve_len..(k + 1) * curve_len];
-                let entries = share
-                    .q8
-                    .iter()
-                    .chain(share.fine.iter())
-                    .chain(std::iter::once(&share.normal));
-                for (texel, e) in curve.chunks_exact_mut(4).zip(entries) {
+                for (texel, e) in curve.chunks_exact_mut(4).zip(share.entries()) {
                     (0..3).for_each(|c| texel[c] += e[c]);
                 }
             }

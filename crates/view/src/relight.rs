@@ -86,15 +86,9 @@ pub fn with_parts(
         });
         let decoded = decode_frame(&files, &one, luts, budget, &DecodeTarget::display())?;
         if page.is_empty() {
-            let basis = decoded.table.basis;
-            let t_dif = |id: u16| {
-                luts.table(basis)
-                    .and_then(|t| t.glass(id))
-                    .map(|g| g.t_dif())
-            };
             let glass = ApertureGlass {
                 lut: decoded.lut,
-                t_dif: &t_dif,
+                table: luts.table(decoded.table.basis),
                 registry: &settings.registry_label,
             };
             let refs: Vec<&LightPart> = parts.parts.iter().collect();

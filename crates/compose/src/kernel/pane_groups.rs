@@ -165,7 +165,7 @@ impl Sweep<'_> {
                 outside = true;
                 continue;
             };
-            let s = cos.share(share, at.band_index);
+            let s = cos.at(share, at.band_index);
             for c in 0..3 {
                 let w = s[c] * at.coverage;
                 if w != 0.0 {

@@ -33,7 +33,7 @@ impl BandBins {
     pub(super) fn new(order: &DrawOrder, bands: usize, rows_per_band: u32) -> BandBins {
         let mut counts = vec![0u32; bands + 1];
         for c in &order.entries {
-            for b in (c.rows.0 / rows_per_band)..=(c.rows.1 / rows_per_band) {
+            for b in (c.bbox.rows.0 / rows_per_band)..=(c.bbox.rows.1 / rows_per_band) {
                 counts[b as usize + 1] += 1;
             }
         }
@@ -44,7 +44,7 @@ impl BandBins {
         let mut binned = vec![0u32; counts[bands] as usize];
         let mut cover = vec![BandCover::default(); bands];
         for (p, c) in order.entries.iter().enumerate() {
-            let (j0, j1) = c.rows;
+            let (j0, j1) = c.bbox.rows;
             for b in (j0 / rows_per_band)..=(j1 / rows_per_band) {
                 let slot = &mut fill[b as usize];
                 binned[*slot as usize] = p as u32;
@@ -54,7 +54,7 @@ impl BandBins {
                 let in_band = f64::from(j1.min(row1) + 1 - j0.max(row0));
                 let band = &mut cover[b as usize];
                 band.area += c.area * in_band / f64::from(j1 + 1 - j0);
-                band.boxes += f64::from(c.columns.1 + 1 - c.columns.0) * in_band;
+                band.boxes += f64::from(c.bbox.columns.1 + 1 - c.bbox.columns.0) * in_band;
             }
         }
         BandBins {

@@ -13,7 +13,7 @@
 
 use super::bins::{BandCover, BandTriangles};
 use super::edge::CanonicalEdge;
-use super::setup::Setup;
+use super::setup::{PixelBox, Setup};
 
 /// Columns per tile of the occlusion test.
 const TILE: usize = 32;
@@ -41,9 +41,8 @@ pub(super) struct DrawOrder {
 pub(super) struct Candidate {
     /// Its index in the setups.
     pub(super) k: u32,
-    /// Its box's columns and rows.
-    pub(super) columns: (u32, u32),
-    pub(super) rows: (u32, u32),
+    /// Its box.
+    pub(super) bbox: PixelBox,
     /// Its area, pixels.
     pub(super) area: f64,
     /// Its largest possible `1/z` ([`z_bound`]).
@@ -61,8 +60,7 @@ impl DrawOrder {
             .enumerate()
             .map(|(k, s)| Candidate {
                 k: k as u32,
-                columns: (s.i0, s.i1),
-                rows: (s.j0, s.j1),
+                bbox: s.bbox,
                 area: 0.5 / s.inv_area2,
                 z_bound: z_bound(s),
             })
@@ -109,15 +107,21 @@ pub(super) fn nearest_labels(
     for &p in drawn {
         let c = &order.entries[p as usize];
         let k = c.k;
-        let (j0, j1) = (c.rows.0.max(row0), c.rows.1.min(row1));
+        let (j0, j1) = (c.bbox.rows.0.max(row0), c.bbox.rows.1.min(row1));
         let (c0, c1) = match tiles.as_mut() {
             Some(t) => {
-                match t.open_columns(c.columns, c.z_bound, (j1 - j0 + 1) as usize, &depth, ns) {
+                match t.open_columns(
+                    c.bbox.columns,
+                    c.z_bound,
+                    (j1 - j0 + 1) as usize,
+                    &depth,
+                    ns,
+                ) {
                     Some(c) => c,
                     None => continue,
                 }
             }
-            None => c.columns,
+            None => c.bbox.columns,
         };
         let s = &setups[k as usize];
         let edges = s.edges();
@@ -243,7 +247,7 @@ fn column_span(
     rows_terms: &[f64; 3],
     off_x: f64,
 ) -> Option<(u32, u32)> {
-    let (mut lo, mut hi) = (s.i0 as f64, s.i1 as f64);
+    let (mut lo, mut hi) = (s.bbox.columns.0 as f64, s.bbox.columns.1 as f64);
     for (e, &t) in edges.iter().zip(rows_terms) {
         if e.s_dy > 0.0 {
             hi = hi.min((e.ax + t / e.s_dy - off_x).floor() + 1.0);
@@ -268,8 +272,12 @@ fn column_span(
 fn z_bound(s: &Setup) -> f64 {
     let eps = 16.0 * f64::EPSILON;
     let (x, y) = (&s.x, &s.y);
-    let columns = (f64::from(s.i0) - 1.0, f64::from(s.i1) + 2.0);
-    let rows = (f64::from(s.j0) - 1.0, f64::from(s.j1) + 2.0);
+    let PixelBox {
+        columns: (i0, i1),
+        rows: (j0, j1),
+    } = s.bbox;
+    let columns = (f64::from(i0) - 1.0, f64::from(i1) + 2.0);
+    let rows = (f64::from(j0) - 1.0, f64::from(j1) + 2.0);
     let far = |v: f64, (lo, hi): (f64, f64)| (lo - v).abs().max((hi - v).abs());
     let mut terms = 0.0;
     for (a, b) in [(1, 2), (2, 0), (0, 1)] {
@@ -304,17 +312,13 @@ mod tests {
             y.swap(1, 2);
             w.swap(1, 2);
         }
-        let clampi = |v: f64| v.floor().clamp(0.0, f64::from(size - 1)) as u32;
         Setup {
             x,
             y,
             w,
             inv_area2: 1.0 / area2.abs(),
             label,
-            i0: clampi(x[0].min(x[1]).min(x[2])),
-            i1: clampi(x[0].max(x[1]).max(x[2])),
-            j0: clampi(y[0].min(y[1]).min(y[2])),
-            j1: clampi(y[0].max(y[1]).max(y[2])),
+            bbox: PixelBox::of_triangle(&x, &y, size, size),
         }
     }
 
@@ -325,8 +329,12 @@ mod tests {
         let mut winner = vec![0u32; depth.len()];
         for s in setups {
             let edges = s.edges();
-            for j in s.j0..=s.j1.min(rows - 1) {
-                for i in s.i0..=s.i1 {
+            let PixelBox {
+                columns: (i0, i1),
+                rows: (j0, j1),
+            } = s.bbox;
+            for j in j0..=j1.min(rows - 1) {
+                for i in i0..=i1 {
                     for (si, off) in offsets.iter().enumerate() {
                         let (px, py) = (i as f64 + off[0], j as f64 + off[1]);
                         let e: Vec<f64> = edges.iter().map(|e| e.eval(e.row(py), px)).collect();
@@ -364,7 +372,7 @@ mod tests {
                 // Few depth levels, so that many samples tie; some triangles repeat exactly.
                 let w = [0, 1, 2].map(|_| 0.1 + (lcg(&mut state) * 4.0).floor() * 0.1);
                 let s = setup(x, y, w, k + 1, width);
-                if s.j0 >= rows {
+                if s.bbox.rows.0 >= rows {
                     continue;
                 }
                 if k % 7 == 0 {

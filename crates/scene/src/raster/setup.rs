@@ -64,11 +64,33 @@ pub(super) struct Setup {
     pub(super) w: [f64; 3],
     pub(super) inv_area2: f64,
     pub(super) label: u32,
-    /// Pixel bounding box, inclusive.
-    pub(super) i0: u32,
-    pub(super) i1: u32,
-    pub(super) j0: u32,
-    pub(super) j1: u32,
+    /// Pixel bounding box.
+    pub(super) bbox: PixelBox,
+}
+
+/// A box of whole pixels, inclusive: columns `columns.0..=columns.1`, rows `rows.0..=rows.1`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct PixelBox {
+    pub(super) columns: (u32, u32),
+    pub(super) rows: (u32, u32),
+}
+
+impl PixelBox {
+    /// The pixels of a `width` × `height` image that the box of a triangle with corners
+    /// (`x`, `y`) touches (clamped to the image).
+    pub(super) fn of_triangle(x: &[f64; 3], y: &[f64; 3], width: u32, height: u32) -> PixelBox {
+        let clampi = |v: f64, hi: u32| -> u32 { v.floor().clamp(0.0, (hi - 1) as f64) as u32 };
+        PixelBox {
+            columns: (
+                clampi(x[0].min(x[1]).min(x[2]), width),
+                clampi(x[0].max(x[1]).max(x[2]), width),
+            ),
+            rows: (
+                clampi(y[0].min(y[1]).min(y[2]), height),
+                clampi(y[0].max(y[1]).max(y[2]), height),
+            ),
+        }
+    }
 }
 
 impl Setup {
@@ -129,16 +151,12 @@ fn make_setup(cam: &Camera, c: [Vec3; 3], label: u32) -> Option<Setup> {
     if xmax < 0.0 || ymax < 0.0 || xmin > wf || ymin > hf {
         return None;
     }
-    let clampi = |v: f64, hi: u32| -> u32 { v.floor().clamp(0.0, (hi - 1) as f64) as u32 };
     Some(Setup {
         x,
         y,
         w,
         inv_area2: 1.0 / area2.abs(),
         label,
-        i0: clampi(xmin, cam.width),
-        i1: clampi(xmax, cam.width),
-        j0: clampi(ymin, cam.height),
-        j1: clampi(ymax, cam.height),
+        bbox: PixelBox::of_triangle(&x, &y, cam.width, cam.height),
     })
 }
