@@ -52,7 +52,7 @@ pub fn stack_figure(
             let points = angles
                 .iter()
                 .zip(system)
-                .map(|(&a, o)| (a, o.share_front[g]))
+                .map(|(&a, o)| (a, o.share.front[g]))
                 .collect();
             let label = format!("Rf share of pane group {}", g + 1);
             unit.lines
