@@ -34,44 +34,66 @@ pub fn palette(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
-/// A polyline. Non-finite points break the line (they are never joined across).
+/// A plotted series: points in data coordinates, their colour and legend entry, drawn in the
+/// style `S` ([`Line`] and [`Markers`]).
 #[derive(Debug, Clone)]
-pub struct Line {
+pub struct Series<S> {
     /// Its legend entry, if any.
     pub label: Option<String>,
     /// Its colour.
     pub colour: RGBColor,
-    /// Drawn dashed.
-    pub dashed: bool,
-    /// Stroke width in pixels.
-    pub width: u32,
+    /// How it is drawn.
+    pub style: S,
     /// Its points, in data coordinates.
     pub points: Vec<(f64, f64)>,
 }
 
-impl Line {
-    /// A solid line, 2 px wide.
+impl<S> Series<S> {
+    /// `points` drawn in `style` and `colour`, with an optional legend entry.
     pub fn new(
         label: impl Into<Option<String>>,
         colour: RGBColor,
+        style: S,
         points: Vec<(f64, f64)>,
     ) -> Self {
         Self {
             label: label.into(),
             colour,
-            dashed: false,
-            width: 2,
+            style,
             points,
         }
     }
+}
+
+/// How a [`Line`] is stroked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Stroke {
+    /// Drawn dashed.
+    pub dashed: bool,
+    /// Stroke width in pixels.
+    pub width: u32,
+}
+
+impl Stroke {
+    /// A solid line, 2 px wide.
+    pub const SOLID: Stroke = Stroke {
+        dashed: false,
+        width: 2,
+    };
+}
+
+/// A polyline. Non-finite points break the line (they are never joined across).
+pub type Line = Series<Stroke>;
+
+impl Line {
     /// The same line, dashed.
     pub fn dashed(mut self) -> Self {
-        self.dashed = true;
+        self.style.dashed = true;
         self
     }
     /// The same line with another stroke width in pixels.
     pub fn width(mut self, px: u32) -> Self {
-        self.width = px;
+        self.style.width = px;
         self
     }
 }
@@ -89,38 +111,17 @@ pub enum MarkerShape {
     Square,
 }
 
-/// A set of markers (measured points, marked channel values).
-#[derive(Debug, Clone)]
-pub struct Markers {
-    /// Its legend entry, if any.
-    pub label: Option<String>,
-    /// Its colour.
-    pub colour: RGBColor,
+/// How [`Markers`] are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Marker {
     /// Its shape.
     pub shape: MarkerShape,
     /// Its size in pixels.
     pub size: u32,
-    /// Its points, in data coordinates.
-    pub points: Vec<(f64, f64)>,
 }
 
-impl Markers {
-    /// Markers of `shape` at `points`, 4 pixels, with an optional legend entry.
-    pub fn new(
-        label: impl Into<Option<String>>,
-        colour: RGBColor,
-        shape: MarkerShape,
-        points: Vec<(f64, f64)>,
-    ) -> Self {
-        Self {
-            label: label.into(),
-            colour,
-            shape,
-            size: 4,
-            points,
-        }
-    }
-}
+/// A set of markers (measured points, marked channel values).
+pub type Markers = Series<Marker>;
 
 /// A shaded vertical band from `x0` to `x1` over the whole height of the panel.
 #[derive(Debug, Clone)]
@@ -552,10 +553,11 @@ fn draw_lines<'a, DB: DrawingBackend + 'a>(
 ) -> Result<bool, PlotError> {
     let mut any_label = false;
     for line in &panel.lines {
-        let style = line.colour.stroke_width(line.width);
+        let Stroke { dashed, width } = line.style;
+        let style = line.colour.stroke_width(width);
         let mut labelled = false;
         for run in clipped_runs(&line.points, (x0, x1), (y0, y1)) {
-            let anno = if line.dashed {
+            let anno = if dashed {
                 chart
                     .draw_series(DashedLineSeries::new(run, 9, 6, style))
                     .map_err(draw_err)?
@@ -567,7 +569,7 @@ fn draw_lines<'a, DB: DrawingBackend + 'a>(
             if let (Some(l), false) = (&line.label, labelled) {
                 labelled = true;
                 any_label = true;
-                let (colour, dashed, width) = (line.colour, line.dashed, line.width);
+                let colour = line.colour;
                 anno.label(l.as_str()).legend(move |(x, y)| {
                     let style = colour.stroke_width(width);
                     if dashed {
@@ -606,7 +608,7 @@ fn draw_markers<'a, DB: DrawingBackend + 'a>(
         if inside.is_empty() {
             continue;
         }
-        let (colour, size) = (m.colour, m.size);
+        let (colour, size) = (m.colour, m.style.size);
         let sz = size as i32;
         // Each shape is its own element type, so each gets its own series.
         macro_rules! draw_markers {
@@ -623,7 +625,7 @@ fn draw_markers<'a, DB: DrawingBackend + 'a>(
                 }
             }};
         }
-        match m.shape {
+        match m.style.shape {
             MarkerShape::Circle => draw_markers!(p => Circle::new(p, size, colour.filled())),
             MarkerShape::Cross => draw_markers!(p => Cross::new(p, size, colour.stroke_width(2))),
             MarkerShape::Triangle => {
