@@ -486,20 +486,25 @@ pub fn draw_panel<DB: DrawingBackend>(
         .draw()
         .map_err(draw_err)?;
 
-    let mut any_label = draw_shades(&mut chart, panel, (x0, x1), (y0, y1))?;
+    let mut plot = PanelPlot {
+        chart: &mut chart,
+        x: (x0, x1),
+        y: (y0, y1),
+    };
+    let mut any_label = plot.shades(&panel.shades)?;
     if panel.zero_line && y0 < 0.0 && y1 > 0.0 {
-        chart
+        plot.chart
             .draw_series(std::iter::once(PathElement::new(
                 vec![(x0, 0.0), (x1, 0.0)],
                 BLACK.mix(0.55).stroke_width(1),
             )))
             .map_err(draw_err)?;
     }
-    any_label |= draw_lines(&mut chart, panel, (x0, x1), (y0, y1))?;
-    any_label |= draw_markers(&mut chart, panel, (x0, x1), (y0, y1))?;
+    any_label |= plot.lines(&panel.lines)?;
+    any_label |= plot.markers(&panel.markers)?;
     for a in &panel.annotations {
         if a.x.is_finite() && a.y.is_finite() && a.x >= x0 && a.x <= x1 && a.y >= y0 && a.y <= y1 {
-            chart
+            plot.chart
                 .draw_series(std::iter::once(Text::new(
                     a.text.clone(),
                     (a.x, a.y),
@@ -509,165 +514,159 @@ pub fn draw_panel<DB: DrawingBackend>(
         }
     }
     if let (Some(corner), true) = (panel.legend, any_label) {
-        draw_legend(&mut chart, panel, corner, (x0, x1), (y0, y1))?;
+        plot.legend(panel, corner)?;
     }
     Ok(())
 }
 
-/// The shaded x ranges (clipped to the panel); whether one has a label.
-fn draw_shades<'a, DB: DrawingBackend + 'a>(
-    chart: &mut PanelChart<'a, DB>,
-    panel: &Panel,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Result<bool, PlotError> {
-    let mut any_label = false;
-    for s in &panel.shades {
-        let (sx0, sx1) = (s.x0.max(x0), s.x1.min(x1));
-        if sx1.partial_cmp(&sx0) != Some(std::cmp::Ordering::Greater) {
-            continue;
-        }
-        let colour = s.colour;
-        let anno = chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [(sx0, y0), (sx1, y1)],
-                colour.mix(0.16).filled(),
-            )))
-            .map_err(draw_err)?;
-        if let Some(l) = &s.label {
-            any_label = true;
-            anno.label(l.as_str()).legend(move |(x, y)| {
-                Rectangle::new([(x, y - 6), (x + 18, y + 6)], colour.mix(0.3).filled())
-            });
-        }
-    }
-    Ok(any_label)
+/// A panel's chart and the x and y ranges it shows, into which its parts are drawn.
+struct PanelPlot<'c, 'a, DB: DrawingBackend> {
+    chart: &'c mut PanelChart<'a, DB>,
+    x: (f64, f64),
+    y: (f64, f64),
 }
 
-/// The lines, each clipped into runs inside the panel; whether one has a label.
-fn draw_lines<'a, DB: DrawingBackend + 'a>(
-    chart: &mut PanelChart<'a, DB>,
-    panel: &Panel,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Result<bool, PlotError> {
-    let mut any_label = false;
-    for line in &panel.lines {
-        let Stroke { dashed, width } = line.style;
-        let style = line.colour.stroke_width(width);
-        let mut labelled = false;
-        for run in clipped_runs(&line.points, (x0, x1), (y0, y1)) {
-            let anno = if dashed {
-                chart
-                    .draw_series(DashedLineSeries::new(run, 9, 6, style))
-                    .map_err(draw_err)?
-            } else {
-                chart
-                    .draw_series(LineSeries::new(run, style))
-                    .map_err(draw_err)?
-            };
-            if let (Some(l), false) = (&line.label, labelled) {
-                labelled = true;
+impl<'a, DB: DrawingBackend + 'a> PanelPlot<'_, 'a, DB> {
+    /// The shaded x ranges (clipped to the panel); whether one has a label.
+    fn shades(&mut self, shades: &[Shade]) -> Result<bool, PlotError> {
+        let (chart, (x0, x1), (y0, y1)) = (&mut *self.chart, self.x, self.y);
+        let mut any_label = false;
+        for s in shades {
+            let (sx0, sx1) = (s.x0.max(x0), s.x1.min(x1));
+            if sx1.partial_cmp(&sx0) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            let colour = s.colour;
+            let anno = chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(sx0, y0), (sx1, y1)],
+                    colour.mix(0.16).filled(),
+                )))
+                .map_err(draw_err)?;
+            if let Some(l) = &s.label {
                 any_label = true;
-                let colour = line.colour;
                 anno.label(l.as_str()).legend(move |(x, y)| {
-                    let style = colour.stroke_width(width);
-                    if dashed {
-                        EmptyElement::at((x, y))
-                            + PathElement::new(vec![(0, 0), (7, 0)], style)
-                            + PathElement::new(vec![(11, 0), (18, 0)], style)
-                    } else {
-                        EmptyElement::at((x, y))
-                            + PathElement::new(vec![(0, 0), (18, 0)], style)
-                            + PathElement::new(vec![(0, 0), (0, 0)], style)
-                    }
+                    Rectangle::new([(x, y - 6), (x + 18, y + 6)], colour.mix(0.3).filled())
                 });
             }
         }
+        Ok(any_label)
     }
-    Ok(any_label)
-}
 
-/// The markers inside the panel; whether a series of them has a label.
-fn draw_markers<'a, DB: DrawingBackend + 'a>(
-    chart: &mut PanelChart<'a, DB>,
-    panel: &Panel,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Result<bool, PlotError> {
-    let mut any_label = false;
-    for m in &panel.markers {
-        let inside: Vec<(f64, f64)> = m
-            .points
-            .iter()
-            .copied()
-            .filter(|&(x, y)| {
-                x.is_finite() && y.is_finite() && x >= x0 && x <= x1 && y >= y0 && y <= y1
-            })
-            .collect();
-        if inside.is_empty() {
-            continue;
-        }
-        let (colour, size) = (m.colour, m.style.size);
-        let sz = size as i32;
-        // Each shape is its own element type, so each gets its own series.
-        macro_rules! draw_markers {
-            ($p:ident => $make:expr) => {{
-                let anno = chart
-                    .draw_series(inside.into_iter().map(|$p| $make))
-                    .map_err(draw_err)?;
-                if let Some(l) = &m.label {
+    /// The lines, each clipped into runs inside the panel; whether one has a label.
+    fn lines(&mut self, lines: &[Line]) -> Result<bool, PlotError> {
+        let (chart, (x0, x1), (y0, y1)) = (&mut *self.chart, self.x, self.y);
+        let mut any_label = false;
+        for line in lines {
+            let Stroke { dashed, width } = line.style;
+            let style = line.colour.stroke_width(width);
+            let mut labelled = false;
+            for run in clipped_runs(&line.points, (x0, x1), (y0, y1)) {
+                let anno = if dashed {
+                    chart
+                        .draw_series(DashedLineSeries::new(run, 9, 6, style))
+                        .map_err(draw_err)?
+                } else {
+                    chart
+                        .draw_series(LineSeries::new(run, style))
+                        .map_err(draw_err)?
+                };
+                if let (Some(l), false) = (&line.label, labelled) {
+                    labelled = true;
                     any_label = true;
+                    let colour = line.colour;
                     anno.label(l.as_str()).legend(move |(x, y)| {
-                        let $p = (x + 9, y);
-                        $make
+                        let style = colour.stroke_width(width);
+                        if dashed {
+                            EmptyElement::at((x, y))
+                                + PathElement::new(vec![(0, 0), (7, 0)], style)
+                                + PathElement::new(vec![(11, 0), (18, 0)], style)
+                        } else {
+                            EmptyElement::at((x, y))
+                                + PathElement::new(vec![(0, 0), (18, 0)], style)
+                                + PathElement::new(vec![(0, 0), (0, 0)], style)
+                        }
                     });
                 }
-            }};
-        }
-        match m.style.shape {
-            MarkerShape::Circle => draw_markers!(p => Circle::new(p, size, colour.filled())),
-            MarkerShape::Cross => draw_markers!(p => Cross::new(p, size, colour.stroke_width(2))),
-            MarkerShape::Triangle => {
-                draw_markers!(p => TriangleMarker::new(p, size, colour.filled()))
             }
-            MarkerShape::Square => draw_markers!(p => {
-                EmptyElement::at(p) + Rectangle::new([(-sz, -sz), (sz, sz)], colour.filled())
-            }),
         }
+        Ok(any_label)
     }
-    Ok(any_label)
-}
 
-/// The legend in `corner` (chosen where the data leave room, for `Auto`).
-fn draw_legend<'a, DB: DrawingBackend + 'a>(
-    chart: &mut PanelChart<'a, DB>,
-    panel: &Panel,
-    corner: LegendCorner,
-    x_range: (f64, f64),
-    y_range: (f64, f64),
-) -> Result<(), PlotError> {
-    let position = match corner {
-        LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
-        LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
-        LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
-        LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
-        LegendCorner::MiddleRight => SeriesLabelPosition::MiddleRight,
-        LegendCorner::MiddleLeft => SeriesLabelPosition::MiddleLeft,
-        LegendCorner::UpperMiddle => SeriesLabelPosition::UpperMiddle,
-        LegendCorner::LowerMiddle => SeriesLabelPosition::LowerMiddle,
-        LegendCorner::Auto => {
-            let (pw, ph) = chart.plotting_area().dim_in_pixel();
-            auto_legend_position(panel, x_range, y_range, (pw, ph))
+    /// The markers inside the panel; whether a series of them has a label.
+    fn markers(&mut self, markers: &[Markers]) -> Result<bool, PlotError> {
+        let (chart, (x0, x1), (y0, y1)) = (&mut *self.chart, self.x, self.y);
+        let mut any_label = false;
+        for m in markers {
+            let inside: Vec<(f64, f64)> = m
+                .points
+                .iter()
+                .copied()
+                .filter(|&(x, y)| {
+                    x.is_finite() && y.is_finite() && x >= x0 && x <= x1 && y >= y0 && y <= y1
+                })
+                .collect();
+            if inside.is_empty() {
+                continue;
+            }
+            let (colour, size) = (m.colour, m.style.size);
+            let sz = size as i32;
+            // Each shape is its own element type, so each gets its own series.
+            macro_rules! draw_markers {
+                ($p:ident => $make:expr) => {{
+                    let anno = chart
+                        .draw_series(inside.into_iter().map(|$p| $make))
+                        .map_err(draw_err)?;
+                    if let Some(l) = &m.label {
+                        any_label = true;
+                        anno.label(l.as_str()).legend(move |(x, y)| {
+                            let $p = (x + 9, y);
+                            $make
+                        });
+                    }
+                }};
+            }
+            match m.style.shape {
+                MarkerShape::Circle => draw_markers!(p => Circle::new(p, size, colour.filled())),
+                MarkerShape::Cross => {
+                    draw_markers!(p => Cross::new(p, size, colour.stroke_width(2)))
+                }
+                MarkerShape::Triangle => {
+                    draw_markers!(p => TriangleMarker::new(p, size, colour.filled()))
+                }
+                MarkerShape::Square => draw_markers!(p => {
+                    EmptyElement::at(p) + Rectangle::new([(-sz, -sz), (sz, sz)], colour.filled())
+                }),
+            }
         }
-    };
-    chart
-        .configure_series_labels()
-        .position(position)
-        .label_font((FAMILY, 13))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.35))
-        .draw()
-        .map_err(draw_err)?;
-    Ok(())
+        Ok(any_label)
+    }
+
+    /// The legend of `panel` in `corner` (chosen where the data leave room, for `Auto`).
+    fn legend(&mut self, panel: &Panel, corner: LegendCorner) -> Result<(), PlotError> {
+        let chart = &mut *self.chart;
+        let position = match corner {
+            LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
+            LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
+            LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
+            LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
+            LegendCorner::MiddleRight => SeriesLabelPosition::MiddleRight,
+            LegendCorner::MiddleLeft => SeriesLabelPosition::MiddleLeft,
+            LegendCorner::UpperMiddle => SeriesLabelPosition::UpperMiddle,
+            LegendCorner::LowerMiddle => SeriesLabelPosition::LowerMiddle,
+            LegendCorner::Auto => {
+                let (pw, ph) = chart.plotting_area().dim_in_pixel();
+                auto_legend_position(panel, self.x, self.y, (pw, ph))
+            }
+        };
+        chart
+            .configure_series_labels()
+            .position(position)
+            .label_font((FAMILY, 13))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.35))
+            .draw()
+            .map_err(draw_err)?;
+        Ok(())
+    }
 }
