@@ -127,7 +127,7 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
     let mut groups_reversed = vec![zero; ng];
     let mut abs = vec![0.0; nl];
     let mut shares = vec![0.0; ng];
-    let mut scratch = vec![0.0; nl.max(ng) + 1];
+    let mut r_behind = vec![0.0; nl.max(ng) + 1];
     for i in 0..n {
         for (r, l) in rt.iter_mut().zip(layers) {
             *r = Rt {
@@ -143,7 +143,7 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         from_both_sides(
             &rt,
             &mut reversed,
-            (&mut abs, &mut scratch),
+            (&mut abs, &mut r_behind),
             absorptances,
             &mut out.absorptance,
             i,
@@ -155,7 +155,7 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         from_both_sides(
             &group_rt,
             &mut groups_reversed,
-            (&mut shares, &mut scratch),
+            (&mut shares, &mut r_behind),
             reflectance_shares,
             &mut out.share,
             i,
@@ -166,23 +166,26 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
 
 /// `per_item` (absorptances, reflectance shares) of `items` lit from the front, then from the
 /// back (`items` in reverse order, each turned round, in `reversed`), written at sample `i` of
-/// `out`'s front and back, both indexed as `items` are.
+/// `out`'s front and back, both indexed as `items` are. `per_item` is given the reflectance
+/// behind each item ([`reflectance_behind`], computed into `r_behind`).
 fn from_both_sides(
     items: &[Rt],
     reversed: &mut [Rt],
-    (values, scratch): (&mut [f64], &mut [f64]),
-    per_item: fn(&[Rt], &mut [f64], &mut [f64]),
+    (values, r_behind): (&mut [f64], &mut [f64]),
+    per_item: fn(&[Rt], &[f64], &mut [f64]),
     out: &mut FrontBack<Vec<Vec<f64>>>,
     i: usize,
 ) {
-    per_item(items, values, scratch);
+    reflectance_behind(items, r_behind);
+    per_item(items, r_behind, values);
     for (f, v) in out.front.iter_mut().zip(values.iter()) {
         f[i] = *v;
     }
     for (r, l) in reversed.iter_mut().zip(items.iter().rev()) {
         *r = l.reversed();
     }
-    per_item(reversed, values, scratch);
+    reflectance_behind(reversed, r_behind);
+    per_item(reversed, r_behind, values);
     for (b, v) in out.back.iter_mut().rev().zip(values.iter()) {
         b[i] = *v;
     }
@@ -200,14 +203,13 @@ fn reflectance_behind(items: &[Rt], r_behind: &mut [f64]) {
     }
 }
 
-/// Absorptance of each layer for unit flux arriving at the first (eqs. 4–5): from the last
-/// layer forwards, `r_k = Rf_k + T_k²·r_{k+1}/(1 − Rb_k·r_{k+1})` is the reflectance of layers
-/// k… and `τ_k = T_k/(1 − Rb_k·r_{k+1})` the flux layer k passes on per unit arriving; then
-/// `I⁻_0 = 1`, `I⁻_{k+1} = τ_k·I⁻_k`, `I⁺_k = r_{k+1}·I⁻_{k+1}` and
+/// Absorptance of each layer for unit flux arriving at the first (eqs. 4–5): with
+/// `r_k = Rf_k + T_k²·r_{k+1}/(1 − Rb_k·r_{k+1})` the reflectance of layers k… (`r_behind`,
+/// [`reflectance_behind`]), `τ_k = T_k/(1 − Rb_k·r_{k+1})` is the flux layer k passes on per
+/// unit arriving; then `I⁻_0 = 1`, `I⁻_{k+1} = τ_k·I⁻_k`, `I⁺_k = r_{k+1}·I⁻_{k+1}` and
 /// `A_k = I⁻_k·(1 − T_k − Rf_k) + I⁺_k·(1 − T_k − Rb_k)`.
-fn absorptances(layers: &[Rt], abs: &mut [f64], r_behind: &mut [f64]) {
+fn absorptances(layers: &[Rt], r_behind: &[f64], abs: &mut [f64]) {
     let n = layers.len();
-    reflectance_behind(layers, r_behind);
     let mut down = 1.0;
     for k in 0..n {
         let l = layers[k];
@@ -222,9 +224,9 @@ fn absorptances(layers: &[Rt], abs: &mut [f64], r_behind: &mut [f64]) {
 /// Each group's share of the reflectance of `groups` in series (eq. 6): with `B_k` the groups
 /// k… combined, `s_1 = Rf(G_1)`, and `s_k = Π_{j<k} T_j²/(1 − Rb(G_j)·Rf(B_{j+1})) · Rf(G_k)`:
 /// light first reflected by group k, with every interreflection in front of it; Σ s_k = Rf(B_1).
-fn reflectance_shares(groups: &[Rt], shares: &mut [f64], r_behind: &mut [f64]) {
+/// `r_behind[k]` is `Rf(B_k)` ([`reflectance_behind`]).
+fn reflectance_shares(groups: &[Rt], r_behind: &[f64], shares: &mut [f64]) {
     let n = groups.len();
-    reflectance_behind(groups, r_behind);
     let mut reach = 1.0;
     for k in 0..n {
         let g = groups[k];
