@@ -310,14 +310,14 @@ fn optics_json<V: serde::Serialize + Clone>(per_angle: &[Optics<V>], absorptance
         "Rf": column(per_angle, |o| o.rf.clone()),
         "Rb": column(per_angle, |o| o.rb.clone()),
         "group_shares": {
-            "front": column(per_angle, |o| o.share_front.clone()),
-            "back": column(per_angle, |o| o.share_back.clone()),
+            "front": column(per_angle, |o| o.share.front.clone()),
+            "back": column(per_angle, |o| o.share.back.clone()),
         },
     });
     if absorptance {
         v["absorptance"] = json!({
-            "front": column(per_angle, |o| o.absorptance_front.clone()),
-            "back": column(per_angle, |o| o.absorptance_back.clone()),
+            "front": column(per_angle, |o| o.absorptance.front.clone()),
+            "back": column(per_angle, |o| o.absorptance.back.clone()),
         });
     }
     v

@@ -222,8 +222,7 @@ fn judge(
 /// Warnings for the angles given on several rows (averaged).
 fn repeated_angle_warnings(table: &GlassAngleTable) -> Vec<String> {
     table
-        .repeated_angles
-        .iter()
+        .repeated_angles()
         .map(|rep| {
             let mut spreads = Vec::new();
             if let Some(s) = rep.reflectance_spread {
@@ -235,7 +234,7 @@ fn repeated_angle_warnings(table: &GlassAngleTable) -> Vec<String> {
             format!(
                 "angle {}° given on {} rows: averaged ({})",
                 rep.angle_deg,
-                rep.rows,
+                rep.lines.len(),
                 spreads.join(", ")
             )
         })

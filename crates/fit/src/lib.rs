@@ -50,6 +50,6 @@ pub use solve::{
     EXTRAPOLATION_MARGIN_DEG, LOO_GUARD_FACTOR, MAX_DEGREE, SUSPECT_STUDENTIZED, fit_curve,
 };
 pub use table::{
-    ANGLE_TABLE_FILE, AngleRows, GlassAngleTable, MAX_TABLE_BYTES, RepeatedAngle,
-    parse_angle_table, read_angle_table,
+    ANGLE_TABLE_FILE, AngleRows, GlassAngleTable, MAX_TABLE_BYTES, parse_angle_table,
+    read_angle_table,
 };

@@ -20,26 +20,25 @@ pub const ANGLE_TABLE_FILE: glassdb_io::InputLimit =
 /// Largest angle table read (bytes).
 pub const MAX_TABLE_BYTES: u64 = ANGLE_TABLE_FILE.bytes;
 
-/// An angle that appeared on more than one row of a glass: the values were averaged.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RepeatedAngle {
-    /// The repeated angle (degrees).
-    pub angle_deg: f64,
-    /// How many rows gave this angle.
-    pub rows: usize,
-    /// Largest minus smallest R among those rows (None: R not measured there).
-    pub reflectance_spread: Option<f64>,
-    /// Largest minus smallest T among those rows (None: T not measured there).
-    pub transmittance_spread: Option<f64>,
-}
-
-/// Where one angle of a glass was read: the file's line numbers of its rows (1-based).
+/// One distinct angle of a glass as read: the file's line numbers of its rows (1-based) and,
+/// when the angle is repeated (its values averaged), how far those rows disagree.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AngleRows {
     /// The angle of incidence (degrees).
     pub angle_deg: f64,
     /// The lines of the rows that give this angle, ascending (several when it is repeated).
     pub lines: Vec<u64>,
+    /// Largest minus smallest R among those rows (None: R not measured there).
+    pub reflectance_spread: Option<f64>,
+    /// Largest minus smallest T among those rows (None: T not measured there).
+    pub transmittance_spread: Option<f64>,
+}
+
+impl AngleRows {
+    /// Whether the angle was given on more than one row (its values were averaged).
+    pub fn is_repeated(&self) -> bool {
+        self.lines.len() > 1
+    }
 }
 
 /// The measured curves of one glass, sorted by angle, repeated angles averaged.
@@ -53,8 +52,6 @@ pub struct GlassAngleTable {
     pub reflectance: Option<AngleSamples>,
     /// The transmittance curve, if the table has T values for this glass.
     pub transmittance: Option<AngleSamples>,
-    /// Angles given on several rows (averaged), ascending.
-    pub repeated_angles: Vec<RepeatedAngle>,
     /// The rows of each distinct angle, ascending by angle.
     pub rows: Vec<AngleRows>,
 }
@@ -68,6 +65,11 @@ impl GlassAngleTable {
             p.lines = self.lines_of(p.angle_deg).to_vec();
         }
         screening
+    }
+
+    /// The angles given on several rows (averaged), ascending.
+    pub fn repeated_angles(&self) -> impl Iterator<Item = &AngleRows> {
+        self.rows.iter().filter(|r| r.is_repeated())
     }
 
     /// The file lines that give `angle_deg` (empty when the table has no such angle).
@@ -515,7 +517,6 @@ fn group(rows: Vec<Row>, path: &Path, divisor: f64) -> Result<Vec<GlassAngleTabl
         });
         let mut r = AngleSamples::default();
         let mut t = AngleSamples::default();
-        let mut repeated = Vec::new();
         let mut angle_rows = Vec::new();
         let mut i = 0;
         while i < rows.len() {
@@ -543,17 +544,11 @@ fn group(rows: Vec<Row>, path: &Path, divisor: f64) -> Result<Vec<GlassAngleTabl
                 t.angle_deg.push(angle);
                 t.value.push(mean(&ts));
             }
-            if group.len() > 1 {
-                repeated.push(RepeatedAngle {
-                    angle_deg: angle,
-                    rows: group.len(),
-                    reflectance_spread: spread(&rs),
-                    transmittance_spread: spread(&ts),
-                });
-            }
             angle_rows.push(AngleRows {
                 angle_deg: angle,
                 lines: group.iter().map(|row| row.line).collect(),
+                reflectance_spread: spread(&rs),
+                transmittance_spread: spread(&ts),
             });
             i = j;
         }
@@ -568,7 +563,6 @@ fn group(rows: Vec<Row>, path: &Path, divisor: f64) -> Result<Vec<GlassAngleTabl
             path: path.to_path_buf(),
             reflectance: (!r.angle_deg.is_empty()).then_some(r),
             transmittance: (!t.angle_deg.is_empty()).then_some(t),
-            repeated_angles: repeated,
             rows: angle_rows,
         });
     }

@@ -683,9 +683,10 @@ fn reader_accepts_variants_any_order_and_averages_repeats() {
     assert!((r.value[2] - 0.11).abs() < 1e-15);
     let tr = t[0].transmittance.as_ref().unwrap();
     assert_eq!(tr.angle_deg, vec![0.0, 60.0]); // the empty T cell at 30° is "not measured"
-    assert_eq!(t[0].repeated_angles.len(), 1);
-    assert_eq!(t[0].repeated_angles[0].rows, 2);
-    assert!((t[0].repeated_angles[0].reflectance_spread.unwrap() - 0.02).abs() < 1e-15);
+    let repeated: Vec<_> = t[0].repeated_angles().collect();
+    assert_eq!(repeated.len(), 1);
+    assert_eq!(repeated[0].lines.len(), 2);
+    assert!((repeated[0].reflectance_spread.unwrap() - 0.02).abs() < 1e-15);
 }
 
 #[test]

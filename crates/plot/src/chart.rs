@@ -34,44 +34,66 @@ pub fn palette(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
-/// A polyline. Non-finite points break the line (they are never joined across).
+/// A plotted series: points in data coordinates, their colour and legend entry, drawn in the
+/// style `S` ([`Line`] and [`Markers`]).
 #[derive(Debug, Clone)]
-pub struct Line {
+pub struct Series<S> {
     /// Its legend entry, if any.
     pub label: Option<String>,
     /// Its colour.
     pub colour: RGBColor,
-    /// Drawn dashed.
-    pub dashed: bool,
-    /// Stroke width in pixels.
-    pub width: u32,
+    /// How it is drawn.
+    pub style: S,
     /// Its points, in data coordinates.
     pub points: Vec<(f64, f64)>,
 }
 
-impl Line {
-    /// A solid line, 2 px wide.
+impl<S> Series<S> {
+    /// `points` drawn in `style` and `colour`, with an optional legend entry.
     pub fn new(
         label: impl Into<Option<String>>,
         colour: RGBColor,
+        style: S,
         points: Vec<(f64, f64)>,
     ) -> Self {
         Self {
             label: label.into(),
             colour,
-            dashed: false,
-            width: 2,
+            style,
             points,
         }
     }
+}
+
+/// How a [`Line`] is stroked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Stroke {
+    /// Drawn dashed.
+    pub dashed: bool,
+    /// Stroke width in pixels.
+    pub width: u32,
+}
+
+impl Stroke {
+    /// A solid line, 2 px wide.
+    pub const SOLID: Stroke = Stroke {
+        dashed: false,
+        width: 2,
+    };
+}
+
+/// A polyline. Non-finite points break the line (they are never joined across).
+pub type Line = Series<Stroke>;
+
+impl Line {
     /// The same line, dashed.
     pub fn dashed(mut self) -> Self {
-        self.dashed = true;
+        self.style.dashed = true;
         self
     }
     /// The same line with another stroke width in pixels.
     pub fn width(mut self, px: u32) -> Self {
-        self.width = px;
+        self.style.width = px;
         self
     }
 }
@@ -89,38 +111,17 @@ pub enum MarkerShape {
     Square,
 }
 
-/// A set of markers (measured points, marked channel values).
-#[derive(Debug, Clone)]
-pub struct Markers {
-    /// Its legend entry, if any.
-    pub label: Option<String>,
-    /// Its colour.
-    pub colour: RGBColor,
+/// How [`Markers`] are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Marker {
     /// Its shape.
     pub shape: MarkerShape,
     /// Its size in pixels.
     pub size: u32,
-    /// Its points, in data coordinates.
-    pub points: Vec<(f64, f64)>,
 }
 
-impl Markers {
-    /// Markers of `shape` at `points`, 4 pixels, with an optional legend entry.
-    pub fn new(
-        label: impl Into<Option<String>>,
-        colour: RGBColor,
-        shape: MarkerShape,
-        points: Vec<(f64, f64)>,
-    ) -> Self {
-        Self {
-            label: label.into(),
-            colour,
-            shape,
-            size: 4,
-            points,
-        }
-    }
-}
+/// A set of markers (measured points, marked channel values).
+pub type Markers = Series<Marker>;
 
 /// A shaded vertical band from `x0` to `x1` over the whole height of the panel.
 #[derive(Debug, Clone)]
@@ -485,20 +486,25 @@ pub fn draw_panel<DB: DrawingBackend>(
         .draw()
         .map_err(draw_err)?;
 
-    let mut any_label = draw_shades(&mut chart, panel, (x0, x1), (y0, y1))?;
+    let mut plot = PanelPlot {
+        chart: &mut chart,
+        x: (x0, x1),
+        y: (y0, y1),
+    };
+    let mut any_label = plot.shades(&panel.shades)?;
     if panel.zero_line && y0 < 0.0 && y1 > 0.0 {
-        chart
+        plot.chart
             .draw_series(std::iter::once(PathElement::new(
                 vec![(x0, 0.0), (x1, 0.0)],
                 BLACK.mix(0.55).stroke_width(1),
             )))
             .map_err(draw_err)?;
     }
-    any_label |= draw_lines(&mut chart, panel, (x0, x1), (y0, y1))?;
-    any_label |= draw_markers(&mut chart, panel, (x0, x1), (y0, y1))?;
+    any_label |= plot.lines(&panel.lines)?;
+    any_label |= plot.markers(&panel.markers)?;
     for a in &panel.annotations {
         if a.x.is_finite() && a.y.is_finite() && a.x >= x0 && a.x <= x1 && a.y >= y0 && a.y <= y1 {
-            chart
+            plot.chart
                 .draw_series(std::iter::once(Text::new(
                     a.text.clone(),
                     (a.x, a.y),
@@ -508,164 +514,159 @@ pub fn draw_panel<DB: DrawingBackend>(
         }
     }
     if let (Some(corner), true) = (panel.legend, any_label) {
-        draw_legend(&mut chart, panel, corner, (x0, x1), (y0, y1))?;
+        plot.legend(panel, corner)?;
     }
     Ok(())
 }
 
-/// The shaded x ranges (clipped to the panel); whether one has a label.
-fn draw_shades<'a, DB: DrawingBackend + 'a>(
-    chart: &mut PanelChart<'a, DB>,
-    panel: &Panel,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Result<bool, PlotError> {
-    let mut any_label = false;
-    for s in &panel.shades {
-        let (sx0, sx1) = (s.x0.max(x0), s.x1.min(x1));
-        if sx1.partial_cmp(&sx0) != Some(std::cmp::Ordering::Greater) {
-            continue;
-        }
-        let colour = s.colour;
-        let anno = chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [(sx0, y0), (sx1, y1)],
-                colour.mix(0.16).filled(),
-            )))
-            .map_err(draw_err)?;
-        if let Some(l) = &s.label {
-            any_label = true;
-            anno.label(l.as_str()).legend(move |(x, y)| {
-                Rectangle::new([(x, y - 6), (x + 18, y + 6)], colour.mix(0.3).filled())
-            });
-        }
-    }
-    Ok(any_label)
+/// A panel's chart and the x and y ranges it shows, into which its parts are drawn.
+struct PanelPlot<'c, 'a, DB: DrawingBackend> {
+    chart: &'c mut PanelChart<'a, DB>,
+    x: (f64, f64),
+    y: (f64, f64),
 }
 
-/// The lines, each clipped into runs inside the panel; whether one has a label.
-fn draw_lines<'a, DB: DrawingBackend + 'a>(
-    chart: &mut PanelChart<'a, DB>,
-    panel: &Panel,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Result<bool, PlotError> {
-    let mut any_label = false;
-    for line in &panel.lines {
-        let style = line.colour.stroke_width(line.width);
-        let mut labelled = false;
-        for run in clipped_runs(&line.points, (x0, x1), (y0, y1)) {
-            let anno = if line.dashed {
-                chart
-                    .draw_series(DashedLineSeries::new(run, 9, 6, style))
-                    .map_err(draw_err)?
-            } else {
-                chart
-                    .draw_series(LineSeries::new(run, style))
-                    .map_err(draw_err)?
-            };
-            if let (Some(l), false) = (&line.label, labelled) {
-                labelled = true;
+impl<'a, DB: DrawingBackend + 'a> PanelPlot<'_, 'a, DB> {
+    /// The shaded x ranges (clipped to the panel); whether one has a label.
+    fn shades(&mut self, shades: &[Shade]) -> Result<bool, PlotError> {
+        let (chart, (x0, x1), (y0, y1)) = (&mut *self.chart, self.x, self.y);
+        let mut any_label = false;
+        for s in shades {
+            let (sx0, sx1) = (s.x0.max(x0), s.x1.min(x1));
+            if sx1.partial_cmp(&sx0) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            let colour = s.colour;
+            let anno = chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(sx0, y0), (sx1, y1)],
+                    colour.mix(0.16).filled(),
+                )))
+                .map_err(draw_err)?;
+            if let Some(l) = &s.label {
                 any_label = true;
-                let (colour, dashed, width) = (line.colour, line.dashed, line.width);
                 anno.label(l.as_str()).legend(move |(x, y)| {
-                    let style = colour.stroke_width(width);
-                    if dashed {
-                        EmptyElement::at((x, y))
-                            + PathElement::new(vec![(0, 0), (7, 0)], style)
-                            + PathElement::new(vec![(11, 0), (18, 0)], style)
-                    } else {
-                        EmptyElement::at((x, y))
-                            + PathElement::new(vec![(0, 0), (18, 0)], style)
-                            + PathElement::new(vec![(0, 0), (0, 0)], style)
-                    }
+                    Rectangle::new([(x, y - 6), (x + 18, y + 6)], colour.mix(0.3).filled())
                 });
             }
         }
+        Ok(any_label)
     }
-    Ok(any_label)
-}
 
-/// The markers inside the panel; whether a series of them has a label.
-fn draw_markers<'a, DB: DrawingBackend + 'a>(
-    chart: &mut PanelChart<'a, DB>,
-    panel: &Panel,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Result<bool, PlotError> {
-    let mut any_label = false;
-    for m in &panel.markers {
-        let inside: Vec<(f64, f64)> = m
-            .points
-            .iter()
-            .copied()
-            .filter(|&(x, y)| {
-                x.is_finite() && y.is_finite() && x >= x0 && x <= x1 && y >= y0 && y <= y1
-            })
-            .collect();
-        if inside.is_empty() {
-            continue;
-        }
-        let (colour, size) = (m.colour, m.size);
-        let sz = size as i32;
-        // Each shape is its own element type, so each gets its own series.
-        macro_rules! draw_markers {
-            ($p:ident => $make:expr) => {{
-                let anno = chart
-                    .draw_series(inside.into_iter().map(|$p| $make))
-                    .map_err(draw_err)?;
-                if let Some(l) = &m.label {
+    /// The lines, each clipped into runs inside the panel; whether one has a label.
+    fn lines(&mut self, lines: &[Line]) -> Result<bool, PlotError> {
+        let (chart, (x0, x1), (y0, y1)) = (&mut *self.chart, self.x, self.y);
+        let mut any_label = false;
+        for line in lines {
+            let Stroke { dashed, width } = line.style;
+            let style = line.colour.stroke_width(width);
+            let mut labelled = false;
+            for run in clipped_runs(&line.points, (x0, x1), (y0, y1)) {
+                let anno = if dashed {
+                    chart
+                        .draw_series(DashedLineSeries::new(run, 9, 6, style))
+                        .map_err(draw_err)?
+                } else {
+                    chart
+                        .draw_series(LineSeries::new(run, style))
+                        .map_err(draw_err)?
+                };
+                if let (Some(l), false) = (&line.label, labelled) {
+                    labelled = true;
                     any_label = true;
+                    let colour = line.colour;
                     anno.label(l.as_str()).legend(move |(x, y)| {
-                        let $p = (x + 9, y);
-                        $make
+                        let style = colour.stroke_width(width);
+                        if dashed {
+                            EmptyElement::at((x, y))
+                                + PathElement::new(vec![(0, 0), (7, 0)], style)
+                                + PathElement::new(vec![(11, 0), (18, 0)], style)
+                        } else {
+                            EmptyElement::at((x, y))
+                                + PathElement::new(vec![(0, 0), (18, 0)], style)
+                                + PathElement::new(vec![(0, 0), (0, 0)], style)
+                        }
                     });
                 }
-            }};
-        }
-        match m.shape {
-            MarkerShape::Circle => draw_markers!(p => Circle::new(p, size, colour.filled())),
-            MarkerShape::Cross => draw_markers!(p => Cross::new(p, size, colour.stroke_width(2))),
-            MarkerShape::Triangle => {
-                draw_markers!(p => TriangleMarker::new(p, size, colour.filled()))
             }
-            MarkerShape::Square => draw_markers!(p => {
-                EmptyElement::at(p) + Rectangle::new([(-sz, -sz), (sz, sz)], colour.filled())
-            }),
         }
+        Ok(any_label)
     }
-    Ok(any_label)
-}
 
-/// The legend in `corner` (chosen where the data leave room, for `Auto`).
-fn draw_legend<'a, DB: DrawingBackend + 'a>(
-    chart: &mut PanelChart<'a, DB>,
-    panel: &Panel,
-    corner: LegendCorner,
-    x_range: (f64, f64),
-    y_range: (f64, f64),
-) -> Result<(), PlotError> {
-    let position = match corner {
-        LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
-        LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
-        LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
-        LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
-        LegendCorner::MiddleRight => SeriesLabelPosition::MiddleRight,
-        LegendCorner::MiddleLeft => SeriesLabelPosition::MiddleLeft,
-        LegendCorner::UpperMiddle => SeriesLabelPosition::UpperMiddle,
-        LegendCorner::LowerMiddle => SeriesLabelPosition::LowerMiddle,
-        LegendCorner::Auto => {
-            let (pw, ph) = chart.plotting_area().dim_in_pixel();
-            auto_legend_position(panel, x_range, y_range, (pw, ph))
+    /// The markers inside the panel; whether a series of them has a label.
+    fn markers(&mut self, markers: &[Markers]) -> Result<bool, PlotError> {
+        let (chart, (x0, x1), (y0, y1)) = (&mut *self.chart, self.x, self.y);
+        let mut any_label = false;
+        for m in markers {
+            let inside: Vec<(f64, f64)> = m
+                .points
+                .iter()
+                .copied()
+                .filter(|&(x, y)| {
+                    x.is_finite() && y.is_finite() && x >= x0 && x <= x1 && y >= y0 && y <= y1
+                })
+                .collect();
+            if inside.is_empty() {
+                continue;
+            }
+            let (colour, size) = (m.colour, m.style.size);
+            let sz = size as i32;
+            // Each shape is its own element type, so each gets its own series.
+            macro_rules! draw_markers {
+                ($p:ident => $make:expr) => {{
+                    let anno = chart
+                        .draw_series(inside.into_iter().map(|$p| $make))
+                        .map_err(draw_err)?;
+                    if let Some(l) = &m.label {
+                        any_label = true;
+                        anno.label(l.as_str()).legend(move |(x, y)| {
+                            let $p = (x + 9, y);
+                            $make
+                        });
+                    }
+                }};
+            }
+            match m.style.shape {
+                MarkerShape::Circle => draw_markers!(p => Circle::new(p, size, colour.filled())),
+                MarkerShape::Cross => {
+                    draw_markers!(p => Cross::new(p, size, colour.stroke_width(2)))
+                }
+                MarkerShape::Triangle => {
+                    draw_markers!(p => TriangleMarker::new(p, size, colour.filled()))
+                }
+                MarkerShape::Square => draw_markers!(p => {
+                    EmptyElement::at(p) + Rectangle::new([(-sz, -sz), (sz, sz)], colour.filled())
+                }),
+            }
         }
-    };
-    chart
-        .configure_series_labels()
-        .position(position)
-        .label_font((FAMILY, 13))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.35))
-        .draw()
-        .map_err(draw_err)?;
-    Ok(())
+        Ok(any_label)
+    }
+
+    /// The legend of `panel` in `corner` (chosen where the data leave room, for `Auto`).
+    fn legend(&mut self, panel: &Panel, corner: LegendCorner) -> Result<(), PlotError> {
+        let chart = &mut *self.chart;
+        let position = match corner {
+            LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
+            LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
+            LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
+            LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
+            LegendCorner::MiddleRight => SeriesLabelPosition::MiddleRight,
+            LegendCorner::MiddleLeft => SeriesLabelPosition::MiddleLeft,
+            LegendCorner::UpperMiddle => SeriesLabelPosition::UpperMiddle,
+            LegendCorner::LowerMiddle => SeriesLabelPosition::LowerMiddle,
+            LegendCorner::Auto => {
+                let (pw, ph) = chart.plotting_area().dim_in_pixel();
+                auto_legend_position(panel, self.x, self.y, (pw, ph))
+            }
+        };
+        chart
+            .configure_series_labels()
+            .position(position)
+            .label_font((FAMILY, 13))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.35))
+            .draw()
+            .map_err(draw_err)?;
+        Ok(())
+    }
 }

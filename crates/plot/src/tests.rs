@@ -69,6 +69,7 @@ fn one_panel_figure(points: Vec<(f64, f64)>) -> GridFigure {
     p.lines.push(Line::new(
         Some("line".into()),
         crate::chart::palette(0),
+        crate::chart::Stroke::SOLID,
         points,
     ));
     GridFigure {

@@ -19,19 +19,11 @@ use std::path::{Path, PathBuf};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glassdb_registry::{BuildOptions, ChosenElement, UnitBuilder, UnitChoice, build_registry};
-use glassdb_spectral::{IntegrationSettings, RgbSpace};
+use glassdb_spectral::RgbSpace;
 use glassdb_stack::Gas;
 
 fn glazing() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/glazing")
-}
-
-/// Colorimetric tables (CIE 1931, D65) in these spaces.
-fn tables(spaces: &[RgbSpace]) -> Vec<IntegrationSettings> {
-    spaces
-        .iter()
-        .map(|&space| IntegrationSettings::colorimetric(space, Default::default()))
-        .collect()
 }
 
 /// A catalog of 50 units: every ordered pair of outer and inner panes from the bundled files
@@ -111,10 +103,8 @@ fn bench(c: &mut Criterion) {
     let dir = std::env::temp_dir().join(format!("glassdb-bench-units-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let catalog = catalog_of_50_units(&dir);
-    let opts = BuildOptions {
-        tables: tables(&[RgbSpace::Srgb, RgbSpace::AcesCg, RgbSpace::Rec2020]),
-        ..BuildOptions::default()
-    };
+    let opts =
+        BuildOptions::colorimetric_in(&[RgbSpace::Srgb, RgbSpace::AcesCg, RgbSpace::Rec2020]);
     let reg = build_registry(&catalog, &opts).expect("the 50 units build");
     assert_eq!(reg.default_table().glasses.len(), 50);
     for _ in 0..5 {
@@ -133,15 +123,12 @@ fn bench(c: &mut Criterion) {
         b.iter(|| black_box(build_registry(&catalog, &opts).expect("build")))
     });
     let bundled = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/catalog.toml");
-    let viewer_opts = BuildOptions {
-        tables: tables(&[
-            RgbSpace::Srgb,
-            RgbSpace::AcesCg,
-            RgbSpace::Rec2020,
-            RgbSpace::Aces2065_1,
-        ]),
-        ..BuildOptions::default()
-    };
+    let viewer_opts = BuildOptions::colorimetric_in(&[
+        RgbSpace::Srgb,
+        RgbSpace::AcesCg,
+        RgbSpace::Rec2020,
+        RgbSpace::Aces2065_1,
+    ]);
     let builder = UnitBuilder::new(&bundled, viewer_opts).expect("the bundled catalog");
     let choice = UnitChoice {
         id: 100,

@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use glassdb_spectral::{IntegrationSettings, Integrator};
+use glassdb_spectral::{IntegrationSettings, Integrator, RgbSpace};
 use glassdb_stack::LayerModel;
 use rayon::prelude::*;
 
@@ -64,6 +64,21 @@ impl Default for BuildOptions {
             fit_tol: glassdb_fit::DEFAULT_TOL,
             max_degree: 12,
             application: Application::PerWavelength,
+        }
+    }
+}
+
+impl BuildOptions {
+    /// Options that build one colorimetric table per space of `spaces`, the first the
+    /// default ([`IntegrationSettings::colorimetric`] under the default illuminant; other
+    /// options default).
+    pub fn colorimetric_in(spaces: &[RgbSpace]) -> BuildOptions {
+        BuildOptions {
+            tables: spaces
+                .iter()
+                .map(|&space| IntegrationSettings::colorimetric(space, Default::default()))
+                .collect(),
+            ..BuildOptions::default()
         }
     }
 }

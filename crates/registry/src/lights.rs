@@ -371,18 +371,10 @@ mod tests {
         NamedLight::parse(&format!("{name}={illuminant}")).unwrap()
     }
 
-    fn spaces(spaces: &[RgbSpace]) -> Vec<IntegrationSettings> {
-        spaces
-            .iter()
-            .map(|&s| IntegrationSettings::colorimetric(s, Illuminant::default()))
-            .collect()
-    }
-
     fn two_lights(dir: &Path) -> Registry {
         let opts = BuildOptions {
-            tables: spaces(&[RgbSpace::Srgb, RgbSpace::AcesCg]),
             lights: vec![light("sun", "D65"), light("warm", "A")],
-            ..BuildOptions::default()
+            ..BuildOptions::colorimetric_in(&[RgbSpace::Srgb, RgbSpace::AcesCg])
         };
         build_registry(&catalog(dir), &opts).unwrap()
     }
@@ -527,7 +519,7 @@ mod tests {
             build_registry(&catalog(dir.path()), &opts).unwrap_err()
         };
         let e = build(
-            spaces(&[RgbSpace::Srgb]),
+            BuildOptions::colorimetric_in(&[RgbSpace::Srgb]).tables,
             vec![light("sun", "D65"), light("sun", "A")],
         );
         assert!(matches!(e, RegistryError::DuplicateLight { .. }), "{e}");

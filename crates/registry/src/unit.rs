@@ -361,11 +361,11 @@ impl<'a> UnitBuild<'a> {
             per_angle.iter().map(f).collect()
         };
         let shares_front = stored_shares(
-            (0..n_groups).map(|g| row(&|o| o.share_front[g])).collect(),
+            (0..n_groups).map(|g| row(&|o| o.share.front[g])).collect(),
             &tables.rf,
         );
         let shares_back = stored_shares(
-            (0..n_groups).map(|g| row(&|o| o.share_back[g])).collect(),
+            (0..n_groups).map(|g| row(&|o| o.share.back[g])).collect(),
             &tables.rb,
         );
         let mut groups = Vec::with_capacity(n_groups);
@@ -429,8 +429,8 @@ impl<'a> UnitBuild<'a> {
                     let (index, (_, l, unit_layer)) = next_layer.next().expect("one per layer");
                     debug_assert_eq!(self.layers[index].0, i);
                     let absorptance = at_normal.solar.as_ref().map(|s| Absorptance {
-                        front: s[0].absorptance_front[index],
-                        back: s[0].absorptance_back[index],
+                        front: s[0].absorptance.front[index],
+                        back: s[0].absorptance.back[index],
                     });
                     unit_elements.push(UnitElement::Layer(Box::new(layer_record(
                         l,

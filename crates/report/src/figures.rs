@@ -7,7 +7,7 @@ use std::path::Path;
 use glassdb_fit::cos_deg;
 use glassdb_io::StagedOutput;
 use glassdb_mask::CosCode;
-use glassdb_plot::chart::{LegendCorner, Line, Panel, palette};
+use glassdb_plot::chart::{LegendCorner, Line, Panel, Stroke, palette};
 use glassdb_plot::figure::{Cell, GridFigure};
 use glassdb_plot::plots::fit::{FitPlotOptions, fit_figure_from_table};
 use glassdb_plot::plots::mask::{MaskPlotOptions, mask_figure_of};
@@ -260,8 +260,12 @@ fn log10_error_panel(title: &str, refs: &[Reference]) -> Panel {
                 pts.push((at, worst.log10()));
             }
         }
-        p.lines
-            .push(Line::new(Some(st.name().to_string()), palette(k), pts));
+        p.lines.push(Line::new(
+            Some(st.name().to_string()),
+            palette(k),
+            Stroke::SOLID,
+            pts,
+        ));
     }
     p
 }

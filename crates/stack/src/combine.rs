@@ -8,6 +8,15 @@ use std::ops::Range;
 
 use crate::layer::LayerValues;
 
+/// A quantity for light from outdoors (`front`) and for light from indoors (`back`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FrontBack<T> {
+    /// For light from outdoors.
+    pub front: T,
+    /// For light from indoors.
+    pub back: T,
+}
+
 /// The optics of a unit at one angle for some quantity (`V`: a spectrum, a colour's three
 /// channels, or one averaged value): system T, Rf, Rb, absorptance of each layer, and the
 /// share of each pane group in the system reflectance.
@@ -19,25 +28,26 @@ pub struct Optics<V> {
     pub rf: V,
     /// Reflectance for light from indoors.
     pub rb: V,
-    /// Per layer (outside first), the fraction absorbed of light from outdoors.
-    pub absorptance_front: Vec<V>,
-    /// Per layer (outside first), the fraction absorbed of light from indoors.
-    pub absorptance_back: Vec<V>,
-    /// Per pane group (outside first), its share of `rf`: they sum to `rf`.
-    pub share_front: Vec<V>,
-    /// Per pane group (outside first), its share of `rb`: they sum to `rb`.
-    pub share_back: Vec<V>,
+    /// Per layer (outside first), the fraction absorbed of light from outdoors and from indoors.
+    pub absorptance: FrontBack<Vec<V>>,
+    /// Per pane group (outside first), its share of `rf` (front) and of `rb` (back): they sum
+    /// to that reflectance.
+    pub share: FrontBack<Vec<V>>,
 }
 
 impl<V> Optics<V> {
     /// The same optics with every value mapped by `f` (e.g. a spectrum integrated).
     pub fn try_map<U, E>(&self, mut f: impl FnMut(&V) -> Result<U, E>) -> Result<Optics<U>, E> {
         let mut all = |vs: &[V]| vs.iter().map(&mut f).collect::<Result<Vec<U>, E>>();
+        let mut both = |fb: &FrontBack<Vec<V>>| -> Result<FrontBack<Vec<U>>, E> {
+            Ok(FrontBack {
+                front: all(&fb.front)?,
+                back: all(&fb.back)?,
+            })
+        };
         Ok(Optics {
-            absorptance_front: all(&self.absorptance_front)?,
-            absorptance_back: all(&self.absorptance_back)?,
-            share_front: all(&self.share_front)?,
-            share_back: all(&self.share_back)?,
+            absorptance: both(&self.absorptance)?,
+            share: both(&self.share)?,
             t: f(&self.t)?,
             rf: f(&self.rf)?,
             rb: f(&self.rb)?,
@@ -97,10 +107,14 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         t: vec![0.0; n],
         rf: vec![0.0; n],
         rb: vec![0.0; n],
-        absorptance_front: vec![vec![0.0; n]; nl],
-        absorptance_back: vec![vec![0.0; n]; nl],
-        share_front: vec![vec![0.0; n]; ng],
-        share_back: vec![vec![0.0; n]; ng],
+        absorptance: FrontBack {
+            front: vec![vec![0.0; n]; nl],
+            back: vec![vec![0.0; n]; nl],
+        },
+        share: FrontBack {
+            front: vec![vec![0.0; n]; ng],
+            back: vec![vec![0.0; n]; ng],
+        },
     };
     let zero = Rt {
         t: 0.0,
@@ -113,7 +127,7 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
     let mut groups_reversed = vec![zero; ng];
     let mut abs = vec![0.0; nl];
     let mut shares = vec![0.0; ng];
-    let mut scratch = vec![0.0; nl.max(ng) + 1];
+    let mut r_behind = vec![0.0; nl.max(ng) + 1];
     for i in 0..n {
         for (r, l) in rt.iter_mut().zip(layers) {
             *r = Rt {
@@ -129,9 +143,9 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         from_both_sides(
             &rt,
             &mut reversed,
-            (&mut abs, &mut scratch),
+            (&mut abs, &mut r_behind),
             absorptances,
-            (&mut out.absorptance_front, &mut out.absorptance_back),
+            &mut out.absorptance,
             i,
         );
         for (g, range) in group_rt.iter_mut().zip(groups) {
@@ -141,9 +155,9 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
         from_both_sides(
             &group_rt,
             &mut groups_reversed,
-            (&mut shares, &mut scratch),
+            (&mut shares, &mut r_behind),
             reflectance_shares,
-            (&mut out.share_front, &mut out.share_back),
+            &mut out.share,
             i,
         );
     }
@@ -152,24 +166,27 @@ pub fn combine(layers: &[LayerValues], groups: &[Range<usize>]) -> Optics<Vec<f6
 
 /// `per_item` (absorptances, reflectance shares) of `items` lit from the front, then from the
 /// back (`items` in reverse order, each turned round, in `reversed`), written at sample `i` of
-/// `front` and `back`, both indexed as `items` are.
+/// `out`'s front and back, both indexed as `items` are. `per_item` is given the reflectance
+/// behind each item ([`reflectance_behind`], computed into `r_behind`).
 fn from_both_sides(
     items: &[Rt],
     reversed: &mut [Rt],
-    (values, scratch): (&mut [f64], &mut [f64]),
-    per_item: fn(&[Rt], &mut [f64], &mut [f64]),
-    (front, back): (&mut [Vec<f64>], &mut [Vec<f64>]),
+    (values, r_behind): (&mut [f64], &mut [f64]),
+    per_item: fn(&[Rt], &[f64], &mut [f64]),
+    out: &mut FrontBack<Vec<Vec<f64>>>,
     i: usize,
 ) {
-    per_item(items, values, scratch);
-    for (f, v) in front.iter_mut().zip(values.iter()) {
+    reflectance_behind(items, r_behind);
+    per_item(items, r_behind, values);
+    for (f, v) in out.front.iter_mut().zip(values.iter()) {
         f[i] = *v;
     }
     for (r, l) in reversed.iter_mut().zip(items.iter().rev()) {
         *r = l.reversed();
     }
-    per_item(reversed, values, scratch);
-    for (b, v) in back.iter_mut().rev().zip(values.iter()) {
+    reflectance_behind(reversed, r_behind);
+    per_item(reversed, r_behind, values);
+    for (b, v) in out.back.iter_mut().rev().zip(values.iter()) {
         b[i] = *v;
     }
 }
@@ -186,14 +203,13 @@ fn reflectance_behind(items: &[Rt], r_behind: &mut [f64]) {
     }
 }
 
-/// Absorptance of each layer for unit flux arriving at the first (eqs. 4–5): from the last
-/// layer forwards, `r_k = Rf_k + T_k²·r_{k+1}/(1 − Rb_k·r_{k+1})` is the reflectance of layers
-/// k… and `τ_k = T_k/(1 − Rb_k·r_{k+1})` the flux layer k passes on per unit arriving; then
-/// `I⁻_0 = 1`, `I⁻_{k+1} = τ_k·I⁻_k`, `I⁺_k = r_{k+1}·I⁻_{k+1}` and
+/// Absorptance of each layer for unit flux arriving at the first (eqs. 4–5): with
+/// `r_k = Rf_k + T_k²·r_{k+1}/(1 − Rb_k·r_{k+1})` the reflectance of layers k… (`r_behind`,
+/// [`reflectance_behind`]), `τ_k = T_k/(1 − Rb_k·r_{k+1})` is the flux layer k passes on per
+/// unit arriving; then `I⁻_0 = 1`, `I⁻_{k+1} = τ_k·I⁻_k`, `I⁺_k = r_{k+1}·I⁻_{k+1}` and
 /// `A_k = I⁻_k·(1 − T_k − Rf_k) + I⁺_k·(1 − T_k − Rb_k)`.
-fn absorptances(layers: &[Rt], abs: &mut [f64], r_behind: &mut [f64]) {
+fn absorptances(layers: &[Rt], r_behind: &[f64], abs: &mut [f64]) {
     let n = layers.len();
-    reflectance_behind(layers, r_behind);
     let mut down = 1.0;
     for k in 0..n {
         let l = layers[k];
@@ -208,9 +224,9 @@ fn absorptances(layers: &[Rt], abs: &mut [f64], r_behind: &mut [f64]) {
 /// Each group's share of the reflectance of `groups` in series (eq. 6): with `B_k` the groups
 /// k… combined, `s_1 = Rf(G_1)`, and `s_k = Π_{j<k} T_j²/(1 − Rb(G_j)·Rf(B_{j+1})) · Rf(G_k)`:
 /// light first reflected by group k, with every interreflection in front of it; Σ s_k = Rf(B_1).
-fn reflectance_shares(groups: &[Rt], shares: &mut [f64], r_behind: &mut [f64]) {
+/// `r_behind[k]` is `Rf(B_k)` ([`reflectance_behind`]).
+fn reflectance_shares(groups: &[Rt], r_behind: &[f64], shares: &mut [f64]) {
     let n = groups.len();
-    reflectance_behind(groups, r_behind);
     let mut reach = 1.0;
     for k in 0..n {
         let g = groups[k];
@@ -310,19 +326,19 @@ mod tests {
             let o = combine(&values, &groups);
             let (t, r, abs) = trace(&layers, true);
             prop_assert!((o.t[0] - t).abs() < 1e-9 && (o.rf[0] - r).abs() < 1e-9);
-            for (ours, traced) in o.absorptance_front.iter().zip(&abs) {
+            for (ours, traced) in o.absorptance.front.iter().zip(&abs) {
                 prop_assert!((ours[0] - traced).abs() < 1e-9);
             }
             let (tb, rb, absb) = trace(&layers, false);
             prop_assert!((o.t[0] - tb).abs() < 1e-9 && (o.rb[0] - rb).abs() < 1e-9);
-            for (ours, traced) in o.absorptance_back.iter().zip(&absb) {
+            for (ours, traced) in o.absorptance.back.iter().zip(&absb) {
                 prop_assert!((ours[0] - traced).abs() < 1e-9);
             }
             // energy: T + R + ΣA = 1 from each side; shares sum to R
-            let sum_a: f64 = o.absorptance_front.iter().map(|a| a[0]).sum();
+            let sum_a: f64 = o.absorptance.front.iter().map(|a| a[0]).sum();
             prop_assert!((o.t[0] + o.rf[0] + sum_a - 1.0).abs() < 1e-12);
-            let sf: f64 = o.share_front.iter().map(|s| s[0]).sum();
-            let sb: f64 = o.share_back.iter().map(|s| s[0]).sum();
+            let sf: f64 = o.share.front.iter().map(|s| s[0]).sum();
+            let sb: f64 = o.share.back.iter().map(|s| s[0]).sum();
             prop_assert!((sf - o.rf[0]).abs() < 1e-12 && (sb - o.rb[0]).abs() < 1e-12);
         }
     }
@@ -332,12 +348,12 @@ mod tests {
         let (t1, rf1, rb1) = (0.8, 0.1, 0.12);
         let (t2, rf2, rb2) = (0.85, 0.08, 0.08);
         let o = combine(&[layer(t1, rf1, rb1), layer(t2, rf2, rb2)], &[0..1, 1..2]);
-        assert_eq!(o.share_front[0][0], rf1);
+        assert_eq!(o.share.front[0][0], rf1);
         let inner = t1 * t1 * rf2 / (1.0 - rb1 * rf2);
-        assert!((o.share_front[1][0] - inner).abs() < 1e-15);
-        assert_eq!(o.share_back[1][0], rb2);
+        assert!((o.share.front[1][0] - inner).abs() < 1e-15);
+        assert_eq!(o.share.back[1][0], rb2);
         let outer_from_inside = t2 * t2 * rb1 / (1.0 - rf2 * rb1);
-        assert!((o.share_back[0][0] - outer_from_inside).abs() < 1e-15);
+        assert!((o.share.back[0][0] - outer_from_inside).abs() < 1e-15);
         assert!((o.t[0] - t1 * t2 / (1.0 - rb1 * rf2)).abs() < 1e-15);
     }
 }

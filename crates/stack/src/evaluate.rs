@@ -273,16 +273,14 @@ fn quantity_names(o: &Optics<Vec<f64>>) -> Vec<String> {
         "front reflectance".into(),
         "back reflectance".into(),
     ];
-    names.extend(
-        (1..=o.absorptance_front.len()).map(|k| format!("absorptance of layer {k} (front)")),
-    );
-    names
-        .extend((1..=o.absorptance_back.len()).map(|k| format!("absorptance of layer {k} (back)")));
-    names.extend(
-        (1..=o.share_front.len()).map(|k| format!("reflectance share of group {k} (front)")),
-    );
-    names
-        .extend((1..=o.share_back.len()).map(|k| format!("reflectance share of group {k} (back)")));
+    for (what, per) in [
+        ("absorptance of layer", &o.absorptance),
+        ("reflectance share of group", &o.share),
+    ] {
+        for (side, values) in [("front", &per.front), ("back", &per.back)] {
+            names.extend((1..=values.len()).map(|k| format!("{what} {k} ({side})")));
+        }
+    }
     names
 }
 

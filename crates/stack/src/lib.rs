@@ -29,7 +29,7 @@ pub mod model;
 pub mod physics;
 mod stack;
 
-pub use combine::{Optics, combine};
+pub use combine::{FrontBack, Optics, combine};
 pub use error::StackError;
 pub use evaluate::{Application, Combination, EvalOptions, Evaluation, Spectra};
 pub use layer::{Layer, LayerData, LayerOptions, LayerValues};

@@ -12,7 +12,9 @@ use plotters::style::RGBColor;
 
 use super::{ANGLE_AXIS, curve_points};
 use crate::PlotError;
-use crate::chart::{LegendCorner, Line, MarkerShape, Markers, Panel, Shade, format_tick};
+use crate::chart::{
+    LegendCorner, Line, Marker, MarkerShape, Markers, Panel, Shade, Stroke, format_tick,
+};
 use crate::figure::{Cell, GridFigure};
 
 /// Colour of reflectance curves and points.
@@ -208,6 +210,7 @@ fn glass_cell(name: &str, parts: &[QuantityPlot]) -> Cell {
             let mut line = Line::new(
                 Some(f.label.clone()),
                 colour,
+                Stroke::SOLID,
                 curve_points(move |c| fit.eval_cos(c)),
             );
             if f.dashed {
@@ -225,7 +228,7 @@ fn glass_cell(name: &str, parts: &[QuantityPlot]) -> Cell {
             main.markers.push(Markers::new(
                 Some(format!("{sym} measured")),
                 colour,
-                shape,
+                Marker { shape, size: 4 },
                 pts,
             ));
             for f in &p.fits {
@@ -235,13 +238,15 @@ fn glass_cell(name: &str, parts: &[QuantityPlot]) -> Cell {
                     .zip(&s.value)
                     .map(|(&a, &v)| (a, f.fit.eval_angle_deg(a) - v))
                     .collect();
-                let mut m = Markers::new(
+                let m = Markers::new(
                     Some(format!("{sym}, {}", f.fit.polynomial.basis.name())),
                     colour,
-                    if f.dashed { MarkerShape::Cross } else { shape },
+                    Marker {
+                        shape: if f.dashed { MarkerShape::Cross } else { shape },
+                        size: 3,
+                    },
                     res,
                 );
-                m.size = 3;
                 if !f.dashed {
                     for &(_, r) in &m.points {
                         main_residual_max = main_residual_max.max(r.abs());

@@ -7,7 +7,7 @@ use glassdb_registry::{ColourBasis, GlassRecord, Registry, Side};
 
 use super::{ANGLE_AXIS, curve_points};
 use crate::PlotError;
-use crate::chart::{CHANNEL_COLOURS, LegendCorner, Line, Panel};
+use crate::chart::{CHANNEL_COLOURS, LegendCorner, Line, Panel, Stroke};
 use crate::figure::{Cell, GridFigure};
 
 const CHANNEL_NAMES: [&str; 3] = ["R", "G", "B"];
@@ -42,7 +42,7 @@ fn glass_cell(g: &GlassRecord) -> Cell {
                 let (r, t) = g.eval(side, c);
                 if reflectance { r[ch] } else { t[ch] }
             });
-            Line::new(Some(label), colour, points)
+            Line::new(Some(label), colour, Stroke::SOLID, points)
         };
         let r_label = format!("r {name} (r0 {:.4})", g.r0[ch]);
         p.lines.push(line(r_label, Side::Front, true));

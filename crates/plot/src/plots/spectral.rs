@@ -9,7 +9,9 @@ use glassdb_spectral::{
 };
 
 use crate::PlotError;
-use crate::chart::{Annotation, CHANNEL_COLOURS, LegendCorner, Line, MarkerShape, Markers, Panel};
+use crate::chart::{
+    Annotation, CHANNEL_COLOURS, LegendCorner, Line, Marker, MarkerShape, Markers, Panel, Stroke,
+};
 use crate::figure::{Cell, GridFigure};
 use crate::plots::fit::{REFLECTANCE_COLOUR, TRANSMITTANCE_COLOUR};
 
@@ -98,7 +100,7 @@ pub fn spectral_figure_of(
             .copied()
             .zip(values.iter().copied())
             .collect();
-        let mut line = Line::new(Some(format!("{sym}(λ)")), colour, pts);
+        let mut line = Line::new(Some(format!("{sym}(λ)")), colour, Stroke::SOLID, pts);
         if dashed {
             line = line.dashed();
         }
@@ -116,9 +118,13 @@ pub fn spectral_figure_of(
             } else {
                 format!("{sym} {} = {:.4}", ["R", "G", "B"][c], rgb[c])
             };
-            let mut m = Markers::new(Some(label), ch_colour, shape, vec![(x, rgb[c])]);
-            m.size = 6;
-            main.markers.push(m);
+            let marker = Marker { shape, size: 6 };
+            main.markers.push(Markers::new(
+                Some(label),
+                ch_colour,
+                marker,
+                vec![(x, rgb[c])],
+            ));
             main.annotations.push(Annotation {
                 x: x + 6.0,
                 y: rgb[c],
@@ -185,9 +191,12 @@ fn weights_panel(opts: &SpectralPlotOptions, grid: &[f64], weights: &[[f64; 3]])
         } else {
             CHANNEL_COLOURS[c]
         };
-        lower
-            .lines
-            .push(Line::new(Some(names[c].to_string()), colour, pts));
+        lower.lines.push(Line::new(
+            Some(names[c].to_string()),
+            colour,
+            Stroke::SOLID,
+            pts,
+        ));
     }
     lower.title = Some(match opts.settings.method {
         Method::Paper(_) => {

@@ -6,7 +6,7 @@ use glassdb_stack::{Evaluation, Stack};
 
 use super::{ANGLE_AXIS, angle_grid};
 use crate::PlotError;
-use crate::chart::{LegendCorner, Line, Panel, palette};
+use crate::chart::{LegendCorner, Line, Panel, Stroke, palette};
 use crate::figure::{Cell, GridFigure};
 
 /// One panel of T, Rf, Rb against angle; `rows` per angle `[T, Rf, Rb]`.
@@ -20,7 +20,7 @@ fn panel(title: String, angles: &[f64], rows: &[[f64; 3]]) -> Panel {
         .enumerate()
     {
         let points = angles.iter().zip(rows).map(|(&a, r)| (a, r[k])).collect();
-        let line = Line::new(Some(name.to_string()), palette(k), points);
+        let line = Line::new(Some(name.to_string()), palette(k), Stroke::SOLID, points);
         p.lines.push(if k == 0 { line } else { line.dashed() });
     }
     p
@@ -52,11 +52,11 @@ pub fn stack_figure(
             let points = angles
                 .iter()
                 .zip(system)
-                .map(|(&a, o)| (a, o.share_front[g]))
+                .map(|(&a, o)| (a, o.share.front[g]))
                 .collect();
             let label = format!("Rf share of pane group {}", g + 1);
             unit.lines
-                .push(Line::new(Some(label), palette(3 + g), points).width(1));
+                .push(Line::new(Some(label), palette(3 + g), Stroke::SOLID, points).width(1));
         }
     }
     let mut cells = vec![Cell {
