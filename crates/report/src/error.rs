@@ -27,9 +27,6 @@ pub enum ReportError {
     /// Drawing or saving a figure failed.
     #[error(transparent)]
     Plot(#[from] glassdb_plot::PlotError),
-    /// An error from the fit crate (angle tables, fitting).
-    #[error(transparent)]
-    Fit(#[from] glassdb_fit::FitError),
     /// An error from the spectral crate (reading spectra, integrating them).
     #[error(transparent)]
     Spectral(#[from] glassdb_spectral::SpectralError),
@@ -53,7 +50,6 @@ impl ReportError {
             ReportError::CreateDir { .. } => glassdb_io::ErrorKind::Io,
             ReportError::Output(e) => e.kind(),
             ReportError::Plot(e) => e.kind(),
-            ReportError::Fit(e) => e.kind(),
             ReportError::Spectral(e) => e.kind(),
             ReportError::Registry(e) => e.kind(),
             ReportError::Scene(e) => e.kind(),
