@@ -36,8 +36,13 @@ pub struct Optics<V> {
 }
 
 impl<V> Optics<V> {
-    /// The same optics with every value mapped by `f` (e.g. a spectrum integrated).
+    /// The same optics with every value mapped by `f` (e.g. a spectrum integrated), called in
+    /// the order t, rf, rb, each layer's absorptance (front, then back), each group's share
+    /// (front, then back): the order in which messages name them.
     pub fn try_map<U, E>(&self, mut f: impl FnMut(&V) -> Result<U, E>) -> Result<Optics<U>, E> {
+        let t = f(&self.t)?;
+        let rf = f(&self.rf)?;
+        let rb = f(&self.rb)?;
         let mut all = |vs: &[V]| vs.iter().map(&mut f).collect::<Result<Vec<U>, E>>();
         let mut both = |fb: &FrontBack<Vec<V>>| -> Result<FrontBack<Vec<U>>, E> {
             Ok(FrontBack {
@@ -46,11 +51,11 @@ impl<V> Optics<V> {
             })
         };
         Ok(Optics {
+            t,
+            rf,
+            rb,
             absorptance: both(&self.absorptance)?,
             share: both(&self.share)?,
-            t: f(&self.t)?,
-            rf: f(&self.rf)?,
-            rb: f(&self.rb)?,
         })
     }
 }

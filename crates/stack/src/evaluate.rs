@@ -539,3 +539,59 @@ impl Stack {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::combine::FrontBack;
+    use glassdb_spectral::SpectralError;
+
+    /// A unit of two layers and two pane groups whose spectra are all 1 but one, NaN, at `bad`
+    /// in the order of [`quantity_names`].
+    fn optics_with_nan_at(bad: usize) -> Optics<Vec<f64>> {
+        let mut k = 0;
+        let mut next = || {
+            k += 1;
+            vec![if k - 1 == bad { f64::NAN } else { 1.0 }]
+        };
+        let (t, rf, rb) = (next(), next(), next());
+        let absorptance = FrontBack {
+            front: vec![next(), next()],
+            back: vec![next(), next()],
+        };
+        let share = FrontBack {
+            front: vec![next(), next()],
+            back: vec![next(), next()],
+        };
+        Optics {
+            t,
+            rf,
+            rb,
+            absorptance,
+            share,
+        }
+    }
+
+    #[test]
+    fn an_integration_error_names_the_spectrum_that_failed() {
+        let names = quantity_names(&optics_with_nan_at(usize::MAX));
+        assert_eq!(names.len(), 11);
+        for (bad, name) in names.iter().enumerate() {
+            let err = integrate_optics(&optics_with_nan_at(bad), 30.0, |v| {
+                if v[0].is_finite() {
+                    Ok(v[0])
+                } else {
+                    Err(SpectralError::NonFinite {
+                        what: "value",
+                        index: 0,
+                    })
+                }
+            })
+            .unwrap_err();
+            match err {
+                StackError::Integration { what, .. } => assert_eq!(what, format!("{name} at 30°")),
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+}
