@@ -77,18 +77,24 @@ pub(super) struct PixelBox {
 
 impl PixelBox {
     /// The pixels of a `width` × `height` image that the box of a triangle with corners
-    /// (`x`, `y`) touches (clamped to the image).
+    /// (`x`, `y`) touches (clamped to the image): for tests that build a [`Setup`] by hand.
+    #[cfg(test)]
     pub(super) fn of_triangle(x: &[f64; 3], y: &[f64; 3], width: u32, height: u32) -> PixelBox {
+        PixelBox::of_bounds(
+            (x[0].min(x[1]).min(x[2]), x[0].max(x[1]).max(x[2])),
+            (y[0].min(y[1]).min(y[2]), y[0].max(y[1]).max(y[2])),
+            width,
+            height,
+        )
+    }
+
+    /// The pixels of a `width` × `height` image that the box from `x.0` to `x.1` across and
+    /// `y.0` to `y.1` down (pixel coordinates) touches, clamped to the image.
+    fn of_bounds(x: (f64, f64), y: (f64, f64), width: u32, height: u32) -> PixelBox {
         let clampi = |v: f64, hi: u32| -> u32 { v.floor().clamp(0.0, (hi - 1) as f64) as u32 };
         PixelBox {
-            columns: (
-                clampi(x[0].min(x[1]).min(x[2]), width),
-                clampi(x[0].max(x[1]).max(x[2]), width),
-            ),
-            rows: (
-                clampi(y[0].min(y[1]).min(y[2]), height),
-                clampi(y[0].max(y[1]).max(y[2]), height),
-            ),
+            columns: (clampi(x.0, width), clampi(x.1, width)),
+            rows: (clampi(y.0, height), clampi(y.1, height)),
         }
     }
 }
@@ -157,6 +163,6 @@ fn make_setup(cam: &Camera, c: [Vec3; 3], label: u32) -> Option<Setup> {
         w,
         inv_area2: 1.0 / area2.abs(),
         label,
-        bbox: PixelBox::of_triangle(&x, &y, cam.width, cam.height),
+        bbox: PixelBox::of_bounds((xmin, xmax), (ymin, ymax), cam.width, cam.height),
     })
 }
