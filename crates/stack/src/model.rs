@@ -3,7 +3,6 @@
 //! file's product type or the data themselves ([`choose_model`]); and the model evaluated for
 //! one wavelength or channel ([`model_at`]). Equations in `docs/registry.md`.
 
-use std::fmt;
 use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
@@ -49,39 +48,28 @@ impl ModelChoice {
         ModelChoice::CoatedBronzePublished,
         ModelChoice::Opaque,
     ];
-
-    /// The name used in catalogs and in the registry's `angle_model.kind`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ModelChoice::Auto => "auto",
-            ModelChoice::Uncoated => "uncoated",
-            ModelChoice::Coated => "coated",
-            ModelChoice::CoatedClear => "coated-clear",
-            ModelChoice::CoatedBronze => "coated-bronze",
-            ModelChoice::CoatedBronzePublished => "coated-bronze-published",
-            ModelChoice::Opaque => "opaque",
-        }
-    }
 }
 
-impl fmt::Display for ModelChoice {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+// The name used in catalogs and in the registry's `angle_model.kind`.
+glassdb_io::enum_names!(ModelChoice {
+    Auto => "auto",
+    Uncoated => "uncoated",
+    Coated => "coated",
+    CoatedClear => "coated-clear",
+    CoatedBronze => "coated-bronze",
+    CoatedBronzePublished => "coated-bronze-published",
+    Opaque => "opaque",
+});
 
 impl FromStr for ModelChoice {
     type Err = String;
 
     /// A model's name as [`ModelChoice::name`] writes it, any case.
     fn from_str(s: &str) -> Result<ModelChoice, String> {
-        ModelChoice::ALL
-            .into_iter()
-            .find(|m| m.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| {
-                let names: Vec<&str> = ModelChoice::ALL.iter().map(|m| m.name()).collect();
-                format!("unknown model `{s}`; expected one of {}", names.join(", "))
-            })
+        ModelChoice::from_name(s.trim()).ok_or_else(|| {
+            let names: Vec<&str> = ModelChoice::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown model `{s}`; expected one of {}", names.join(", "))
+        })
     }
 }
 
@@ -143,18 +131,7 @@ pub enum ModelSample {
         back: UncoatedSlab,
     },
     /// A coated curve and the normal values it scales.
-    Coated {
-        /// The curve.
-        curve: CoatedCurve,
-        /// As published (not renormalised).
-        published: bool,
-        /// Normal transmittance.
-        t0: f64,
-        /// Normal front reflectance.
-        rf0: f64,
-        /// Normal back reflectance.
-        rb0: f64,
-    },
+    Coated(CoatedSample),
     /// An opaque surface.
     Opaque {
         /// Normal front reflectance.
@@ -164,6 +141,38 @@ pub enum ModelSample {
         /// `(n, k)` when given.
         ior: Option<(f64, f64)>,
     },
+}
+
+/// A coated layer's curve and the normal values it scales, for one sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoatedSample {
+    /// The curve.
+    pub curve: CoatedCurve,
+    /// As published (not renormalised).
+    pub published: bool,
+    /// Normal transmittance.
+    pub t0: f64,
+    /// Normal front reflectance.
+    pub rf0: f64,
+    /// Normal back reflectance.
+    pub rb0: f64,
+}
+
+impl CoatedSample {
+    /// `(Rf, T, Rb)` at `cos θ`: the curve applied to each side's normal reflectance.
+    #[inline]
+    pub fn at(&self, cos_theta: f64) -> (f64, f64, f64) {
+        let at = |r0| {
+            if self.published {
+                self.curve.at_published(self.t0, r0, cos_theta)
+            } else {
+                self.curve.at(self.t0, r0, cos_theta)
+            }
+        };
+        let (rf, t) = at(self.rf0);
+        let (rb, _) = at(self.rb0);
+        (rf, t, rb)
+    }
 }
 
 impl ModelSample {
@@ -181,13 +190,13 @@ impl ModelSample {
                     LayerModel::CoatedPublished(c) => (c, true),
                     _ => (CoatedCurve::for_t0(t0), false),
                 };
-                ModelSample::Coated {
+                ModelSample::Coated(CoatedSample {
                     curve,
                     published,
                     t0,
                     rf0,
                     rb0,
-                }
+                })
             }
             LayerModel::Opaque => ModelSample::Opaque { rf0, rb0, ior },
         }
@@ -202,24 +211,7 @@ impl ModelSample {
                 let (rb, _) = back.at(cos_theta);
                 (rf, t, rb)
             }
-            ModelSample::Coated {
-                curve,
-                published,
-                t0,
-                rf0,
-                rb0,
-            } => {
-                let at = |r0| {
-                    if published {
-                        curve.at_published(t0, r0, cos_theta)
-                    } else {
-                        curve.at(t0, r0, cos_theta)
-                    }
-                };
-                let (rf, t) = at(rf0);
-                let (rb, _) = at(rb0);
-                (rf, t, rb)
-            }
+            ModelSample::Coated(coated) => coated.at(cos_theta),
             ModelSample::Opaque { rf0, rb0, ior } => {
                 let f = |r0: f64| match ior {
                     Some(nk) => opaque_reflectance(r0, nk, cos_theta),
