@@ -1,7 +1,6 @@
 //! A build-up: layers and gaps, outside first, validated ([`Stack::new`]); its pane groups and
 //! their depths; and the wavelengths its layers share.
 
-use std::fmt;
 use std::ops::Range;
 use std::str::FromStr;
 
@@ -29,32 +28,21 @@ pub enum Gas {
 impl Gas {
     /// Every gas, in the order help texts list them.
     pub const ALL: [Gas; 4] = [Gas::Air, Gas::Argon, Gas::Krypton, Gas::Xenon];
-
-    /// The lowercase name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Gas::Air => "air",
-            Gas::Argon => "argon",
-            Gas::Krypton => "krypton",
-            Gas::Xenon => "xenon",
-        }
-    }
 }
 
-impl fmt::Display for Gas {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+glassdb_io::enum_names!(Gas {
+    Air => "air",
+    Argon => "argon",
+    Krypton => "krypton",
+    Xenon => "xenon",
+});
 
 impl FromStr for Gas {
     type Err = String;
 
     /// `air`, `argon`, `krypton` or `xenon`, any case.
     fn from_str(s: &str) -> Result<Gas, String> {
-        Gas::ALL
-            .into_iter()
-            .find(|g| g.name().eq_ignore_ascii_case(s.trim()))
+        Gas::from_name(s.trim())
             .ok_or_else(|| format!("unknown gas `{s}`; expected air, argon, krypton or xenon"))
     }
 }
