@@ -40,8 +40,8 @@ pub use input::{
 };
 pub use kind::{FileKind, lowercase_extension};
 pub use output::{
-    OutputError, StagedOutput, SyncingFile, create_output_dirs, refuse_input_as_output,
-    write_atomic, write_bytes_atomic,
+    OutputError, StagedOutput, SyncingFile, create_output_dirs, create_output_folder,
+    refuse_input_as_output, write_atomic, write_bytes_atomic,
 };
 pub use registry::{
     OnStop, TEMP_PREFIX, declare_inputs, exit_removing_temporaries, on_stop, protect_inputs,

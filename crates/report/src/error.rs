@@ -13,14 +13,6 @@ pub enum ReportError {
         /// Why it could not be read.
         source: glassdb_io::InputError,
     },
-    /// The figures directory could not be created.
-    #[error("cannot create the figures directory {path}")]
-    CreateDir {
-        /// The folder.
-        path: PathBuf,
-        /// Why it could not be made.
-        source: std::io::Error,
-    },
     /// Writing the page or a figure failed (nothing was written).
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),
@@ -47,7 +39,6 @@ impl ReportError {
     pub fn kind(&self) -> glassdb_io::ErrorKind {
         match self {
             ReportError::Read { source, .. } => source.kind(),
-            ReportError::CreateDir { .. } => glassdb_io::ErrorKind::Io,
             ReportError::Output(e) => e.kind(),
             ReportError::Plot(e) => e.kind(),
             ReportError::Spectral(e) => e.kind(),

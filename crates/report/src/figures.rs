@@ -61,10 +61,7 @@ pub(crate) fn section_figures(
     scene_mask: Option<&SceneMask>,
     staged: &mut StagedOutput,
 ) -> Result<(), ReportError> {
-    std::fs::create_dir_all(dir).map_err(|source| ReportError::CreateDir {
-        path: dir.into(),
-        source,
-    })?;
+    glassdb_io::create_output_folder(dir, "figures directory")?;
     let _ = writeln!(md, "## Figures\n");
     let _ = writeln!(
         md,

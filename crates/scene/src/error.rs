@@ -188,14 +188,6 @@ pub enum SceneError {
         /// serde's error.
         source: serde_json::Error,
     },
-    /// The output directory could not be created.
-    #[error("cannot create the output directory {path}")]
-    CreateDir {
-        /// The folder.
-        path: PathBuf,
-        /// Why it could not be made.
-        source: std::io::Error,
-    },
     /// Writing an output failed (atomic: the target is left as it was).
     #[error(transparent)]
     Output(#[from] glassdb_io::OutputError),
@@ -223,7 +215,6 @@ impl SceneError {
             SceneError::Output(e) => e.kind(),
             SceneError::Mask(e) => e.kind(),
             SceneError::Frame(e) => e.kind(),
-            SceneError::CreateDir { .. } => ErrorKind::Io,
             SceneError::BadImageSize { .. } => ErrorKind::Limits,
             SceneError::EncodeJson { .. } => ErrorKind::Internal,
             _ => ErrorKind::Invalid,

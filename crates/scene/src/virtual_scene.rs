@@ -97,10 +97,7 @@ fn write_virtual_scenes_staged(req: &MirrorRequest<'_>) -> Result<MirrorReport, 
             .is_some()
     };
     let planes = glass_planes(req, is_glass)?;
-    std::fs::create_dir_all(req.out_dir).map_err(|source| SceneError::CreateDir {
-        path: req.out_dir.to_path_buf(),
-        source,
-    })?;
+    glassdb_io::create_output_folder(req.out_dir, "output directory")?;
     let mtllibs = mtllibs_from(scene, req.out_dir);
     let mut staged = glassdb_io::StagedOutput::new();
     let mut entries = Vec::with_capacity(planes.len());

@@ -66,6 +66,17 @@ pub enum OutputError {
         /// Why it failed.
         source: std::io::Error,
     },
+    /// A folder that is itself an output (a run's output folder, a report's figures folder)
+    /// could not be created ([`create_output_folder`]).
+    #[error("cannot create the {what} {path}")]
+    CreateFolder {
+        /// What the folder is for, as the message names it ("output directory").
+        what: &'static str,
+        /// The folder.
+        path: PathBuf,
+        /// Why it failed.
+        source: std::io::Error,
+    },
     /// The output is one of the run's own inputs (the same file, whatever the spelling, link
     /// or hard link).
     #[error(
@@ -100,7 +111,8 @@ impl OutputError {
             | OutputError::Write { .. }
             | OutputError::Persist { .. }
             | OutputError::MissingDirectory { .. }
-            | OutputError::CreateDirectory { .. } => ErrorKind::Io,
+            | OutputError::CreateDirectory { .. }
+            | OutputError::CreateFolder { .. } => ErrorKind::Io,
         }
     }
 }
@@ -322,6 +334,17 @@ pub fn create_output_dirs(path: &Path) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|source| OutputError::CreateDirectory {
         path: path.to_path_buf(),
         dir: dir.to_path_buf(),
+        source,
+    })
+}
+
+/// Creates the folder `dir` that a command writes its outputs into, and the folders above it,
+/// where they are missing (as `mkdir -p`); `what` names the folder in the error
+/// ("output directory").
+pub fn create_output_folder(dir: &Path, what: &'static str) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::CreateFolder {
+        what,
+        path: dir.to_path_buf(),
         source,
     })
 }

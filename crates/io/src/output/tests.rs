@@ -335,3 +335,28 @@ fn same_file_as<'a>(output: &Path, inputs: &[&'a Path]) -> Option<&'a Path> {
         .copied()
         .find(|input| FileId::of_path(input).as_ref() == Some(&out))
 }
+
+/// An output folder is created with the folders above it, an existing one is kept, and one
+/// that cannot be made (a file stands where a folder above it should be) is an I/O error
+/// naming the folder and what it is for.
+#[test]
+fn an_output_folder_is_made_with_its_parents_or_named_in_the_error() {
+    let (dir, [file]) = scratch(["a-file"]);
+    let nested = dir.path().join("renders").join("frames");
+    create_output_folder(&nested, "output directory").unwrap();
+    assert!(nested.is_dir());
+    create_output_folder(&nested, "output directory").unwrap();
+
+    std::fs::write(&file, b"not a folder").unwrap();
+    let under_file = file.join("figures");
+    let err = create_output_folder(&under_file, "figures directory").unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "cannot create the figures directory {}",
+            under_file.display()
+        )
+    );
+    assert_eq!(err.kind(), ErrorKind::Io);
+    assert_eq!(std::fs::read(&file).unwrap(), b"not a folder");
+}
