@@ -11,7 +11,8 @@ use glassdb_registry::{
     Side, UnitElement, UnitRecord,
 };
 use glassdb_spectral::{
-    Illuminant, IntegrationSettings, Method, MethodKind, Observer, RgbCmf, RgbSpace, WhiteBalance,
+    ColorimetricSettings, Illuminant, IntegrationSettings, Method, MethodKind, Observer, RgbCmf,
+    RgbSpace, WhiteBalance,
 };
 
 #[derive(Debug, clap::Args)]
@@ -171,12 +172,12 @@ fn table_settings(a: &BuildArgs) -> anyhow::Result<Vec<IntegrationSettings>> {
     Ok(spaces
         .into_iter()
         .map(|space| {
-            with(Method::Colorimetric {
+            with(Method::Colorimetric(ColorimetricSettings {
                 observer,
                 illuminant: illuminant.clone(),
                 space,
                 white_balance: a.white_balance.unwrap_or_default(),
-            })
+            }))
         })
         .collect())
 }
@@ -340,17 +341,13 @@ fn method_text(s: &IntegrationSettings) -> String {
     let kind = s.method.kind();
     match &s.method {
         Method::Paper(cmf) => format!("{kind} {cmf}"),
-        Method::Colorimetric {
-            observer,
-            illuminant,
-            space,
-            white_balance,
-        } => match white_balance {
-            WhiteBalance::Light => format!("{kind} {observer} {illuminant} {space}"),
-            WhiteBalance::Fixed(w) => {
-                format!("{kind} {observer} {illuminant} {space}, camera balanced to {w}")
+        Method::Colorimetric(c) => {
+            let text = format!("{kind} {} {} {}", c.observer, c.illuminant, c.space);
+            match c.white_balance {
+                WhiteBalance::Light => text,
+                WhiteBalance::Fixed(w) => format!("{text}, camera balanced to {w}"),
             }
-        },
+        }
         Method::Luminous => kind.to_string(),
     }
 }

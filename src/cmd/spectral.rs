@@ -6,8 +6,9 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use glassdb_spectral::{
-    Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method, Observer, ReadOptions,
-    RgbCmf, RgbSpace, SpectralData, WhiteBalance, luminous, read_spectral_file,
+    ColorimetricSettings, Illuminant, IntegrationSettings, Integrator, LuminousGrid, Method,
+    Observer, ReadOptions, RgbCmf, RgbSpace, SpectralData, WhiteBalance, luminous,
+    read_spectral_file,
 };
 use serde_json::{Value, json};
 
@@ -158,7 +159,7 @@ impl SpectralSettingsArgs {
                 if self.cmf.is_some() {
                     bail!("--cmf applies to --method paper, not colorimetric");
                 }
-                Method::Colorimetric {
+                Method::Colorimetric(ColorimetricSettings {
                     observer: match self.observer.unwrap_or(ObserverArg::Cie1931) {
                         ObserverArg::Cie1931 => Observer::Cie1931,
                         ObserverArg::Cie1964 => Observer::Cie1964,
@@ -171,7 +172,7 @@ impl SpectralSettingsArgs {
                     },
                     space: self.space.unwrap_or(SpaceArg::Srgb).space(),
                     white_balance: self.white_balance.unwrap_or_default(),
-                }
+                })
             }
             MethodArg::Luminous => {
                 if colorimetric_flags || self.cmf.is_some() {
@@ -297,17 +298,12 @@ fn check_channel_balance(data: &SpectralData, results: &[QuantityResult]) -> any
 fn to_json(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> Value {
     let (cmf, observer, illuminant, space, white_balance) = match method {
         Method::Paper(c) => (Some(c.name()), None, None, None, None),
-        Method::Colorimetric {
-            observer,
-            illuminant,
-            space,
-            white_balance,
-        } => (
+        Method::Colorimetric(c) => (
             None,
-            Some(observer.name()),
-            Some(illuminant.name()),
-            Some(space.name()),
-            Some(white_balance.name()),
+            Some(c.observer.name()),
+            Some(c.illuminant.name()),
+            Some(c.space.name()),
+            Some(c.white_balance.name()),
         ),
         Method::Luminous => (None, None, None, None, None),
     };

@@ -235,10 +235,8 @@ fn colour_settings(args: &Args) -> anyhow::Result<IntegrationSettings> {
         None => Default::default(),
     };
     let mut settings = IntegrationSettings::colorimetric(args.space.space(), illuminant);
-    if let (Some(wb), Method::Colorimetric { white_balance, .. }) =
-        (args.white_balance, &mut settings.method)
-    {
-        *white_balance = wb;
+    if let (Some(wb), Method::Colorimetric(c)) = (args.white_balance, &mut settings.method) {
+        c.white_balance = wb;
     }
     Ok(settings)
 }
@@ -330,16 +328,10 @@ fn to_json(
     settings: &IntegrationSettings,
 ) -> Value {
     let mut rgb = optics_json(&eval.colour[0], false);
-    if let Method::Colorimetric {
-        space,
-        illuminant,
-        white_balance,
-        ..
-    } = &settings.method
-    {
-        rgb["space"] = json!(space.name());
-        rgb["illuminant"] = json!(illuminant.name());
-        rgb["white_balance"] = json!(white_balance.name());
+    if let Method::Colorimetric(c) = &settings.method {
+        rgb["space"] = json!(c.space.name());
+        rgb["illuminant"] = json!(c.illuminant.name());
+        rgb["white_balance"] = json!(c.white_balance.name());
     }
     let mut layers = Vec::new();
     for ((l, origin), own) in built

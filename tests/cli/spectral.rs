@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use glassdb_spectral::{
-    CieIlluminant, IntegrationSettings, Integrator, LuminousGrid, Method, Observer, ReadOptions,
-    RgbCmf, RgbSpace, SpectralData, WhiteBalance, luminous, read_spectral_file,
+    CieIlluminant, ColorimetricSettings, IntegrationSettings, Integrator, LuminousGrid, Method,
+    Observer, ReadOptions, RgbCmf, RgbSpace, SpectralData, WhiteBalance, luminous,
+    read_spectral_file,
 };
 use serde_json::Value;
 
@@ -100,12 +101,12 @@ fn compare_with_oracle(files: &[PathBuf], opts: &ReadOptions, extrapolate: bool,
             for observer in Observer::ALL {
                 for illuminant in ORACLE_ILLUMINANTS {
                     for space in RgbSpace::ALL {
-                        let method = Method::Colorimetric {
+                        let method = Method::Colorimetric(ColorimetricSettings {
                             observer: *observer,
                             illuminant: illuminant.into(),
                             space: *space,
                             white_balance: WhiteBalance::Light,
-                        };
+                        });
                         let it = Integrator::new(&IntegrationSettings {
                             method,
                             extrapolate,
@@ -186,12 +187,12 @@ fn every_rgb_space_matches_colour_science_on_clear_and_tinted_glass() {
                 for observer in Observer::ALL {
                     for illuminant in ORACLE_ILLUMINANTS {
                         let it = Integrator::new(&IntegrationSettings {
-                            method: Method::Colorimetric {
+                            method: Method::Colorimetric(ColorimetricSettings {
                                 observer: *observer,
                                 illuminant: illuminant.into(),
                                 space: *space,
                                 white_balance: WhiteBalance::Light,
-                            },
+                            }),
                             extrapolate: false,
                         })
                         .unwrap();

@@ -101,11 +101,7 @@ impl RegistryTable {
     /// The light of this table: its name, illuminant and white balance.
     pub fn registry_light(&self) -> RegistryLight<'_> {
         let (illuminant, white_balance) = match &self.spectral.method {
-            Method::Colorimetric {
-                illuminant,
-                white_balance,
-                ..
-            } => (Some(illuminant), *white_balance),
+            Method::Colorimetric(c) => (Some(&c.illuminant), c.white_balance),
             _ => (None, WhiteBalance::Light),
         };
         RegistryLight {
@@ -212,7 +208,7 @@ impl Registry {
                 name: light.clone(),
                 reason,
             })?;
-            let Method::Colorimetric { observer, .. } = &t.spectral.method else {
+            let Method::Colorimetric(colorimetric) = &t.spectral.method else {
                 return Err(RegistryError::LightNotColorimetric {
                     source_name: source_name.to_string(),
                     light: light.clone(),
@@ -223,10 +219,10 @@ impl Registry {
             if let Some(first) = first {
                 let (a, b) = (first.registry_light(), t.registry_light());
                 let first_observer = match &first.spectral.method {
-                    Method::Colorimetric { observer, .. } => Some(*observer),
+                    Method::Colorimetric(c) => Some(c.observer),
                     _ => None,
                 };
-                if a != b || first_observer != Some(*observer) {
+                if a != b || first_observer != Some(colorimetric.observer) {
                     let say = |l: RegistryLight<'_>, t: &RegistryTable| {
                         format!("{} ({})", l.describe(), t.spectral.method)
                     };
@@ -281,12 +277,12 @@ impl BuildOptions {
                 .iter()
                 .filter_map(|t| {
                     let name = t.light.clone()?;
-                    let Method::Colorimetric { illuminant, .. } = &t.spectral.method else {
+                    let Method::Colorimetric(c) = &t.spectral.method else {
                         return None;
                     };
                     Some(NamedLight {
                         name,
-                        illuminant: illuminant.clone(),
+                        illuminant: c.illuminant.clone(),
                     })
                 })
                 .fold(Vec::new(), |mut lights: Vec<NamedLight>, l| {
@@ -327,7 +323,7 @@ pub(crate) fn planned_tables(opts: &BuildOptions) -> Result<Vec<RegistryTable>, 
         for settings in &opts.tables {
             let mut spectral = settings.clone();
             match &mut spectral.method {
-                Method::Colorimetric { illuminant, .. } => *illuminant = light.illuminant.clone(),
+                Method::Colorimetric(c) => c.illuminant = light.illuminant.clone(),
                 other => {
                     return Err(RegistryError::LightsNeedColorimetric {
                         method: other.kind().to_string(),

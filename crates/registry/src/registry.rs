@@ -108,7 +108,7 @@ impl RegistryTable {
     /// The colour basis of this table's channels.
     pub fn basis(&self) -> ColourBasis {
         match self.spectral.method {
-            Method::Colorimetric { space, .. } => ColourBasis::Space(space),
+            Method::Colorimetric(ref c) => ColourBasis::Space(c.space),
             Method::Paper(_) => ColourBasis::PaperRgb,
             Method::Luminous => ColourBasis::Luminous,
         }
@@ -129,9 +129,9 @@ impl RegistryTable {
         self.light.is_some()
             || matches!(
                 &self.spectral.method,
-                Method::Colorimetric { illuminant, white_balance, .. }
-                    if matches!(illuminant, glassdb_spectral::Illuminant::Spd(_))
-                        || *white_balance != glassdb_spectral::WhiteBalance::Light
+                Method::Colorimetric(c)
+                    if matches!(c.illuminant, glassdb_spectral::Illuminant::Spd(_))
+                        || c.white_balance != glassdb_spectral::WhiteBalance::Light
             )
     }
 

@@ -51,8 +51,8 @@ pub use illuminant::{
     read_spd_file,
 };
 pub use integrate::{
-    GridIntegrator, IntegrationSettings, Integrator, LuminousGrid, Method, MethodKind, Observer,
-    RgbCmf, luminous, luminous_iso9050, rgb_matrix,
+    ColorimetricSettings, GridIntegrator, IntegrationSettings, Integrator, LuminousGrid, Method,
+    MethodKind, Observer, RgbCmf, luminous, luminous_iso9050, rgb_matrix,
 };
 pub use interp::resample;
 pub use open::{SPECTRAL_FILE, detect_format, read_spectral_bytes, read_spectral_file};

@@ -173,7 +173,7 @@ fn weights_panel(opts: &SpectralPlotOptions, grid: &[f64], weights: &[[f64; 3]])
     lower.legend = Some(LegendCorner::Auto);
     let names: [&str; 3] = match opts.settings.method {
         Method::Paper(_) => ["r̄(λ)", "ḡ(λ)", "b̄(λ)"],
-        Method::Colorimetric { .. } => ["R weight", "G weight", "B weight"],
+        Method::Colorimetric(_) => ["R weight", "G weight", "B weight"],
         Method::Luminous => ["D65·V(λ)", "", ""],
     };
     for c in 0..(if luminous { 1 } else { 3 }) {
@@ -202,7 +202,7 @@ fn weights_panel(opts: &SpectralPlotOptions, grid: &[f64], weights: &[[f64; 3]])
         Method::Paper(_) => {
             "colour-matching functions (each divided by its peak; ∫ over the CMF's own grid)".into()
         }
-        Method::Colorimetric { .. } => {
+        Method::Colorimetric(_) => {
             "effective channel weights: illuminant × CIE CMFs → RGB, over the illuminant's RGB"
                 .into()
         }

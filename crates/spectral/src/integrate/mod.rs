@@ -60,18 +60,102 @@ pub enum Method {
     /// 360–780 nm at 1 nm, then CAT02 from the white the camera is balanced to (by default the
     /// illuminant's own) to the space's white (identity when they are equal, and for
     /// [`RgbSpace::Xyz`]) and the space's XYZ→RGB matrix ([`rgb_matrix`]).
-    Colorimetric {
-        /// The CIE standard observer.
-        observer: Observer,
-        /// The light the glass is seen under.
-        illuminant: Illuminant,
-        /// The linear RGB space of the channels.
-        space: RgbSpace,
-        /// The white the camera is balanced to: where the adaptation starts.
-        white_balance: WhiteBalance,
-    },
+    Colorimetric(ColorimetricSettings),
     /// ISO 9050 / EN 410 luminous value (D65 × V(λ), 380–780 nm at 10 nm) in all three channels.
     Luminous,
+}
+
+/// The options of the colorimetric method ([`Method::Colorimetric`]).
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct ColorimetricSettings {
+    /// The CIE standard observer.
+    pub observer: Observer,
+    /// The light the glass is seen under.
+    pub illuminant: Illuminant,
+    /// The linear RGB space of the channels.
+    pub space: RgbSpace,
+    /// The white the camera is balanced to: where the adaptation starts.
+    pub white_balance: WhiteBalance,
+}
+
+/// The readable description, as [`Method`]'s `Display` gives it.
+impl fmt::Display for ColorimetricSettings {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "colorimetric, {} observer, illuminant {}, {} (linear)",
+            self.observer, self.illuminant, self.space
+        )?;
+        match &self.white_balance {
+            WhiteBalance::Light => Ok(()),
+            WhiteBalance::Fixed(w) => write!(f, ", camera balanced to {w}"),
+        }
+    }
+}
+
+impl ColorimetricSettings {
+    /// The method's grid (360–780 nm at 1 nm), each grid point's RGB weights and the
+    /// integrator's label: XYZ through the observer under the illuminant, CAT02 from the white
+    /// the camera is balanced to, then the space's matrix, normalised so that the light's own
+    /// spectrum gives its white.
+    fn weights(&self) -> Result<MethodWeights, SpectralError> {
+        let grid: Vec<f64> = (360..=780).map(f64::from).collect();
+        let xyz_weights = xyz_weights_of(self.observer, &self.illuminant, &grid)?;
+        let white_xyz = xyz_weights
+            .iter()
+            .fold(Vector3::zeros(), |acc, w| acc + Vector3::from(*w));
+        // The adaptation starts from the white the camera is balanced to: the light's
+        // own (tabulated for a CIE illuminant, integrated above for an SPD) or a fixed one.
+        let from_white = match (&self.white_balance, &self.illuminant) {
+            (WhiteBalance::Light, Illuminant::Spd(_)) => {
+                xy_of([white_xyz[0], white_xyz[1], white_xyz[2]])
+            }
+            _ => self
+                .white_balance
+                .white_xy(&self.illuminant, self.observer)?,
+        };
+        let m = rgb_matrix(from_white, self.space);
+        let white_rgb = m * white_xyz;
+        for (c, name) in ["red", "green", "blue"].iter().enumerate() {
+            if white_rgb[c].is_nan() || white_rgb[c] <= 1e-12 * white_xyz[1].abs() {
+                return Err(SpectralError::DegenerateWhite {
+                    illuminant: self.illuminant.name().to_owned(),
+                    channel: name,
+                    value: white_rgb[c],
+                });
+            }
+        }
+        let weights = xyz_weights
+            .iter()
+            .map(|w| {
+                let rgb = m * Vector3::from(*w);
+                [
+                    rgb[0] / white_rgb[0],
+                    rgb[1] / white_rgb[1],
+                    rgb[2] / white_rgb[2],
+                ]
+            })
+            .collect();
+        let label = format!(
+            "the colorimetric method ({}, {}, {})",
+            self.observer.name(),
+            self.illuminant.name(),
+            self.space.name()
+        );
+        Ok(MethodWeights {
+            grid_nm: grid,
+            weights,
+            label,
+        })
+    }
+}
+
+/// What an [`Integrator`] is built from: a method's grid, each grid point's channel weights
+/// and the integrator's label.
+struct MethodWeights {
+    grid_nm: Vec<f64>,
+    weights: Vec<[f64; 3]>,
+    label: String,
 }
 
 /// Which of the three methods, by name: what `--method` and the JSON `method` key hold.
@@ -91,7 +175,7 @@ impl Method {
     pub fn kind(&self) -> MethodKind {
         match self {
             Method::Paper(_) => MethodKind::Paper,
-            Method::Colorimetric { .. } => MethodKind::Colorimetric,
+            Method::Colorimetric(_) => MethodKind::Colorimetric,
             Method::Luminous => MethodKind::Luminous,
         }
     }
@@ -103,21 +187,7 @@ impl fmt::Display for Method {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Method::Paper(cmf) => write!(f, "paper method (eqs. 15–20), {cmf} RGB CMFs"),
-            Method::Colorimetric {
-                observer,
-                illuminant,
-                space,
-                white_balance,
-            } => {
-                write!(
-                    f,
-                    "colorimetric, {observer} observer, illuminant {illuminant}, {space} (linear)"
-                )?;
-                match white_balance {
-                    WhiteBalance::Light => Ok(()),
-                    WhiteBalance::Fixed(w) => write!(f, ", camera balanced to {w}"),
-                }
-            }
+            Method::Colorimetric(c) => c.fmt(f),
             Method::Luminous => f.write_str("luminous (ISO 9050: D65 × V(λ), 380–780 nm at 10 nm)"),
         }
     }
@@ -149,12 +219,12 @@ impl IntegrationSettings {
     /// balanced to the light, no extrapolation).
     pub fn colorimetric(space: RgbSpace, illuminant: Illuminant) -> IntegrationSettings {
         IntegrationSettings {
-            method: Method::Colorimetric {
+            method: Method::Colorimetric(ColorimetricSettings {
                 observer: Observer::Cie1931,
                 illuminant,
                 space,
                 white_balance: WhiteBalance::Light,
-            },
+            }),
             extrapolate: false,
         }
     }
@@ -192,17 +262,12 @@ impl From<IntegrationSettings> for SettingsJson {
         };
         match s.method {
             Method::Paper(cmf) => json.cmf = Some(cmf),
-            Method::Colorimetric {
-                observer,
-                illuminant,
-                space,
-                white_balance,
-            } => {
-                json.observer = Some(observer);
-                json.illuminant = Some(illuminant);
-                json.space = Some(space);
+            Method::Colorimetric(c) => {
+                json.observer = Some(c.observer);
+                json.illuminant = Some(c.illuminant);
+                json.space = Some(c.space);
                 json.white_balance =
-                    (white_balance != WhiteBalance::Light).then_some(white_balance);
+                    (c.white_balance != WhiteBalance::Light).then_some(c.white_balance);
             }
             Method::Luminous => {}
         }
@@ -229,12 +294,12 @@ impl TryFrom<SettingsJson> for IntegrationSettings {
             MethodKind::Colorimetric if j.cmf.is_some() => {
                 return Err("cmf applies to method paper, not colorimetric".into());
             }
-            MethodKind::Colorimetric => Method::Colorimetric {
+            MethodKind::Colorimetric => Method::Colorimetric(ColorimetricSettings {
                 observer: j.observer.unwrap_or(Observer::Cie1931),
                 illuminant: j.illuminant.unwrap_or_default(),
                 space: j.space.unwrap_or(RgbSpace::Srgb),
                 white_balance: j.white_balance.unwrap_or_default(),
-            },
+            }),
             MethodKind::Luminous if colorimetric || j.cmf.is_some() => {
                 return Err(
                     "cmf, observer, illuminant, space and white_balance do not apply to method luminous".into(),
@@ -276,7 +341,11 @@ impl Integrator {
     /// Builds the integrator: loads the embedded tables and precomputes the weights.
     pub fn new(settings: &IntegrationSettings) -> Result<Self, SpectralError> {
         let t = tables()?;
-        let (grid_nm, weights, label) = match &settings.method {
+        let MethodWeights {
+            grid_nm,
+            weights,
+            label,
+        } = match &settings.method {
             Method::Paper(cmf) => {
                 let table = match *cmf {
                     RgbCmf::WrightGuild1931 => &t.wright_guild_1931,
@@ -287,68 +356,20 @@ impl Integrator {
                 let weights = (0..table.wavelength_nm.len())
                     .map(|j| [0, 1, 2].map(|c| table.columns[c][j] / sums[c]))
                     .collect();
-                (
-                    table.wavelength_nm.clone(),
+                MethodWeights {
+                    grid_nm: table.wavelength_nm.clone(),
                     weights,
-                    format!("the paper method ({})", cmf.name()),
-                )
-            }
-            Method::Colorimetric {
-                observer,
-                illuminant,
-                space,
-                white_balance,
-            } => {
-                let grid: Vec<f64> = (360..=780).map(f64::from).collect();
-                let xyz_weights = xyz_weights_of(*observer, illuminant, &grid)?;
-                let white_xyz = xyz_weights
-                    .iter()
-                    .fold(Vector3::zeros(), |acc, w| acc + Vector3::from(*w));
-                // The adaptation starts from the white the camera is balanced to: the light's
-                // own (tabulated for a CIE illuminant, integrated above for an SPD) or a fixed one.
-                let from_white = match (white_balance, illuminant) {
-                    (WhiteBalance::Light, Illuminant::Spd(_)) => {
-                        xy_of([white_xyz[0], white_xyz[1], white_xyz[2]])
-                    }
-                    _ => white_balance.white_xy(illuminant, *observer)?,
-                };
-                let m = rgb_matrix(from_white, *space);
-                let white_rgb = m * white_xyz;
-                for (c, name) in ["red", "green", "blue"].iter().enumerate() {
-                    if white_rgb[c].is_nan() || white_rgb[c] <= 1e-12 * white_xyz[1].abs() {
-                        return Err(SpectralError::DegenerateWhite {
-                            illuminant: illuminant.name().to_owned(),
-                            channel: name,
-                            value: white_rgb[c],
-                        });
-                    }
+                    label: format!("the paper method ({})", cmf.name()),
                 }
-                let weights = xyz_weights
-                    .iter()
-                    .map(|w| {
-                        let rgb = m * Vector3::from(*w);
-                        [
-                            rgb[0] / white_rgb[0],
-                            rgb[1] / white_rgb[1],
-                            rgb[2] / white_rgb[2],
-                        ]
-                    })
-                    .collect();
-                let label = format!(
-                    "the colorimetric method ({}, {}, {})",
-                    observer.name(),
-                    illuminant.name(),
-                    space.name()
-                );
-                (grid, weights, label)
             }
+            Method::Colorimetric(c) => c.weights()?,
             Method::Luminous => {
-                let (grid, weights) = luminous_weights(LuminousGrid::Iso9050)?;
-                (
-                    grid,
-                    weights.iter().map(|&w| [w; 3]).collect(),
-                    "the ISO 9050 luminous value".to_owned(),
-                )
+                let (grid_nm, weights) = luminous_weights(LuminousGrid::Iso9050)?;
+                MethodWeights {
+                    grid_nm,
+                    weights: weights.iter().map(|&w| [w; 3]).collect(),
+                    label: "the ISO 9050 luminous value".to_owned(),
+                }
             }
         };
         Ok(Integrator {

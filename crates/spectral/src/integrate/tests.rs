@@ -28,12 +28,12 @@ fn a_flat_spectrum_gives_its_value_in_every_method() {
             for &space in RgbSpace::ALL {
                 for white_balance in [WhiteBalance::Light, WhiteBalance::Fixed(CieIlluminant::D65)]
                 {
-                    methods.push(Method::Colorimetric {
+                    methods.push(Method::Colorimetric(ColorimetricSettings {
                         observer,
                         illuminant: illuminant.clone(),
                         space,
                         white_balance,
-                    });
+                    }));
                 }
             }
         }
@@ -201,12 +201,12 @@ fn settings_json_is_flat_and_round_trips() {
         serde_json::from_str(r#"{"method":"colorimetric","space":"acescg"}"#).unwrap();
     assert_eq!(
         col.method,
-        Method::Colorimetric {
+        Method::Colorimetric(ColorimetricSettings {
             observer: Observer::Cie1931,
             illuminant: Illuminant::default(),
             space: RgbSpace::AcesCg,
             white_balance: WhiteBalance::Light,
-        }
+        })
     );
     for bad in [
         r#"{"method":"paper","space":"srgb"}"#,
