@@ -11,6 +11,8 @@ use glassdb_fit::{
     FileContent, FitError, FitFile, FitOptions, GlassFit, GlassFitOptions, Quantity,
 };
 
+use crate::cmd::table::{Column, TextTable};
+
 /// The basis names accepted by `--basis`.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 pub enum BasisArg {
@@ -144,6 +146,39 @@ fn glass_warnings(g: &GlassFit) -> Vec<String> {
     out
 }
 
+/// The readable report's table of curves: one row per curve of a glass.
+const CURVE_TABLE: TextTable<10> = TextTable {
+    columns: [
+        Column::left("  ", 13),
+        Column::right(" ", 9),
+        Column::right(" ", 5),
+        Column::right(" ", 3),
+        Column::right(" ", 6),
+        Column::right(" ", 10),
+        Column::right(" ", 10),
+        Column::right(" ", 7),
+        Column::right(" ", 10),
+        Column::right(" ", 10),
+    ],
+};
+
+/// The angles (degrees) at which the readable report gives each fitted r(θ) and t(θ).
+const PROBE_ANGLES_DEG: [f64; 7] = [0.0, 30.0, 45.0, 60.0, 75.0, 85.0, 90.0];
+
+/// The readable report's table of r(θ) and t(θ) at [`PROBE_ANGLES_DEG`].
+const PROBE_TABLE: TextTable<8> = TextTable {
+    columns: [
+        Column::left("  ", 8),
+        Column::right("", 9),
+        Column::right("", 9),
+        Column::right("", 9),
+        Column::right("", 9),
+        Column::right("", 9),
+        Column::right("", 9),
+        Column::right("", 9),
+    ],
+};
+
 /// The readable report: one block per glass, one row per curve, then its coefficients.
 fn fit_report(file: &FitFile, args: &FitArgs) -> String {
     let mut s = String::new();
@@ -159,20 +194,11 @@ fn fit_report(file: &FitFile, args: &FitArgs) -> String {
     );
     for g in &file.glasses {
         let _ = writeln!(s, "\nglass {}", g.name);
-        let _ = writeln!(
-            s,
-            "  {:<13} {:>9} {:>5} {:>3} {:>6} {:>10} {:>10} {:>7} {:>10} {:>10}",
-            "curve",
-            "normal",
-            "basis",
-            "deg",
-            "points",
-            "rms err",
-            "max err",
-            "at °",
-            "loo rms",
-            "cond"
-        );
+        let titles = [
+            "curve", "normal", "basis", "deg", "points", "rms err", "max err", "at °", "loo rms",
+            "cond",
+        ];
+        let _ = writeln!(s, "{}", CURVE_TABLE.line(titles));
         for (q, c) in [
             ("reflectance", &g.reflectance),
             ("transmittance", &g.transmittance),
@@ -182,20 +208,19 @@ fn fit_report(file: &FitFile, args: &FitArgs) -> String {
             let loo = d
                 .loo_rms_error
                 .map_or_else(|| "-".to_string(), |v| format!("{v:.6}"));
-            let _ = writeln!(
-                s,
-                "  {:<13} {:>9.6} {:>5} {:>3} {:>6} {:>10.6} {:>10.6} {:>7} {:>10} {:>10.3e}",
-                q,
-                c.normal,
-                c.polynomial.basis.name(),
-                d.summary.degree,
-                d.points,
-                d.summary.rms_error,
-                d.summary.max_abs_error,
+            let row = [
+                q.to_string(),
+                format!("{:.6}", c.normal),
+                c.polynomial.basis.name().to_string(),
+                d.summary.degree.to_string(),
+                d.points.to_string(),
+                format!("{:.6}", d.summary.rms_error),
+                format!("{:.6}", d.summary.max_abs_error),
                 trim_num(d.summary.max_error_angle_deg),
                 loo,
-                d.summary.condition_number
-            );
+                format!("{:.3e}", d.summary.condition_number),
+            ];
+            let _ = writeln!(s, "{}", CURVE_TABLE.line(row));
         }
         for (sym, c) in [("C_r", &g.reflectance), ("C_t", &g.transmittance)] {
             let Some(c) = c else { continue };
@@ -210,19 +235,18 @@ fn fit_report(file: &FitFile, args: &FitArgs) -> String {
                 );
             }
         }
-        let mut angles_line = String::from("  θ (°)   ");
-        let probe = [0.0, 30.0, 45.0, 60.0, 75.0, 85.0, 90.0];
-        for a in probe {
-            let _ = write!(angles_line, "{:>9}", trim_num(a));
-        }
-        let _ = writeln!(s, "{angles_line}");
+        let titles: [String; 8] = std::array::from_fn(|k| match k {
+            0 => "θ (°)".to_string(),
+            k => trim_num(PROBE_ANGLES_DEG[k - 1]),
+        });
+        let _ = writeln!(s, "{}", PROBE_TABLE.line(titles));
         for (sym, c) in [("r(θ)", &g.reflectance), ("t(θ)", &g.transmittance)] {
             let Some(c) = c else { continue };
-            let mut line = format!("  {sym:<8}");
-            for a in probe {
-                let _ = write!(line, "{:>9.5}", c.eval_angle_deg(a));
-            }
-            let _ = writeln!(s, "{line}");
+            let row: [String; 8] = std::array::from_fn(|k| match k {
+                0 => sym.to_string(),
+                k => format!("{:.5}", c.eval_angle_deg(PROBE_ANGLES_DEG[k - 1])),
+            });
+            let _ = writeln!(s, "{}", PROBE_TABLE.line(row));
         }
         let warnings = glass_warnings(g).len();
         if warnings > 0 {

@@ -33,6 +33,7 @@ pub mod report;
 pub mod scene;
 pub mod spectral;
 pub mod stack;
+pub mod table;
 pub mod view;
 
 use std::process::ExitCode;

@@ -15,6 +15,8 @@ use glassdb_spectral::{
     RgbSpace, WhiteBalance,
 };
 
+use crate::cmd::table::{Column, TextTable};
+
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(subcommand)]
@@ -402,10 +404,17 @@ fn print_glass(g: &GlassRecord, side: Side) {
         c_r,
     );
     fit_line("C_t", &g.c_t);
-    outln!("  {:>6}  {:>22}  {:>22}", "angle", "r (R G B)", "t (R G B)");
+    let table = TextTable {
+        columns: [
+            Column::right("  ", 6),
+            Column::right("  ", 22),
+            Column::right("  ", 22),
+        ],
+    };
+    outln!("{}", table.line(["angle", "r (R G B)", "t (R G B)"]));
     for deg in [0.0f64, 45.0, 60.0, 75.0] {
         let (r, t) = g.eval(side, deg.to_radians().cos());
-        outln!("  {:>5}°  {:>22}  {:>22}", deg, rgb(&r), rgb(&t));
+        outln!("{}", table.line([format!("{deg}°"), rgb(&r), rgb(&t)]));
     }
 }
 

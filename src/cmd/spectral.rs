@@ -12,6 +12,8 @@ use glassdb_spectral::{
 };
 use serde_json::{Value, json};
 
+use crate::cmd::table::{Column, TextTable};
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum MethodArg {
     /// The paper's eqs. 15–20: ∫ρ·c̄ / ∫c̄ with RGB colour-matching functions (--cmf).
@@ -329,6 +331,18 @@ fn to_json(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> 
     obj
 }
 
+/// The readable report's table: one row per quantity, its RGB and luminous values.
+const QUANTITY_TABLE: TextTable<6> = TextTable {
+    columns: [
+        Column::left("", 22),
+        Column::right("", 10),
+        Column::right("", 10),
+        Column::right("", 10),
+        Column::right("", 14),
+        Column::right("", 14),
+    ],
+};
+
 fn to_text(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> String {
     let mut s = String::new();
     let p = &data.product;
@@ -363,17 +377,19 @@ fn to_text(data: &SpectralData, method: &Method, results: &[QuantityResult]) -> 
         );
     }
     let _ = writeln!(s, "method: {method}");
-    let _ = writeln!(
-        s,
-        "{:<22}{:>10}{:>10}{:>10}{:>14}{:>14}",
-        "", "R", "G", "B", "luminous", "luminous 1nm"
-    );
+    let titles = ["", "R", "G", "B", "luminous", "luminous 1nm"];
+    let _ = writeln!(s, "{}", QUANTITY_TABLE.line(titles));
     for r in results {
-        let _ = writeln!(
-            s,
-            "{:<22}{:>10.6}{:>10.6}{:>10.6}{:>14.6}{:>14.6}",
-            r.label, r.rgb[0], r.rgb[1], r.rgb[2], r.luminous_iso, r.luminous_1nm
-        );
+        let v = |x: f64| format!("{x:.6}");
+        let row = [
+            r.label.to_string(),
+            v(r.rgb[0]),
+            v(r.rgb[1]),
+            v(r.rgb[2]),
+            v(r.luminous_iso),
+            v(r.luminous_1nm),
+        ];
+        let _ = writeln!(s, "{}", QUANTITY_TABLE.line(row));
     }
     s
 }

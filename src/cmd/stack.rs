@@ -15,6 +15,7 @@ use glassdb_stack::{
 use serde_json::{Value, json};
 
 use crate::cmd::spectral::SpaceArg;
+use crate::cmd::table::{Column, TextTable};
 
 /// The gap used between layers when no `--gap` is given (WINDOW's default air gap).
 pub const DEFAULT_GAP_MM: f64 = 12.7;
@@ -405,6 +406,23 @@ fn spectra_json(stack: &Stack, angles: &[f64]) -> anyhow::Result<Value> {
     Ok(json!({"wavelength_nm": wavelength_nm, "T": t, "Rf": rf, "Rb": rb}))
 }
 
+/// The readable report's table: per angle WINDOW's photopic and solar values, then the
+/// colour table's T, R out and R in.
+const ANGLE_TABLE: TextTable<10> = TextTable {
+    columns: [
+        Column::right("", 5),
+        Column::right("  ", 6),
+        Column::right(" ", 7),
+        Column::right(" ", 6),
+        Column::right("  ", 6),
+        Column::right(" ", 8),
+        Column::right(" ", 7),
+        Column::left("   ", 22),
+        Column::left(" ", 22),
+        Column::left(" ", 22),
+    ],
+};
+
 fn rgb_text(v: [f64; 3]) -> String {
     format!("{:.4} {:.4} {:.4}", v[0], v[1], v[2])
 }
@@ -461,9 +479,7 @@ fn to_text(built: &CommandStack, eval: &Evaluation, settings: &IntegrationSettin
         );
     }
     let _ = writeln!(s, "colours: {}", settings.method);
-    let _ = writeln!(
-        s,
-        "{:>5}  {:>6} {:>7} {:>6}  {:>6} {:>8} {:>7}   {:<22} {:<22} {:<22}",
+    let titles = [
         "θ(°)",
         "Tv",
         "Rv out",
@@ -473,24 +489,31 @@ fn to_text(built: &CommandStack, eval: &Evaluation, settings: &IntegrationSettin
         "Rsol in",
         "T rgb",
         "R out rgb",
-        "R in rgb"
-    );
+        "R in rgb",
+    ];
+    let _ = writeln!(s, "{}", ANGLE_TABLE.line(titles));
     for (i, &a) in eval.angles_deg.iter().enumerate() {
         let c = &eval.colour[0][i];
-        let w = |o: Option<&Vec<Optics<f64>>>| {
-            o.map(|v| (v[i].t, v[i].rf, v[i].rb))
-                .map(|(t, f, b)| format!("{t:>6.4} {f:>7.4} {b:>6.4}"))
-                .unwrap_or_else(|| format!("{:>6} {:>7} {:>6}", "–", "–", "–"))
+        // WINDOW's T, R out and R in, or dashes where the unit has none.
+        let window = |o: Option<&Vec<Optics<f64>>>| match o {
+            Some(v) => [v[i].t, v[i].rf, v[i].rb].map(|x| format!("{x:.4}")),
+            None => ["–", "–", "–"].map(String::from),
         };
-        let _ = writeln!(
-            s,
-            "{a:>5}  {}  {}   {:<22} {:<22} {:<22}",
-            w(eval.photopic.as_ref()),
-            w(eval.solar.as_ref()).replacen(' ', "  ", 1),
+        let ([tv, rv_out, rv_in], [tsol, rsol_out, rsol_in]) =
+            (window(eval.photopic.as_ref()), window(eval.solar.as_ref()));
+        let row = [
+            a.to_string(),
+            tv,
+            rv_out,
+            rv_in,
+            tsol,
+            rsol_out,
+            rsol_in,
             rgb_text(c.t),
             rgb_text(c.rf),
-            rgb_text(c.rb)
-        );
+            rgb_text(c.rb),
+        ];
+        let _ = writeln!(s, "{}", ANGLE_TABLE.line(row));
     }
     s
 }
