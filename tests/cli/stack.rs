@@ -654,3 +654,58 @@ fn curve_at(c: &Value, cos: f64) -> f64 {
         .map(|(p, k)| k.as_f64().unwrap() * cos.powi(p.as_u64().unwrap() as i32))
         .sum()
 }
+
+/// The readable table puts each value under its title: a right-aligned column's values end
+/// where its title ends, a left-aligned column's start where its title starts.
+#[test]
+fn the_readable_table_puts_each_value_under_its_title() {
+    let text = ok(glassdb().args([
+        "stack",
+        &format!("{}:flip", glazing("LOW-E_5.LOF")),
+        &glazing("CLEAR_6.DAT"),
+        "--gap",
+        "12.7:argon",
+        "--angles",
+        "0,40,80",
+    ]));
+    let lines: Vec<Vec<char>> = text.lines().map(|l| l.chars().collect()).collect();
+    let header_at = lines
+        .iter()
+        .position(|l| {
+            l.iter()
+                .collect::<String>()
+                .trim_start()
+                .starts_with("θ(°)")
+        })
+        .unwrap_or_else(|| panic!("no table header in:\n{text}"));
+    let header: String = lines[header_at].iter().collect();
+    let rows = &lines[header_at + 1..];
+    assert_eq!(rows.len(), 3, "{text}");
+    let right = [
+        "θ(°)", "Tv", "Rv out", "Rv in", "Tsol", "Rsol out", "Rsol in",
+    ];
+    let left = ["T rgb", "R out rgb", "R in rgb"];
+    let mut from = 0;
+    for (k, title) in right.iter().chain(&left).enumerate() {
+        let byte = from
+            + header[from..]
+                .find(title)
+                .unwrap_or_else(|| panic!("{title}"));
+        from = byte + title.len();
+        let start = header[..byte].chars().count();
+        let end = start + title.chars().count() - 1;
+        for row in rows {
+            let row_text: String = row.iter().collect();
+            let at = |i: usize| row.get(i).copied().unwrap_or(' ');
+            let under = if k < right.len() {
+                at(end) != ' ' && at(end + 1) == ' '
+            } else {
+                at(start) != ' ' && at(start - 1) == ' '
+            };
+            assert!(
+                under,
+                "`{title}` is not over its value:\n{header}\n{row_text}"
+            );
+        }
+    }
+}

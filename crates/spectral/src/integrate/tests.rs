@@ -254,3 +254,24 @@ fn names_round_trip() {
     );
     assert!("bogus".parse::<RgbSpace>().is_err());
 }
+
+/// A method's own JSON form (as opposed to [`IntegrationSettings`]' flat one) keeps the
+/// colorimetric options as the fields of one `colorimetric` object.
+#[test]
+fn a_colorimetric_method_serialises_as_one_object_of_its_options() {
+    let method = Method::Colorimetric(ColorimetricSettings {
+        observer: Observer::Cie1964,
+        illuminant: Illuminant::default(),
+        space: RgbSpace::AcesCg,
+        white_balance: WhiteBalance::Light,
+    });
+    let json = serde_json::to_value(&method).unwrap();
+    let expected = serde_json::json!({"colorimetric": {
+        "observer": "cie1964",
+        "illuminant": Illuminant::default().name(),
+        "space": "acescg",
+        "white_balance": "light",
+    }});
+    assert_eq!(json, expected);
+    assert_eq!(serde_json::from_value::<Method>(expected).unwrap(), method);
+}
