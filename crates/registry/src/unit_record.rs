@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::record::{AngleCurve, LuminousRecord, Provenance};
 use glassdb_side::Side;
+use glassdb_stack::FrontBack;
 
 /// A unit's build-up and per-group reflectances.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -80,14 +81,9 @@ pub struct UnitLayerRecord {
     pub provenance: Provenance,
 }
 
-/// A layer's absorptance in its unit for light from either side.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Absorptance {
-    /// For light from outdoors.
-    pub front: f64,
-    /// For light from indoors.
-    pub back: f64,
-}
+/// A layer's absorptance in its unit for light from either side: the stack engine's
+/// [`FrontBack`] of one value (JSON `{"front": …, "back": …}`).
+pub type Absorptance = FrontBack<f64>;
 
 /// A gap of a unit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -9,7 +9,7 @@ use std::ops::Range;
 use crate::layer::LayerValues;
 
 /// A quantity for light from outdoors (`front`) and for light from indoors (`back`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FrontBack<T> {
     /// For light from outdoors.
     pub front: T,
